@@ -1,0 +1,10 @@
+# Every dependency of the engine, found in one place. All come from Debian 12 packages
+# (scripts/install-deps.sh installs them).
+find_package(Threads REQUIRED)  # glslang 12's package config needs Threads first
+find_package(Vulkan REQUIRED)
+find_package(SPIRV-Tools-opt REQUIRED)
+find_package(glslang REQUIRED)
+find_package(simdjson REQUIRED)
+find_package(glm REQUIRED)
+find_path(STB_INCLUDE_DIR stb_image_write.h PATH_SUFFIXES stb REQUIRED)
+find_program(GLSLANG_VALIDATOR glslangValidator REQUIRED)

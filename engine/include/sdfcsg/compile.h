@@ -1,0 +1,39 @@
+// sdfcsg: scene -> GLSL -> SPIR-V.
+//
+// Each scene becomes one generated GLSL file holding `float sceneDistance(vec3 p)` and
+// `vec4 sceneSample(vec3 p)` (rgb colour, distance in w). Every node is evaluated once into a
+// local, one line per node, commented with its name or JSON path, so compile time is linear in
+// the scene size. Static GLSL (the SDF library in shaders/sdf.glsl and the kernels) is embedded
+// in the library; the generated file is what a kernel's `#include "scene.glsl"` resolves to.
+#pragma once
+
+#include "sdfcsg/error.h"
+#include "sdfcsg/eval.h"
+#include "sdfcsg/scene.h"
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace sdfcsg {
+
+struct CodegenOptions {
+    // false: numeric parameters, transforms and bounds are read from the node buffer, so
+    // changing a value needs no recompile (the viewer). true: they are baked in as literals,
+    // which the driver's compiler folds (fastest for one-off headless renders).
+    bool inlineParams = false;
+};
+
+std::string generateSceneGlsl(const Scene& scene, const CodegenOptions& options = {});
+
+// Source of an embedded shader file (e.g. "sdf.glsl", "raymarch.comp"); empty if unknown.
+std::string_view shaderSource(std::string_view name);
+
+// Compiles an embedded kernel with `scene.glsl` resolving to `sceneGlsl`. SPIR-V is cached by a
+// hash of the full preprocessed input, in memory and on disk ($XDG_CACHE_HOME/sdfcsg or
+// ~/.cache/sdfcsg; SDFCSG_CACHE_DIR overrides, "off" disables). Errors carry the compiler log.
+// Thread-safe.
+Result<std::vector<uint32_t>> compileKernel(std::string_view kernel, std::string_view sceneGlsl);
+
+} // namespace sdfcsg

@@ -1,0 +1,44 @@
+// sdfcsg: the headless Vulkan compute context.
+//
+// No window and no surface extensions. Any device with a compute queue is acceptable,
+// CPU devices (Mesa lavapipe) included; a discrete GPU is preferred, then integrated, virtual,
+// CPU. SDFCSG_DEVICE=<index or part of the name> overrides the choice.
+#pragma once
+
+#include "sdfcsg/error.h"
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+namespace sdfcsg {
+
+struct ContextOptions {
+    // Enable VK_LAYER_KHRONOS_validation and count its messages. Defaults to on in debug builds
+    // and when SDFCSG_VALIDATION=1; SDFCSG_VALIDATION=0 forces it off.
+    int validation = -1; // -1: default, 0: off, 1: on (an error if the layer is missing)
+    std::string device;  // overrides SDFCSG_DEVICE when not empty
+};
+
+class Context {
+  public:
+    static Result<std::unique_ptr<Context>> create(const ContextOptions& options = {});
+    ~Context();
+    Context(const Context&) = delete;
+    Context& operator=(const Context&) = delete;
+
+    std::string deviceName() const;
+    bool validationEnabled() const;
+    // Messages the validation layer has reported so far (warnings and errors). Each is also
+    // printed to stderr.
+    uint32_t validationMessageCount() const;
+
+    struct Impl;
+    Impl& impl() { return *impl_; }
+
+  private:
+    explicit Context(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> impl_;
+};
+
+} // namespace sdfcsg

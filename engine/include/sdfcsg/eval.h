@@ -1,0 +1,70 @@
+// sdfcsg: the CPU reference evaluator.
+//
+// Evaluates exactly the field that the generated GLSL evaluates (same formulas, same operation
+// order), in double-free single precision. Used for bounds, camera framing, tests and any
+// host-side query. Thread-safe for concurrent reads once built.
+#pragma once
+
+#include "sdfcsg/scene.h"
+
+#include <glm/mat3x3.hpp>
+#include <glm/vec3.hpp>
+
+#include <limits>
+#include <vector>
+
+namespace sdfcsg {
+
+struct Aabb {
+    glm::vec3 min{std::numeric_limits<float>::infinity()};
+    glm::vec3 max{-std::numeric_limits<float>::infinity()};
+
+    bool empty() const { return min.x > max.x || min.y > max.y || min.z > max.z; }
+    bool finite() const; // no infinite coordinate (false for planes)
+    // Euclidean distance from p to the box, 0 inside.
+    float distance(glm::vec3 p) const;
+};
+
+// A node with everything resolved to world space. Index-aligned with Scene::nodes.
+struct FlatNode {
+    NodeKind kind;
+    glm::mat3 toLocal;   // world -> local linear part (rotation transposed, divided by scale)
+    glm::vec3 offset;    // local = toLocal * world + offset
+    float scale;         // accumulated uniform scale: world distance = scale * local distance
+    glm::vec3 color;     // resolved (inherited) colour
+    float smooth;        // operations: blend radius in world units
+    std::array<float, kMaxParams> params; // as in Node, with derived values (normalised plane)
+    Aabb bounds;         // world bounds; the node's value at p is >= bounds.distance(p)
+    std::vector<uint32_t> children;
+};
+
+struct Sample {
+    float distance;
+    glm::vec3 color;
+};
+
+class Evaluator {
+  public:
+    explicit Evaluator(const Scene& scene);
+
+    // Signed distance (a lower bound away from the surface, exact near it for exact primitives).
+    float distance(glm::vec3 p) const;
+    // Distance and blended colour.
+    Sample sample(glm::vec3 p) const;
+    // Bounds of the whole solid; infinite along axes where a plane reaches.
+    const Aabb& bounds() const { return nodes_[0].bounds; }
+    const std::vector<FlatNode>& nodes() const { return nodes_; }
+
+    // With skipping on, union and difference operands whose bounds cannot change the result are
+    // not evaluated, exactly as the generated GLSL does; the value is the same either way.
+    void setBoundsSkipping(bool on) { skipping_ = on; }
+
+  private:
+    std::vector<FlatNode> nodes_;
+    bool skipping_ = true;
+};
+
+// A camera looking at the finite part of the scene's bounds from the front and slightly above.
+Camera frameCamera(const Evaluator& evaluator, float aspect, float fov = 45.0f);
+
+} // namespace sdfcsg

@@ -1,0 +1,71 @@
+// sdfcsg: ray-marched images of a scene, computed in a Vulkan compute pass.
+#pragma once
+
+#include "sdfcsg/context.h"
+#include "sdfcsg/error.h"
+#include "sdfcsg/scene.h"
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+namespace sdfcsg {
+
+enum class RenderMode : uint32_t { Shaded, Normals, Depth, Steps };
+std::optional<RenderMode> parseRenderMode(std::string_view name);
+
+enum class BoxOverlay : uint32_t { None, All, Selected };
+
+struct RenderOptions {
+    uint32_t width = 800, height = 600;
+    RenderMode mode = RenderMode::Shaded;
+    std::optional<Camera> camera; // unset: the scene's camera, else framed from its bounds
+    uint32_t aa = 1;              // N x N samples per pixel
+    bool shadows = true;
+    bool ambientOcclusion = true;
+    bool boundsSkipping = true;   // skip operands whose bounds cannot change the result
+    BoxOverlay boxes = BoxOverlay::None;
+    int selectedNode = -1;        // for BoxOverlay::Selected
+};
+
+// Tightly packed 8-bit RGBA, rows top to bottom.
+struct Image {
+    uint32_t width = 0, height = 0;
+    std::vector<uint8_t> rgba;
+};
+
+// Per-pixel data of the last render, for tests and picking: hit mask, ray distance and
+// iteration count (first sample of each pixel).
+struct PixelInfo {
+    float depth;     // ray parameter t of the hit, or a negative value for a miss
+    uint32_t steps;
+};
+
+class Renderer {
+  public:
+    // Generates, compiles and builds the pipeline for this scene.
+    static Result<std::unique_ptr<Renderer>> create(Context& context, const Scene& scene);
+    ~Renderer();
+
+    // Replaces numeric values (sizes, transforms, colours, smooth radii) without recompiling.
+    // Fails with ErrorKind::Usage if the structure (kinds, children) differs from the compiled one.
+    Status updateValues(const Scene& scene);
+
+    Result<Image> render(const RenderOptions& options);
+    // Per-pixel hit depth and step count of the last render().
+    const std::vector<PixelInfo>& lastPixelInfo() const;
+
+    struct Impl;
+
+  private:
+    explicit Renderer(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> impl_;
+};
+
+// Writes a PNG atomically: to a temporary file beside `path`, then renamed over it.
+Status writePng(const Image& image, const std::filesystem::path& path);
+
+} // namespace sdfcsg

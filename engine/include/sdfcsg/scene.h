@@ -1,0 +1,83 @@
+// sdfcsg: scenes, their JSON format, and loading with strict validation.
+//
+// The format is documented in README.md ("Scene format") and assets/scene.schema.json.
+// Lengths are in scene units (metres by convention), angles in degrees, colours in 0..1.
+#pragma once
+
+#include "sdfcsg/error.h"
+#include "sdfcsg/nodes.h"
+
+#include <glm/vec3.hpp>
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace sdfcsg {
+
+inline constexpr int kSceneVersion = 1;
+
+struct Transform {
+    glm::vec3 translate{0.0f};
+    glm::vec3 rotate{0.0f}; // degrees about x, then y, then z
+    float scale = 1.0f;     // uniform, > 0
+};
+
+struct Node {
+    NodeKind kind = NodeKind::Sphere;
+    std::string name;               // optional label
+    std::string path;               // JSON path in the source, e.g. "root.children[1]"
+    Transform transform;
+    std::optional<glm::vec3> color; // unset: inherited from the parent
+    std::array<float, kMaxParams> params{}; // laid out by the kind's ParamInfo::slot
+    std::vector<uint32_t> children;  // indices into Scene::nodes, operations only
+};
+
+struct Camera {
+    glm::vec3 eye{0.0f, 0.0f, 5.0f};
+    glm::vec3 target{0.0f};
+    glm::vec3 up{0.0f, 1.0f, 0.0f};
+    float fov = 45.0f; // vertical field of view, degrees
+};
+
+struct Light {
+    glm::vec3 direction{-0.4f, -1.0f, -0.3f}; // direction the light travels (towards the scene)
+    glm::vec3 color{1.0f};
+    float intensity = 1.0f;
+};
+
+struct Scene {
+    std::string file;          // where it came from, for messages
+    std::vector<Node> nodes;   // nodes[0] is the root; a parent always precedes its children
+    std::optional<Camera> camera; // unset: framed automatically from the scene's bounds
+    std::vector<Light> lights;    // empty: the default two-light rig (defaultLights())
+    glm::vec3 background{0.60f, 0.72f, 0.85f};
+};
+
+// Limits enforced while loading, before any work that depends on the input's size.
+struct Limits {
+    size_t maxFileBytes = 16u << 20; // 16 MiB
+    uint32_t maxNodes = 16384;
+    uint32_t maxDepth = 64;          // operations nested inside operations
+};
+
+// Parses and validates a scene in either the current format or the legacy SDFBooleanEngine
+// format (detected by its top-level "nodes" array). `file` is used in messages only.
+// Every problem found is reported (up to a few dozen), each with its JSON path.
+Result<Scene> parseScene(std::string_view json, std::string_view file = "<input>",
+                         const Limits& limits = {});
+
+// Reads and parses a file; I/O errors and oversize files are reported like any other.
+Result<Scene> loadScene(const std::filesystem::path& path, const Limits& limits = {});
+
+// Serialises to the current format (2-space indent, stable key order). parseScene(toJson(s))
+// gives back an equal scene.
+std::string toJson(const Scene& scene);
+
+std::vector<Light> defaultLights();
+
+} // namespace sdfcsg

@@ -1,0 +1,14 @@
+// sdfcsg: Constructive Solid Geometry on signed distance fields, computed with Vulkan.
+#pragma once
+
+#define SDFCSG_VERSION_MAJOR 0
+#define SDFCSG_VERSION_MINOR 1
+#define SDFCSG_VERSION_PATCH 0
+
+#include "sdfcsg/compile.h"
+#include "sdfcsg/context.h"
+#include "sdfcsg/error.h"
+#include "sdfcsg/eval.h"
+#include "sdfcsg/nodes.h"
+#include "sdfcsg/render.h"
+#include "sdfcsg/scene.h"

@@ -1,0 +1,17 @@
+#!/bin/sh
+# Installs every build and test dependency from Debian 12 packages. Idempotent; run as root.
+set -eu
+PACKAGES="build-essential cmake ninja-build pkg-config git
+  libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers
+  glslang-dev glslang-tools spirv-tools
+  libglm-dev libsimdjson-dev libstb-dev libgtest-dev"
+missing=""
+for p in $PACKAGES; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
+done
+if [ -n "$missing" ]; then
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -qq
+    # shellcheck disable=SC2086
+    apt-get install -y -qq --no-install-recommends $missing
+fi
