@@ -1,7 +1,8 @@
-# cmake -DOUTPUT=file.cpp -DINPUTS="a;b" -P EmbedFiles.cmake
+# cmake -DOUTPUT=file.cpp -DINPUTS="a|b" -P EmbedFiles.cmake
 # Writes a C++ source that holds every input file as a string, looked up by file name.
 set(body "// Generated from shaders/ by cmake/EmbedFiles.cmake. Do not edit.\n")
 string(APPEND body "#include \"embedded_shaders.h\"\n\nnamespace sdfcsg::detail {\nnamespace {\n")
+string(REPLACE "|" ";" INPUTS "${INPUTS}")
 set(entries "")
 set(index 0)
 foreach(input IN LISTS INPUTS)

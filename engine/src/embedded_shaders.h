@@ -1,0 +1,16 @@
+// Shader files embedded at build time by cmake/EmbedFiles.cmake.
+#pragma once
+
+#include <span>
+#include <string_view>
+
+namespace sdfcsg::detail {
+
+struct EmbeddedFile {
+    std::string_view name; // file name within shaders/, e.g. "sdf.glsl"
+    std::string_view text;
+};
+
+std::span<const EmbeddedFile> embeddedShaders();
+
+} // namespace sdfcsg::detail
