@@ -1,1 +1,348 @@
-int main() { return 0; }
+// sdfcsg: the command-line tool. A thin layer over the engine library: argument parsing,
+// messages and exit codes live here, everything else in sdfcsg::engine.
+#include "bench.h"
+
+#include <sdfcsg/sdfcsg.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <functional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace {
+
+// Exit codes, documented in the README.
+enum Exit : int {
+    kOk = 0,
+    kInvalidScene = 1, // the scene failed to parse or validate
+    kUsage = 2,        // bad command line
+    kIo = 3,           // a file could not be read or written
+    kGpu = 4,          // no usable Vulkan device, or a shader failed to compile
+};
+
+int exitCode(const sdfcsg::Error& e) {
+    switch (e.kind) {
+    case sdfcsg::ErrorKind::Io: return kIo;
+    case sdfcsg::ErrorKind::Syntax:
+    case sdfcsg::ErrorKind::Validation:
+    case sdfcsg::ErrorKind::Limit: return kInvalidScene;
+    case sdfcsg::ErrorKind::Usage: return kUsage;
+    case sdfcsg::ErrorKind::Shader:
+    case sdfcsg::ErrorKind::Vulkan: return kGpu;
+    }
+    return kGpu;
+}
+
+int fail(const sdfcsg::Error& e) {
+    std::fprintf(stderr, "%s\n", e.str().c_str());
+    return exitCode(e);
+}
+
+int usageError(const std::string& command, const std::string& message) {
+    std::fprintf(stderr, "sdfcsg %s: %s\nTry 'sdfcsg %s --help'.\n", command.c_str(),
+                 message.c_str(), command.c_str());
+    return kUsage;
+}
+
+// A minimal option reader: positional arguments, and options that take a value.
+struct Args {
+    std::string command;
+    std::vector<std::string> positional;
+    std::vector<std::pair<std::string, std::string>> options; // name -> value ("" for flags)
+    std::string error;
+
+    Args(std::string cmd, int argc, char** argv, std::vector<std::string_view> valued,
+         std::vector<std::string_view> flags)
+        : command(std::move(cmd)) {
+        for (int i = 0; i < argc; ++i) {
+            std::string_view a = argv[i];
+            if (a.size() > 1 && a[0] == '-' && !(a.size() > 1 && (std::isdigit(a[1]) || a[1] == '.'))) {
+                std::string name(a), value;
+                if (auto eq = name.find('='); eq != std::string::npos) {
+                    value = name.substr(eq + 1);
+                    name.resize(eq);
+                } else if (std::find(valued.begin(), valued.end(), name) != valued.end()) {
+                    if (i + 1 >= argc) {
+                        error = "option " + name + " needs a value";
+                        return;
+                    }
+                    value = argv[++i];
+                }
+                bool known = std::find(valued.begin(), valued.end(), name) != valued.end() ||
+                             std::find(flags.begin(), flags.end(), name) != flags.end();
+                if (!known) {
+                    error = "unknown option " + name;
+                    return;
+                }
+                options.emplace_back(name, value);
+            } else {
+                positional.emplace_back(a);
+            }
+        }
+    }
+    bool has(std::string_view name) const {
+        for (auto& [n, v] : options)
+            if (n == name) return true;
+        return false;
+    }
+    std::string get(std::string_view name, std::string fallback = {}) const {
+        for (auto it = options.rbegin(); it != options.rend(); ++it)
+            if (it->first == name) return it->second;
+        return fallback;
+    }
+};
+
+bool parseUint(const std::string& s, uint32_t lo, uint32_t hi, uint32_t& out) {
+    char* end = nullptr;
+    errno = 0;
+    unsigned long v = std::strtoul(s.c_str(), &end, 10);
+    if (s.empty() || *end || errno || v < lo || v > hi || s[0] == '-') return false;
+    out = uint32_t(v);
+    return true;
+}
+
+bool parseFloat(const std::string& s, float& out) {
+    char* end = nullptr;
+    float v = std::strtof(s.c_str(), &end);
+    if (s.empty() || *end || !std::isfinite(v)) return false;
+    out = v;
+    return true;
+}
+
+bool parseVec3(const std::string& s, glm::vec3& out) {
+    std::vector<std::string> parts;
+    size_t start = 0;
+    for (size_t i = 0; i <= s.size(); ++i)
+        if (i == s.size() || s[i] == ',') {
+            parts.push_back(s.substr(start, i - start));
+            start = i + 1;
+        }
+    if (parts.size() != 3) return false;
+    for (int i = 0; i < 3; ++i)
+        if (!parseFloat(parts[i], out[i])) return false;
+    return true;
+}
+
+sdfcsg::Result<sdfcsg::Scene> load(const std::string& path) { return sdfcsg::loadScene(path); }
+
+const char* kMainHelp = R"(sdfcsg - constructive solid geometry on signed distance fields, with Vulkan
+
+Usage: sdfcsg COMMAND [ARGS...]
+
+Commands:
+  render    ray-march a scene to a PNG image
+  validate  check scene files and list every problem found
+  glsl      print the GLSL a scene compiles to
+  convert   convert a scene (e.g. the legacy format) to the current format
+  schema    print the JSON Schema of the scene format
+  bench     measure frame times and compile times on the bundled scenes
+
+'sdfcsg COMMAND --help' describes a command. Exit codes: 0 success, 1 invalid scene,
+2 bad command line, 3 file read or write failure, 4 Vulkan or shader failure.
+)";
+
+const char* kRenderHelp = R"(Usage: sdfcsg render SCENE -o OUT.png [options]
+
+Ray-marches SCENE with a Vulkan compute pass and writes a PNG (atomically).
+
+Options:
+  -o, --output FILE     output PNG (required)
+  --width W, --height H image size in pixels (default 800 x 600, at most 16384 each)
+  --mode M              shaded (default), normals, depth or steps (iteration heat map)
+  --eye X,Y,Z           camera position (default: the scene's camera, else framed)
+  --target X,Y,Z        point the camera looks at
+  --fov DEG             vertical field of view in degrees (default 45)
+  --aa N                N x N samples per pixel (1..8, default 1)
+  --no-shadows          disable soft shadows
+  --no-ao               disable ambient occlusion
+  --boxes all|none      overlay every node's bounding box
+  --no-skip             evaluate every operand (disable bounds skipping)
+  --device NAME         Vulkan device: index or part of its name (also SDFCSG_DEVICE)
+  --validation          enable the Vulkan validation layer
+)";
+
+int cmdRender(int argc, char** argv) {
+    Args args("render", argc, argv,
+              {"-o", "--output", "--width", "--height", "--mode", "--eye", "--target", "--fov",
+               "--aa", "--boxes", "--device"},
+              {"--no-shadows", "--no-ao", "--no-skip", "--validation", "--help", "-h"});
+    if (args.has("--help") || args.has("-h")) return std::fputs(kRenderHelp, stdout), kOk;
+    if (!args.error.empty()) return usageError("render", args.error);
+    if (args.positional.size() != 1) return usageError("render", "expected one SCENE file");
+    std::string out = args.get("-o", args.get("--output"));
+    if (out.empty()) return usageError("render", "missing -o OUT.png");
+
+    sdfcsg::RenderOptions options;
+    if (args.has("--width") && !parseUint(args.get("--width"), 1, 16384, options.width))
+        return usageError("render", "--width expects an integer in 1..16384");
+    if (args.has("--height") && !parseUint(args.get("--height"), 1, 16384, options.height))
+        return usageError("render", "--height expects an integer in 1..16384");
+    if (args.has("--aa") && !parseUint(args.get("--aa"), 1, 8, options.aa))
+        return usageError("render", "--aa expects an integer in 1..8");
+    if (args.has("--mode")) {
+        auto mode = sdfcsg::parseRenderMode(args.get("--mode"));
+        if (!mode)
+            return usageError("render", "--mode expects shaded, normals, depth or steps, got '" +
+                                            args.get("--mode") + "'");
+        options.mode = *mode;
+    }
+    if (args.has("--boxes")) {
+        std::string b = args.get("--boxes");
+        if (b != "all" && b != "none") return usageError("render", "--boxes expects all or none");
+        options.boxes = b == "all" ? sdfcsg::BoxOverlay::All : sdfcsg::BoxOverlay::None;
+    }
+    options.shadows = !args.has("--no-shadows");
+    options.ambientOcclusion = !args.has("--no-ao");
+    options.boundsSkipping = !args.has("--no-skip");
+
+    auto scene = load(args.positional[0]);
+    if (!scene) return fail(scene.error());
+
+    // Camera: explicit flags override the scene's camera, which overrides automatic framing.
+    if (args.has("--eye") || args.has("--target") || args.has("--fov")) {
+        sdfcsg::Evaluator evaluator(*scene);
+        float aspect = float(options.width) / float(options.height);
+        sdfcsg::Camera camera = scene->camera.value_or(sdfcsg::frameCamera(evaluator, aspect));
+        if (args.has("--eye") && !parseVec3(args.get("--eye"), camera.eye))
+            return usageError("render", "--eye expects X,Y,Z");
+        if (args.has("--target") && !parseVec3(args.get("--target"), camera.target))
+            return usageError("render", "--target expects X,Y,Z");
+        if (args.has("--fov") && (!parseFloat(args.get("--fov"), camera.fov) ||
+                                  camera.fov <= 0.0f || camera.fov >= 180.0f))
+            return usageError("render", "--fov expects degrees in (0, 180)");
+        if (camera.eye == camera.target)
+            return usageError("render", "the camera's eye and target must differ");
+        options.camera = camera;
+    }
+
+    sdfcsg::ContextOptions contextOptions;
+    contextOptions.device = args.get("--device");
+    if (args.has("--validation")) contextOptions.validation = 1;
+    auto context = sdfcsg::Context::create(contextOptions);
+    if (!context) return fail(context.error());
+    auto renderer = sdfcsg::Renderer::create(**context, *scene);
+    if (!renderer) return fail(renderer.error());
+    auto image = (*renderer)->render(options);
+    if (!image) return fail(image.error());
+    if (auto written = sdfcsg::writePng(*image, out); !written) return fail(written.error());
+    return kOk;
+}
+
+const char* kValidateHelp = R"(Usage: sdfcsg validate SCENE...
+
+Parses and validates each scene (current or legacy format) and prints every problem found,
+one per line as FILE: JSON.PATH: MESSAGE (or FILE:LINE:COLUMN: MESSAGE for syntax errors).
+Exits with 0 if all scenes are valid, 1 if any is not, 3 if a file cannot be read.
+)";
+
+int cmdValidate(int argc, char** argv) {
+    Args args("validate", argc, argv, {}, {"--help", "-h"});
+    if (args.has("--help") || args.has("-h")) return std::fputs(kValidateHelp, stdout), kOk;
+    if (!args.error.empty()) return usageError("validate", args.error);
+    if (args.positional.empty()) return usageError("validate", "expected at least one SCENE file");
+    int worst = kOk;
+    for (const std::string& path : args.positional) {
+        auto scene = load(path);
+        if (!scene) {
+            int code = fail(scene.error());
+            worst = std::max(worst, code == kIo ? kIo : kInvalidScene);
+            continue;
+        }
+        std::printf("%s: ok (%zu nodes)\n", path.c_str(), scene->nodes.size());
+    }
+    return worst;
+}
+
+// Writes text to -o FILE atomically, or to standard output.
+int emit(const std::string& text, const std::string& out) {
+    if (out.empty()) {
+        std::fwrite(text.data(), 1, text.size(), stdout);
+        return kOk;
+    }
+    if (auto written = sdfcsg::writeFileAtomic(out, text); !written) return fail(written.error());
+    return kOk;
+}
+
+const char* kGlslHelp = R"(Usage: sdfcsg glsl SCENE [-o FILE] [--inline]
+
+Prints the GLSL that SCENE compiles to: sceneDistance() and sceneSample(), one line per node.
+  -o, --output FILE  write to FILE (atomically) instead of standard output
+  --inline           bake parameters in as literals instead of reading the node buffer
+)";
+
+int cmdGlsl(int argc, char** argv) {
+    Args args("glsl", argc, argv, {"-o", "--output"}, {"--inline", "--help", "-h"});
+    if (args.has("--help") || args.has("-h")) return std::fputs(kGlslHelp, stdout), kOk;
+    if (!args.error.empty()) return usageError("glsl", args.error);
+    if (args.positional.size() != 1) return usageError("glsl", "expected one SCENE file");
+    auto scene = load(args.positional[0]);
+    if (!scene) return fail(scene.error());
+    sdfcsg::CodegenOptions options;
+    options.inlineParams = args.has("--inline");
+    return emit(sdfcsg::generateSceneGlsl(*scene, options), args.get("-o", args.get("--output")));
+}
+
+const char* kConvertHelp = R"(Usage: sdfcsg convert IN -o OUT.json
+
+Reads a scene in any supported format (the legacy SDFBooleanEngine node list is detected
+automatically), validates it and writes it in the current format (atomically).
+)";
+
+int cmdConvert(int argc, char** argv) {
+    Args args("convert", argc, argv, {"-o", "--output"}, {"--help", "-h"});
+    if (args.has("--help") || args.has("-h")) return std::fputs(kConvertHelp, stdout), kOk;
+    if (!args.error.empty()) return usageError("convert", args.error);
+    if (args.positional.size() != 1) return usageError("convert", "expected one input file");
+    std::string out = args.get("-o", args.get("--output"));
+    if (out.empty()) return usageError("convert", "missing -o OUT.json");
+    auto scene = load(args.positional[0]);
+    if (!scene) return fail(scene.error());
+    return emit(sdfcsg::toJson(*scene), out);
+}
+
+const char* kSchemaHelp = R"(Usage: sdfcsg schema [-o FILE]
+
+Prints the JSON Schema (draft 2020-12) of the scene format, generated from the node table.
+)";
+
+int cmdSchema(int argc, char** argv) {
+    Args args("schema", argc, argv, {"-o", "--output"}, {"--help", "-h"});
+    if (args.has("--help") || args.has("-h")) return std::fputs(kSchemaHelp, stdout), kOk;
+    if (!args.error.empty()) return usageError("schema", args.error);
+    if (!args.positional.empty()) return usageError("schema", "takes no arguments");
+    return emit(sdfcsg::sceneJsonSchema(), args.get("-o", args.get("--output")));
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    if (argc < 2) {
+        std::fputs(kMainHelp, stderr);
+        return kUsage;
+    }
+    std::string_view command = argv[1];
+    if (command == "--help" || command == "-h" || command == "help") {
+        std::fputs(kMainHelp, stdout);
+        return kOk;
+    }
+    if (command == "--version") {
+        std::printf("sdfcsg %d.%d.%d\n", SDFCSG_VERSION_MAJOR, SDFCSG_VERSION_MINOR,
+                    SDFCSG_VERSION_PATCH);
+        return kOk;
+    }
+    const std::pair<std::string_view, std::function<int(int, char**)>> commands[] = {
+        {"render", cmdRender},   {"validate", cmdValidate}, {"glsl", cmdGlsl},
+        {"convert", cmdConvert}, {"schema", cmdSchema},     {"bench", sdfcsg::app::runBench},
+    };
+    for (auto& [name, run] : commands)
+        if (command == name) return run(argc - 2, argv + 2);
+    std::fprintf(stderr, "sdfcsg: unknown command '%s'\n\n%s", argv[1], kMainHelp);
+    return kUsage;
+}

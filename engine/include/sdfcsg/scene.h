@@ -80,4 +80,8 @@ std::string toJson(const Scene& scene);
 
 std::vector<Light> defaultLights();
 
+// The JSON Schema (draft 2020-12) of the current format, generated from the node kind table.
+// assets/scene.schema.json holds a copy; a test keeps the two equal.
+std::string sceneJsonSchema();
+
 } // namespace sdfcsg

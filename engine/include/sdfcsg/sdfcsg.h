@@ -9,6 +9,7 @@
 #include "sdfcsg/context.h"
 #include "sdfcsg/error.h"
 #include "sdfcsg/eval.h"
+#include "sdfcsg/io.h"
 #include "sdfcsg/nodes.h"
 #include "sdfcsg/render.h"
 #include "sdfcsg/scene.h"

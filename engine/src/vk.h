@@ -1,0 +1,120 @@
+// Private Vulkan plumbing: the context's internals and small helpers for buffers, compute
+// pipelines, descriptors and one-shot submissions. Plain structs and free functions.
+//
+// Errors the user can cause (no device, out of memory for a requested size) come back as
+// Results; every other VkResult that is not VK_SUCCESS is a bug and aborts via VK_CHECK, in
+// every build type.
+#pragma once
+
+#include "sdfcsg/context.h"
+#include "sdfcsg/error.h"
+
+#include <vulkan/vulkan.h>
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+
+namespace sdfcsg::detail {
+
+[[noreturn]] void vkFail(const char* call, VkResult result, const char* file, int line);
+const char* vkResultName(VkResult result);
+
+} // namespace sdfcsg::detail
+
+#define VK_CHECK(call)                                                                             \
+    do {                                                                                           \
+        VkResult vkCheckResult_ = (call);                                                          \
+        if (vkCheckResult_ != VK_SUCCESS)                                                          \
+            ::sdfcsg::detail::vkFail(#call, vkCheckResult_, __FILE__, __LINE__);                   \
+    } while (0)
+
+namespace sdfcsg {
+
+struct Context::Impl {
+    VkInstance instance = VK_NULL_HANDLE;
+    VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
+    VkPhysicalDevice physicalDevice = VK_NULL_HANDLE;
+    VkPhysicalDeviceProperties properties{};
+    VkPhysicalDeviceMemoryProperties memoryProperties{};
+    VkDevice device = VK_NULL_HANDLE;
+    uint32_t queueFamily = 0;
+    VkQueue queue = VK_NULL_HANDLE;
+    VkCommandPool commandPool = VK_NULL_HANDLE;
+    VkCommandBuffer commandBuffer = VK_NULL_HANDLE; // reused by submitAndWait()
+    VkFence fence = VK_NULL_HANDLE;
+    bool validation = false;
+    std::atomic<uint32_t> validationMessages{0};
+
+    ~Impl();
+};
+
+namespace detail {
+
+enum class MemoryUse {
+    Upload,   // written by the host every frame, read by shaders (uniforms, node data)
+    Readback, // written by shaders, read by the host; device-local where that is also mappable
+    Staging,  // transfer target for Readback buffers that turned out not to be mappable
+};
+
+struct Buffer {
+    VkBuffer buffer = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    VkDeviceSize size = 0;
+    void* data = nullptr;  // persistently mapped, or null when the memory is not host visible
+    bool coherent = false; // no flush/invalidate needed
+};
+
+// Out of device or host memory is an ErrorKind::Limit error naming the size; anything else
+// aborts. Sizes of 0 are rounded up to 4 bytes.
+Result<Buffer> createBuffer(Context::Impl& ctx, VkDeviceSize size, VkBufferUsageFlags usage,
+                            MemoryUse use);
+void destroyBuffer(Context::Impl& ctx, Buffer& buffer);
+// Copies to a mapped buffer and flushes it when not coherent.
+void uploadBuffer(Context::Impl& ctx, const Buffer& buffer, const void* data, size_t size);
+// Makes device writes visible to the host (after the fence): invalidates when not coherent.
+void invalidateBuffer(Context::Impl& ctx, const Buffer& buffer);
+
+struct SpecConstant {
+    uint32_t id;
+    uint32_t value; // 32-bit scalars only (bool is 0/1)
+};
+
+VkShaderModule createShaderModule(Context::Impl& ctx, std::span<const uint32_t> spirv);
+// Every binding is visible to the compute stage.
+VkDescriptorSetLayout createDescriptorSetLayout(Context::Impl& ctx,
+                                                std::span<const VkDescriptorType> bindings);
+VkPipelineLayout createPipelineLayout(Context::Impl& ctx, VkDescriptorSetLayout setLayout,
+                                      uint32_t pushConstantBytes);
+VkPipeline createComputePipeline(Context::Impl& ctx, VkShaderModule module,
+                                 VkPipelineLayout layout, std::span<const SpecConstant> spec);
+// A pool sized for exactly one set of the given bindings.
+VkDescriptorPool createDescriptorPool(Context::Impl& ctx,
+                                      std::span<const VkDescriptorType> bindings);
+VkDescriptorSet allocateDescriptorSet(Context::Impl& ctx, VkDescriptorPool pool,
+                                      VkDescriptorSetLayout layout);
+// Points binding i at buffers[i] (whole range), with the descriptor type of bindings[i].
+void writeDescriptorSet(Context::Impl& ctx, VkDescriptorSet set,
+                        std::span<const VkDescriptorType> bindings,
+                        std::span<const Buffer* const> buffers);
+
+// Begins the context's command buffer for a one-shot submission.
+VkCommandBuffer beginCommands(Context::Impl& ctx);
+// Ends, submits and waits on the fence.
+void submitAndWait(Context::Impl& ctx);
+
+// Shader writes -> host reads: records the barrier and, when `buffer` is not mappable, a copy
+// into `staging` (which must then exist). Call before submitAndWait(), then readback().
+void recordReadback(VkCommandBuffer cmd, const Buffer& buffer, const Buffer* staging);
+// The mapped bytes of whichever buffer holds the result, invalidated.
+const void* readback(Context::Impl& ctx, const Buffer& buffer, const Buffer* staging);
+
+// Dispatch with group counts derived from a local size.
+inline uint32_t groupCount(uint32_t threads, uint32_t localSize) {
+    return (threads + localSize - 1) / localSize;
+}
+
+} // namespace detail
+} // namespace sdfcsg

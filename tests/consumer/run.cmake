@@ -1,0 +1,19 @@
+# Installs the built engine into a private prefix, builds tests/consumer/project against it
+# with find_package(sdfcsg), runs the result and checks the PNG it writes.
+# Inputs: BUILD_DIR, SOURCE_DIR, WORK_DIR, GENERATOR.
+file(REMOVE_RECURSE ${WORK_DIR})
+function(run)
+    execute_process(COMMAND ${ARGV} RESULT_VARIABLE rc)
+    if(NOT rc EQUAL 0)
+        message(FATAL_ERROR "failed (${rc}): ${ARGV}")
+    endif()
+endfunction()
+run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${WORK_DIR}/prefix)
+run(${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/consumer/project -B ${WORK_DIR}/build -G ${GENERATOR}
+    -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix)
+run(${CMAKE_COMMAND} --build ${WORK_DIR}/build)
+run(${WORK_DIR}/build/consumer ${SOURCE_DIR}/assets/scenes/csg_part.json ${WORK_DIR}/out.png)
+file(READ ${WORK_DIR}/out.png header LIMIT 8 HEX)
+if(NOT header STREQUAL "89504e470d0a1a0a")
+    message(FATAL_ERROR "the consumer did not write a PNG")
+endif()
