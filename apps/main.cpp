@@ -307,17 +307,20 @@ int cmdConvert(int argc, char** argv) {
     return emit(sdfcsg::toJson(*scene), out);
 }
 
-const char* kSchemaHelp = R"(Usage: sdfcsg schema [-o FILE]
+const char* kSchemaHelp = R"(Usage: sdfcsg schema [-o FILE] [--markdown]
 
 Prints the JSON Schema (draft 2020-12) of the scene format, generated from the node table.
+  --markdown  print the field reference in Markdown instead (as in the README)
 )";
 
 int cmdSchema(int argc, char** argv) {
-    Args args("schema", argc, argv, {"-o", "--output"}, {"--help", "-h"});
+    Args args("schema", argc, argv, {"-o", "--output"}, {"--markdown", "--help", "-h"});
     if (args.has("--help") || args.has("-h")) return std::fputs(kSchemaHelp, stdout), kOk;
     if (!args.error.empty()) return usageError("schema", args.error);
     if (!args.positional.empty()) return usageError("schema", "takes no arguments");
-    return emit(sdfcsg::sceneJsonSchema(), args.get("-o", args.get("--output")));
+    std::string text =
+        args.has("--markdown") ? sdfcsg::sceneFormatReference() : sdfcsg::sceneJsonSchema();
+    return emit(text, args.get("-o", args.get("--output")));
 }
 
 } // namespace

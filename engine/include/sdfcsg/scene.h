@@ -84,4 +84,8 @@ std::vector<Light> defaultLights();
 // assets/scene.schema.json holds a copy; a test keeps the two equal.
 std::string sceneJsonSchema();
 
+// The Markdown reference of every node kind and field (units, defaults, meaning), generated from
+// the same table; README.md embeds it and a test keeps the two equal.
+std::string sceneFormatReference();
+
 } // namespace sdfcsg

@@ -1,0 +1,54 @@
+// The scene format reference in Markdown, made from the node kind table so it cannot drift.
+#include "sdfcsg/scene.h"
+
+#include <cstdio>
+
+namespace sdfcsg {
+namespace {
+
+std::string number(float v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", double(v));
+    return buf;
+}
+
+std::string describeValue(const ParamInfo& p) {
+    std::string kind = p.type == ValueType::Vec3 ? "[x, y, z]" : "number";
+    switch (p.check) {
+    case Check::Any: break;
+    case Check::Positive: kind += p.type == ValueType::Vec3 ? ", each > 0" : ", > 0"; break;
+    case Check::NonNegative: kind += p.type == ValueType::Vec3 ? ", each >= 0" : ", >= 0"; break;
+    case Check::NonZero: kind += ", not zero"; break;
+    }
+    return kind;
+}
+
+std::string fallback(const ParamInfo& p) {
+    if (p.required) return "required";
+    if (p.type == ValueType::Number) return "default " + number(p.fallback[0]);
+    return "default [" + number(p.fallback[0]) + ", " + number(p.fallback[1]) + ", " +
+           number(p.fallback[2]) + "]";
+}
+
+} // namespace
+
+std::string sceneFormatReference() {
+    std::string out;
+    out += "Keys every node may have:\n\n| key | meaning |\n|---|---|\n";
+    for (const CommonKey& k : commonNodeKeys())
+        out += "| `" + std::string(k.name) + "` | " + std::string(k.doc) + " |\n";
+    out += "\n| type | fields (unit; constraint; default) | meaning |\n|---|---|---|\n";
+    for (const KindInfo& kind : nodeKinds()) {
+        std::string fields;
+        for (const ParamInfo& p : kind.params) {
+            if (!fields.empty()) fields += "<br>";
+            fields += "`" + std::string(p.name) + "` (" + std::string(p.unit) + "; " +
+                      describeValue(p) + "; " + fallback(p) + "): " + std::string(p.doc);
+        }
+        out += "| `" + std::string(kind.name) + "` | " + fields + " | " + std::string(kind.doc) +
+               " |\n";
+    }
+    return out;
+}
+
+} // namespace sdfcsg
