@@ -41,7 +41,7 @@ constexpr ParamInfo kCone[] = {
     {"radius", Number, Positive, 0, true, {}, "length", "Base radius (at the bottom, y = -height/2)."},
     {"height", Number, Positive, 1, true, {}, "length", "Full height along y."},
     {"top_radius", Number, NonNegative, 2, false, {0, 0, 0}, "length",
-     "Radius at the top (y = +height/2); 0 makes a pointed cone, more a frustum."},
+     "Radius at the top (y = +height/2); 0 gives a pointed cone, more a frustum (truncated cone)."},
 };
 constexpr ParamInfo kCapsule[] = {
     {"a", Vec3, Any, 0, true, {}, "point", "First end point of the axis segment."},
