@@ -252,7 +252,7 @@ int cmdValidate(int argc, char** argv) {
         auto scene = load(path);
         if (!scene) {
             int code = fail(scene.error());
-            worst = std::max(worst, code == kIo ? kIo : kInvalidScene);
+            worst = std::max(worst, int(code == kIo ? kIo : kInvalidScene));
             continue;
         }
         std::printf("%s: ok (%zu nodes)\n", path.c_str(), scene->nodes.size());

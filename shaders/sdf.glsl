@@ -1,19 +1,21 @@
 // The SDF function library: exact distance functions after Inigo Quilez
-// (https://iquilezles.org/articles/distfunctions/, .../distfunctions2d/) and the CSG
-// operators. engine/src/sdf.h implements the same formulas in C++; tests hold them together.
-// Every primitive is centred at the origin in its local frame; sizes are half extents here.
+// (https://iquilezles.org/articles/distfunctions/, .../distfunctions2d/, .../smin/) and the CSG
+// operators. engine/src/sdf.h implements the same formulas line by line in C++; tests hold the
+// two together. Every primitive is centred at the origin of its local frame and takes the
+// kernel parameters that packNodes() derives (half extents, half heights), not the JSON values.
 
 float dot2(vec2 v) { return dot(v, v); }
 float dot2(vec3 v) { return dot(v, v); }
 
 float sdSphere(vec3 p, float r) { return length(p) - r; }
 
+// b: half extents.
 float sdBox(vec3 p, vec3 b) {
     vec3 q = abs(p) - b;
     return length(max(q, 0.0)) + min(max(q.x, max(q.y, q.z)), 0.0);
 }
 
-// b: half extents including the rounding r.
+// b: half extents including the rounding r (r <= min(b)).
 float sdRoundBox(vec3 p, vec3 b, float r) {
     vec3 q = abs(p) - b + r;
     return length(max(q, 0.0)) + min(max(q.x, max(q.y, q.z)), 0.0) - r;
@@ -22,8 +24,8 @@ float sdRoundBox(vec3 p, vec3 b, float r) {
 // n: unit normal; the solid is where dot(p, n) < offset.
 float sdPlane(vec3 p, vec3 n, float offset) { return dot(p, n) - offset; }
 
-// Isosceles triangle prism: base width 2*hw, height h (apex up), bounding box centred; half
-// length hl along z. IQ's exact sdTriangleIsosceles, extruded exactly.
+// Isosceles triangle in xy (base width 2*hw at y = -h/2, apex at y = +h/2) extruded to z in
+// [-hl, hl]: IQ's exact sdTriangleIsosceles (apex at t = 0, base at t.y = h) and opExtrusion.
 float sdTriangularPrism(vec3 p, float hw, float h, float hl) {
     vec2 q = vec2(hw, h);
     vec2 t = vec2(abs(p.x), 0.5 * h - p.y);
@@ -35,18 +37,19 @@ float sdTriangularPrism(vec3 p, float hw, float h, float hl) {
     return min(max(w.x, w.y), 0.0) + length(max(w, 0.0));
 }
 
+// Ring around the y axis.
 float sdTorus(vec3 p, float major, float minor) {
     vec2 q = vec2(length(p.xz) - major, p.y);
     return length(q) - minor;
 }
 
-// hh: half height.
+// Capped cylinder along y; hh: half height.
 float sdCylinder(vec3 p, float r, float hh) {
     vec2 d = abs(vec2(length(p.xz), p.y)) - vec2(r, hh);
     return min(max(d.x, d.y), 0.0) + length(max(d, 0.0));
 }
 
-// Capped cone: radius r1 at y = -hh, r2 at y = +hh.
+// IQ's exact sdCappedCone: radius r1 at y = -hh, r2 at y = +hh.
 float sdCone(vec3 p, float r1, float hh, float r2) {
     vec2 q = vec2(length(p.xz), p.y);
     vec2 k1 = vec2(r2, hh);
@@ -63,32 +66,39 @@ float sdCapsule(vec3 p, vec3 a, vec3 b, float r) {
     return length(pa - ba * h) - r;
 }
 
-// CSG operators. k is the blend radius (IQ's polynomial smooth minimum); k <= 0 is the sharp
-// operator, and ties go to the first operand. The vec4 forms carry colour in rgb and the
-// distance in w, blending colour by the same factor as the distance.
+// CSG operators: IQ's polynomial smooth minimum with blend radius k, and smooth max(a, b) =
+// -smin(-a, -b). Once the operands differ by k or more the blend factor is exactly 0 or 1, so
+// those cases return an operand unchanged: this makes bounds skipping exact in floating point
+// (the skipped operand could not have changed a single bit) and gives k = 0 the sharp operator
+// without a division, ties going to the first operand. The vec4 forms carry colour in rgb and
+// the distance in w; colour blends by the same factor. Difference(a, b) = max(a, -b).
 float opUnion(float a, float b, float k) {
-    if (k <= 0.0) return min(a, b);
-    float h = clamp(0.5 + 0.5 * (b - a) / k, 0.0, 1.0);
+    if (b - a >= k) return a;
+    if (a - b >= k) return b;
+    float h = 0.5 + 0.5 * (b - a) / k;
     return mix(b, a, h) - k * h * (1.0 - h);
 }
 
 float opIntersection(float a, float b, float k) {
-    if (k <= 0.0) return max(a, b);
-    float h = clamp(0.5 - 0.5 * (b - a) / k, 0.0, 1.0);
+    if (a - b >= k) return a;
+    if (b - a >= k) return b;
+    float h = 0.5 - 0.5 * (b - a) / k;
     return mix(b, a, h) + k * h * (1.0 - h);
 }
 
 float opDifference(float a, float b, float k) { return opIntersection(a, -b, k); }
 
 vec4 opUnion(vec4 a, vec4 b, float k) {
-    if (k <= 0.0) return (b.w < a.w) ? b : a;
-    float h = clamp(0.5 + 0.5 * (b.w - a.w) / k, 0.0, 1.0);
+    if (b.w - a.w >= k) return a;
+    if (a.w - b.w >= k) return b;
+    float h = 0.5 + 0.5 * (b.w - a.w) / k;
     return vec4(mix(b.rgb, a.rgb, h), mix(b.w, a.w, h) - k * h * (1.0 - h));
 }
 
 vec4 opIntersection(vec4 a, vec4 b, float k) {
-    if (k <= 0.0) return (b.w > a.w) ? b : a;
-    float h = clamp(0.5 - 0.5 * (b.w - a.w) / k, 0.0, 1.0);
+    if (a.w - b.w >= k) return a;
+    if (b.w - a.w >= k) return b;
+    float h = 0.5 - 0.5 * (b.w - a.w) / k;
     return vec4(mix(b.rgb, a.rgb, h), mix(b.w, a.w, h) + k * h * (1.0 - h));
 }
 

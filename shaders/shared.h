@@ -13,6 +13,10 @@
 #define SDFCSG_BINDING_NODES 1  // readonly buffer of Node (see nodes.glsl), index-aligned with the scene
 #define SDFCSG_BINDING_PIXELS 2 // buffer of packed RGBA8, row-major, top row first
 #define SDFCSG_BINDING_INFO 3   // buffer of vec2 per pixel: (hit depth or -1, step count)
+#define SDFCSG_BINDING_PROBE_IN 4  // probe.comp: readonly buffer of vec4 points (xyz used)
+#define SDFCSG_BINDING_PROBE_OUT 5 // probe.comp: buffer of vec4 sceneSample() results
+
+#define SDFCSG_PROBE_GROUP_X 64
 
 #define SDFCSG_MAX_LIGHTS 4
 #define SDFCSG_MAX_STEPS 256

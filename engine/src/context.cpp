@@ -51,11 +51,12 @@ bool extensionAvailable(const char* layer, const char* name) {
     });
 }
 
-// Requested: 1 on, 0 off, -1 default (debug builds, or SDFCSG_VALIDATION=1).
+// 1: required, 0: off, -1: on if installed. SDFCSG_VALIDATION=1 asks for it explicitly, so a
+// missing layer is an error then; debug builds merely use it when present.
 int wantedValidation(int requested) {
     if (requested >= 0) return requested;
     if (const char* env = std::getenv("SDFCSG_VALIDATION"); env && *env)
-        return std::string_view(env) == "0" ? 0 : -1; // -1: on if available
+        return std::string_view(env) == "0" ? 0 : 1;
 #ifndef NDEBUG
     return -1;
 #else

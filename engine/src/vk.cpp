@@ -169,12 +169,11 @@ VkShaderModule createShaderModule(Context::Impl& ctx, std::span<const uint32_t> 
     return module;
 }
 
-VkDescriptorSetLayout createDescriptorSetLayout(Context::Impl& ctx,
-                                                std::span<const VkDescriptorType> bindings) {
+VkDescriptorSetLayout createDescriptorSetLayout(Context::Impl& ctx, std::span<const Binding> bindings) {
     std::vector<VkDescriptorSetLayoutBinding> list(bindings.size());
     for (uint32_t i = 0; i < list.size(); ++i) {
-        list[i].binding = i;
-        list[i].descriptorType = bindings[i];
+        list[i].binding = bindings[i].binding;
+        list[i].descriptorType = bindings[i].type;
         list[i].descriptorCount = 1;
         list[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
     }
@@ -223,14 +222,13 @@ VkPipeline createComputePipeline(Context::Impl& ctx, VkShaderModule module,
     return pipeline;
 }
 
-VkDescriptorPool createDescriptorPool(Context::Impl& ctx,
-                                      std::span<const VkDescriptorType> bindings) {
+VkDescriptorPool createDescriptorPool(Context::Impl& ctx, std::span<const Binding> bindings) {
     std::vector<VkDescriptorPoolSize> sizes;
-    for (VkDescriptorType type : bindings) {
+    for (const Binding& b : bindings) {
         bool found = false;
         for (VkDescriptorPoolSize& s : sizes)
-            if (s.type == type) ++s.descriptorCount, found = true;
-        if (!found) sizes.push_back({type, 1});
+            if (s.type == b.type) ++s.descriptorCount, found = true;
+        if (!found) sizes.push_back({b.type, 1});
     }
     VkDescriptorPoolCreateInfo info = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
     info.maxSets = 1;
@@ -252,8 +250,7 @@ VkDescriptorSet allocateDescriptorSet(Context::Impl& ctx, VkDescriptorPool pool,
     return set;
 }
 
-void writeDescriptorSet(Context::Impl& ctx, VkDescriptorSet set,
-                        std::span<const VkDescriptorType> bindings,
+void writeDescriptorSet(Context::Impl& ctx, VkDescriptorSet set, std::span<const Binding> bindings,
                         std::span<const Buffer* const> buffers) {
     std::vector<VkDescriptorBufferInfo> infos(bindings.size());
     std::vector<VkWriteDescriptorSet> writes(bindings.size());
@@ -261,9 +258,9 @@ void writeDescriptorSet(Context::Impl& ctx, VkDescriptorSet set,
         infos[i] = {buffers[i]->buffer, 0, VK_WHOLE_SIZE};
         writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
         writes[i].dstSet = set;
-        writes[i].dstBinding = i;
+        writes[i].dstBinding = bindings[i].binding;
         writes[i].descriptorCount = 1;
-        writes[i].descriptorType = bindings[i];
+        writes[i].descriptorType = bindings[i].type;
         writes[i].pBufferInfo = &infos[i];
     }
     vkUpdateDescriptorSets(ctx.device, uint32_t(writes.size()), writes.data(), 0, nullptr);

@@ -82,22 +82,24 @@ struct SpecConstant {
     uint32_t value; // 32-bit scalars only (bool is 0/1)
 };
 
+struct Binding {
+    uint32_t binding;
+    VkDescriptorType type;
+};
+
 VkShaderModule createShaderModule(Context::Impl& ctx, std::span<const uint32_t> spirv);
 // Every binding is visible to the compute stage.
-VkDescriptorSetLayout createDescriptorSetLayout(Context::Impl& ctx,
-                                                std::span<const VkDescriptorType> bindings);
+VkDescriptorSetLayout createDescriptorSetLayout(Context::Impl& ctx, std::span<const Binding> bindings);
 VkPipelineLayout createPipelineLayout(Context::Impl& ctx, VkDescriptorSetLayout setLayout,
                                       uint32_t pushConstantBytes);
 VkPipeline createComputePipeline(Context::Impl& ctx, VkShaderModule module,
                                  VkPipelineLayout layout, std::span<const SpecConstant> spec);
 // A pool sized for exactly one set of the given bindings.
-VkDescriptorPool createDescriptorPool(Context::Impl& ctx,
-                                      std::span<const VkDescriptorType> bindings);
+VkDescriptorPool createDescriptorPool(Context::Impl& ctx, std::span<const Binding> bindings);
 VkDescriptorSet allocateDescriptorSet(Context::Impl& ctx, VkDescriptorPool pool,
                                       VkDescriptorSetLayout layout);
-// Points binding i at buffers[i] (whole range), with the descriptor type of bindings[i].
-void writeDescriptorSet(Context::Impl& ctx, VkDescriptorSet set,
-                        std::span<const VkDescriptorType> bindings,
+// Points bindings[i] at buffers[i] (the whole buffer).
+void writeDescriptorSet(Context::Impl& ctx, VkDescriptorSet set, std::span<const Binding> bindings,
                         std::span<const Buffer* const> buffers);
 
 // Begins the context's command buffer for a one-shot submission.

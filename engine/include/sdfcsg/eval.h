@@ -23,6 +23,9 @@ struct Aabb {
     bool finite() const; // no infinite coordinate (false for planes)
     // Euclidean distance from p to the box, 0 inside.
     float distance(glm::vec3 p) const;
+    // Signed distance: as distance() outside, minus the distance to the nearest face inside
+    // (-infinity inside an unbounded box).
+    float signedDistance(glm::vec3 p) const;
 };
 
 // A node with everything resolved to world space. Index-aligned with Scene::nodes.
@@ -33,8 +36,9 @@ struct FlatNode {
     float scale;         // accumulated uniform scale: world distance = scale * local distance
     glm::vec3 color;     // resolved (inherited) colour
     float smooth;        // operations: blend radius in world units
-    std::array<float, kMaxParams> params; // as in Node, with derived values (normalised plane)
-    Aabb bounds;         // world bounds; the node's value at p is >= bounds.distance(p)
+    std::array<float, kMaxParams> params; // the kernel's parameters (half extents, unit normal,
+                                          // ...): kernelParams() in engine/src/sdf.h
+    Aabb bounds;         // world bounds; the node's value at p is >= bounds.signedDistance(p)
     std::vector<uint32_t> children;
 };
 
@@ -51,6 +55,9 @@ class Evaluator {
     float distance(glm::vec3 p) const;
     // Distance and blended colour.
     Sample sample(glm::vec3 p) const;
+    // The same for the subtree rooted at nodes()[node] alone (picking, per-node tests).
+    float distance(glm::vec3 p, uint32_t node) const;
+    Sample sample(glm::vec3 p, uint32_t node) const;
     // Bounds of the whole solid; infinite along axes where a plane reaches.
     const Aabb& bounds() const { return nodes_[0].bounds; }
     const std::vector<FlatNode>& nodes() const { return nodes_; }

@@ -44,14 +44,25 @@ struct PixelInfo {
     uint32_t steps;
 };
 
+struct RendererOptions {
+    // true: numeric values are baked into the kernel as literals. CPU drivers (lavapipe) run
+    // that several times faster, but updateValues() must then regenerate and recompile.
+    // false: values are read from a buffer, so updateValues() only uploads them (the viewer).
+    bool inlineValues = true;
+};
+
 class Renderer {
   public:
-    // Generates, compiles and builds the pipeline for this scene.
-    static Result<std::unique_ptr<Renderer>> create(Context& context, const Scene& scene);
+    // Generates, compiles and builds the pipeline for this scene; the pipeline is ready to run
+    // (drivers that compile on first use have done so) when this returns.
+    static Result<std::unique_ptr<Renderer>> create(Context& context, const Scene& scene,
+                                                    const RendererOptions& options = {});
     ~Renderer();
 
-    // Replaces numeric values (sizes, transforms, colours, smooth radii) without recompiling.
-    // Fails with ErrorKind::Usage if the structure (kinds, children) differs from the compiled one.
+    // Replaces numeric values (sizes, transforms, colours, smooth radii, lights, background,
+    // camera). With inlineValues == false this is an upload, without recompiling; otherwise
+    // the kernel is regenerated. Fails with ErrorKind::Usage if the structure (kinds, children)
+    // differs from the compiled one.
     Status updateValues(const Scene& scene);
 
     Result<Image> render(const RenderOptions& options);

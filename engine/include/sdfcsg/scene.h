@@ -56,6 +56,8 @@ struct Scene {
     std::optional<Camera> camera; // unset: framed automatically from the scene's bounds
     std::vector<Light> lights;    // empty: the default two-light rig (defaultLights())
     glm::vec3 background{0.60f, 0.72f, 0.85f};
+    std::string name;          // optional title ("name" in the file)
+    std::string description;   // optional free text ("description" in the file)
 };
 
 // Limits enforced while loading, before any work that depends on the input's size.

@@ -1,0 +1,103 @@
+// Ray generation and ray clipping shared by the renderer (which uploads these values) and the CPU
+// tests (which trace the same rays). shaders/raymarch.comp implements the same formulas; keep the
+// two in step.
+#pragma once
+
+#include "sdfcsg/eval.h"
+#include "sdfcsg/scene.h"
+
+#include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
+#include <glm/vec3.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+namespace sdfcsg::detail {
+
+// Smallest hit epsilon, in scene units; farther away it grows with the pixel footprint.
+inline constexpr float kMinHitEpsilon = 1.0e-4f;
+
+struct RayCamera {
+    glm::vec3 eye;
+    glm::vec3 right, up, forward; // orthonormal, right-handed: forward = -z of the view
+    float tanHalfFov;             // vertical
+    float aspect;                 // width / height
+    float footprint;              // width of one pixel at unit distance (2 tan(fov/2) / height)
+};
+
+inline RayCamera makeRayCamera(const Camera& camera, uint32_t width, uint32_t height) {
+    RayCamera rc;
+    rc.eye = camera.eye;
+    rc.forward = glm::normalize(camera.target - camera.eye);
+    glm::vec3 up = camera.up;
+    if (glm::length(glm::cross(rc.forward, up)) < 1e-6f) // looking straight along up
+        up = std::abs(rc.forward.z) < 0.9f ? glm::vec3(0, 0, 1) : glm::vec3(1, 0, 0);
+    rc.right = glm::normalize(glm::cross(rc.forward, up));
+    rc.up = glm::cross(rc.right, rc.forward);
+    rc.tanHalfFov = std::tan(glm::radians(camera.fov) * 0.5f);
+    rc.aspect = float(width) / float(height);
+    rc.footprint = 2.0f * rc.tanHalfFov / float(height);
+    return rc;
+}
+
+// Direction through the image point (x, y) in pixels from the top-left corner; the centre of
+// pixel (i, j) is (i + 0.5, j + 0.5).
+inline glm::vec3 rayDirection(const RayCamera& rc, float x, float y, uint32_t width,
+                              uint32_t height) {
+    float u = (2.0f * x / float(width) - 1.0f) * rc.tanHalfFov * rc.aspect;
+    float v = (1.0f - 2.0f * y / float(height)) * rc.tanHalfFov;
+    return glm::normalize(rc.forward + u * rc.right + v * rc.up);
+}
+
+// About half a pixel's footprint at distance t: finer is invisible and costs steps.
+inline float hitEpsilon(const RayCamera& rc, float t) {
+    return std::max(kMinHitEpsilon, 0.5f * t * rc.footprint);
+}
+
+// The part of space rays are traced in: the scene's bounds, cut to a cube around the eye whose
+// half size is the far distance (planes make bounds infinite).
+struct ClipVolume {
+    Aabb box;
+    float far; // no ray goes beyond this t
+};
+
+// Bounds of the finite primitives: what a camera looks at and what "far" is measured against.
+inline Aabb finitePrimitiveBounds(const Evaluator& evaluator) {
+    Aabb box;
+    for (const FlatNode& node : evaluator.nodes()) {
+        if (kindInfo(node.kind).operation || !node.bounds.finite() || node.bounds.empty()) continue;
+        box.min = glm::min(box.min, node.bounds.min);
+        box.max = glm::max(box.max, node.bounds.max);
+    }
+    if (box.empty()) box = Aabb{glm::vec3(-1.0f), glm::vec3(1.0f)};
+    return box;
+}
+
+inline ClipVolume makeClipVolume(const Evaluator& evaluator, glm::vec3 eye) {
+    Aabb finite = finitePrimitiveBounds(evaluator);
+    glm::vec3 centre = 0.5f * (finite.min + finite.max);
+    float radius = 0.5f * glm::length(finite.max - finite.min);
+    ClipVolume clip;
+    clip.far = std::max(4.0f * (glm::length(eye - centre) + radius), 20.0f);
+    clip.box = evaluator.bounds();
+    clip.box.min = glm::max(clip.box.min, eye - glm::vec3(clip.far));
+    clip.box.max = glm::min(clip.box.max, eye + glm::vec3(clip.far));
+    return clip;
+}
+
+// Slab test; returns false when the ray misses. tNear is clamped to 0 (eye inside the box).
+inline bool clipRay(const Aabb& box, glm::vec3 origin, glm::vec3 dir, float& tNear, float& tFar) {
+    glm::vec3 inv;
+    for (int i = 0; i < 3; ++i)
+        inv[i] = 1.0f / (std::abs(dir[i]) < 1e-20f ? (dir[i] >= 0.0f ? 1e-20f : -1e-20f) : dir[i]);
+    glm::vec3 t0 = (box.min - origin) * inv;
+    glm::vec3 t1 = (box.max - origin) * inv;
+    glm::vec3 lo = glm::min(t0, t1), hi = glm::max(t0, t1);
+    tNear = std::max(std::max(lo.x, lo.y), std::max(lo.z, 0.0f));
+    tFar = std::min(std::min(hi.x, hi.y), hi.z);
+    return tNear <= tFar;
+}
+
+} // namespace sdfcsg::detail

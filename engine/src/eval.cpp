@@ -1,0 +1,281 @@
+// The CPU reference evaluator. Flattening resolves transforms, colours, smooth radii and bounds
+// to world space once; evaluation then walks the pre-order node array with an explicit stack,
+// in exactly the order (and with exactly the skipping rules) of the code that codegen.cpp
+// generates, so the CPU and GPU fields agree to rounding.
+#include "sdfcsg/eval.h"
+
+#include "sdf.h"
+
+#include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
+#include <glm/trigonometric.hpp>
+#include <glm/vec4.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace sdfcsg {
+
+bool Aabb::finite() const {
+    for (int i = 0; i < 3; ++i)
+        if (!std::isfinite(min[i]) || !std::isfinite(max[i])) return false;
+    return true;
+}
+
+float Aabb::distance(glm::vec3 p) const {
+    return glm::length(glm::max(glm::max(min - p, p - max), glm::vec3(0.0f)));
+}
+
+// Same formula as boundsDistance() in shaders/nodes.glsl. A node's value is never below it:
+// outside, the solid is no nearer than its box; inside, the solid's boundary is no farther than
+// the box's. (The unsigned distance would not do: 0 inside the box says nothing about a value
+// that may be negative there.)
+float Aabb::signedDistance(glm::vec3 p) const {
+    glm::vec3 q = glm::max(min - p, p - max);
+    return glm::length(glm::max(q, 0.0f)) + std::min(std::max(q.x, std::max(q.y, q.z)), 0.0f);
+}
+
+namespace {
+
+constexpr glm::vec3 kDefaultColor{0.8f, 0.8f, 0.8f};
+
+bool isOperation(NodeKind kind) { return kindInfo(kind).operation; }
+
+// cos and sin of an angle in degrees, exact for multiples of 90 so that quarter turns keep
+// boxes axis-aligned to the last bit.
+glm::dvec2 cosSin(double degrees) {
+    double r = std::fmod(degrees, 360.0);
+    if (r < 0) r += 360.0;
+    if (r == 0.0) return {1, 0};
+    if (r == 90.0) return {0, 1};
+    if (r == 180.0) return {-1, 0};
+    if (r == 270.0) return {0, -1};
+    double a = r * std::numbers::pi / 180.0;
+    return {std::cos(a), std::sin(a)};
+}
+
+// R = Rz * Ry * Rx: rotate about x first, then y, then z.
+glm::dmat3 rotation(glm::vec3 degrees) {
+    glm::dvec2 x = cosSin(degrees.x), y = cosSin(degrees.y), z = cosSin(degrees.z);
+    glm::dmat3 rx(1, 0, 0, 0, x[0], x[1], 0, -x[1], x[0]); // columns
+    glm::dmat3 ry(y[0], 0, -y[1], 0, 1, 0, y[1], 0, y[0]);
+    glm::dmat3 rz(z[0], z[1], 0, -z[1], z[0], 0, 0, 0, 1);
+    return rz * ry * rx;
+}
+
+// Float bounds that contain the double ones: round outwards, then pad a little so that the
+// single-precision fields evaluated against them still never undercut them.
+Aabb outwardBox(glm::dvec3 lo, glm::dvec3 hi) {
+    double pad = 1e-5 * (glm::length(hi - lo) + glm::length(hi + lo) * 0.5) + 1e-6;
+    Aabb box;
+    for (int i = 0; i < 3; ++i) {
+        box.min[i] = std::nextafter(float(lo[i] - pad), -INFINITY);
+        box.max[i] = std::nextafter(float(hi[i] + pad), INFINITY);
+    }
+    return box;
+}
+
+Aabb infiniteBox() { return Aabb{glm::vec3(-INFINITY), glm::vec3(INFINITY)}; }
+
+float volume(const Aabb& b) {
+    glm::vec3 e = b.max - b.min;
+    return e.x * e.y * e.z;
+}
+
+// local = toLocal * p + offset, associated as dot(row, vec4(p, 1)) in nodes.glsl.
+glm::vec3 localPoint(const FlatNode& n, glm::vec3 p) {
+    const glm::mat3& m = n.toLocal;
+    return {m[0][0] * p.x + m[1][0] * p.y + m[2][0] * p.z + n.offset.x,
+            m[0][1] * p.x + m[1][1] * p.y + m[2][1] * p.z + n.offset.y,
+            m[0][2] * p.x + m[1][2] * p.y + m[2][2] * p.z + n.offset.z};
+}
+
+// The value types of sceneDistance (float) and sceneSample (vec4: colour, distance in w).
+float leaf(const FlatNode& n, glm::vec3 p, float*) {
+    return sdf::evalPrimitive(n.kind, localPoint(n, p), n.params) * n.scale;
+}
+glm::vec4 leaf(const FlatNode& n, glm::vec3 p, glm::vec4*) {
+    return glm::vec4(n.color, leaf(n, p, static_cast<float*>(nullptr)));
+}
+float dist(float v) { return v; }
+float dist(const glm::vec4& v) { return v.w; }
+
+// The generated code's walk, iteratively: a frame per open operation holds the running fold
+// and the next child to visit. Operand i > 0 of a union is skipped when its bounds lie at least
+// k beyond the running value, a subtrahend when they lie at least k beyond its negation; with
+// sdf.glsl's exact operator ends, the skipped operand could not have changed the result.
+template <class V> V evaluate(const std::vector<FlatNode>& nodes, uint32_t root, glm::vec3 p,
+                              bool skipping) {
+    struct Frame {
+        uint32_t node, next;
+        V acc;
+    };
+    thread_local std::vector<Frame> stack;
+    stack.clear();
+    uint32_t current = root;
+    for (;;) {
+        const FlatNode& n = nodes[current];
+        if (isOperation(n.kind)) {
+            stack.push_back({current, 1, V{}});
+            current = n.children[0];
+            continue;
+        }
+        V value = leaf(n, p, static_cast<V*>(nullptr));
+        // Deliver the value to the enclosing operations until one has another child to visit.
+        for (;;) {
+            if (stack.empty()) return value;
+            Frame& f = stack.back();
+            const FlatNode& op = nodes[f.node];
+            if (f.next == 1) {
+                f.acc = value;
+            } else if (op.kind == NodeKind::Union) {
+                f.acc = sdf::opUnion(f.acc, value, op.smooth);
+            } else if (op.kind == NodeKind::Intersection) {
+                f.acc = sdf::opIntersection(f.acc, value, op.smooth);
+            } else {
+                f.acc = sdf::opDifference(f.acc, value, op.smooth);
+            }
+            while (f.next < op.children.size() && skipping && op.kind != NodeKind::Intersection) {
+                float bd = nodes[op.children[f.next]].bounds.signedDistance(p);
+                float d = dist(f.acc);
+                bool skip = op.kind == NodeKind::Union ? bd - d >= op.smooth : bd + d >= op.smooth;
+                if (!skip) break;
+                ++f.next;
+            }
+            if (f.next < op.children.size()) {
+                current = op.children[f.next++];
+                break;
+            }
+            value = f.acc;
+            stack.pop_back();
+        }
+    }
+}
+
+} // namespace
+
+Evaluator::Evaluator(const Scene& scene) {
+    const size_t count = scene.nodes.size();
+    nodes_.resize(count);
+    if (count == 0) return;
+
+    // Pass 1, parents first: transforms (accumulated in double), colours, parameters.
+    struct Acc {
+        glm::dmat3 toLocal{1.0}, toWorld{1.0};
+        glm::dvec3 offset{0.0}, origin{0.0}; // local = toLocal*p + offset; world = toWorld*l + origin
+        double scale = 1.0;
+    };
+    const Acc identity;
+    std::vector<Acc> acc(count);
+    std::vector<uint32_t> parent(count, UINT32_MAX);
+    for (size_t i = 0; i < count; ++i) {
+        const Node& src = scene.nodes[i];
+        for (uint32_t c : src.children) parent[c] = uint32_t(i);
+        const bool hasParent = parent[i] != UINT32_MAX;
+        const Acc& up = hasParent ? acc[parent[i]] : identity;
+        const FlatNode* upNode = hasParent ? &nodes_[parent[i]] : nullptr;
+
+        glm::dmat3 r = rotation(src.transform.rotate);
+        double s = src.transform.scale;
+        glm::dvec3 t(src.transform.translate);
+        glm::dmat3 inv = glm::transpose(r) * (1.0 / s);
+        Acc& a = acc[i];
+        a.toLocal = inv * up.toLocal;
+        a.offset = inv * (up.offset - t);
+        a.toWorld = up.toWorld * (r * s);
+        a.origin = up.toWorld * t + up.origin;
+        a.scale = up.scale * s;
+
+        FlatNode& n = nodes_[i];
+        n.kind = src.kind;
+        n.toLocal = glm::mat3(a.toLocal);
+        n.offset = glm::vec3(a.offset);
+        n.scale = float(a.scale);
+        n.color = src.color ? *src.color : upNode ? upNode->color : kDefaultColor;
+        n.params = sdf::kernelParams(src.kind, src.params);
+        n.smooth = isOperation(src.kind) ? float(double(src.params[0]) * a.scale) : 0.0f;
+        n.children = src.children;
+    }
+
+    // Pass 2, children first: bounds.
+    for (size_t i = count; i-- > 0;) {
+        FlatNode& n = nodes_[i];
+        if (!isOperation(n.kind)) {
+            glm::vec3 lo, hi;
+            if (!sdf::localBounds(n.kind, n.params, lo, hi)) {
+                n.bounds = infiniteBox();
+                continue;
+            }
+            glm::dvec3 wlo(INFINITY), whi(-INFINITY);
+            for (int c = 0; c < 8; ++c) {
+                glm::dvec3 corner(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z);
+                glm::dvec3 w = acc[i].toWorld * corner + acc[i].origin;
+                wlo = glm::min(wlo, w);
+                whi = glm::max(whi, w);
+            }
+            n.bounds = outwardBox(wlo, whi);
+        } else if (n.kind == NodeKind::Union) {
+            Aabb box;
+            for (uint32_t c : n.children) {
+                box.min = glm::min(box.min, nodes_[c].bounds.min);
+                box.max = glm::max(box.max, nodes_[c].bounds.max);
+            }
+            // Each smooth fold lowers the value by at most k/4 below the sharp minimum.
+            if (n.smooth > 0.0f) {
+                float grow = float(n.children.size() - 1) * n.smooth * 0.25f * (1.0f + 1e-5f);
+                box.min -= grow;
+                box.max += grow;
+            }
+            n.bounds = box;
+        } else if (n.kind == NodeKind::Intersection) {
+            // A smooth maximum is never below the sharp one, so any operand's box bounds it.
+            const Aabb* best = &nodes_[n.children[0]].bounds;
+            for (uint32_t c : n.children)
+                if (volume(nodes_[c].bounds) < volume(*best)) best = &nodes_[c].bounds;
+            n.bounds = *best;
+        } else {
+            n.bounds = nodes_[n.children[0]].bounds;
+        }
+    }
+}
+
+float Evaluator::distance(glm::vec3 p) const { return distance(p, 0); }
+
+Sample Evaluator::sample(glm::vec3 p) const { return sample(p, 0); }
+
+float Evaluator::distance(glm::vec3 p, uint32_t node) const {
+    return evaluate<float>(nodes_, node, p, skipping_);
+}
+
+Sample Evaluator::sample(glm::vec3 p, uint32_t node) const {
+    glm::vec4 v = evaluate<glm::vec4>(nodes_, node, p, skipping_);
+    return {v.w, glm::vec3(v)};
+}
+
+Camera frameCamera(const Evaluator& evaluator, float aspect, float fov) {
+    Camera camera;
+    camera.fov = fov;
+    Aabb box = evaluator.bounds();
+    if (!box.finite()) {
+        box = Aabb{};
+        for (const FlatNode& n : evaluator.nodes()) {
+            if (isOperation(n.kind) || !n.bounds.finite()) continue;
+            box.min = glm::min(box.min, n.bounds.min);
+            box.max = glm::max(box.max, n.bounds.max);
+        }
+    }
+    if (box.empty()) box = Aabb{glm::vec3(-1.0f), glm::vec3(1.0f)};
+
+    glm::vec3 centre = 0.5f * (box.min + box.max);
+    float radius = std::max(0.5f * glm::length(box.max - box.min), 1e-3f);
+    float halfV = 0.5f * glm::radians(fov);
+    float halfH = std::atan(std::tan(halfV) * std::max(aspect, 1e-3f));
+    float distance = 1.1f * radius / std::sin(std::min(halfV, halfH));
+    glm::vec3 direction = glm::normalize(glm::vec3(0.0f, 0.35f, 1.0f)); // front, ~20 deg up
+    camera.eye = centre + direction * distance;
+    camera.target = centre;
+    return camera;
+}
+
+} // namespace sdfcsg

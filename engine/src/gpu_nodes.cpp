@@ -1,0 +1,39 @@
+#include "gpu_nodes.h"
+
+#include "shared.h"
+
+#include <algorithm>
+
+namespace sdfcsg::detail {
+
+namespace {
+
+// Infinite bounds become +-SDFCSG_HUGE: boundsDistance() then still gives 0 inside them
+// without inf - inf arithmetic on the GPU.
+glm::vec3 clampHuge(glm::vec3 v) {
+    constexpr float huge = float(SDFCSG_HUGE);
+    return glm::clamp(v, glm::vec3(-huge), glm::vec3(huge));
+}
+
+} // namespace
+
+std::vector<GpuNode> packNodes(const Evaluator& evaluator) {
+    std::vector<GpuNode> out;
+    out.reserve(evaluator.nodes().size());
+    for (const FlatNode& n : evaluator.nodes()) {
+        GpuNode g;
+        const glm::mat3& m = n.toLocal; // column-major: m[column][row]
+        g.row0 = glm::vec4(m[0][0], m[1][0], m[2][0], n.offset.x);
+        g.row1 = glm::vec4(m[0][1], m[1][1], m[2][1], n.offset.y);
+        g.row2 = glm::vec4(m[0][2], m[1][2], m[2][2], n.offset.z);
+        g.p0 = glm::vec4(n.params[0], n.params[1], n.params[2], n.params[3]);
+        g.p1 = glm::vec4(n.params[4], n.params[5], n.params[6], n.params[7]);
+        g.color = glm::vec4(n.color, n.scale);
+        g.bmin = glm::vec4(clampHuge(n.bounds.min), n.smooth);
+        g.bmax = glm::vec4(clampHuge(n.bounds.max), 0.0f);
+        out.push_back(g);
+    }
+    return out;
+}
+
+} // namespace sdfcsg::detail

@@ -1,0 +1,89 @@
+// Helpers shared by the scene parser (parse.cpp) and the legacy importer (legacy.cpp): a capped
+// list of problems, descriptions of JSON values for messages, did-you-mean, and typed readers
+// that report what was expected and what was found.
+#pragma once
+
+#include "sdfcsg/scene.h"
+
+#include <simdjson.h>
+
+#include <glm/vec3.hpp>
+
+#include <initializer_list>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace sdfcsg::detail {
+
+using simdjson::dom::element;
+
+// The array or object behind an element whose type was checked. By value: ranging over
+// get_array().value_unsafe() directly would refer into a destroyed temporary.
+inline simdjson::dom::array asArray(element e) {
+    return e.get_array().value_unsafe();
+}
+inline simdjson::dom::object asObject(element e) {
+    return e.get_object().value_unsafe();
+}
+
+// Enough to fix a file in a few rounds without flooding a terminal.
+inline constexpr size_t kMaxProblems = 50;
+
+class Problems {
+  public:
+    explicit Problems(std::string file) : file_(std::move(file)) {}
+
+    // Once full, further problems are counted but not kept; callers may skip costly checks.
+    bool full() const { return diagnostics_.size() >= kMaxProblems; }
+    bool empty() const { return diagnostics_.empty(); }
+    void add(std::string path, std::string message, ErrorKind kind = ErrorKind::Validation);
+    // The collected problems; the error's kind is that of the first one.
+    Error error() const;
+    const std::string& file() const { return file_; }
+
+  private:
+    std::string file_;
+    std::vector<Diagnostic> diagnostics_;
+    ErrorKind kind_ = ErrorKind::Validation;
+    size_t dropped_ = 0;
+};
+
+// A JSON value as it appears in "got ...": -1, "abc", true, [1, 2], an object, ...
+std::string describe(element value);
+// A string as it appears in messages: quoted, escaped and cut short when long.
+std::string quote(std::string_view text);
+// "a.b" / "a[3]" path building.
+std::string member(std::string_view path, std::string_view key);
+std::string item(std::string_view path, size_t index);
+// `; did you mean "x"?` for the closest candidate, or "" when none is close.
+std::string didYouMean(std::string_view word, std::span<const std::string_view> candidates);
+// "a, b and c" (or "a, b or c")
+std::string joinNames(std::span<const std::string_view> names, std::string_view last = "and");
+
+// What a value of this type and check must be, e.g. "a positive number".
+std::string expectedText(ValueType type, Check check);
+
+// Typed readers. On failure they report one problem (with path) and return nothing.
+std::optional<double> readNumber(element value, const std::string& path, Check check,
+                                 Problems& problems);
+std::optional<glm::vec3> readVec3(element value, const std::string& path, Check check,
+                                  Problems& problems);
+// [r, g, b] with components in 0..1, or "#rrggbb".
+std::optional<glm::vec3> readColor(element value, const std::string& path, Problems& problems);
+std::optional<std::string> readString(element value, const std::string& path, size_t maxChars,
+                                      Problems& problems);
+
+// Object members by key, with unknown keys and duplicates reported. The result holds, per key
+// of `keys`, the member's value or nothing. Only the first `listed` keys are suggested and
+// listed in messages; the rest are accepted for the caller to judge. `owner` ("for a sphere")
+// goes into the message for an unknown key that has no close match.
+std::vector<std::optional<element>> readMembers(simdjson::dom::object object,
+                                                const std::string& path,
+                                                std::span<const std::string_view> keys,
+                                                size_t listed, std::string_view owner,
+                                                Problems& problems);
+
+} // namespace sdfcsg::detail

@@ -1,0 +1,341 @@
+// The ray-march pass: one compute dispatch per image, read back to RGBA8 and per-pixel info.
+#include "sdfcsg/render.h"
+
+#include "camera.h"
+#include "gpu_nodes.h"
+#include "vk.h"
+
+#include "sdfcsg/compile.h"
+#include "sdfcsg/eval.h"
+
+#include "shared.h"
+
+#include <glm/vec4.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+#include <string>
+
+namespace sdfcsg {
+namespace {
+
+using detail::Buffer;
+
+struct FrameLight {
+    glm::vec4 direction; // towards the light
+    glm::vec4 inverse;   // 1 / direction, finite
+    glm::vec4 color;
+};
+
+// Mirrors the Frame uniform block in shaders/raymarch.comp (std140: every member is 16 bytes).
+struct FrameUniform {
+    glm::vec4 eye, right, up, forward;
+    glm::vec4 clipMin, clipMax;
+    glm::vec4 background, sky;
+    glm::vec4 distances; // depth near, depth far, occlusion scale, shadow reach
+    glm::uvec4 size;     // width, height, mode, flags
+    glm::uvec4 counts;   // aa, lights, nodes, selected
+    FrameLight lights[SDFCSG_MAX_LIGHTS];
+};
+static_assert(sizeof(FrameUniform) == 11 * 16 + SDFCSG_MAX_LIGHTS * 48);
+static_assert(SDFCSG_MAX_LIGHTS == 4, "raymarch.comp reads the lights into four locals");
+
+constexpr detail::Binding kBindings[] = {
+    {SDFCSG_BINDING_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
+    {SDFCSG_BINDING_NODES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+    {SDFCSG_BINDING_PIXELS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+    {SDFCSG_BINDING_INFO, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+};
+
+// What must not change for updateValues() to reuse the compiled kernel.
+bool sameStructure(const Scene& a, const Scene& b) {
+    if (a.nodes.size() != b.nodes.size()) return false;
+    for (size_t i = 0; i < a.nodes.size(); ++i)
+        if (a.nodes[i].kind != b.nodes[i].kind || a.nodes[i].children != b.nodes[i].children)
+            return false;
+    return true;
+}
+
+Error usage(std::string text) { return Error::message(ErrorKind::Usage, "<render>", std::move(text)); }
+
+} // namespace
+
+struct Renderer::Impl {
+    Context::Impl& ctx;
+    RendererOptions options;
+    Scene scene; // the values last uploaded; structure fixed at creation
+    std::unique_ptr<Evaluator> evaluator;
+    uint32_t nodeCount = 0;
+
+    VkShaderModule module = VK_NULL_HANDLE;
+    VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
+    VkPipelineLayout pipelineLayout = VK_NULL_HANDLE;
+    VkPipeline pipelines[2] = {}; // [0]: bounds skipping off (made on first use), [1]: on
+    VkDescriptorPool pool = VK_NULL_HANDLE;
+    VkDescriptorSet set = VK_NULL_HANDLE;
+
+    Buffer frame, nodes, pixels, info, pixelsStaging, infoStaging;
+    uint32_t capacity = 0; // pixels the image buffers hold
+    std::vector<PixelInfo> lastInfo;
+
+    explicit Impl(Context::Impl& c) : ctx(c) {}
+    ~Impl() {
+        VkDevice device = ctx.device;
+        vkDeviceWaitIdle(device);
+        for (Buffer* b : {&frame, &nodes, &pixels, &info, &pixelsStaging, &infoStaging})
+            detail::destroyBuffer(ctx, *b);
+        destroyKernel();
+        if (pool) vkDestroyDescriptorPool(device, pool, nullptr);
+        if (pipelineLayout) vkDestroyPipelineLayout(device, pipelineLayout, nullptr);
+        if (setLayout) vkDestroyDescriptorSetLayout(device, setLayout, nullptr);
+    }
+
+    // Generates and compiles the kernel for `scene`, replacing any previous one. Pipelines are
+    // made on first use.
+    Status buildKernel() {
+        CodegenOptions codegen;
+        codegen.inlineParams = options.inlineValues;
+        auto spirv = compileKernel("raymarch.comp", generateSceneGlsl(scene, codegen));
+        if (!spirv) return spirv.error();
+        destroyKernel();
+        module = detail::createShaderModule(ctx, *spirv);
+        return Ok{};
+    }
+
+    void destroyKernel() {
+        for (VkPipeline& p : pipelines) {
+            if (p) vkDestroyPipeline(ctx.device, p, nullptr);
+            p = VK_NULL_HANDLE;
+        }
+        if (module) vkDestroyShaderModule(ctx.device, module, nullptr);
+        module = VK_NULL_HANDLE;
+    }
+
+    VkPipeline pipeline(bool skipping) {
+        VkPipeline& p = pipelines[skipping ? 1 : 0];
+        if (!p) {
+            detail::SpecConstant spec[] = {{SDFCSG_SPEC_BOUNDS_SKIPPING, skipping ? 1u : 0u}};
+            p = detail::createComputePipeline(ctx, module, pipelineLayout, spec);
+            warmUp(p);
+        }
+        return p;
+    }
+
+    // Some drivers (llvmpipe among them) compile a compute pipeline to machine code only at its
+    // first dispatch. An empty dispatch (image size 0: every invocation returns at once) moves
+    // that cost here, so a created pipeline is ready and the first frame costs what later ones do.
+    void warmUp(VkPipeline p) {
+        FrameUniform empty = {};
+        detail::uploadBuffer(ctx, frame, &empty, sizeof(empty));
+        VkCommandBuffer cmd = detail::beginCommands(ctx);
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p);
+        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipelineLayout, 0, 1, &set, 0,
+                                nullptr);
+        vkCmdDispatch(cmd, 1, 1, 1);
+        detail::submitAndWait(ctx);
+    }
+
+    void uploadNodes() {
+        std::vector<detail::GpuNode> packed = detail::packNodes(*evaluator);
+        detail::uploadBuffer(ctx, nodes, packed.data(), packed.size() * sizeof(detail::GpuNode));
+    }
+
+    void writeDescriptors() {
+        const Buffer* buffers[] = {&frame, &nodes, &pixels, &info};
+        detail::writeDescriptorSet(ctx, set, kBindings, buffers);
+    }
+
+    // Grows the image buffers to hold `count` pixels; never shrinks them.
+    Status reserve(uint32_t count) {
+        if (count <= capacity) return Ok{};
+        Buffer newPixels, newInfo, newPixelsStaging, newInfoStaging;
+        auto release = [&] {
+            for (Buffer* b : {&newPixels, &newInfo, &newPixelsStaging, &newInfoStaging})
+                detail::destroyBuffer(ctx, *b);
+        };
+        constexpr VkBufferUsageFlags usage =
+            VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+        auto p = detail::createBuffer(ctx, VkDeviceSize(count) * 4, usage, detail::MemoryUse::Readback);
+        if (!p) return p.error();
+        newPixels = *p;
+        auto i = detail::createBuffer(ctx, VkDeviceSize(count) * 8, usage, detail::MemoryUse::Readback);
+        if (!i) return release(), i.error();
+        newInfo = *i;
+        if (!newPixels.data || !newInfo.data) { // not mappable: read back through staging copies
+            constexpr VkBufferUsageFlags dst = VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+            auto ps = detail::createBuffer(ctx, VkDeviceSize(count) * 4, dst, detail::MemoryUse::Staging);
+            if (!ps) return release(), ps.error();
+            newPixelsStaging = *ps;
+            auto is = detail::createBuffer(ctx, VkDeviceSize(count) * 8, dst, detail::MemoryUse::Staging);
+            if (!is) return release(), is.error();
+            newInfoStaging = *is;
+        }
+        for (Buffer* b : {&pixels, &info, &pixelsStaging, &infoStaging})
+            detail::destroyBuffer(ctx, *b);
+        pixels = newPixels, info = newInfo;
+        pixelsStaging = newPixelsStaging, infoStaging = newInfoStaging;
+        capacity = count;
+        writeDescriptors();
+        return Ok{};
+    }
+
+    FrameUniform frameUniform(const RenderOptions& options, const Camera& camera) const {
+        detail::RayCamera rc = detail::makeRayCamera(camera, options.width, options.height);
+        detail::ClipVolume clip = detail::makeClipVolume(*evaluator, rc.eye);
+        Aabb finite = detail::finitePrimitiveBounds(*evaluator);
+
+        FrameUniform f = {};
+        f.eye = glm::vec4(rc.eye, rc.tanHalfFov);
+        f.right = glm::vec4(rc.right, rc.aspect);
+        f.up = glm::vec4(rc.up, rc.footprint);
+        f.forward = glm::vec4(rc.forward, detail::kMinHitEpsilon);
+        f.clipMin = glm::vec4(clip.box.min, clip.far);
+        f.clipMax = glm::vec4(clip.box.max, 0.0f);
+        f.background = glm::vec4(scene.background, 0.0f);
+        f.sky = glm::vec4(scene.background * scene.background, 0.0f); // gamma 2, as the kernel
+        const float size = std::max(glm::length(finite.max - finite.min), 1e-3f);
+        float nearest = finite.distance(rc.eye), farthest = 0.0f;
+        for (int c = 0; c < 8; ++c) {
+            glm::vec3 corner((c & 1) ? finite.max.x : finite.min.x, (c & 2) ? finite.max.y : finite.min.y,
+                             (c & 4) ? finite.max.z : finite.min.z);
+            farthest = std::max(farthest, glm::length(corner - rc.eye));
+        }
+        f.distances = glm::vec4(nearest, farthest, 0.2f * size, size);
+
+        uint32_t flags = 0;
+        if (options.shadows) flags |= SDFCSG_FLAG_SHADOWS;
+        if (options.ambientOcclusion) flags |= SDFCSG_FLAG_AO;
+        if (options.boxes == BoxOverlay::All) flags |= SDFCSG_FLAG_BOXES_ALL;
+        if (options.boxes == BoxOverlay::Selected) flags |= SDFCSG_FLAG_BOXES_SELECTED;
+        f.size = glm::uvec4(options.width, options.height, uint32_t(options.mode), flags);
+
+        std::vector<Light> lights = scene.lights.empty() ? defaultLights() : scene.lights;
+        uint32_t lightCount = uint32_t(std::min<size_t>(lights.size(), SDFCSG_MAX_LIGHTS));
+        for (uint32_t i = 0; i < lightCount; ++i) {
+            glm::vec3 l = -glm::normalize(lights[i].direction);
+            f.lights[i].direction = glm::vec4(l, 0.0f);
+            for (int c = 0; c < 3; ++c) // as safeInverse() in the kernel
+                f.lights[i].inverse[c] =
+                    1.0f / (std::abs(l[c]) < 1e-20f ? (l[c] >= 0.0f ? 1e-20f : -1e-20f) : l[c]);
+            f.lights[i].color = glm::vec4(lights[i].color * lights[i].intensity, 0.0f);
+        }
+        uint32_t selected = options.selectedNode >= 0 ? uint32_t(options.selectedNode) : nodeCount;
+        f.counts = glm::uvec4(options.aa, lightCount, nodeCount, selected);
+        return f;
+    }
+};
+
+std::optional<RenderMode> parseRenderMode(std::string_view name) {
+    if (name == "shaded") return RenderMode::Shaded;
+    if (name == "normals") return RenderMode::Normals;
+    if (name == "depth") return RenderMode::Depth;
+    if (name == "steps") return RenderMode::Steps;
+    return std::nullopt;
+}
+
+Renderer::Renderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Renderer::~Renderer() = default;
+
+Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene& scene,
+                                                   const RendererOptions& options) {
+    if (scene.nodes.empty()) return usage("the scene has no nodes");
+    auto impl = std::make_unique<Impl>(context.impl());
+    Impl& r = *impl;
+    r.options = options;
+    r.scene = scene;
+    r.evaluator = std::make_unique<Evaluator>(scene);
+    r.nodeCount = uint32_t(scene.nodes.size());
+
+    if (auto built = r.buildKernel(); !built) return built.error();
+    r.setLayout = detail::createDescriptorSetLayout(r.ctx, kBindings);
+    r.pipelineLayout = detail::createPipelineLayout(r.ctx, r.setLayout, 0);
+    r.pool = detail::createDescriptorPool(r.ctx, kBindings);
+    r.set = detail::allocateDescriptorSet(r.ctx, r.pool, r.setLayout);
+
+    auto frame = detail::createBuffer(r.ctx, sizeof(FrameUniform), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
+                                      detail::MemoryUse::Upload);
+    if (!frame) return frame.error();
+    r.frame = *frame;
+    auto nodes = detail::createBuffer(r.ctx, r.nodeCount * sizeof(detail::GpuNode),
+                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, detail::MemoryUse::Upload);
+    if (!nodes) return nodes.error();
+    r.nodes = *nodes;
+    r.uploadNodes();
+    if (auto reserved = r.reserve(64 * 64); !reserved) return reserved.error();
+    r.pipeline(true);
+    return std::unique_ptr<Renderer>(new Renderer(std::move(impl)));
+}
+
+Status Renderer::updateValues(const Scene& scene) {
+    if (!sameStructure(impl_->scene, scene))
+        return usage("updateValues: the scene's structure (node kinds or children) differs from "
+                     "the compiled one; create a new Renderer instead");
+    Impl& r = *impl_;
+    Scene previous = std::move(r.scene);
+    r.scene = scene;
+    if (r.options.inlineValues) {
+        if (auto built = r.buildKernel(); !built) {
+            r.scene = std::move(previous);
+            return built.error();
+        }
+        r.pipeline(true);
+    }
+    r.evaluator = std::make_unique<Evaluator>(scene);
+    r.uploadNodes(); // no render is in flight: render() waits for its fence
+    return Ok{};
+}
+
+Result<Image> Renderer::render(const RenderOptions& options) {
+    Impl& r = *impl_;
+    const VkPhysicalDeviceLimits& limits = r.ctx.properties.limits;
+    if (options.width == 0 || options.height == 0)
+        return usage("the image must be at least 1 x 1 pixels");
+    if (options.aa == 0 || options.aa > 16) return usage("aa must be in 1..16");
+    if (options.boxes == BoxOverlay::Selected &&
+        (options.selectedNode < 0 || uint32_t(options.selectedNode) >= r.nodeCount))
+        return usage("selectedNode " + std::to_string(options.selectedNode) +
+                     " is not a node of the scene (it has " + std::to_string(r.nodeCount) + ")");
+    uint64_t count = uint64_t(options.width) * options.height;
+    uint32_t groupsX = detail::groupCount(options.width, SDFCSG_RAYMARCH_GROUP_X);
+    uint32_t groupsY = detail::groupCount(options.height, SDFCSG_RAYMARCH_GROUP_Y);
+    if (count * 8 > limits.maxStorageBufferRange || groupsX > limits.maxComputeWorkGroupCount[0] ||
+        groupsY > limits.maxComputeWorkGroupCount[1])
+        return Error::message(ErrorKind::Limit, "<render>",
+                              "an image of " + std::to_string(options.width) + " x " +
+                                  std::to_string(options.height) + " pixels is too large for " +
+                                  r.ctx.properties.deviceName);
+    if (auto reserved = r.reserve(uint32_t(count)); !reserved) return reserved.error();
+
+    float aspect = float(options.width) / float(options.height);
+    Camera camera = options.camera   ? *options.camera
+                    : r.scene.camera ? *r.scene.camera
+                                     : frameCamera(*r.evaluator, aspect);
+    VkPipeline pipeline = r.pipeline(options.boundsSkipping); // may submit its warm-up
+    FrameUniform f = r.frameUniform(options, camera);
+    detail::uploadBuffer(r.ctx, r.frame, &f, sizeof(f));
+
+    VkCommandBuffer cmd = detail::beginCommands(r.ctx);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r.pipelineLayout, 0, 1, &r.set, 0,
+                            nullptr);
+    vkCmdDispatch(cmd, groupsX, groupsY, 1);
+    detail::recordReadback(cmd, r.pixels, &r.pixelsStaging);
+    detail::recordReadback(cmd, r.info, &r.infoStaging);
+    detail::submitAndWait(r.ctx);
+
+    Image image;
+    image.width = options.width;
+    image.height = options.height;
+    image.rgba.resize(count * 4);
+    std::memcpy(image.rgba.data(), detail::readback(r.ctx, r.pixels, &r.pixelsStaging), count * 4);
+    const auto* info = static_cast<const float*>(detail::readback(r.ctx, r.info, &r.infoStaging));
+    r.lastInfo.resize(count);
+    for (uint64_t i = 0; i < count; ++i)
+        r.lastInfo[i] = PixelInfo{info[2 * i], uint32_t(info[2 * i + 1])};
+    return image;
+}
+
+const std::vector<PixelInfo>& Renderer::lastPixelInfo() const { return impl_->lastInfo; }
+
+} // namespace sdfcsg

@@ -1,0 +1,255 @@
+#version 450
+// Sphere tracing of the generated scene, one invocation per pixel.
+//
+// Rays are generated and clipped exactly as engine/src/camera.h does on the CPU (the tests trace
+// the same rays with the reference evaluator). Normals use the four-tap tetrahedral difference
+// of the original system; soft shadows are IQ's improved technique
+// (https://iquilezles.org/articles/rmshadows/); ambient occlusion samples along the normal.
+#extension GL_GOOGLE_include_directive : require
+
+#include "shared.h"
+#include "sdf.glsl"
+#include "nodes.glsl"
+#include "scene.glsl"
+
+layout(local_size_x = SDFCSG_RAYMARCH_GROUP_X, local_size_y = SDFCSG_RAYMARCH_GROUP_Y) in;
+
+struct FrameLight {
+    vec4 direction; // xyz: unit vector towards the light
+    vec4 inverse;   // xyz: 1 / direction, per component (finite), for slab tests
+    vec4 color;     // rgb: colour times intensity
+};
+
+// Mirrors FrameUniform in engine/src/render.cpp (std140).
+layout(std140, set = 0, binding = SDFCSG_BINDING_FRAME) uniform Frame {
+    vec4 eye;        // xyz; w: tan(fov / 2)
+    vec4 right;      // xyz; w: aspect (width / height)
+    vec4 up;         // xyz; w: pixel footprint at unit distance
+    vec4 forward;    // xyz; w: minimum hit epsilon
+    vec4 clipMin;    // xyz: ray clip box; w: far distance
+    vec4 clipMax;    // xyz
+    vec4 background; // rgb as given (output space)
+    vec4 sky;        // rgb: background in linear space, for the ambient term
+    vec4 distances;  // x: depth-mode near, y: depth-mode far, z: occlusion scale, w: shadow reach
+    uvec4 size;      // width, height, mode, flags
+    uvec4 counts;    // aa, light count, node count, selected node
+    FrameLight lights[SDFCSG_MAX_LIGHTS];
+} frame;
+
+layout(std430, set = 0, binding = SDFCSG_BINDING_PIXELS) writeonly buffer Pixels {
+    uint pixels[];
+};
+
+layout(std430, set = 0, binding = SDFCSG_BINDING_INFO) writeonly buffer Info {
+    vec2 info[];
+};
+
+float hitEpsilon(float t) {
+    return max(frame.forward.w, 0.5 * t * frame.up.w);
+}
+
+vec3 rayDirection(vec2 xy) {
+    vec2 size = vec2(frame.size.xy);
+    float u = (2.0 * xy.x / size.x - 1.0) * frame.eye.w * frame.right.w;
+    float v = (1.0 - 2.0 * xy.y / size.y) * frame.eye.w;
+    return normalize(frame.forward.xyz + u * frame.right.xyz + v * frame.up.xyz);
+}
+
+vec3 safeInverse(vec3 d) {
+    vec3 s = mix(vec3(-1.0e-20), vec3(1.0e-20), greaterThanEqual(d, vec3(0.0)));
+    return 1.0 / mix(d, s, lessThan(abs(d), vec3(1.0e-20)));
+}
+
+// Slab test against a box; x: entry (clamped to 0), y: exit. Misses when x > y.
+vec2 clipRay(vec3 bmin, vec3 bmax, vec3 ro, vec3 rd) {
+    vec3 inv = safeInverse(rd);
+    vec3 t0 = (bmin - ro) * inv;
+    vec3 t1 = (bmax - ro) * inv;
+    vec3 lo = min(t0, t1), hi = max(t0, t1);
+    return vec2(max(max(lo.x, lo.y), max(lo.z, 0.0)), min(min(hi.x, hi.y), hi.z));
+}
+
+// All scene evaluations of a sample go through one call of sceneDistance in one loop, driven by
+// a small state machine: march, then four normal taps, five occlusion taps and one shadow ray
+// per light. Every phase evaluates the scene at origin + dir * t. Two reasons, both about
+// lavapipe: its compiler inlines every call site, so one site keeps the JIT compile short; and
+// it runs invocations in SIMD lanes without skipping masked-off code, so a lane that has
+// finished marching evaluates its normal or shadow taps in the same instructions as its
+// neighbours' march steps instead of idling through them.
+const uint kMarch = 0u, kNormal = 1u, kOcclusion = 2u, kShadow = 3u, kDone = 4u;
+const int kShadowSteps = 32;
+const float kShadowSharpness = 10.0;
+
+struct Trace {
+    float t;     // hit: ray parameter; negative for a miss
+    uint steps;  // march iterations
+    vec3 n;      // surface normal (normals and shaded modes)
+    float ao;    // 1: open, 0: occluded
+    vec4 shadow; // per light: 1 lit, 0 shadowed
+};
+
+// The tetrahedron k = (1, -1): k.xyy, k.yyx, k.yxy, k.xxx.
+vec3 tetraTap(int i) {
+    return i == 0 ? vec3(1.0, -1.0, -1.0)
+         : i == 1 ? vec3(-1.0, -1.0, 1.0)
+         : i == 2 ? vec3(-1.0, 1.0, -1.0)
+                  : vec3(1.0);
+}
+
+Trace trace(vec3 ro, vec3 rd) {
+    uint mode = frame.size.z;
+    uint flags = frame.size.w;
+    uint lightCount = (flags & SDFCSG_FLAG_SHADOWS) != 0u ? frame.counts.y : 0u;
+    float aoScale = frame.distances.z;
+    float shadowReach = frame.distances.w;
+
+    Trace r = Trace(-1.0, 0u, vec3(0.0), 1.0, vec4(1.0));
+    vec2 range = clipRay(frame.clipMin.xyz, frame.clipMax.xyz, ro, rd);
+    float tFar = min(range.y, frame.clipMin.w);
+    uint phase = range.x > tFar ? kDone : kMarch;
+    vec3 origin = ro, dir = rd;
+    float t = range.x;
+
+    vec3 light0 = frame.lights[0].direction.xyz, inverse0 = frame.lights[0].inverse.xyz;
+    vec3 light1 = frame.lights[1].direction.xyz, inverse1 = frame.lights[1].inverse.xyz;
+    vec3 light2 = frame.lights[2].direction.xyz, inverse2 = frame.lights[2].inverse.xyz;
+    vec3 light3 = frame.lights[3].direction.xyz, inverse3 = frame.lights[3].inverse.xyz;
+
+    vec3 p = vec3(0.0); // the hit, then the hit lifted off the surface
+    float eps = 0.0;
+    int tap = 0;
+    float weight = 1.0;
+    uint light = 0u;
+    float res = 1.0, ph = 1.0e20, shadowEnd = 0.0; // shadow ray (IQ's improved soft shadow)
+
+    while (phase != kDone) {
+        float d = sceneDistance(origin + dir * t);
+        bool nextLight = false;
+
+        if (phase == kMarch) {
+            r.steps += 1u;
+            float e = hitEpsilon(t);
+            if (d < e) {
+                r.t = t;
+                eps = e;
+                p = origin + dir * t;
+                phase = kDone;
+                tap = 0;
+                origin = p;
+                dir = tetraTap(0);
+                t = eps;
+            } else {
+                t += d;
+                if (t > tFar || r.steps >= SDFCSG_MAX_STEPS) phase = kDone;
+            }
+        }
+    }
+    return r;
+}
+
+// Scene colours are treated as gamma 2 (sRGB, close enough): squared to shade, square-rooted
+// back. pow() is slow on CPU drivers.
+vec3 heat(float x) {
+    x = clamp(x, 0.0, 1.0);
+    // Blue -> cyan -> green -> yellow -> red.
+    return clamp(vec3(1.5 - abs(4.0 * x - 3.0), 1.5 - abs(4.0 * x - 2.0), 1.5 - abs(4.0 * x - 1.0)),
+                 0.0, 1.0);
+}
+
+float pow48(float x) {
+    float x2 = x * x, x4 = x2 * x2, x8 = x4 * x4, x16 = x8 * x8;
+    return x16 * x16 * x16;
+}
+
+vec3 shade(vec3 ro, vec3 rd, Trace r) {
+    uint mode = frame.size.z;
+    // Steps on a log scale: a handful already shows, and 256 is red.
+    if (mode == SDFCSG_MODE_STEPS) return heat(log2(1.0 + float(r.steps)) / log2(1.0 + float(SDFCSG_MAX_STEPS)));
+    if (r.t < 0.0) return mode == SDFCSG_MODE_SHADED ? frame.background.rgb : vec3(0.0);
+    if (mode == SDFCSG_MODE_DEPTH) {
+        float x = (r.t - frame.distances.x) / max(frame.distances.y - frame.distances.x, 1e-6);
+        return vec3(1.0 - 0.85 * clamp(x, 0.0, 1.0));
+    }
+    vec3 n = r.n;
+    if (mode == SDFCSG_MODE_NORMALS) return n * 0.5 + 0.5;
+
+    vec3 albedo = sceneSample(ro + rd * r.t).rgb;
+    albedo *= albedo;
+    vec3 col = albedo * (0.10 + 0.15 * frame.sky.rgb * (0.5 + 0.5 * n.y)) * r.ao;
+    // Unrolled with constant indices: a per-lane index into r.shadow would keep it in memory.
+    for (int i = 0; i < SDFCSG_MAX_LIGHTS; ++i) {
+        vec3 l = frame.lights[i].direction.xyz;
+        float lambert = max(dot(n, l), 0.0);
+        float spec = pow48(max(dot(n, normalize(l - rd)), 0.0)) * 0.25;
+        float lit = uint(i) < frame.counts.y ? r.shadow[i] * lambert : 0.0;
+        col += frame.lights[i].color.rgb * lit * (albedo + spec);
+    }
+    col = sqrt(col);
+    // Fade into the background towards the far limit so a ground plane has no hard edge.
+    float fog = smoothstep(0.6, 1.0, r.t / frame.clipMin.w);
+    return mix(col, frame.background.rgb, fog);
+}
+
+// Thin edges of node boxes in front of the hit: where the ray enters or leaves a box close to
+// one of its edges (the second-smallest distance to a face plane is within a pixel or so).
+vec4 boxOverlay(vec3 ro, vec3 rd, float tHit) {
+    uint flags = frame.size.w;
+    uint first = 0u, last = frame.counts.z;
+    if ((flags & SDFCSG_FLAG_BOXES_SELECTED) != 0u) {
+        first = frame.counts.w;
+        last = min(first + 1u, frame.counts.z);
+    }
+    float tLimit = tHit < 0.0 ? frame.clipMin.w : tHit;
+    vec4 result = vec4(0.0);
+    for (uint i = first; i < last; ++i) {
+        vec3 bmin = nodes[i].bmin.xyz, bmax = nodes[i].bmax.xyz;
+        if (any(greaterThan(bmax - bmin, vec3(1.0e29))) || any(greaterThan(bmin, bmax))) continue;
+        vec2 range = clipRay(bmin, bmax, ro, rd);
+        if (range.x > range.y) continue;
+        for (int e = 0; e < 2; ++e) {
+            float t = e == 0 ? range.x : range.y;
+            if (t <= 0.0 || t > tLimit) continue;
+            vec3 p = ro + rd * t;
+            vec3 d = min(abs(p - bmin), abs(p - bmax));
+            // Second smallest component: distance to the nearest edge on this face.
+            float edge = max(min(d.x, d.y), min(max(d.x, d.y), d.z));
+            float width = 1.2 * t * frame.up.w;
+            if (edge < width) {
+                float a = 1.0 - edge / width;
+                result = max(result, vec4(1.0, 0.85, 0.2, 0.9 * a));
+            }
+        }
+    }
+    return result;
+}
+
+uint packColor(vec3 c) {
+    uvec3 u = uvec3(clamp(c, 0.0, 1.0) * 255.0 + 0.5);
+    return u.r | (u.g << 8) | (u.b << 16) | (255u << 24);
+}
+
+void main() {
+    uvec2 pixel = gl_GlobalInvocationID.xy;
+    if (any(greaterThanEqual(pixel, frame.size.xy))) return;
+    uint index = pixel.y * frame.size.x + pixel.x;
+    uint aa = max(frame.counts.x, 1u);
+    bool boxes = (frame.size.w & (SDFCSG_FLAG_BOXES_ALL | SDFCSG_FLAG_BOXES_SELECTED)) != 0u;
+
+    vec3 ro = frame.eye.xyz;
+    vec3 sum = vec3(0.0);
+    for (uint sy = 0u; sy < aa; ++sy) {
+        for (uint sx = 0u; sx < aa; ++sx) {
+            vec2 offset = (vec2(sx, sy) + 0.5) / float(aa);
+            vec3 rd = rayDirection(vec2(pixel) + offset);
+            Trace r = trace(ro, rd);
+            if (sx == 0u && sy == 0u) info[index] = vec2(r.t, float(r.steps));
+            vec3 c = shade(ro, rd, r);
+            if (boxes) {
+                vec4 o = boxOverlay(ro, rd, r.t);
+                c = mix(c, o.rgb, o.a);
+            }
+            sum += c;
+        }
+    }
+    pixels[index] = packColor(sum / float(aa * aa));
+}

@@ -1,0 +1,194 @@
+// Scenes built in code for the evaluator and code generator tests: a small tree literal that
+// flattens into Scene's pre-order node array, and a seeded random scene generator.
+#pragma once
+
+#include <sdfcsg/scene.h>
+
+#include <glm/vec3.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <initializer_list>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace sdfcsg::test {
+
+// One node and its subtree. Parameters are the table's values (full sizes), by slot.
+struct Tree {
+    NodeKind kind = NodeKind::Sphere;
+    std::array<float, kMaxParams> params{};
+    Transform transform;
+    std::optional<glm::vec3> color;
+    std::string name;
+    std::vector<Tree> children;
+
+    Tree& at(float x, float y, float z) {
+        transform.translate = {x, y, z};
+        return *this;
+    }
+    Tree& rotated(float x, float y, float z) {
+        transform.rotate = {x, y, z};
+        return *this;
+    }
+    Tree& scaled(float s) {
+        transform.scale = s;
+        return *this;
+    }
+    Tree& colored(float r, float g, float b) {
+        color = glm::vec3(r, g, b);
+        return *this;
+    }
+    Tree& named(std::string n) {
+        name = std::move(n);
+        return *this;
+    }
+};
+
+inline Tree leaf(NodeKind kind, std::initializer_list<float> params) {
+    Tree t;
+    t.kind = kind;
+    int i = 0;
+    for (float v : params) t.params[size_t(i++)] = v;
+    return t;
+}
+inline Tree sphere(float r) { return leaf(NodeKind::Sphere, {r}); }
+inline Tree box(float x, float y, float z) { return leaf(NodeKind::Box, {x, y, z}); }
+inline Tree roundBox(float x, float y, float z, float r) {
+    return leaf(NodeKind::RoundBox, {x, y, z, r});
+}
+inline Tree plane(glm::vec3 n, float offset) { return leaf(NodeKind::Plane, {n.x, n.y, n.z, offset}); }
+inline Tree prism(float w, float h, float l) { return leaf(NodeKind::TriangularPrism, {w, h, l}); }
+inline Tree torus(float major, float minor) { return leaf(NodeKind::Torus, {major, minor}); }
+inline Tree cylinder(float r, float h) { return leaf(NodeKind::Cylinder, {r, h}); }
+inline Tree cone(float r, float h, float top = 0.0f) { return leaf(NodeKind::Cone, {r, h, top}); }
+inline Tree capsule(glm::vec3 a, glm::vec3 b, float r) {
+    return leaf(NodeKind::Capsule, {a.x, a.y, a.z, b.x, b.y, b.z, r});
+}
+inline Tree op(NodeKind kind, std::vector<Tree> children, float smooth = 0.0f) {
+    Tree t;
+    t.kind = kind;
+    t.params[0] = smooth;
+    t.children = std::move(children);
+    return t;
+}
+inline Tree unite(std::vector<Tree> c, float k = 0.0f) { return op(NodeKind::Union, std::move(c), k); }
+inline Tree intersect(std::vector<Tree> c, float k = 0.0f) {
+    return op(NodeKind::Intersection, std::move(c), k);
+}
+inline Tree subtract(std::vector<Tree> c, float k = 0.0f) {
+    return op(NodeKind::Difference, std::move(c), k);
+}
+
+inline void appendTree(Scene& scene, const Tree& t, const std::string& path) {
+    const uint32_t index = uint32_t(scene.nodes.size());
+    Node n;
+    n.kind = t.kind;
+    n.name = t.name;
+    n.path = path;
+    n.transform = t.transform;
+    n.color = t.color;
+    n.params = t.params;
+    scene.nodes.push_back(std::move(n));
+    for (size_t i = 0; i < t.children.size(); ++i) {
+        scene.nodes[index].children.push_back(uint32_t(scene.nodes.size()));
+        appendTree(scene, t.children[i], path + ".children[" + std::to_string(i) + "]");
+    }
+}
+
+inline Scene makeScene(const Tree& root, std::string file = "<test>") {
+    Scene scene;
+    scene.file = std::move(file);
+    appendTree(scene, root, "root");
+    return scene;
+}
+
+// Every primitive once, spread out on a grid, some turned and scaled.
+inline Scene primitiveGallery() {
+    std::vector<Tree> all = {
+        sphere(0.6f).at(-3, 0, 0).colored(0.9f, 0.2f, 0.2f),
+        box(1.0f, 0.8f, 1.2f).at(-1.5f, 0, 0).rotated(10, 20, 30),
+        roundBox(1.0f, 1.0f, 0.6f, 0.2f).at(0, 0, 0).scaled(1.3f),
+        prism(1.2f, 0.9f, 1.0f).at(1.5f, 0, 0).rotated(0, 45, 0),
+        torus(0.5f, 0.15f).at(3, 0, 0).rotated(90, 0, 0),
+        cylinder(0.4f, 1.2f).at(-3, 0, 2),
+        cone(0.5f, 1.0f).at(-1.5f, 0, 2),
+        cone(0.5f, 1.0f, 0.2f).at(0, 0, 2).rotated(0, 0, 180),
+        capsule({-0.3f, -0.4f, 0}, {0.3f, 0.4f, 0.1f}, 0.2f).at(1.5f, 0, 2),
+        plane({0, 1, 0}, -1.0f).colored(0.5f, 0.5f, 0.5f),
+    };
+    return makeScene(unite(std::move(all)), "<gallery>");
+}
+
+// A random scene of about `count` nodes: every kind, random transforms, colours and smooth radii,
+// operations nested up to `maxDepth`. Planes only when `planes` is set.
+inline Scene randomScene(uint32_t seed, int count, int maxDepth = 6, bool planes = false) {
+    std::mt19937 rng(seed);
+    auto uni = [&](float a, float b) { return std::uniform_real_distribution<float>(a, b)(rng); };
+    auto pick = [&](int n) { return std::uniform_int_distribution<int>(0, n - 1)(rng); };
+    int budget = count;
+    auto transform = [&](Tree& t) {
+        if (pick(3) > 0) t.at(uni(-1.5f, 1.5f), uni(-1.5f, 1.5f), uni(-1.5f, 1.5f));
+        if (pick(2) > 0) t.rotated(uni(-180, 180), uni(-180, 180), uni(-180, 180));
+        if (pick(3) == 0) t.scaled(uni(0.5f, 1.8f));
+        if (pick(3) == 0) t.colored(uni(0, 1), uni(0, 1), uni(0, 1));
+    };
+    auto primitive = [&]() {
+        Tree t;
+        switch (pick(planes ? 9 : 8)) {
+        case 0: t = sphere(uni(0.2f, 1.0f)); break;
+        case 1: t = box(uni(0.2f, 2), uni(0.2f, 2), uni(0.2f, 2)); break;
+        case 2: {
+            float x = uni(0.3f, 2), y = uni(0.3f, 2), z = uni(0.3f, 2);
+            t = roundBox(x, y, z, uni(0.0f, 0.5f) * std::min(x, std::min(y, z)));
+            break;
+        }
+        case 3: t = prism(uni(0.3f, 2), uni(0.3f, 2), uni(0.3f, 2)); break;
+        case 4: t = torus(uni(0.4f, 1.0f), uni(0.1f, 0.35f)); break;
+        case 5: t = cylinder(uni(0.2f, 1), uni(0.3f, 2)); break;
+        case 6: t = cone(uni(0.2f, 1), uni(0.3f, 2), pick(2) ? 0.0f : uni(0.0f, 1.0f)); break;
+        case 7:
+            t = capsule({uni(-1, 1), uni(-1, 1), uni(-1, 1)}, {uni(-1, 1), uni(-1, 1), uni(-1, 1)},
+                        uni(0.1f, 0.5f));
+            break;
+        default: {
+            glm::vec3 n(uni(-1, 1), uni(0.2f, 1), uni(-1, 1));
+            t = plane(n / std::sqrt(n.x * n.x + n.y * n.y + n.z * n.z), uni(-3, -1));
+        }
+        }
+        transform(t);
+        return t;
+    };
+    // Recursion is fine here: maxDepth is small.
+    auto build = [&](auto&& self, int depth) -> Tree {
+        --budget;
+        if (depth >= maxDepth || budget <= 1 || pick(3) == 0) return primitive();
+        int n = 1 + pick(4);
+        std::vector<Tree> children;
+        for (int i = 0; i < n && budget > 0; ++i) children.push_back(self(self, depth + 1));
+        static constexpr NodeKind kinds[] = {NodeKind::Union, NodeKind::Union, NodeKind::Intersection,
+                                             NodeKind::Difference};
+        Tree t = op(kinds[pick(4)], std::move(children), pick(2) ? 0.0f : uni(0.05f, 0.6f));
+        transform(t);
+        return t;
+    };
+    std::vector<Tree> top;
+    while (budget > 0) top.push_back(build(build, 1));
+    return makeScene(unite(std::move(top), uni(0.0f, 0.3f)), "<random " + std::to_string(seed) + ">");
+}
+
+// The bundled scenes, assets/scenes/*.json, sorted by name.
+inline std::vector<std::filesystem::path> bundledScenePaths() {
+    std::vector<std::filesystem::path> paths;
+    for (const auto& entry :
+         std::filesystem::directory_iterator(std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes"))
+        if (entry.path().extension() == ".json") paths.push_back(entry.path());
+    std::sort(paths.begin(), paths.end());
+    return paths;
+}
+
+} // namespace sdfcsg::test

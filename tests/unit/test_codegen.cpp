@@ -1,0 +1,299 @@
+// Scene -> GLSL -> SPIR-V without a GPU: the generated code's shape (one line per node, nothing
+// pasted twice, linear size), that it compiles in both modes through compileKernel, compile
+// errors as values, and the SPIR-V cache in memory and on disk.
+#include "scene_build_util.h"
+#include "shader_compile.h"
+
+#include <sdfcsg/compile.h>
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace sdfcsg {
+namespace {
+
+using namespace sdfcsg::test;
+namespace fs = std::filesystem;
+
+double seconds(std::chrono::steady_clock::time_point since) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+std::vector<std::string> lines(const std::string& text) {
+    std::vector<std::string> out;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) out.push_back(line);
+    return out;
+}
+
+// The body of one generated function.
+std::string function(const std::string& glsl, const std::string& signature) {
+    size_t begin = glsl.find(signature);
+    EXPECT_NE(begin, std::string::npos) << signature;
+    size_t end = glsl.find("\n}\n", begin);
+    return glsl.substr(begin, end - begin);
+}
+
+size_t count(const std::string& text, const std::regex& pattern) {
+    return size_t(std::distance(std::sregex_iterator(text.begin(), text.end(), pattern),
+                                std::sregex_iterator()));
+}
+
+// Sets SDFCSG_CACHE_DIR for one test and restores it afterwards.
+class CacheDir {
+  public:
+    explicit CacheDir(const std::string& value) {
+        if (const char* old = std::getenv("SDFCSG_CACHE_DIR")) old_ = old;
+        setenv("SDFCSG_CACHE_DIR", value.c_str(), 1);
+    }
+    ~CacheDir() {
+        if (old_) setenv("SDFCSG_CACHE_DIR", old_->c_str(), 1);
+        else unsetenv("SDFCSG_CACHE_DIR");
+    }
+
+  private:
+    std::optional<std::string> old_;
+};
+
+std::vector<Scene> testScenes() {
+    std::vector<Scene> scenes = {primitiveGallery()};
+    for (uint32_t seed = 1; seed <= 3; ++seed) scenes.push_back(randomScene(seed, 50, 6, true));
+    return scenes;
+}
+
+TEST(Codegen, OneCommentedLinePerNode) {
+    Scene scene = primitiveGallery();
+    scene.nodes[1].name = "red ball";
+    std::string glsl = generateSceneGlsl(scene);
+    for (const char* signature : {"float sceneDistance(vec3 p)", "vec4 sceneSample(vec3 p)"}) {
+        std::string body = function(glsl, signature);
+        const char v = body[0] == 'f' ? 'd' : 's';
+        for (uint32_t i = 0; i < scene.nodes.size(); ++i) {
+            const Node& n = scene.nodes[i];
+            std::string label = n.name.empty() ? n.path : n.name;
+            std::string comment = "// " + label + " (" + std::string(kindInfo(n.kind).name) + ")";
+            // Exactly one line declares the node's value, and it carries the comment.
+            std::regex declaration("(float|vec4) " + std::string(1, v) + std::to_string(i) + " = ");
+            int found = 0;
+            for (const std::string& line : lines(body)) {
+                if (!std::regex_search(line, declaration)) continue;
+                ++found;
+                EXPECT_NE(line.find(comment), std::string::npos) << line;
+            }
+            EXPECT_EQ(found, 1) << "node " << i;
+            // Read exactly once by its parent (never pasted twice); the root is returned.
+            if (i > 0 && !kindInfo(n.kind).operation) {
+                std::regex use("\\b" + std::string(1, v) + std::to_string(i) + "\\b");
+                EXPECT_EQ(count(body, use), 2u) << "node " << i << " defined once, used once";
+            }
+        }
+    }
+}
+
+TEST(Codegen, IndentationFollowsDepth) {
+    Scene scene = makeScene(unite({sphere(1), subtract({box(1, 1, 1), sphere(0.6f)})}));
+    std::string body = function(generateSceneGlsl(scene), "float sceneDistance");
+    auto indentOf = [&](const std::string& what) {
+        for (const std::string& line : lines(body))
+            if (line.find(what) != std::string::npos) return line.find_first_not_of(' ');
+        return std::string::npos;
+    };
+    size_t root = indentOf("// root (union)");
+    size_t op = indentOf("// root.children[1] (difference)");
+    size_t leaf = indentOf("// root.children[1].children[1] (sphere)");
+    EXPECT_LT(root, op);
+    EXPECT_LT(op, leaf);
+}
+
+TEST(Codegen, GeneratedCodeCompilesInBothModes) {
+    for (const Scene& scene : testScenes()) {
+        SCOPED_TRACE(scene.file);
+        for (bool inlineParams : {false, true}) {
+            CodegenOptions options;
+            options.inlineParams = inlineParams;
+            std::string glsl = generateSceneGlsl(scene, options);
+            auto spirv = compileKernel("probe.comp", glsl);
+            ASSERT_TRUE(spirv) << spirv.error().str() << "\n" << glsl;
+            EXPECT_EQ((*spirv)[0], 0x07230203u);
+            // Values stay out of buffer-mode code, and inline code reads no node buffer.
+            EXPECT_EQ(glsl.find("nodes[") == std::string::npos, inlineParams);
+        }
+    }
+}
+
+TEST(Codegen, BundledScenesCompile) {
+    std::vector<fs::path> paths = bundledScenePaths();
+    ASSERT_GE(paths.size(), 6u);
+    CacheDir off("off");
+    for (const fs::path& path : paths) {
+        auto scene = loadScene(path);
+        ASSERT_TRUE(scene) << scene.error().str();
+        for (bool inlineParams : {false, true}) {
+            CodegenOptions options;
+            options.inlineParams = inlineParams;
+            std::string glsl = generateSceneGlsl(*scene, options);
+            for (const char* kernel : {"probe.comp", "raymarch.comp"}) {
+                detail::clearShaderMemoryCache();
+                auto start = std::chrono::steady_clock::now();
+                auto spirv = compileKernel(kernel, glsl);
+                ASSERT_TRUE(spirv) << path << " " << kernel << ": " << spirv.error().str();
+                std::printf("%-18s %3zu nodes %-6s %-14s %6zu B GLSL -> %6zu B SPIR-V in %5.1f ms\n",
+                            path.stem().c_str(), scene->nodes.size(),
+                            inlineParams ? "inline" : "buffer", kernel, glsl.size(),
+                            spirv->size() * 4, seconds(start) * 1000);
+            }
+        }
+    }
+}
+
+TEST(Codegen, EveryKernelCompilesAgainstGeneratedCode) {
+    std::string glsl = generateSceneGlsl(primitiveGallery());
+    for (const char* kernel : {"probe.comp", "raymarch.comp"}) {
+        if (shaderSource(kernel).empty()) continue; // not written yet
+        auto spirv = compileKernel(kernel, glsl);
+        EXPECT_TRUE(spirv) << kernel << ": " << (spirv ? "" : spirv.error().str());
+    }
+}
+
+TEST(Codegen, ChangingValuesKeepsTheBufferModeCode) {
+    Scene a = randomScene(8, 40);
+    Scene b = a;
+    for (Node& n : b.nodes) {
+        n.transform.translate += glm::vec3(0.5f);
+        n.params[0] *= 1.5f;
+        n.color = glm::vec3(0.1f, 0.2f, 0.3f);
+    }
+    EXPECT_EQ(generateSceneGlsl(a), generateSceneGlsl(b));
+    CodegenOptions inl;
+    inl.inlineParams = true;
+    EXPECT_NE(generateSceneGlsl(a, inl), generateSceneGlsl(b, inl));
+}
+
+Scene smoothChain(int spheres) {
+    std::vector<Tree> children;
+    for (int i = 0; i < spheres; ++i)
+        children.push_back(sphere(0.3f).at(0.2f * float(i), std::sin(float(i)), 0));
+    return makeScene(unite(std::move(children), 0.25f), "<chain " + std::to_string(spheres) + ">");
+}
+
+// A smooth minimum reads both operands twice; pasting expressions would double the code per
+// operand. Size must grow linearly, and 2000 smoothly united spheres compile quickly.
+TEST(Codegen, SizeAndCompileTimeAreLinear) {
+    std::string small = generateSceneGlsl(smoothChain(1000));
+    std::string large = generateSceneGlsl(smoothChain(2000));
+    EXPECT_LT(double(large.size()) / double(small.size()), 2.1);
+
+    // Also nested 64 deep (the parser's limit), each level smoothly blended.
+    Tree deep = sphere(0.5f);
+    for (int i = 0; i < 63; ++i) deep = unite({sphere(0.5f).at(0.1f * float(i), 0, 0), deep}, 0.1f);
+    std::string nested = generateSceneGlsl(makeScene(deep));
+    size_t text = 0; // without indentation, which grows with depth (at most 64 levels)
+    for (const std::string& line : lines(nested)) text += line.size() - std::min(line.size(), line.find_first_not_of(' '));
+    EXPECT_LT(text, 2u * 127 * 300);
+
+    CacheDir off("off");
+    detail::clearShaderMemoryCache();
+    auto start = std::chrono::steady_clock::now();
+    auto spirv = compileKernel("probe.comp", large);
+    double elapsed = seconds(start);
+    ASSERT_TRUE(spirv) << spirv.error().str();
+    std::printf("2000 smoothly united spheres: %zu bytes of GLSL, compiled in %.0f ms\n",
+                large.size(), elapsed * 1000);
+    EXPECT_LT(elapsed, 3.0);
+    EXPECT_TRUE(compileKernel("probe.comp", nested));
+}
+
+TEST(Codegen, CompileErrorsComeBackWithTheLog) {
+    auto broken = compileKernel("probe.comp", "float sceneDistance(vec3 p) { return undefinedThing; }\n");
+    ASSERT_FALSE(broken);
+    EXPECT_EQ(broken.error().kind, ErrorKind::Shader);
+    std::string log = broken.error().str();
+    EXPECT_NE(log.find("undefinedThing"), std::string::npos) << log;
+    EXPECT_NE(log.find("probe.comp"), std::string::npos) << log;
+
+    auto missing = compileKernel("no_such_kernel.comp", "");
+    ASSERT_FALSE(missing);
+    EXPECT_EQ(missing.error().kind, ErrorKind::Shader);
+
+    auto syntax = compileKernel("probe.comp", "float sceneDistance(vec3 p) { return 1.0 }\n");
+    ASSERT_FALSE(syntax);
+    EXPECT_NE(syntax.error().str().find("scene.glsl"), std::string::npos) << syntax.error().str();
+}
+
+TEST(Codegen, SpirvIsCachedInMemoryAndOnDisk) {
+    fs::path dir = fs::path(SDFCSG_TEST_OUTPUT_DIR) / "codegen-cache";
+    fs::remove_all(dir);
+    CacheDir cacheDir(dir.string());
+    // A scene no other test (or earlier run) compiles.
+    std::string glsl = generateSceneGlsl(randomScene(99, 30));
+    glsl += "// " + std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) + "\n";
+
+    auto before = detail::shaderCacheStats();
+    auto first = compileKernel("probe.comp", glsl);
+    ASSERT_TRUE(first) << first.error().str();
+    auto afterFirst = detail::shaderCacheStats();
+    EXPECT_EQ(afterFirst.compiles, before.compiles + 1);
+
+    auto second = compileKernel("probe.comp", glsl);
+    ASSERT_TRUE(second);
+    EXPECT_EQ(*second, *first);
+    EXPECT_EQ(detail::shaderCacheStats().memoryHits, afterFirst.memoryHits + 1);
+    EXPECT_EQ(detail::shaderCacheStats().compiles, afterFirst.compiles);
+
+    // A new process would find it on disk.
+    std::vector<fs::path> files;
+    for (const auto& entry : fs::directory_iterator(dir)) files.push_back(entry.path());
+    ASSERT_EQ(files.size(), 1u) << "one entry, no temporary files left behind";
+    EXPECT_EQ(files[0].extension(), ".spv");
+    detail::clearShaderMemoryCache();
+    auto diskHits = detail::shaderCacheStats().diskHits;
+    auto third = compileKernel("probe.comp", glsl);
+    ASSERT_TRUE(third);
+    EXPECT_EQ(*third, *first);
+    EXPECT_EQ(detail::shaderCacheStats().diskHits, diskHits + 1);
+
+    // A damaged entry is ignored, recompiled and replaced.
+    for (int damage = 0; damage < 2; ++damage) {
+        if (damage == 0) fs::resize_file(files[0], fs::file_size(files[0]) / 2);
+        else {
+            std::fstream f(files[0], std::ios::in | std::ios::out | std::ios::binary);
+            f.seekg(100);
+            char byte = char(f.get());
+            f.seekp(100);
+            f.put(char(byte ^ 0x5a));
+        }
+        detail::clearShaderMemoryCache();
+        auto compiles = detail::shaderCacheStats().compiles;
+        auto again = compileKernel("probe.comp", glsl);
+        ASSERT_TRUE(again);
+        EXPECT_EQ(*again, *first);
+        EXPECT_EQ(detail::shaderCacheStats().compiles, compiles + 1);
+        detail::clearShaderMemoryCache();
+        diskHits = detail::shaderCacheStats().diskHits;
+        EXPECT_TRUE(compileKernel("probe.comp", glsl));
+        EXPECT_EQ(detail::shaderCacheStats().diskHits, diskHits + 1) << "rewritten";
+    }
+
+    // "off" disables the disk cache.
+    {
+        fs::remove_all(dir);
+        CacheDir off("off");
+        detail::clearShaderMemoryCache();
+        EXPECT_TRUE(compileKernel("probe.comp", glsl));
+        EXPECT_FALSE(fs::exists(dir));
+    }
+}
+
+} // namespace
+} // namespace sdfcsg

@@ -1,0 +1,362 @@
+// The CPU reference evaluator: transforms, colours, smooth blending, bounds and bounds skipping.
+#include "gpu_nodes.h"
+#include "scene_build_util.h"
+#include "shared.h"
+
+#include <sdfcsg/eval.h>
+
+#include <gtest/gtest.h>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/mat4x4.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <random>
+
+namespace sdfcsg {
+namespace {
+
+using namespace sdfcsg::test;
+
+std::vector<glm::vec3> randomPoints(uint32_t seed, int count, float reach) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(-reach, reach);
+    std::vector<glm::vec3> points;
+    for (int i = 0; i < count; ++i) points.push_back({u(rng), u(rng), u(rng)});
+    return points;
+}
+
+// Half again the size of the scene's finite part, and at least 5.
+float reach(const Evaluator& eval) {
+    float r = 5.0f;
+    for (const FlatNode& n : eval.nodes())
+        if (!kindInfo(n.kind).operation && n.bounds.finite())
+            r = std::max({r, 1.5f * glm::length(n.bounds.min), 1.5f * glm::length(n.bounds.max)});
+    return r;
+}
+
+double boxDistance(glm::dvec3 p, glm::dvec3 half) {
+    glm::dvec3 q = glm::abs(p) - half;
+    return glm::length(glm::max(q, 0.0)) + std::min(std::max(q.x, std::max(q.y, q.z)), 0.0);
+}
+
+// translate * Rz * Ry * Rx * scale, built with GLM's matrix helpers (an independent route to
+// the same convention as the evaluator).
+glm::dmat4 modelMatrix(const Transform& t) {
+    glm::dmat4 m = glm::translate(glm::dmat4(1.0), glm::dvec3(t.translate));
+    m = glm::rotate(m, glm::radians(double(t.rotate.z)), glm::dvec3(0, 0, 1));
+    m = glm::rotate(m, glm::radians(double(t.rotate.y)), glm::dvec3(0, 1, 0));
+    m = glm::rotate(m, glm::radians(double(t.rotate.x)), glm::dvec3(1, 0, 0));
+    return glm::scale(m, glm::dvec3(t.scale));
+}
+
+TEST(Eval, NestedTransformsCompose) {
+    Tree inner = box(1.0f, 2.0f, 0.5f).at(0.3f, -0.2f, 0.7f).rotated(25, -40, 70).scaled(0.7f);
+    Tree outer = unite({inner}).at(1.0f, 2.0f, -1.0f).rotated(-30, 15, 120).scaled(1.6f);
+    Scene scene = makeScene(outer);
+    Evaluator eval(scene);
+
+    glm::dmat4 toWorld = modelMatrix(scene.nodes[0].transform) * modelMatrix(scene.nodes[1].transform);
+    glm::dmat4 toLocal = glm::inverse(toWorld);
+    const double scale = 1.6 * 0.7;
+    for (glm::vec3 p : randomPoints(1, 2000, 4.0f)) {
+        glm::dvec3 local(toLocal * glm::dvec4(glm::dvec3(p), 1.0));
+        double expected = scale * boxDistance(local, {0.5, 1.0, 0.25});
+        EXPECT_NEAR(eval.distance(p), expected, 1e-5 * (1 + glm::length(p)));
+    }
+}
+
+TEST(Eval, RotationIsRightHandedXThenYThenZ) {
+    // A capsule from the origin to +x, turned +90 degrees about z, reaches +y.
+    Scene z = makeScene(capsule({0, 0, 0}, {1, 0, 0}, 0.1f).rotated(0, 0, 90));
+    EXPECT_NEAR(Evaluator(z).distance({0, 1, 0}), -0.1f, 1e-6f);
+    // About x first (+x stays), then y: +90 about y takes +x to -z.
+    Scene xy = makeScene(capsule({0, 0, 0}, {1, 0, 0}, 0.1f).rotated(90, 90, 0));
+    EXPECT_NEAR(Evaluator(xy).distance({0, 0, -1}), -0.1f, 1e-6f);
+    // x then z: +90 about x takes +y to +z; a capsule along +y ends at +z, then z leaves it.
+    Scene xz = makeScene(capsule({0, 0, 0}, {0, 1, 0}, 0.1f).rotated(90, 0, 90));
+    EXPECT_NEAR(Evaluator(xz).distance({0, 0, 1}), -0.1f, 1e-6f);
+}
+
+TEST(Eval, ScaleScalesDistances) {
+    Scene scene = makeScene(unite({sphere(1.0f).at(1, 0, 0)}).scaled(2.0f));
+    Evaluator eval(scene);
+    EXPECT_FLOAT_EQ(eval.distance({2, 0, 0}), -2.0f); // sphere centre at world x = 2
+    EXPECT_FLOAT_EQ(eval.distance({7, 0, 0}), 3.0f);
+}
+
+TEST(Eval, ColoursAreInherited) {
+    Scene scene = makeScene(unite({
+        sphere(0.5f).at(-3, 0, 0),
+        unite({sphere(0.5f).at(0, 0, 0), sphere(0.5f).at(3, 0, 0).colored(0, 0, 1)})
+            .colored(1, 0, 0),
+    }));
+    Evaluator eval(scene);
+    EXPECT_EQ(eval.sample({-3, 0, 0}).color, glm::vec3(0.8f)); // the default
+    EXPECT_EQ(eval.sample({0, 0, 0}).color, glm::vec3(1, 0, 0));
+    EXPECT_EQ(eval.sample({3, 0, 0}).color, glm::vec3(0, 0, 1));
+    EXPECT_EQ(eval.nodes()[3].color, glm::vec3(1, 0, 0));
+}
+
+TEST(Eval, SmoothUnionBlendsDistanceAndColour) {
+    // Two unit spheres 2.4 apart, blend radius 0.5 in the union's units, union scaled by 2.
+    Scene scene = makeScene(unite({sphere(1).at(-1.2f, 0, 0).colored(1, 0, 0),
+                                   sphere(1).at(1.2f, 0, 0).colored(0, 0, 1)},
+                                  0.5f)
+                                .scaled(2.0f));
+    Evaluator eval(scene);
+    EXPECT_FLOAT_EQ(eval.nodes()[0].smooth, 1.0f); // world units
+    // Half way between: both operands are 0.4 (world), h = 0.5, the blend dips by k/4.
+    Sample mid = eval.sample({0, 0, 0});
+    EXPECT_NEAR(mid.distance, 0.4f - 1.0f / 4, 1e-6f);
+    EXPECT_NEAR(mid.color.r, 0.5f, 1e-6f);
+    EXPECT_NEAR(mid.color.b, 0.5f, 1e-6f);
+    // Near the red sphere and more than k from the blue one: untouched.
+    Sample red = eval.sample({-4, 0, 0});
+    EXPECT_FLOAT_EQ(red.distance, 4.0f - 2.4f - 2.0f);
+    EXPECT_EQ(red.color, glm::vec3(1, 0, 0));
+    // Part way: colour weights follow the distance blend factor h.
+    glm::vec3 p(-0.3f, 0.2f, 0);
+    float a = glm::length(p - glm::vec3(-2.4f, 0, 0)) - 2, b = glm::length(p - glm::vec3(2.4f, 0, 0)) - 2;
+    float h = std::clamp(0.5f + 0.5f * (b - a) / 1.0f, 0.0f, 1.0f);
+    Sample s = eval.sample(p);
+    EXPECT_NEAR(s.distance, b + (a - b) * h - h * (1 - h), 1e-5f);
+    EXPECT_NEAR(s.color.r, h, 1e-5f);
+    EXPECT_NEAR(s.color.b, 1 - h, 1e-5f);
+}
+
+TEST(Eval, DifferenceCutTakesTheSubtrahendsColour) {
+    Scene scene = makeScene(subtract({box(2, 2, 2).colored(1, 0, 0), sphere(0.8f).at(1, 1, 1).colored(0, 1, 0)}));
+    Evaluator eval(scene);
+    // On the spherical cut, inside the box: green. On an untouched face: red.
+    glm::vec3 cut = glm::vec3(1) - glm::normalize(glm::vec3(1)) * 0.8f;
+    Sample s = eval.sample(cut);
+    EXPECT_NEAR(s.distance, 0.0f, 1e-5f);
+    EXPECT_EQ(s.color, glm::vec3(0, 1, 0));
+    EXPECT_EQ(eval.sample({-1.0f, -0.5f, 0}).color, glm::vec3(1, 0, 0));
+    // A sharp tie goes to the first operand.
+    Scene tie = makeScene(unite({sphere(1).colored(1, 0, 0), sphere(1).colored(0, 1, 0)}));
+    EXPECT_EQ(Evaluator(tie).sample({0, 2, 0}).color, glm::vec3(1, 0, 0));
+}
+
+TEST(Eval, IntersectionAndDifferenceValues) {
+    Scene inter = makeScene(intersect({box(2, 2, 2), sphere(1.2f)}));
+    Scene diff = makeScene(subtract({box(2, 2, 2), sphere(1.2f)}));
+    for (glm::vec3 p : randomPoints(5, 500, 2.0f)) {
+        float b = boxDistance(p, glm::dvec3(1)), s = glm::length(p) - 1.2f;
+        EXPECT_NEAR(Evaluator(inter).distance(p), std::max(b, s), 1e-6f);
+        EXPECT_NEAR(Evaluator(diff).distance(p), std::max(b, -s), 1e-6f);
+    }
+}
+
+std::vector<Scene> bundledScenes() {
+    std::vector<Scene> scenes;
+    for (const auto& path : bundledScenePaths()) {
+        auto scene = loadScene(path);
+        EXPECT_TRUE(scene) << scene.error().str();
+        if (scene) scenes.push_back(std::move(*scene));
+    }
+    return scenes;
+}
+
+std::vector<Scene> boundsScenes() {
+    std::vector<Scene> scenes = bundledScenes();
+    scenes.push_back(primitiveGallery());
+    for (uint32_t seed = 1; seed <= 12; ++seed) scenes.push_back(randomScene(seed, 40, 5, seed % 3 == 0));
+    return scenes;
+}
+
+// The bounds promise: a node's value at p is at least its box's signed distance to p. Checked for every
+// node of every scene, at random points around it.
+TEST(Eval, BoundsAreLowerBounds) {
+    for (const Scene& scene : boundsScenes()) {
+        SCOPED_TRACE(scene.file);
+        Evaluator eval(scene);
+        std::vector<glm::vec3> points = randomPoints(9, 600, reach(eval));
+        for (uint32_t i = 0; i < eval.nodes().size(); ++i) {
+            const Aabb& box = eval.nodes()[i].bounds;
+            ASSERT_FALSE(box.empty());
+            for (glm::vec3 p : points) {
+                float value = eval.distance(p, i);
+                ASSERT_GE(value, box.signedDistance(p) - 1e-5f)
+                    << "node " << i << " (" << kindInfo(eval.nodes()[i].kind).name << ")";
+            }
+        }
+    }
+}
+
+// Points on each node's own surface (found by Newton steps along the numerical gradient) lie in
+// its box.
+TEST(Eval, BoundsContainTheSurface) {
+    for (const Scene& scene : boundsScenes()) {
+        SCOPED_TRACE(scene.file);
+        Evaluator eval(scene);
+        int projected = 0;
+        for (uint32_t i = 0; i < eval.nodes().size(); ++i) {
+            const Aabb& box = eval.nodes()[i].bounds;
+            for (glm::vec3 p : randomPoints(i + 100, 40, 0.6f * reach(eval))) {
+                for (int step = 0; step < 30; ++step) {
+                    float d = eval.distance(p, i);
+                    if (std::abs(d) < 1e-5f) break;
+                    glm::vec3 g;
+                    const float h = 1e-3f;
+                    for (int a = 0; a < 3; ++a) {
+                        glm::vec3 e(0);
+                        e[a] = h;
+                        g[a] = (eval.distance(p + e, i) - eval.distance(p - e, i)) / (2 * h);
+                    }
+                    if (glm::length(g) < 1e-3f) break;
+                    p -= d * g / glm::dot(g, g);
+                }
+                if (std::abs(eval.distance(p, i)) >= 1e-5f) continue;
+                ++projected;
+                EXPECT_LE(box.distance(p), 1e-4f) << "node " << i << " surface point outside its box";
+            }
+        }
+        EXPECT_GT(projected, 20 * int(eval.nodes().size()));
+    }
+}
+
+TEST(Eval, PrimitiveBoundsAreTight) {
+    Scene scene = makeScene(unite({box(2, 4, 6).at(1, 0, 0), sphere(1).at(0, 5, 0), plane({0, 1, 0}, 0)}));
+    Evaluator eval(scene);
+    const Aabb& b = eval.nodes()[1].bounds;
+    EXPECT_NEAR(b.min.x, 0.0f, 1e-4f);
+    EXPECT_NEAR(b.max.z, 3.0f, 1e-4f);
+    EXPECT_TRUE(eval.nodes()[2].bounds.finite());
+    EXPECT_FALSE(eval.nodes()[3].bounds.finite());
+    EXPECT_FALSE(eval.bounds().finite());
+    // Rotating a cube by 45 degrees about z widens its box to the diagonal.
+    Scene turned = makeScene(box(2, 2, 2).rotated(0, 0, 45));
+    EXPECT_NEAR(Evaluator(turned).bounds().max.x, std::sqrt(2.0f), 1e-4f);
+    EXPECT_NEAR(Evaluator(turned).bounds().max.z, 1.0f, 1e-4f);
+}
+
+// Skipping never changes a single bit of the result.
+TEST(Eval, SkippingGivesIdenticalValues) {
+    std::vector<Scene> scenes = bundledScenes();
+    for (uint32_t seed = 20; seed < 40; ++seed) scenes.push_back(randomScene(seed, 60, 6, seed % 2 == 0));
+    for (const Scene& scene : scenes) {
+        Evaluator on(scene), off(scene);
+        off.setBoundsSkipping(false);
+        for (glm::vec3 p : randomPoints(7, 1000, reach(on))) {
+            Sample a = on.sample(p), b = off.sample(p);
+            ASSERT_EQ(a.distance, b.distance) << scene.file;
+            ASSERT_EQ(a.color, b.color) << scene.file;
+            ASSERT_EQ(on.distance(p), off.distance(p)) << scene.file;
+            ASSERT_EQ(on.distance(p), a.distance) << "distance() and sample() disagree";
+        }
+    }
+}
+
+TEST(Eval, SkippingHappens) {
+    // Poison the far operand after its bounds were computed: evaluated, it would make the result
+    // NaN; skipped, it cannot.
+    Scene scene = makeScene(unite({sphere(1), sphere(1).at(100, 0, 0)}));
+    Evaluator eval(scene);
+    const_cast<FlatNode&>(eval.nodes()[2]).params[0] = NAN;
+    EXPECT_FLOAT_EQ(eval.distance({0, 2, 0}), 1.0f);
+    EXPECT_FLOAT_EQ(eval.sample({0, 2, 0}).distance, 1.0f);
+    EXPECT_TRUE(std::isnan(eval.distance({100, 2, 0})));
+    eval.setBoundsSkipping(false);
+    EXPECT_TRUE(std::isnan(eval.distance({0, 2, 0})));
+}
+
+TEST(Eval, DeepTreesNeedNoRecursion) {
+    // 20,000 nested unions (far beyond the parser's depth limit): flattening and evaluation use
+    // explicit stacks.
+    const int depth = 20000;
+    // Pre-order: each union, then its sphere, then the next union.
+    Scene ordered;
+    for (int i = 0; i < depth; ++i) {
+        Node u;
+        u.kind = NodeKind::Union;
+        u.children = {uint32_t(2 * i + 1), uint32_t(2 * i + 2)};
+        ordered.nodes.push_back(u);
+        Node s;
+        s.kind = NodeKind::Sphere;
+        s.params[0] = 0.5f;
+        s.transform.translate = {float(i), 0, 0};
+        ordered.nodes.push_back(s);
+    }
+    Node last;
+    last.kind = NodeKind::Sphere;
+    last.params[0] = 0.5f;
+    last.transform.translate = {float(depth), 0, 0};
+    ordered.nodes.push_back(last);
+    Evaluator eval(ordered);
+    EXPECT_FLOAT_EQ(eval.distance({0, 0, 0}), -0.5f);
+    EXPECT_FLOAT_EQ(eval.distance({float(depth), 2, 0}), 1.5f);
+    eval.setBoundsSkipping(false);
+    EXPECT_FLOAT_EQ(eval.distance({float(depth), 2, 0}), 1.5f);
+}
+
+TEST(Eval, FrameCameraSeesTheWholeScene) {
+    for (const Scene& scene : {primitiveGallery(), randomScene(3, 30)}) {
+        Evaluator eval(scene);
+        for (float aspect : {0.5f, 1.0f, 16.0f / 9.0f}) {
+            Camera cam = frameCamera(eval, aspect, 40.0f);
+            glm::vec3 forward = glm::normalize(cam.target - cam.eye);
+            glm::vec3 right = glm::normalize(glm::cross(forward, cam.up));
+            glm::vec3 up = glm::cross(right, forward);
+            EXPECT_GT(cam.eye.z - cam.target.z, 0.0f) << "looks from the front";
+            EXPECT_GT(cam.eye.y - cam.target.y, 0.0f) << "looks from above";
+            float tanV = std::tan(glm::radians(20.0f)), tanH = tanV * aspect;
+            // Every corner of the scene's box is in view; with a plane making that infinite,
+            // every corner of every finite primitive's box.
+            std::vector<Aabb> boxes;
+            if (eval.bounds().finite()) boxes.push_back(eval.bounds());
+            else
+                for (const FlatNode& n : eval.nodes())
+                    if (!kindInfo(n.kind).operation && n.bounds.finite()) boxes.push_back(n.bounds);
+            ASSERT_FALSE(boxes.empty());
+            for (const Aabb& b : boxes) {
+                for (int c = 0; c < 8; ++c) {
+                    glm::vec3 corner(c & 1 ? b.max.x : b.min.x, c & 2 ? b.max.y : b.min.y,
+                                     c & 4 ? b.max.z : b.min.z);
+                    glm::vec3 v = corner - cam.eye;
+                    float z = glm::dot(v, forward);
+                    ASSERT_GT(z, 0.0f);
+                    EXPECT_LE(std::abs(glm::dot(v, right)) / z, tanH);
+                    EXPECT_LE(std::abs(glm::dot(v, up)) / z, tanV);
+                }
+            }
+        }
+    }
+    // Nothing finite: a sensible default.
+    Camera cam = frameCamera(Evaluator(makeScene(plane({0, 1, 0}, 0))), 1.0f);
+    EXPECT_TRUE(std::isfinite(cam.eye.x + cam.eye.y + cam.eye.z));
+    EXPECT_GT(glm::length(cam.eye - cam.target), 0.0f);
+}
+
+TEST(Eval, PackedNodesMirrorTheEvaluator) {
+    Scene scene = primitiveGallery();
+    Evaluator eval(scene);
+    std::vector<detail::GpuNode> packed = detail::packNodes(eval);
+    ASSERT_EQ(packed.size(), eval.nodes().size());
+    for (glm::vec3 p : randomPoints(4, 200, 3.0f)) {
+        for (size_t i = 0; i < packed.size(); ++i) {
+            const FlatNode& n = eval.nodes()[i];
+            const detail::GpuNode& g = packed[i];
+            glm::vec4 q(p, 1);
+            glm::vec3 local(glm::dot(g.row0, q), glm::dot(g.row1, q), glm::dot(g.row2, q));
+            EXPECT_NEAR(glm::length(local - (n.toLocal * p + n.offset)), 0, 1e-5f);
+        }
+    }
+    for (size_t i = 0; i < packed.size(); ++i) {
+        const FlatNode& n = eval.nodes()[i];
+        EXPECT_EQ(packed[i].color, glm::vec4(n.color, n.scale));
+        EXPECT_EQ(packed[i].bmin.w, n.smooth);
+        EXPECT_EQ(packed[i].p0.x, n.params[0]);
+        if (!n.bounds.finite()) {
+            EXPECT_EQ(packed[i].bmin.x, -float(SDFCSG_HUGE));
+            EXPECT_EQ(packed[i].bmax.y, float(SDFCSG_HUGE));
+        }
+    }
+}
+
+} // namespace
+} // namespace sdfcsg

@@ -1,0 +1,156 @@
+// Golden images: small renders of a few scenes and modes compared with tests/golden/*.png under
+// explicit tolerances. On failure the actual image and a diff are written to
+// SDFCSG_TEST_OUTPUT_DIR/golden; SDFCSG_UPDATE_GOLDEN=1 rewrites the goldens instead.
+#include "gpu_test.h"
+
+#define STB_IMAGE_IMPLEMENTATION
+#define STB_IMAGE_STATIC
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#pragma GCC diagnostic ignored "-Wunused-function"
+#pragma GCC diagnostic ignored "-Wshadow"
+#pragma GCC diagnostic ignored "-Wsign-compare"
+#endif
+#include <stb/stb_image.h>
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
+
+#include <cstdio>
+#include <cstdlib>
+#include <optional>
+
+namespace sdfcsg::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A pixel differs when any channel is off by more than this (of 255): drivers may round
+// transcendental functions differently.
+constexpr int kChannelTolerance = 4;
+// At most this fraction of pixels may differ: edges that a ray grazes can flip either way.
+constexpr double kDifferingFraction = 0.005;
+// Mean absolute channel difference over the whole image, of 255.
+constexpr double kMeanTolerance = 0.5;
+
+struct GoldenCase {
+    const char* scene; // file in assets/scenes, without .json
+    RenderMode mode;
+    bool boxes = false;
+};
+
+const char* modeName(RenderMode mode) {
+    switch (mode) {
+    case RenderMode::Shaded: return "shaded";
+    case RenderMode::Normals: return "normals";
+    case RenderMode::Depth: return "depth";
+    case RenderMode::Steps: return "steps";
+    }
+    return "?";
+}
+
+std::string caseName(const GoldenCase& c) {
+    return std::string(c.scene) + "_" + modeName(c.mode) + (c.boxes ? "_boxes" : "");
+}
+
+std::optional<Image> readPng(const fs::path& path) {
+    int w = 0, h = 0, n = 0;
+    stbi_uc* data = stbi_load(path.string().c_str(), &w, &h, &n, 4);
+    if (!data) return std::nullopt;
+    Image image{uint32_t(w), uint32_t(h), std::vector<uint8_t>(data, data + size_t(w) * h * 4)};
+    stbi_image_free(data);
+    return image;
+}
+
+class Golden : public GpuTest, public ::testing::WithParamInterface<GoldenCase> {};
+
+TEST_P(Golden, MatchesWithinTolerance) {
+    const GoldenCase& c = GetParam();
+    const std::string name = caseName(c);
+    Scene scene = loadOrDie(fs::path(SDFCSG_SOURCE_DIR) / "assets/scenes" / (std::string(c.scene) + ".json"));
+    auto renderer = Renderer::create(context(), scene);
+    ASSERT_TRUE(renderer) << renderer.error().str();
+    RenderOptions options;
+    options.width = 160;
+    options.height = 120;
+    options.mode = c.mode;
+    options.boxes = c.boxes ? BoxOverlay::All : BoxOverlay::None;
+    auto actual = (*renderer)->render(options);
+    ASSERT_TRUE(actual) << actual.error().str();
+
+    const fs::path golden = fs::path(SDFCSG_SOURCE_DIR) / "tests/golden" / (name + ".png");
+    if (const char* update = std::getenv("SDFCSG_UPDATE_GOLDEN"); update && std::string(update) == "1") {
+        auto written = writePng(*actual, golden);
+        ASSERT_TRUE(written) << written.error().str();
+        std::printf("updated %s\n", golden.string().c_str());
+        return;
+    }
+
+    const fs::path outDir = fs::path(SDFCSG_TEST_OUTPUT_DIR) / "golden";
+    fs::create_directories(outDir);
+    const fs::path actualPath = outDir / (name + "_actual.png");
+    const fs::path diffPath = outDir / (name + "_diff.png");
+    fs::remove(actualPath);
+    fs::remove(diffPath);
+
+    std::optional<Image> expected = readPng(golden);
+    if (!expected) {
+        ASSERT_TRUE(writePng(*actual, actualPath));
+        FAIL() << "missing golden " << golden << "; the actual image is " << actualPath
+               << "; run with SDFCSG_UPDATE_GOLDEN=1 to create it";
+    }
+    ASSERT_EQ(expected->width, actual->width);
+    ASSERT_EQ(expected->height, actual->height);
+
+    // Diff image: grey where equal, red where a pixel is beyond tolerance, otherwise the
+    // amplified difference.
+    Image diff{actual->width, actual->height, std::vector<uint8_t>(actual->rgba.size(), 255)};
+    size_t differing = 0;
+    double sum = 0.0;
+    const size_t pixels = size_t(actual->width) * actual->height;
+    for (size_t i = 0; i < pixels; ++i) {
+        int worst = 0;
+        for (int ch = 0; ch < 3; ++ch) {
+            int d = std::abs(int(actual->rgba[4 * i + ch]) - int(expected->rgba[4 * i + ch]));
+            worst = std::max(worst, d);
+            sum += d;
+            diff.rgba[4 * i + ch] = uint8_t(std::min(255, 40 + 8 * d));
+        }
+        if (worst > kChannelTolerance) {
+            ++differing;
+            diff.rgba[4 * i] = 255, diff.rgba[4 * i + 1] = 0, diff.rgba[4 * i + 2] = 0;
+        }
+    }
+    const double fraction = double(differing) / pixels;
+    const double mean = sum / (3.0 * pixels);
+    const bool ok = fraction <= kDifferingFraction && mean <= kMeanTolerance;
+    if (!ok) {
+        EXPECT_TRUE(writePng(*actual, actualPath));
+        EXPECT_TRUE(writePng(diff, diffPath));
+    }
+    EXPECT_TRUE(ok) << name << ": " << differing << " pixels (" << fraction * 100.0
+                    << "%) differ by more than " << kChannelTolerance << "/255 (allowed "
+                    << kDifferingFraction * 100.0 << "%), mean difference " << mean
+                    << "/255 (allowed " << kMeanTolerance << ").\n  golden: " << golden
+                    << "\n  actual: " << actualPath << "\n  diff:   " << diffPath
+                    << "\n  If the change is intended, run with SDFCSG_UPDATE_GOLDEN=1.";
+}
+
+const GoldenCase kCases[] = {
+    {"house", RenderMode::Shaded},
+    {"snowman", RenderMode::Shaded},
+    {"smooth_blend", RenderMode::Shaded},
+    {"csg_part", RenderMode::Normals},
+    {"robot", RenderMode::Depth},
+    {"gallery", RenderMode::Steps},
+    {"csg_part", RenderMode::Shaded, true},
+};
+
+INSTANTIATE_TEST_SUITE_P(Scenes, Golden, ::testing::ValuesIn(kCases),
+                         [](const ::testing::TestParamInfo<GoldenCase>& param) {
+                             return caseName(param.param);
+                         });
+
+} // namespace
+} // namespace sdfcsg::test

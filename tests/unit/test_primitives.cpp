@@ -1,0 +1,340 @@
+// Every primitive's CPU distance (engine/src/sdf.h, fed through the table -> kernel parameter
+// mapping) against a true distance computed independently in double precision: convex polytopes
+// by point-to-triangle distances, solids of revolution by 2D distances to their profile in the
+// meridian half-plane, torus and capsule by minimising over their core curve.
+#include "sdf.h"
+
+#include <gtest/gtest.h>
+
+#include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace sdfcsg {
+namespace {
+
+using glm::dvec2;
+using glm::dvec3;
+
+// ---- Independent truths ----
+
+// Closest point on triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5).
+dvec3 closestOnTriangle(dvec3 p, dvec3 a, dvec3 b, dvec3 c) {
+    dvec3 ab = b - a, ac = c - a, ap = p - a;
+    double d1 = dot(ab, ap), d2 = dot(ac, ap);
+    if (d1 <= 0 && d2 <= 0) return a;
+    dvec3 bp = p - b;
+    double d3 = dot(ab, bp), d4 = dot(ac, bp);
+    if (d3 >= 0 && d4 <= d3) return b;
+    double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
+    dvec3 cp = p - c;
+    double d5 = dot(ab, cp), d6 = dot(ac, cp);
+    if (d6 >= 0 && d5 <= d6) return c;
+    double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
+    double va = d3 * d6 - d5 * d4;
+    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    double denom = 1.0 / (va + vb + vc);
+    return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+// A convex polytope given by its vertices and faces (vertex index loops).
+struct Polytope {
+    std::vector<dvec3> vertices;
+    std::vector<std::vector<int>> faces;
+
+    double signedDistance(dvec3 p) const {
+        dvec3 centre(0.0);
+        for (dvec3 v : vertices) centre += v;
+        centre /= double(vertices.size());
+        double outside = INFINITY, planeMax = -INFINITY;
+        for (const auto& f : faces) {
+            dvec3 a = vertices[size_t(f[0])];
+            dvec3 n = normalize(cross(vertices[size_t(f[1])] - a, vertices[size_t(f[2])] - a));
+            if (dot(n, centre - a) > 0) n = -n; // outward
+            planeMax = std::max(planeMax, dot(n, p - a));
+            for (size_t i = 1; i + 1 < f.size(); ++i) {
+                dvec3 q = closestOnTriangle(p, a, vertices[size_t(f[i])], vertices[size_t(f[i + 1])]);
+                outside = std::min(outside, length(p - q));
+            }
+        }
+        // Inside a convex solid the nearest boundary point lies on the nearest face plane.
+        return planeMax <= 0 ? planeMax : outside;
+    }
+};
+
+Polytope boxPolytope(dvec3 h) {
+    Polytope poly;
+    for (int i = 0; i < 8; ++i)
+        poly.vertices.push_back({i & 1 ? h.x : -h.x, i & 2 ? h.y : -h.y, i & 4 ? h.z : -h.z});
+    poly.faces = {{0, 1, 3, 2}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 3, 7, 5}};
+    return poly;
+}
+
+Polytope prismPolytope(double w, double h, double l) {
+    Polytope poly;
+    for (double z : {-l / 2, l / 2}) {
+        poly.vertices.push_back({-w / 2, -h / 2, z});
+        poly.vertices.push_back({w / 2, -h / 2, z});
+        poly.vertices.push_back({0, h / 2, z});
+    }
+    poly.faces = {{0, 1, 2}, {3, 4, 5}, {0, 1, 4, 3}, {1, 2, 5, 4}, {2, 0, 3, 5}};
+    return poly;
+}
+
+double segmentDistance(dvec2 p, dvec2 a, dvec2 b) {
+    dvec2 ab = b - a;
+    double t = std::clamp(dot(p - a, ab) / dot(ab, ab), 0.0, 1.0);
+    return length(p - (a + ab * t));
+}
+
+// A solid of revolution about y: its profile is a convex polygon in the (r, y) half-plane whose
+// first and last vertices lie on the axis. The axis edge is not surface.
+double revolvedDistance(dvec3 p, const std::vector<dvec2>& profile) {
+    dvec2 q(std::sqrt(p.x * p.x + p.z * p.z), p.y);
+    double d = INFINITY;
+    for (size_t i = 0; i + 1 < profile.size(); ++i)
+        d = std::min(d, segmentDistance(q, profile[i], profile[i + 1]));
+    bool inside = true; // convex and counter-clockwise: left of every edge, the axis edge too
+    for (size_t i = 0; i < profile.size(); ++i) {
+        dvec2 a = profile[i], b = profile[(i + 1) % profile.size()];
+        if ((b.x - a.x) * (q.y - a.y) - (b.y - a.y) * (q.x - a.x) < 0) inside = false;
+    }
+    return inside ? -d : d;
+}
+
+// Minimum of a function that is unimodal on [lo, hi] after bracketing it on a coarse grid.
+double minimise(const std::function<double(double)>& f, double lo, double hi, int grid) {
+    double best = lo, bestValue = INFINITY;
+    for (int i = 0; i <= grid; ++i) {
+        double x = lo + (hi - lo) * i / grid;
+        if (double v = f(x); v < bestValue) bestValue = v, best = x;
+    }
+    double step = (hi - lo) / grid, a = std::max(lo, best - step), b = std::min(hi, best + step);
+    for (int i = 0; i < 200; ++i) {
+        double m1 = a + (b - a) / 3, m2 = b - (b - a) / 3;
+        if (f(m1) < f(m2)) b = m2;
+        else a = m1;
+    }
+    return std::min(bestValue, f(0.5 * (a + b)));
+}
+
+// ---- Cases ----
+
+struct Case {
+    std::string label;
+    NodeKind kind;
+    sdf::Params params;                      // table values: full sizes
+    std::function<double(dvec3)> truth;      // exact signed distance
+    double size;                             // rough extent, for sampling and tolerances
+};
+
+std::vector<Case> cases() {
+    std::vector<Case> out;
+    auto add = [&](std::string label, NodeKind kind, sdf::Params params,
+                   std::function<double(dvec3)> truth, double size) {
+        out.push_back({std::move(label), kind, params, std::move(truth), size});
+    };
+    for (double r : {0.5, 1.7})
+        add("sphere " + std::to_string(r), NodeKind::Sphere, {float(r)},
+            [r](dvec3 p) { return length(p) - r; }, r);
+    for (dvec3 s : {dvec3(1, 2, 3), dvec3(0.2, 1.5, 0.4)}) {
+        Polytope poly = boxPolytope(s / 2.0);
+        add("box", NodeKind::Box, {float(s.x), float(s.y), float(s.z)},
+            [poly](dvec3 p) { return poly.signedDistance(p); }, length(s) / 2);
+    }
+    for (double r : {0.0, 0.15, 0.29}) {
+        dvec3 s(1.2, 0.6, 2.0);
+        // The rounded box is the inner box grown by r (a Minkowski sum with a ball).
+        Polytope inner = boxPolytope(s / 2.0 - r);
+        add("round_box r=" + std::to_string(r), NodeKind::RoundBox,
+            {float(s.x), float(s.y), float(s.z), float(r)},
+            [inner, r](dvec3 p) { return inner.signedDistance(p) - r; }, length(s) / 2);
+    }
+    {
+        dvec3 n = normalize(dvec3(0.3, 1.0, -0.2));
+        add("plane", NodeKind::Plane, {0.3f, 1.0f, -0.2f, 0.4f},
+            [n](dvec3 p) { return dot(p, n) - 0.4; }, 2.0);
+    }
+    for (dvec3 whl : {dvec3(2, 1, 3), dvec3(0.5, 2, 0.8), dvec3(3, 0.3, 1)}) {
+        Polytope poly = prismPolytope(whl.x, whl.y, whl.z);
+        add("triangular_prism", NodeKind::TriangularPrism,
+            {float(whl.x), float(whl.y), float(whl.z)},
+            [poly](dvec3 p) { return poly.signedDistance(p); }, length(whl) / 2);
+    }
+    for (dvec2 rr : {dvec2(1.0, 0.25), dvec2(0.6, 0.5)}) {
+        double major = rr.x, minor = rr.y;
+        // Distance to the core circle, minimised over its angle.
+        add("torus", NodeKind::Torus, {float(major), float(minor)},
+            [major, minor](dvec3 p) {
+                auto f = [&](double a) {
+                    return length(p - dvec3(major * std::cos(a), 0, major * std::sin(a)));
+                };
+                return minimise(f, -M_PI, M_PI, 720) - minor;
+            },
+            major + minor);
+    }
+    for (dvec2 rh : {dvec2(0.5, 2.0), dvec2(1.5, 0.4)}) {
+        double r = rh.x, hh = rh.y / 2;
+        add("cylinder", NodeKind::Cylinder, {float(rh.x), float(rh.y)},
+            [r, hh](dvec3 p) { return revolvedDistance(p, {{0, -hh}, {r, -hh}, {r, hh}, {0, hh}}); },
+            std::max(r, hh));
+    }
+    struct ConeCase {
+        double r1, h, r2;
+    };
+    for (ConeCase c : {ConeCase{1.0, 2.0, 0.0}, ConeCase{0.6, 1.0, 0.3}, ConeCase{0.3, 1.5, 0.9}}) {
+        double hh = c.h / 2;
+        std::vector<dvec2> profile = {{0, -hh}, {c.r1, -hh}, {c.r2, hh}, {0, hh}};
+        if (c.r2 == 0) profile.pop_back(); // apex on the axis
+        add("cone", NodeKind::Cone, {float(c.r1), float(c.h), float(c.r2)},
+            [profile](dvec3 p) { return revolvedDistance(p, profile); }, std::max(c.r1, hh));
+    }
+    {
+        dvec3 a(-0.5, 0.2, 0.1), b(0.7, -0.4, 0.6);
+        double r = 0.3;
+        add("capsule", NodeKind::Capsule,
+            {float(a.x), float(a.y), float(a.z), float(b.x), float(b.y), float(b.z), float(r)},
+            [a, b, r](dvec3 p) {
+                auto f = [&](double t) { return length(p - (a + (b - a) * t)); };
+                return minimise(f, 0, 1, 64) - r;
+            },
+            1.0);
+        add("capsule (a == b)", NodeKind::Capsule, {0.1f, 0.2f, 0.3f, 0.1f, 0.2f, 0.3f, 0.5f},
+            [](dvec3 p) { return length(p - dvec3(0.1, 0.2, 0.3)) - 0.5; }, 0.5);
+    }
+    return out;
+}
+
+float cpu(const Case& c, glm::vec3 p) {
+    return sdf::evalPrimitive(c.kind, p, sdf::kernelParams(c.kind, c.params));
+}
+
+// Points near the shape (inside and out), farther out, and far away.
+std::vector<glm::vec3> samplePoints(double size, uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    std::vector<glm::vec3> points;
+    for (float reach : {0.6f, 1.3f, 3.0f, 20.0f})
+        for (int i = 0; i < 1500; ++i)
+            points.push_back(glm::vec3(u(rng), u(rng), u(rng)) * float(size) * reach);
+    return points;
+}
+
+TEST(Primitives, EveryKindHasACase) {
+    std::vector<bool> seen(kNodeKindCount, false);
+    for (const Case& c : cases()) seen[size_t(c.kind)] = true;
+    for (const KindInfo& k : nodeKinds())
+        EXPECT_TRUE(k.operation || seen[size_t(k.kind)]) << k.name << " has no test case";
+}
+
+TEST(Primitives, MatchTrueDistance) {
+    for (const Case& c : cases()) {
+        SCOPED_TRACE(c.label);
+        int inside = 0, failures = 0;
+        for (glm::vec3 p : samplePoints(c.size, 7)) {
+            double truth = c.truth(dvec3(p));
+            float value = cpu(c, p);
+            // Single precision on coordinates of magnitude |p| and the shape's size.
+            double tolerance = 1e-5 * std::max({1.0, c.size, double(glm::length(p))});
+            inside += truth < 0;
+            if (std::abs(value - truth) > tolerance && ++failures <= 5)
+                ADD_FAILURE() << "at (" << p.x << ", " << p.y << ", " << p.z << "): " << value
+                              << " but the true distance is " << truth;
+        }
+        EXPECT_GT(inside, 20) << "too few samples inside the solid";
+    }
+}
+
+// Exact distance fields have unit gradients wherever they are differentiable; the check runs
+// where the true field is smooth at the scale of the finite difference (off the medial axis).
+TEST(Primitives, UnitGradientAwayFromSurface) {
+    const double h = 1e-3;
+    for (const Case& c : cases()) {
+        SCOPED_TRACE(c.label);
+        int checked = 0, total = 0;
+        for (glm::vec3 pf : samplePoints(c.size, 11)) {
+            if (glm::length(pf) > 5 * c.size) continue; // far points add nothing here
+            ++total;
+            dvec3 p(pf);
+            if (std::abs(c.truth(p)) < 4 * h) continue;
+            dvec3 g, gt;
+            for (int i = 0; i < 3; ++i) {
+                dvec3 e(0.0);
+                e[i] = h;
+                gt[i] = (c.truth(p + e) - c.truth(p - e)) / (2 * h);
+                g[i] = (double(cpu(c, glm::vec3(p + e))) - cpu(c, glm::vec3(p - e))) / (2 * h);
+            }
+            if (std::abs(length(gt) - 1) > 1e-6) continue; // a kink within reach of the stencil
+            ++checked;
+            EXPECT_NEAR(length(g), 1.0, 2e-3) << "at (" << p.x << ", " << p.y << ", " << p.z << ")";
+        }
+        EXPECT_GT(checked, total / 2) << "the gradient was checked at too few points";
+    }
+}
+
+// The kernel parameters are derived from the table's full sizes: spot values by hand.
+TEST(Primitives, TableSizesAreFullLengths) {
+    auto at = [](NodeKind kind, sdf::Params params, glm::vec3 p) {
+        return sdf::evalPrimitive(kind, p, sdf::kernelParams(kind, params));
+    };
+    EXPECT_FLOAT_EQ(at(NodeKind::Box, {2, 4, 6}, {0, 5, 0}), 3.0f);
+    EXPECT_FLOAT_EQ(at(NodeKind::RoundBox, {2, 4, 6, 0.5f}, {0, 0, 4}), 1.0f);
+    EXPECT_FLOAT_EQ(at(NodeKind::Cylinder, {1, 2}, {0, 3, 0}), 2.0f);
+    EXPECT_FLOAT_EQ(at(NodeKind::Cone, {1, 2, 0}, {0, -3, 0}), 2.0f);
+    EXPECT_FLOAT_EQ(at(NodeKind::Cone, {1, 2, 0}, {0, 1.5f, 0}), 0.5f); // above the apex
+    EXPECT_FLOAT_EQ(at(NodeKind::TriangularPrism, {2, 1, 4}, {0, -2, 0}), 1.5f);
+    EXPECT_FLOAT_EQ(at(NodeKind::TriangularPrism, {2, 1, 4}, {0, 2, 0}), 1.5f); // apex at +h/2
+    EXPECT_FLOAT_EQ(at(NodeKind::TriangularPrism, {2, 1, 4}, {0, 0, 5}), 3.0f);
+    EXPECT_FLOAT_EQ(at(NodeKind::Plane, {0, 2, 0, 1}, {0, 3, 0}), 2.0f); // normal normalised
+    // A round box's radius is clamped to what fits, so it stays a valid rounded box.
+    EXPECT_FLOAT_EQ(at(NodeKind::RoundBox, {2, 2, 2, 5}, {0, 0, 0}), -1.0f);
+}
+
+// The CSG operators: the smooth forms meet the sharp ones where the operands are k apart, and
+// the early exits return an operand's exact bits.
+TEST(Primitives, OperatorsBlendAndEndExactly) {
+    using sdf::opDifference, sdf::opIntersection, sdf::opUnion;
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> u(-2, 2), uk(0.01f, 1.0f);
+    for (int i = 0; i < 10000; ++i) {
+        float a = u(rng), b = u(rng), k = uk(rng);
+        float smin = opUnion(a, b, k), smax = opIntersection(a, b, k);
+        EXPECT_LE(smin, std::min(a, b) + 1e-6f);
+        EXPECT_GE(smin, std::min(a, b) - k / 4 - 1e-6f);
+        EXPECT_GE(smax, std::max(a, b) - 1e-6f);
+        EXPECT_LE(smax, std::max(a, b) + k / 4 + 1e-6f);
+        EXPECT_EQ(opDifference(a, b, k), opIntersection(a, -b, k));
+        if (b - a >= k) {
+            EXPECT_EQ(smin, a);
+        }
+        if (a - b >= k) {
+            EXPECT_EQ(smin, b);
+        }
+        glm::vec4 ca(1, 0, 0, a), cb(0, 0, 1, b);
+        glm::vec4 s = opUnion(ca, cb, k);
+        EXPECT_EQ(s.w, smin);
+        EXPECT_NEAR(s.r + s.b, 1.0f, 1e-6f); // one blend factor for colour
+        EXPECT_EQ(opIntersection(ca, cb, k).w, smax);
+        // Sharp operators: ties go to the first operand.
+        EXPECT_EQ(opUnion(ca, glm::vec4(0, 1, 0, a), 0.0f), ca);
+        EXPECT_EQ(opIntersection(ca, glm::vec4(0, 1, 0, a), 0.0f), ca);
+        EXPECT_EQ(opUnion(a, b, 0.0f), std::min(a, b));
+        EXPECT_EQ(opIntersection(a, b, 0.0f), std::max(a, b));
+    }
+    // Equal operands blend halfway and dip by k/4.
+    EXPECT_FLOAT_EQ(opUnion(1.0f, 1.0f, 0.4f), 0.9f);
+    EXPECT_FLOAT_EQ(opIntersection(1.0f, 1.0f, 0.4f), 1.1f);
+}
+
+} // namespace
+} // namespace sdfcsg

@@ -1,0 +1,528 @@
+// The GPU ray march against CPU sphere tracing with the reference evaluator: same rays (camera.h),
+// same clipping, same epsilon rule. Plus modes, bounds skipping, value updates and PNG output.
+#include "camera.h"
+#include "gpu_test.h"
+#include "shared.h"
+
+#define STB_IMAGE_IMPLEMENTATION
+#define STB_IMAGE_STATIC
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#pragma GCC diagnostic ignored "-Wunused-function"
+#pragma GCC diagnostic ignored "-Wshadow"
+#pragma GCC diagnostic ignored "-Wsign-compare"
+#endif
+#include <stb/stb_image.h>
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
+
+#include <glm/common.hpp>
+#include <glm/exponential.hpp>
+#include <glm/geometric.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <random>
+
+namespace sdfcsg::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr uint32_t kSize = 128;
+
+struct CpuHit {
+    float t = -1.0f;
+    uint32_t steps = 0;
+};
+
+// The loop of march() in shaders/raymarch.comp.
+CpuHit traceCpu(const Evaluator& ev, const detail::RayCamera& rc, const detail::ClipVolume& clip,
+                glm::vec3 dir) {
+    CpuHit hit;
+    float tNear, tFar;
+    if (!detail::clipRay(clip.box, rc.eye, dir, tNear, tFar)) return hit;
+    tFar = std::min(tFar, clip.far);
+    if (tNear > tFar) return hit;
+    float t = tNear;
+    for (uint32_t i = 0; i < SDFCSG_MAX_STEPS; ++i) {
+        hit.steps = i + 1;
+        float d = ev.distance(rc.eye + dir * t);
+        if (d < detail::hitEpsilon(rc, t)) {
+            hit.t = t;
+            break;
+        }
+        t += d;
+        if (t > tFar) break;
+    }
+    return hit;
+}
+
+glm::vec3 tetraNormal(const Evaluator& ev, glm::vec3 p, float h) {
+    const glm::vec3 a(1, -1, -1), b(-1, -1, 1), c(-1, 1, -1), d(1, 1, 1);
+    return glm::normalize(a * ev.distance(p + a * h) + b * ev.distance(p + b * h) +
+                          c * ev.distance(p + c * h) + d * ev.distance(p + d * h));
+}
+
+Camera cameraFor(const Scene& scene, const Evaluator& ev, float aspect = 1.0f) {
+    return scene.camera ? *scene.camera : frameCamera(ev, aspect);
+}
+
+glm::vec3 pixel(const Image& image, size_t i) {
+    return glm::vec3(image.rgba[4 * i], image.rgba[4 * i + 1], image.rgba[4 * i + 2]);
+}
+
+// Shading of shaders/raymarch.comp without shadows and occlusion, in 0..255.
+glm::vec3 shadeCpu(const Scene& scene, const Evaluator& ev, const detail::RayCamera& rc,
+                   const detail::ClipVolume& clip, glm::vec3 dir, float t) {
+    glm::vec3 p = rc.eye + dir * t;
+    glm::vec3 n = tetraNormal(ev, p, detail::hitEpsilon(rc, t));
+    glm::vec3 albedo = ev.sample(p).color;
+    albedo *= albedo;
+    glm::vec3 sky = scene.background * scene.background;
+    glm::vec3 col = albedo * (0.10f + 0.15f * sky * (0.5f + 0.5f * n.y));
+    std::vector<Light> lights = scene.lights.empty() ? defaultLights() : scene.lights;
+    for (size_t i = 0; i < lights.size() && i < SDFCSG_MAX_LIGHTS; ++i) {
+        glm::vec3 l = -glm::normalize(lights[i].direction);
+        float lambert = std::max(glm::dot(n, l), 0.0f);
+        float spec = std::pow(std::max(glm::dot(n, glm::normalize(l - dir)), 0.0f), 48.0f) * 0.25f;
+        col += lights[i].color * lights[i].intensity * lambert * (albedo + spec);
+    }
+    col = glm::sqrt(col);
+    float x = glm::clamp((t / clip.far - 0.6f) / 0.4f, 0.0f, 1.0f);
+    float fog = x * x * (3.0f - 2.0f * x);
+    col = glm::mix(col, scene.background, fog);
+    return glm::clamp(col, 0.0f, 1.0f) * 255.0f;
+}
+
+class SceneRender : public GpuTest, public ::testing::WithParamInterface<fs::path> {};
+
+TEST_P(SceneRender, HitMaskDepthAndColoursAgreeWithCpuTracing) {
+    Scene scene = loadOrDie(GetParam());
+    ASSERT_FALSE(scene.nodes.empty());
+    Evaluator ev(scene);
+    Camera camera = cameraFor(scene, ev);
+    auto renderer = Renderer::create(context(), scene);
+    ASSERT_TRUE(renderer) << renderer.error().str();
+
+    RenderOptions options;
+    options.width = options.height = kSize;
+    options.camera = camera;
+    options.shadows = false;
+    options.ambientOcclusion = false;
+    auto shaded = (*renderer)->render(options);
+    ASSERT_TRUE(shaded) << shaded.error().str();
+    std::vector<PixelInfo> info = (*renderer)->lastPixelInfo();
+    options.mode = RenderMode::Normals;
+    auto normals = (*renderer)->render(options);
+    ASSERT_TRUE(normals) << normals.error().str();
+    ASSERT_EQ(info.size(), size_t(kSize) * kSize);
+
+    detail::RayCamera rc = detail::makeRayCamera(camera, kSize, kSize);
+    detail::ClipVolume clip = detail::makeClipVolume(ev, rc.eye);
+    size_t agree = 0, hits = 0, colourChecked = 0, colourOk = 0, normalOk = 0;
+    for (uint32_t y = 0; y < kSize; ++y) {
+        for (uint32_t x = 0; x < kSize; ++x) {
+            size_t i = size_t(y) * kSize + x;
+            glm::vec3 dir = detail::rayDirection(rc, x + 0.5f, y + 0.5f, kSize, kSize);
+            CpuHit cpu = traceCpu(ev, rc, clip, dir);
+            bool gpuHit = info[i].depth >= 0.0f, cpuHit = cpu.t >= 0.0f;
+            hits += cpuHit;
+            if (gpuHit != cpuHit) continue;
+            if (!cpuHit) {
+                ++agree;
+                continue;
+            }
+            float tolerance = 4.0f * detail::hitEpsilon(rc, cpu.t) + 1e-4f * cpu.t;
+            if (std::abs(info[i].depth - cpu.t) > tolerance) continue;
+            ++agree;
+            ++colourChecked;
+            glm::vec3 expected = shadeCpu(scene, ev, rc, clip, dir, info[i].depth);
+            glm::vec3 diff = glm::abs(pixel(*shaded, i) - expected);
+            colourOk += std::max(diff.x, std::max(diff.y, diff.z)) <= 6.0f;
+            glm::vec3 n = tetraNormal(ev, rc.eye + dir * info[i].depth,
+                                      detail::hitEpsilon(rc, info[i].depth));
+            glm::vec3 nDiff = glm::abs(pixel(*normals, i) - glm::clamp(n * 0.5f + 0.5f, 0.0f, 1.0f) * 255.0f);
+            normalOk += std::max(nDiff.x, std::max(nDiff.y, nDiff.z)) <= 6.0f;
+        }
+    }
+    const double total = double(kSize) * kSize;
+    EXPECT_GE(hits, total * 0.05) << "the camera should see the scene";
+    EXPECT_GE(agree / total, 0.995) << agree << " of " << total << " pixels agree";
+    ASSERT_GT(colourChecked, 0u);
+    EXPECT_GE(double(colourOk) / colourChecked, 0.99)
+        << colourOk << " of " << colourChecked << " hit colours within 6/255";
+    EXPECT_GE(double(normalOk) / colourChecked, 0.99)
+        << normalOk << " of " << colourChecked << " normals within 6/255";
+}
+
+TEST_P(SceneRender, BoundsSkippingDoesNotChangeTheImage) {
+    Scene scene = loadOrDie(GetParam());
+    auto renderer = Renderer::create(context(), scene);
+    ASSERT_TRUE(renderer) << renderer.error().str();
+    RenderOptions options;
+    options.width = 96, options.height = 72;
+    auto on = (*renderer)->render(options);
+    ASSERT_TRUE(on);
+    std::vector<PixelInfo> infoOn = (*renderer)->lastPixelInfo();
+    options.boundsSkipping = false;
+    auto off = (*renderer)->render(options);
+    ASSERT_TRUE(off);
+    std::vector<PixelInfo> infoOff = (*renderer)->lastPixelInfo();
+    // Skipping never changes a value, but the compiler may contract the two variants'
+    // arithmetic differently, so allow last-bit differences.
+    size_t same = 0, maxDiff = 0;
+    for (size_t i = 0; i < on->rgba.size(); ++i) {
+        size_t d = size_t(std::abs(int(on->rgba[i]) - int(off->rgba[i])));
+        maxDiff = std::max(maxDiff, d);
+        same += d == 0;
+    }
+    EXPECT_GE(double(same) / on->rgba.size(), 0.999);
+    EXPECT_LE(maxDiff, 64u);
+    size_t maskSame = 0;
+    for (size_t i = 0; i < infoOn.size(); ++i)
+        maskSame += (infoOn[i].depth >= 0) == (infoOff[i].depth >= 0);
+    EXPECT_GE(double(maskSame) / infoOn.size(), 0.999);
+}
+
+TEST_P(SceneRender, DefaultCameraIsTheScenesOrTheFramedOne) {
+    Scene scene = loadOrDie(GetParam());
+    Evaluator ev(scene);
+    auto renderer = Renderer::create(context(), scene);
+    ASSERT_TRUE(renderer) << renderer.error().str();
+    RenderOptions options;
+    options.width = 64, options.height = 48;
+    auto implicit = (*renderer)->render(options);
+    ASSERT_TRUE(implicit);
+    options.camera = cameraFor(scene, ev, 64.0f / 48.0f);
+    auto explicitCamera = (*renderer)->render(options);
+    ASSERT_TRUE(explicitCamera);
+    EXPECT_EQ(implicit->rgba, explicitCamera->rgba);
+}
+
+INSTANTIATE_TEST_SUITE_P(Bundled, SceneRender, ::testing::ValuesIn(bundledScenes()), sceneTestName);
+
+fs::path scenePath(const char* name) { return fs::path(SDFCSG_SOURCE_DIR) / "assets/scenes" / name; }
+
+class Render : public GpuTest {};
+
+TEST_F(Render, AllModesRenderWhatTheyPromise) {
+    Scene scene = loadOrDie(scenePath("snowman.json"));
+    auto renderer = Renderer::create(context(), scene);
+    ASSERT_TRUE(renderer) << renderer.error().str();
+    RenderOptions options;
+    options.width = 80, options.height = 60;
+
+    options.mode = RenderMode::Steps;
+    auto steps = (*renderer)->render(options);
+    ASSERT_TRUE(steps);
+    std::vector<PixelInfo> info = (*renderer)->lastPixelInfo();
+    size_t hits = 0;
+    for (size_t i = 0; i < info.size(); ++i) {
+        ASSERT_GE(info[i].steps, info[i].depth >= 0 ? 1u : 0u);
+        ASSERT_LE(info[i].steps, uint32_t(SDFCSG_MAX_STEPS));
+        hits += info[i].depth >= 0;
+    }
+    ASSERT_GT(hits, info.size() / 20);
+    // The heat map of shaders/raymarch.comp: blue for few steps through green to red, on a log
+    // scale.
+    auto heat = [](uint32_t n) {
+        float x = std::log2(1.0f + float(n)) / std::log2(1.0f + float(SDFCSG_MAX_STEPS));
+        glm::vec3 c(1.5f - std::abs(4 * x - 3), 1.5f - std::abs(4 * x - 2), 1.5f - std::abs(4 * x - 1));
+        return glm::round(glm::clamp(c, 0.0f, 1.0f) * 255.0f);
+    };
+    for (size_t i = 0; i < info.size(); ++i) {
+        glm::vec3 d = glm::abs(pixel(*steps, i) - heat(info[i].steps));
+        ASSERT_LE(std::max(d.x, std::max(d.y, d.z)), 1.0f) << "pixel " << i;
+    }
+    std::mt19937 rng(7);
+    std::uniform_int_distribution<size_t> pick(0, info.size() - 1);
+    int ordered = 0, compared = 0;
+
+    options.mode = RenderMode::Depth;
+    auto depth = (*renderer)->render(options);
+    ASSERT_TRUE(depth);
+    compared = ordered = 0;
+    for (int k = 0; k < 4000; ++k) {
+        size_t a = pick(rng), b = pick(rng);
+        if (info[a].depth < 0) {
+            EXPECT_EQ(pixel(*depth, a), glm::vec3(0.0f)) << "misses are black";
+            continue;
+        }
+        if (info[b].depth < 0 || info[a].depth + 0.05f > info[b].depth) continue;
+        ++compared;
+        ordered += pixel(*depth, a).r >= pixel(*depth, b).r; // nearer is brighter
+    }
+    ASSERT_GT(compared, 20);
+    EXPECT_EQ(ordered, compared);
+
+    options.mode = RenderMode::Normals;
+    auto normals = (*renderer)->render(options);
+    ASSERT_TRUE(normals);
+    for (size_t i = 0; i < info.size(); ++i) {
+        if (info[i].depth < 0) continue;
+        glm::vec3 n = pixel(*normals, i) / 127.5f - 1.0f;
+        EXPECT_NEAR(glm::length(n), 1.0f, 0.03f);
+    }
+
+    options.mode = RenderMode::Shaded;
+    auto shaded = (*renderer)->render(options);
+    ASSERT_TRUE(shaded);
+    EXPECT_NE(shaded->rgba, normals->rgba);
+    for (size_t i = 0; i < info.size(); ++i) { // the background shows where nothing is hit
+        if (info[i].depth >= 0) continue;
+        glm::vec3 expected = glm::round(glm::clamp(scene.background, 0.0f, 1.0f) * 255.0f);
+        ASSERT_EQ(pixel(*shaded, i), expected);
+    }
+}
+
+TEST_F(Render, ShadowsOcclusionAndSupersamplingChangeTheImage) {
+    Scene scene = loadOrDie(scenePath("house.json"));
+    auto renderer = Renderer::create(context(), scene);
+    ASSERT_TRUE(renderer) << renderer.error().str();
+    RenderOptions options;
+    options.width = 80, options.height = 60;
+    options.shadows = options.ambientOcclusion = false;
+    auto plain = (*renderer)->render(options);
+    options.shadows = true;
+    auto shadows = (*renderer)->render(options);
+    options.ambientOcclusion = true;
+    auto both = (*renderer)->render(options);
+    options.aa = 3;
+    auto aa = (*renderer)->render(options);
+    ASSERT_TRUE(plain && shadows && both && aa);
+    auto darker = [](const Image& a, const Image& b) { // pixels of b darker than in a
+        size_t n = 0;
+        for (size_t i = 0; i + 3 < a.rgba.size(); i += 4)
+            n += int(b.rgba[i]) + b.rgba[i + 1] + b.rgba[i + 2] + 6 <
+                 int(a.rgba[i]) + a.rgba[i + 1] + a.rgba[i + 2];
+        return n;
+    };
+    EXPECT_GT(darker(*plain, *shadows), 50u) << "shadows darken some pixels";
+    EXPECT_GT(darker(*shadows, *both), 50u) << "occlusion darkens some pixels";
+    EXPECT_EQ(darker(*shadows, *plain), 0u) << "shadows never brighten";
+    EXPECT_NE(both->rgba, aa->rgba);
+    EXPECT_EQ(aa->rgba.size(), both->rgba.size());
+}
+
+TEST_F(Render, BoxOverlayDrawsEdges) {
+    Scene scene = loadOrDie(scenePath("csg_part.json"));
+    auto renderer = Renderer::create(context(), scene);
+    ASSERT_TRUE(renderer) << renderer.error().str();
+    RenderOptions options;
+    options.width = 96, options.height = 96;
+    auto none = (*renderer)->render(options);
+    options.boxes = BoxOverlay::All;
+    auto all = (*renderer)->render(options);
+    options.boxes = BoxOverlay::Selected;
+    options.selectedNode = 1;
+    auto selected = (*renderer)->render(options);
+    ASSERT_TRUE(none && all && selected);
+    auto changed = [&](const Image& a) {
+        size_t n = 0;
+        for (size_t i = 0; i < a.rgba.size(); ++i) n += a.rgba[i] != none->rgba[i];
+        return n;
+    };
+    EXPECT_GT(changed(*all), 50u);
+    EXPECT_GT(changed(*selected), 10u);
+    EXPECT_LT(changed(*selected), changed(*all));
+    options.selectedNode = int(scene.nodes.size());
+    auto bad = (*renderer)->render(options);
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error().kind, ErrorKind::Usage);
+}
+
+// Grows the first sphere found; returns false if the scene has none.
+bool growFirstSphere(Scene& scene) {
+    for (Node& node : scene.nodes)
+        if (node.kind == NodeKind::Sphere) {
+            node.params[0] *= 1.3f;
+            return true;
+        }
+    return false;
+}
+
+TEST_F(Render, UpdateValuesChangesTheImageToTheNewScene) {
+    Scene scene = loadOrDie(scenePath("snowman.json"));
+    auto renderer = Renderer::create(context(), scene);
+    ASSERT_TRUE(renderer) << renderer.error().str();
+    Evaluator before(scene);
+    RenderOptions options;
+    options.width = options.height = kSize;
+    options.camera = cameraFor(scene, before); // fixed, so only the geometry changes
+    auto first = (*renderer)->render(options);
+    ASSERT_TRUE(first);
+
+    ASSERT_TRUE(growFirstSphere(scene));
+    scene.nodes[0].color = glm::vec3(0.9f, 0.1f, 0.1f);
+    auto updated = (*renderer)->updateValues(scene);
+    ASSERT_TRUE(updated) << updated.error().str();
+    auto second = (*renderer)->render(options);
+    ASSERT_TRUE(second);
+    EXPECT_NE(first->rgba, second->rgba);
+
+    // The new image is the new scene's: its hit mask agrees with CPU tracing of the new values.
+    Evaluator after(scene);
+    const auto& info = (*renderer)->lastPixelInfo();
+    detail::RayCamera rc = detail::makeRayCamera(*options.camera, kSize, kSize);
+    detail::ClipVolume clip = detail::makeClipVolume(after, rc.eye);
+    size_t agree = 0, changed = 0;
+    for (uint32_t y = 0; y < kSize; ++y)
+        for (uint32_t x = 0; x < kSize; ++x) {
+            glm::vec3 dir = detail::rayDirection(rc, x + 0.5f, y + 0.5f, kSize, kSize);
+            bool hitAfter = traceCpu(after, rc, clip, dir).t >= 0;
+            bool hitBefore =
+                traceCpu(before, rc, detail::makeClipVolume(before, rc.eye), dir).t >= 0;
+            agree += hitAfter == (info[size_t(y) * kSize + x].depth >= 0);
+            changed += hitAfter != hitBefore;
+        }
+    EXPECT_GT(changed, 20u) << "the edit should change the silhouette";
+    EXPECT_GE(agree / double(kSize * kSize), 0.995);
+}
+
+TEST_F(Render, UpdateValuesRefusesStructuralChanges) {
+    Scene scene = loadOrDie(scenePath("csg_part.json"));
+    auto renderer = Renderer::create(context(), scene);
+    ASSERT_TRUE(renderer) << renderer.error().str();
+    Scene other = scene;
+    other.nodes.back().kind =
+        other.nodes.back().kind == NodeKind::Sphere ? NodeKind::Box : NodeKind::Sphere;
+    auto result = (*renderer)->updateValues(other);
+    ASSERT_FALSE(result);
+    EXPECT_EQ(result.error().kind, ErrorKind::Usage);
+    Scene fewer = scene;
+    fewer.nodes.pop_back();
+    ASSERT_FALSE((*renderer)->updateValues(fewer));
+    // The renderer still works with its old values.
+    RenderOptions options;
+    options.width = options.height = 16;
+    EXPECT_TRUE((*renderer)->render(options));
+}
+
+TEST_F(Render, RejectsBadOptions) {
+    Scene scene = loadOrDie(scenePath("csg_part.json"));
+    auto renderer = Renderer::create(context(), scene);
+    ASSERT_TRUE(renderer) << renderer.error().str();
+    RenderOptions options;
+    options.width = 0;
+    EXPECT_FALSE((*renderer)->render(options));
+    options.width = 8;
+    options.aa = 0;
+    EXPECT_FALSE((*renderer)->render(options));
+    options.aa = 1;
+    options.width = options.height = 1u << 16; // 4 G pixels
+    auto huge = (*renderer)->render(options);
+    ASSERT_FALSE(huge);
+    EXPECT_EQ(huge.error().kind, ErrorKind::Limit);
+}
+
+TEST(RenderMode, ParsesTheFourNames) {
+    EXPECT_EQ(parseRenderMode("shaded"), RenderMode::Shaded);
+    EXPECT_EQ(parseRenderMode("normals"), RenderMode::Normals);
+    EXPECT_EQ(parseRenderMode("depth"), RenderMode::Depth);
+    EXPECT_EQ(parseRenderMode("steps"), RenderMode::Steps);
+    EXPECT_FALSE(parseRenderMode("Shaded"));
+    EXPECT_FALSE(parseRenderMode(""));
+}
+
+class Png : public GpuTest {};
+
+Image decodePng(const fs::path& path) {
+    int w = 0, h = 0, n = 0;
+    stbi_uc* data = stbi_load(path.string().c_str(), &w, &h, &n, 4);
+    Image image;
+    if (!data) return image;
+    image.width = uint32_t(w), image.height = uint32_t(h);
+    image.rgba.assign(data, data + size_t(w) * h * 4);
+    stbi_image_free(data);
+    return image;
+}
+
+Image gradient(uint32_t w, uint32_t h) {
+    Image image{w, h, std::vector<uint8_t>(size_t(w) * h * 4)};
+    for (size_t i = 0; i < image.rgba.size(); ++i) image.rgba[i] = uint8_t(i * 7 + i / 13);
+    return image;
+}
+
+fs::path freshDir(const char* name) {
+    fs::path dir = fs::path(SDFCSG_TEST_OUTPUT_DIR) / name;
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+TEST_F(Png, WritesARenderAtomicallyAndReplacesWholeFiles) {
+    fs::path dir = freshDir("png_atomic");
+    fs::path out = dir / "image.png";
+    Image big = gradient(300, 200);
+    ASSERT_TRUE(writePng(big, out));
+    Image small = gradient(7, 5);
+    auto written = writePng(small, out);
+    ASSERT_TRUE(written) << written.error().str();
+    Image back = decodePng(out);
+    EXPECT_EQ(back.width, 7u);
+    EXPECT_EQ(back.height, 5u);
+    EXPECT_EQ(back.rgba, small.rgba);
+    size_t files = 0;
+    for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) ++files;
+    EXPECT_EQ(files, 1u) << "no temporary file may be left behind";
+
+    // A real render round-trips exactly.
+    Scene scene = loadOrDie(scenePath("robot.json"));
+    auto renderer = Renderer::create(context(), scene);
+    ASSERT_TRUE(renderer) << renderer.error().str();
+    RenderOptions options;
+    options.width = 64, options.height = 40;
+    auto image = (*renderer)->render(options);
+    ASSERT_TRUE(image);
+    ASSERT_TRUE(writePng(*image, out));
+    back = decodePng(out);
+    EXPECT_EQ(back.width, 64u);
+    EXPECT_EQ(back.rgba, image->rgba);
+}
+
+TEST(PngErrors, NameThePath) {
+    fs::path dir = freshDir("png_errors");
+    fs::path out = dir / "missing-dir" / "x.png";
+    auto result = writePng(gradient(4, 4), out);
+    ASSERT_FALSE(result);
+    EXPECT_EQ(result.error().kind, ErrorKind::Io);
+    EXPECT_NE(result.error().str().find(out.string()), std::string::npos) << result.error().str();
+    EXPECT_FALSE(writePng(Image{}, dir / "empty.png"));
+    EXPECT_FALSE(fs::exists(dir / "empty.png"));
+}
+
+class ContextTest : public GpuTest {};
+
+TEST_F(ContextTest, DeviceOverrideByNameOrIndex) {
+    ContextOptions options;
+    options.validation = 0;
+    options.device = "no such device 42";
+    auto missing = Context::create(options);
+    ASSERT_FALSE(missing);
+    EXPECT_EQ(missing.error().kind, ErrorKind::Vulkan);
+    EXPECT_NE(missing.error().str().find("no such device 42"), std::string::npos);
+
+    std::string name = context().deviceName();
+    ASSERT_FALSE(name.empty());
+    std::string upper = name.substr(0, std::min<size_t>(name.size(), 6));
+    for (char& c : upper) c = char(std::toupper(static_cast<unsigned char>(c)));
+    options.device = upper; // a case-insensitive part of the name
+    auto byName = Context::create(options);
+    ASSERT_TRUE(byName) << byName.error().str();
+    EXPECT_EQ((*byName)->deviceName(), name);
+    EXPECT_FALSE((*byName)->validationEnabled());
+
+    options.device = "0";
+    auto byIndex = Context::create(options);
+    ASSERT_TRUE(byIndex) << byIndex.error().str();
+    options.device = "999";
+    EXPECT_FALSE(Context::create(options));
+}
+
+TEST_F(ContextTest, ValidationIsOnInTests) { EXPECT_TRUE(context().validationEnabled()); }
+
+} // namespace
+} // namespace sdfcsg::test
