@@ -77,7 +77,7 @@ vec2 clipRay(vec3 bmin, vec3 bmax, vec3 ro, vec3 rd) {
 // finished marching evaluates its normal or shadow taps in the same instructions as its
 // neighbours' march steps instead of idling through them.
 const uint kMarch = 0u, kNormal = 1u, kOcclusion = 2u, kShadow = 3u, kDone = 4u;
-const int kShadowSteps = 32;
+const int kShadowSteps = 16; // enough for soft shadows; each step is a full scene evaluation
 const float kShadowSharpness = 10.0;
 
 struct Trace {
@@ -133,7 +133,7 @@ Trace trace(vec3 ro, vec3 rd) {
                 r.t = t;
                 eps = e;
                 p = origin + dir * t;
-                phase = kDone;
+                phase = mode == SDFCSG_MODE_NORMALS || mode == SDFCSG_MODE_SHADED ? kNormal : kDone;
                 tap = 0;
                 origin = p;
                 dir = tetraTap(0);
@@ -142,13 +142,75 @@ Trace trace(vec3 ro, vec3 rd) {
                 t += d;
                 if (t > tFar || r.steps >= SDFCSG_MAX_STEPS) phase = kDone;
             }
+        } else if (phase == kNormal) {
+            r.n += dir * d;
+            tap += 1;
+            dir = tetraTap(tap);
+            if (tap == 4) {
+                r.n = normalize(r.n);
+                // Lift off the surface so occlusion and shadow rays do not re-hit it at once.
+                p += r.n * (2.0 * eps);
+                origin = p;
+                if (mode != SDFCSG_MODE_SHADED) {
+                    phase = kDone;
+                } else if ((flags & SDFCSG_FLAG_AO) != 0u) {
+                    phase = kOcclusion;
+                    tap = 0;
+                    r.ao = 0.0; // accumulates occlusion until the last tap
+                    dir = r.n;
+                    t = aoScale * 0.01;
+                } else {
+                    nextLight = true;
+                }
+            }
+        } else if (phase == kOcclusion) {
+            r.ao += (t - d) * weight;
+            weight *= 0.95;
+            tap += 1;
+            t += aoScale * 0.03;
+            if (tap == 5) {
+                r.ao = clamp(1.0 - 3.0 * r.ao / aoScale, 0.0, 1.0);
+                nextLight = true;
+            }
+        } else { // kShadow
+            if (d < eps * 0.5) {
+                res = 0.0;
+            } else {
+                float y = d * d / (2.0 * ph);
+                float w = sqrt(max(d * d - y * y, 0.0));
+                res = min(res, kShadowSharpness * w / max(0.0, t - y));
+                ph = d;
+                t += max(d, eps);
+            }
+            tap += 1;
+            if (res < 0.02 || t >= shadowEnd || tap >= kShadowSteps) {
+                r.shadow = mix(r.shadow, vec4(res < 0.02 ? 0.0 : res),
+                               equal(uvec4(0u, 1u, 2u, 3u), uvec4(light)));
+                light += 1u;
+                nextLight = true;
+            }
+        }
+
+        if (nextLight) {
+            // Light directions come from locals with selects: indexing the uniform array by a
+            // per-lane index would gather in every iteration of this loop on CPU drivers.
+            dir = light == 0u ? light0 : light == 1u ? light1 : light == 2u ? light2 : light3;
+            vec3 inv = light == 0u ? inverse0 : light == 1u ? inverse1 : light == 2u ? inverse2 : inverse3;
+            phase = light < lightCount ? kShadow : kDone;
+            // Occluders lie inside the clip box: the ray ends where it leaves it.
+            vec3 t0 = (frame.clipMin.xyz - p) * inv, t1 = (frame.clipMax.xyz - p) * inv;
+            vec3 far = max(t0, t1);
+            shadowEnd = min(min(far.x, far.y), min(far.z, shadowReach));
+            t = 2.0 * eps;
+            // A light behind the surface needs no shadow (Lambert is zero): end it at once.
+            tap = dot(r.n, dir) > 0.0 ? 0 : kShadowSteps;
+            res = 1.0;
+            ph = 1.0e20;
         }
     }
     return r;
 }
 
-// Scene colours are treated as gamma 2 (sRGB, close enough): squared to shade, square-rooted
-// back. pow() is slow on CPU drivers.
 vec3 heat(float x) {
     x = clamp(x, 0.0, 1.0);
     // Blue -> cyan -> green -> yellow -> red.
@@ -161,6 +223,9 @@ float pow48(float x) {
     return x16 * x16 * x16;
 }
 
+// Scene colours are treated as gamma 2 (sRGB, close enough): squared to shade, square-rooted
+// back; pow() is slow on CPU drivers. Lambert and Blinn-Phong per light, an ambient term from the
+// background, occlusion and shadows from trace().
 vec3 shade(vec3 ro, vec3 rd, Trace r) {
     uint mode = frame.size.z;
     // Steps on a log scale: a handful already shows, and 256 is red.

@@ -37,8 +37,9 @@ bool layerAvailable(const char* name) {
     VK_CHECK(vkEnumerateInstanceLayerProperties(&count, nullptr));
     std::vector<VkLayerProperties> layers(count);
     VK_CHECK(vkEnumerateInstanceLayerProperties(&count, layers.data()));
-    return std::any_of(layers.begin(), layers.end(),
-                       [&](const VkLayerProperties& l) { return std::string_view(l.layerName) == name; });
+    return std::any_of(layers.begin(), layers.end(), [&](const VkLayerProperties& l) {
+        return std::string_view(l.layerName) == name;
+    });
 }
 
 bool extensionAvailable(const char* layer, const char* name) {
@@ -66,17 +67,23 @@ int wantedValidation(int requested) {
 
 int typeRank(VkPhysicalDeviceType type) {
     switch (type) {
-    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 0;
-    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 1;
-    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
-    case VK_PHYSICAL_DEVICE_TYPE_CPU: return 3;
-    default: return 4;
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+        return 0;
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+        return 1;
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+        return 2;
+    case VK_PHYSICAL_DEVICE_TYPE_CPU:
+        return 3;
+    default:
+        return 4;
     }
 }
 
 std::string lower(std::string_view s) {
     std::string out(s);
-    for (char& c : out) c = char(std::tolower(static_cast<unsigned char>(c)));
+    for (char& c : out)
+        c = char(std::tolower(static_cast<unsigned char>(c)));
     return out;
 }
 
@@ -88,7 +95,8 @@ int computeFamily(VkPhysicalDevice device) {
     vkGetPhysicalDeviceQueueFamilyProperties(device, &count, families.data());
     int best = -1;
     for (uint32_t i = 0; i < count; ++i) {
-        if (!(families[i].queueFlags & VK_QUEUE_COMPUTE_BIT) || families[i].queueCount == 0) continue;
+        if (!(families[i].queueFlags & VK_QUEUE_COMPUTE_BIT) || families[i].queueCount == 0)
+            continue;
         if (best < 0) best = int(i);
         if (!(families[i].queueFlags & VK_QUEUE_GRAPHICS_BIT)) return int(i);
     }
@@ -115,8 +123,12 @@ Context::Impl::~Impl() {
 Context::Context(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 Context::~Context() = default;
 
-std::string Context::deviceName() const { return impl_->properties.deviceName; }
-bool Context::validationEnabled() const { return impl_->validation; }
+std::string Context::deviceName() const {
+    return impl_->properties.deviceName;
+}
+bool Context::validationEnabled() const {
+    return impl_->validation;
+}
 uint32_t Context::validationMessageCount() const {
     return impl_->validationMessages.load(std::memory_order_relaxed);
 }
@@ -137,8 +149,9 @@ Result<std::unique_ptr<Context>> Context::create(const ContextOptions& options) 
         bool available = layerAvailable(kValidationLayer) &&
                          extensionAvailable(nullptr, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
         if (!available && validation == 1)
-            return vulkanError(std::string(kValidationLayer) +
-                               " was requested but is not installed (Debian: vulkan-validationlayers)");
+            return vulkanError(
+                std::string(kValidationLayer) +
+                " was requested but is not installed (Debian: vulkan-validationlayers)");
         impl->validation = available;
     }
 
@@ -223,8 +236,9 @@ Result<std::unique_ptr<Context>> Context::create(const ContextOptions& options) 
     }
     if (chosen < 0) {
         if (!wanted.empty())
-            return vulkanError("no Vulkan 1.1 device with a compute queue matches SDFCSG_DEVICE=\"" +
-                               wanted + "\"; devices:" + list);
+            return vulkanError(
+                "no Vulkan 1.1 device with a compute queue matches SDFCSG_DEVICE=\"" + wanted +
+                "\"; devices:" + list);
         return vulkanError("no Vulkan 1.1 device with a compute queue; devices:" + list);
     }
     impl->physicalDevice = devices[chosen];
@@ -242,8 +256,7 @@ Result<std::unique_ptr<Context>> Context::create(const ContextOptions& options) 
     deviceInfo.pQueueCreateInfos = &queueInfo;
     result = vkCreateDevice(impl->physicalDevice, &deviceInfo, nullptr, &impl->device);
     if (result != VK_SUCCESS)
-        return vulkanError(std::string("cannot create a device on ") +
-                               impl->properties.deviceName,
+        return vulkanError(std::string("cannot create a device on ") + impl->properties.deviceName,
                            result);
     vkGetDeviceQueue(impl->device, impl->queueFamily, 0, &impl->queue);
 

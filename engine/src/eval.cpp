@@ -245,10 +245,12 @@ float Evaluator::distance(glm::vec3 p) const { return distance(p, 0); }
 Sample Evaluator::sample(glm::vec3 p) const { return sample(p, 0); }
 
 float Evaluator::distance(glm::vec3 p, uint32_t node) const {
+    if (node >= nodes_.size()) return INFINITY; // an empty scene is empty space
     return evaluate<float>(nodes_, node, p, skipping_);
 }
 
 Sample Evaluator::sample(glm::vec3 p, uint32_t node) const {
+    if (node >= nodes_.size()) return {INFINITY, kDefaultColor};
     glm::vec4 v = evaluate<glm::vec4>(nodes_, node, p, skipping_);
     return {v.w, glm::vec3(v)};
 }

@@ -57,7 +57,9 @@ bool sameStructure(const Scene& a, const Scene& b) {
     return true;
 }
 
-Error usage(std::string text) { return Error::message(ErrorKind::Usage, "<render>", std::move(text)); }
+Error usage(std::string text) {
+    return Error::message(ErrorKind::Usage, "<render>", std::move(text));
+}
 
 } // namespace
 
@@ -146,35 +148,38 @@ struct Renderer::Impl {
         detail::writeDescriptorSet(ctx, set, kBindings, buffers);
     }
 
-    // Grows the image buffers to hold `count` pixels; never shrinks them.
+    // Grows the image buffers to hold `count` pixels; never shrinks them. On failure the old
+    // buffers stay.
     Status reserve(uint32_t count) {
         if (count <= capacity) return Ok{};
-        Buffer newPixels, newInfo, newPixelsStaging, newInfoStaging;
-        auto release = [&] {
-            for (Buffer* b : {&newPixels, &newInfo, &newPixelsStaging, &newInfoStaging})
-                detail::destroyBuffer(ctx, *b);
-        };
-        constexpr VkBufferUsageFlags usage =
+        constexpr VkBufferUsageFlags kOutput =
             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
-        auto p = detail::createBuffer(ctx, VkDeviceSize(count) * 4, usage, detail::MemoryUse::Readback);
-        if (!p) return p.error();
-        newPixels = *p;
-        auto i = detail::createBuffer(ctx, VkDeviceSize(count) * 8, usage, detail::MemoryUse::Readback);
-        if (!i) return release(), i.error();
-        newInfo = *i;
-        if (!newPixels.data || !newInfo.data) { // not mappable: read back through staging copies
-            constexpr VkBufferUsageFlags dst = VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-            auto ps = detail::createBuffer(ctx, VkDeviceSize(count) * 4, dst, detail::MemoryUse::Staging);
-            if (!ps) return release(), ps.error();
-            newPixelsStaging = *ps;
-            auto is = detail::createBuffer(ctx, VkDeviceSize(count) * 8, dst, detail::MemoryUse::Staging);
-            if (!is) return release(), is.error();
-            newInfoStaging = *is;
+        const VkDeviceSize sizes[] = {VkDeviceSize(count) * 4, VkDeviceSize(count) * 8};
+        Buffer made[4]; // pixels, info, and their staging copies when those are not mappable
+        auto create = [&](int i, VkDeviceSize size, VkBufferUsageFlags usage,
+                          detail::MemoryUse use) -> Status {
+            auto buffer = detail::createBuffer(ctx, size, usage, use);
+            if (!buffer) {
+                for (Buffer& b : made)
+                    detail::destroyBuffer(ctx, b);
+                return buffer.error();
+            }
+            made[i] = *buffer;
+            return Ok{};
+        };
+        for (int i = 0; i < 2; ++i)
+            if (auto ok = create(i, sizes[i], kOutput, detail::MemoryUse::Readback); !ok) return ok;
+        if (!made[0].data || !made[1].data)
+            for (int i = 0; i < 2; ++i)
+                if (auto ok = create(2 + i, sizes[i], VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                     detail::MemoryUse::Staging);
+                    !ok)
+                    return ok;
+        Buffer* current[] = {&pixels, &info, &pixelsStaging, &infoStaging};
+        for (int i = 0; i < 4; ++i) {
+            detail::destroyBuffer(ctx, *current[i]);
+            *current[i] = made[i];
         }
-        for (Buffer* b : {&pixels, &info, &pixelsStaging, &infoStaging})
-            detail::destroyBuffer(ctx, *b);
-        pixels = newPixels, info = newInfo;
-        pixelsStaging = newPixelsStaging, infoStaging = newInfoStaging;
         capacity = count;
         writeDescriptors();
         return Ok{};
@@ -197,7 +202,8 @@ struct Renderer::Impl {
         const float size = std::max(glm::length(finite.max - finite.min), 1e-3f);
         float nearest = finite.distance(rc.eye), farthest = 0.0f;
         for (int c = 0; c < 8; ++c) {
-            glm::vec3 corner((c & 1) ? finite.max.x : finite.min.x, (c & 2) ? finite.max.y : finite.min.y,
+            glm::vec3 corner((c & 1) ? finite.max.x : finite.min.x,
+                             (c & 2) ? finite.max.y : finite.min.y,
                              (c & 4) ? finite.max.z : finite.min.z);
             farthest = std::max(farthest, glm::length(corner - rc.eye));
         }
@@ -253,12 +259,13 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene
     r.pool = detail::createDescriptorPool(r.ctx, kBindings);
     r.set = detail::allocateDescriptorSet(r.ctx, r.pool, r.setLayout);
 
-    auto frame = detail::createBuffer(r.ctx, sizeof(FrameUniform), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
-                                      detail::MemoryUse::Upload);
+    auto frame = detail::createBuffer(
+        r.ctx, sizeof(FrameUniform), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, detail::MemoryUse::Upload);
     if (!frame) return frame.error();
     r.frame = *frame;
-    auto nodes = detail::createBuffer(r.ctx, r.nodeCount * sizeof(detail::GpuNode),
-                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, detail::MemoryUse::Upload);
+    auto nodes =
+        detail::createBuffer(r.ctx, r.nodeCount * sizeof(detail::GpuNode),
+                             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, detail::MemoryUse::Upload);
     if (!nodes) return nodes.error();
     r.nodes = *nodes;
     r.uploadNodes();
@@ -336,6 +343,8 @@ Result<Image> Renderer::render(const RenderOptions& options) {
     return image;
 }
 
-const std::vector<PixelInfo>& Renderer::lastPixelInfo() const { return impl_->lastInfo; }
+const std::vector<PixelInfo>& Renderer::lastPixelInfo() const {
+    return impl_->lastInfo;
+}
 
 } // namespace sdfcsg

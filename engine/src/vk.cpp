@@ -10,7 +10,8 @@ namespace sdfcsg::detail {
 const char* vkResultName(VkResult result) {
     switch (result) {
 #define SDFCSG_RESULT(name)                                                                        \
-    case name: return #name;
+    case name:                                                                                     \
+        return #name;
         SDFCSG_RESULT(VK_SUCCESS)
         SDFCSG_RESULT(VK_NOT_READY)
         SDFCSG_RESULT(VK_TIMEOUT)
@@ -30,7 +31,8 @@ const char* vkResultName(VkResult result) {
         SDFCSG_RESULT(VK_ERROR_OUT_OF_POOL_MEMORY)
         SDFCSG_RESULT(VK_ERROR_UNKNOWN)
 #undef SDFCSG_RESULT
-    default: return "VkResult(unknown)";
+    default:
+        return "VkResult(unknown)";
     }
 }
 
@@ -93,18 +95,18 @@ Result<Buffer> createBuffer(Context::Impl& ctx, VkDeviceSize size, VkBufferUsage
     case MemoryUse::Readback:
         // Device-local first; on CPU drivers and resizable-BAR GPUs it is also mappable, and the
         // caller only adds a staging copy when it is not.
-        type = findMemoryType(props, requirements.memoryTypeBits,
-                              VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT,
-                              VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT);
+        type =
+            findMemoryType(props, requirements.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT,
+                           VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT);
         if (type == UINT32_MAX)
             type = findMemoryType(props, requirements.memoryTypeBits,
                                   VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT,
                                   VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
         break;
     case MemoryUse::Staging:
-        type = findMemoryType(props, requirements.memoryTypeBits,
-                              VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT,
-                              VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
+        type =
+            findMemoryType(props, requirements.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT,
+                           VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
         break;
     }
     if (type == UINT32_MAX) {
@@ -140,7 +142,8 @@ void destroyBuffer(Context::Impl& ctx, Buffer& buffer) {
 void uploadBuffer(Context::Impl& ctx, const Buffer& buffer, const void* data, size_t size) {
     if (!buffer.data || size > buffer.size) {
         std::fprintf(stderr, "%s:%d: upload of %zu bytes to a buffer of %llu (mapped: %d)\n",
-                     __FILE__, __LINE__, size, (unsigned long long)buffer.size, buffer.data != nullptr);
+                     __FILE__, __LINE__, size, (unsigned long long)buffer.size,
+                     buffer.data != nullptr);
         std::abort();
     }
     std::memcpy(buffer.data, data, size);
@@ -169,7 +172,8 @@ VkShaderModule createShaderModule(Context::Impl& ctx, std::span<const uint32_t> 
     return module;
 }
 
-VkDescriptorSetLayout createDescriptorSetLayout(Context::Impl& ctx, std::span<const Binding> bindings) {
+VkDescriptorSetLayout createDescriptorSetLayout(Context::Impl& ctx,
+                                                std::span<const Binding> bindings) {
     std::vector<VkDescriptorSetLayoutBinding> list(bindings.size());
     for (uint32_t i = 0; i < list.size(); ++i) {
         list[i].binding = bindings[i].binding;
@@ -198,11 +202,12 @@ VkPipelineLayout createPipelineLayout(Context::Impl& ctx, VkDescriptorSetLayout 
     return layout;
 }
 
-VkPipeline createComputePipeline(Context::Impl& ctx, VkShaderModule module,
-                                 VkPipelineLayout layout, std::span<const SpecConstant> spec) {
+VkPipeline createComputePipeline(Context::Impl& ctx, VkShaderModule module, VkPipelineLayout layout,
+                                 std::span<const SpecConstant> spec) {
     std::vector<VkSpecializationMapEntry> entries(spec.size());
     for (uint32_t i = 0; i < entries.size(); ++i)
-        entries[i] = {spec[i].id, uint32_t(i * sizeof(SpecConstant) + offsetof(SpecConstant, value)),
+        entries[i] = {spec[i].id,
+                      uint32_t(i * sizeof(SpecConstant) + offsetof(SpecConstant, value)),
                       sizeof(uint32_t)};
     VkSpecializationInfo specialization = {};
     specialization.mapEntryCount = uint32_t(entries.size());
@@ -289,8 +294,8 @@ void recordReadback(VkCommandBuffer cmd, const Buffer& buffer, const Buffer* sta
     barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
     if (buffer.data) {
         barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-        vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                             VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, nullptr, 0, nullptr);
+        vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT,
+                             0, 1, &barrier, 0, nullptr, 0, nullptr);
         return;
     }
     barrier.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;

@@ -89,11 +89,12 @@ struct Binding {
 
 VkShaderModule createShaderModule(Context::Impl& ctx, std::span<const uint32_t> spirv);
 // Every binding is visible to the compute stage.
-VkDescriptorSetLayout createDescriptorSetLayout(Context::Impl& ctx, std::span<const Binding> bindings);
+VkDescriptorSetLayout createDescriptorSetLayout(Context::Impl& ctx,
+                                                std::span<const Binding> bindings);
 VkPipelineLayout createPipelineLayout(Context::Impl& ctx, VkDescriptorSetLayout setLayout,
                                       uint32_t pushConstantBytes);
-VkPipeline createComputePipeline(Context::Impl& ctx, VkShaderModule module,
-                                 VkPipelineLayout layout, std::span<const SpecConstant> spec);
+VkPipeline createComputePipeline(Context::Impl& ctx, VkShaderModule module, VkPipelineLayout layout,
+                                 std::span<const SpecConstant> spec);
 // A pool sized for exactly one set of the given bindings.
 VkDescriptorPool createDescriptorPool(Context::Impl& ctx, std::span<const Binding> bindings);
 VkDescriptorSet allocateDescriptorSet(Context::Impl& ctx, VkDescriptorPool pool,

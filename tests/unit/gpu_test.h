@@ -24,8 +24,10 @@ class GpuEnvironment : public ::testing::Environment {
         ContextOptions options;
         options.validation = 1;
         auto created = Context::create(options);
-        if (created) context_ = std::move(*created);
-        else error_ = created.error().str();
+        if (created)
+            context_ = std::move(*created);
+        else
+            error_ = created.error().str();
     }
     // Before static destruction, while the driver is certainly still loaded.
     void TearDown() override { context_.reset(); }
@@ -60,8 +62,8 @@ class GpuTest : public ::testing::Test {
 // Every bundled scene, sorted by name.
 inline std::vector<std::filesystem::path> bundledScenes() {
     std::vector<std::filesystem::path> paths;
-    for (const auto& entry :
-         std::filesystem::directory_iterator(std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes"))
+    for (const auto& entry : std::filesystem::directory_iterator(
+             std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes"))
         if (entry.path().extension() == ".json") paths.push_back(entry.path());
     std::sort(paths.begin(), paths.end());
     return paths;

@@ -101,6 +101,16 @@ TEST(Codegen, OneCommentedLinePerNode) {
     }
 }
 
+TEST(Codegen, NamesCannotBreakTheCode) {
+    // A trailing backslash would splice the next line into the comment; newlines would end it.
+    Scene scene = makeScene(unite({sphere(1).named("evil\\"), box(1, 1, 1).named("two\nlines */ \xc3\xa9")}));
+    std::string glsl = generateSceneGlsl(scene);
+    EXPECT_EQ(glsl.find('\\'), std::string::npos);
+    EXPECT_NE(glsl.find("// two?lines */ ?? (box)"), std::string::npos) << glsl;
+    auto spirv = compileKernel("probe.comp", glsl);
+    EXPECT_TRUE(spirv) << spirv.error().str();
+}
+
 TEST(Codegen, IndentationFollowsDepth) {
     Scene scene = makeScene(unite({sphere(1), subtract({box(1, 1, 1), sphere(0.6f)})}));
     std::string body = function(generateSceneGlsl(scene), "float sceneDistance");

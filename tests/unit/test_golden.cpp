@@ -20,6 +20,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <optional>
+#include <ostream>
 
 namespace sdfcsg::test {
 namespace {
@@ -42,16 +43,25 @@ struct GoldenCase {
 
 const char* modeName(RenderMode mode) {
     switch (mode) {
-    case RenderMode::Shaded: return "shaded";
-    case RenderMode::Normals: return "normals";
-    case RenderMode::Depth: return "depth";
-    case RenderMode::Steps: return "steps";
+    case RenderMode::Shaded:
+        return "shaded";
+    case RenderMode::Normals:
+        return "normals";
+    case RenderMode::Depth:
+        return "depth";
+    case RenderMode::Steps:
+        return "steps";
     }
     return "?";
 }
 
 std::string caseName(const GoldenCase& c) {
     return std::string(c.scene) + "_" + modeName(c.mode) + (c.boxes ? "_boxes" : "");
+}
+
+// Readable test names and failure messages instead of a byte dump.
+void PrintTo(const GoldenCase& c, std::ostream* os) {
+    *os << caseName(c);
 }
 
 std::optional<Image> readPng(const fs::path& path) {
@@ -68,7 +78,8 @@ class Golden : public GpuTest, public ::testing::WithParamInterface<GoldenCase> 
 TEST_P(Golden, MatchesWithinTolerance) {
     const GoldenCase& c = GetParam();
     const std::string name = caseName(c);
-    Scene scene = loadOrDie(fs::path(SDFCSG_SOURCE_DIR) / "assets/scenes" / (std::string(c.scene) + ".json"));
+    Scene scene =
+        loadOrDie(fs::path(SDFCSG_SOURCE_DIR) / "assets/scenes" / (std::string(c.scene) + ".json"));
     auto renderer = Renderer::create(context(), scene);
     ASSERT_TRUE(renderer) << renderer.error().str();
     RenderOptions options;
@@ -80,7 +91,8 @@ TEST_P(Golden, MatchesWithinTolerance) {
     ASSERT_TRUE(actual) << actual.error().str();
 
     const fs::path golden = fs::path(SDFCSG_SOURCE_DIR) / "tests/golden" / (name + ".png");
-    if (const char* update = std::getenv("SDFCSG_UPDATE_GOLDEN"); update && std::string(update) == "1") {
+    if (const char* update = std::getenv("SDFCSG_UPDATE_GOLDEN");
+        update && std::string(update) == "1") {
         auto written = writePng(*actual, golden);
         ASSERT_TRUE(written) << written.error().str();
         std::printf("updated %s\n", golden.string().c_str());
@@ -138,12 +150,9 @@ TEST_P(Golden, MatchesWithinTolerance) {
 }
 
 const GoldenCase kCases[] = {
-    {"house", RenderMode::Shaded},
-    {"snowman", RenderMode::Shaded},
-    {"smooth_blend", RenderMode::Shaded},
-    {"csg_part", RenderMode::Normals},
-    {"robot", RenderMode::Depth},
-    {"gallery", RenderMode::Steps},
+    {"house", RenderMode::Shaded},          {"snowman", RenderMode::Shaded},
+    {"smooth_blend", RenderMode::Shaded},   {"csg_part", RenderMode::Normals},
+    {"robot", RenderMode::Depth},           {"gallery", RenderMode::Steps},
     {"csg_part", RenderMode::Shaded, true},
 };
 

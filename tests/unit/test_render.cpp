@@ -2,6 +2,7 @@
 // same clipping, same epsilon rule. Plus modes, bounds skipping, value updates and PNG output.
 #include "camera.h"
 #include "gpu_test.h"
+#include "shader_compile.h"
 #include "shared.h"
 
 #define STB_IMAGE_IMPLEMENTATION
@@ -144,7 +145,8 @@ TEST_P(SceneRender, HitMaskDepthAndColoursAgreeWithCpuTracing) {
             colourOk += std::max(diff.x, std::max(diff.y, diff.z)) <= 6.0f;
             glm::vec3 n = tetraNormal(ev, rc.eye + dir * info[i].depth,
                                       detail::hitEpsilon(rc, info[i].depth));
-            glm::vec3 nDiff = glm::abs(pixel(*normals, i) - glm::clamp(n * 0.5f + 0.5f, 0.0f, 1.0f) * 255.0f);
+            glm::vec3 nDiff =
+                glm::abs(pixel(*normals, i) - glm::clamp(n * 0.5f + 0.5f, 0.0f, 1.0f) * 255.0f);
             normalOk += std::max(nDiff.x, std::max(nDiff.y, nDiff.z)) <= 6.0f;
         }
     }
@@ -204,7 +206,9 @@ TEST_P(SceneRender, DefaultCameraIsTheScenesOrTheFramedOne) {
 
 INSTANTIATE_TEST_SUITE_P(Bundled, SceneRender, ::testing::ValuesIn(bundledScenes()), sceneTestName);
 
-fs::path scenePath(const char* name) { return fs::path(SDFCSG_SOURCE_DIR) / "assets/scenes" / name; }
+fs::path scenePath(const char* name) {
+    return fs::path(SDFCSG_SOURCE_DIR) / "assets/scenes" / name;
+}
 
 class Render : public GpuTest {};
 
@@ -230,7 +234,8 @@ TEST_F(Render, AllModesRenderWhatTheyPromise) {
     // scale.
     auto heat = [](uint32_t n) {
         float x = std::log2(1.0f + float(n)) / std::log2(1.0f + float(SDFCSG_MAX_STEPS));
-        glm::vec3 c(1.5f - std::abs(4 * x - 3), 1.5f - std::abs(4 * x - 2), 1.5f - std::abs(4 * x - 1));
+        glm::vec3 c(1.5f - std::abs(4 * x - 3), 1.5f - std::abs(4 * x - 2),
+                    1.5f - std::abs(4 * x - 1));
         return glm::round(glm::clamp(c, 0.0f, 1.0f) * 255.0f);
     };
     for (size_t i = 0; i < info.size(); ++i) {
@@ -322,7 +327,8 @@ TEST_F(Render, BoxOverlayDrawsEdges) {
     ASSERT_TRUE(none && all && selected);
     auto changed = [&](const Image& a) {
         size_t n = 0;
-        for (size_t i = 0; i < a.rgba.size(); ++i) n += a.rgba[i] != none->rgba[i];
+        for (size_t i = 0; i < a.rgba.size(); ++i)
+            n += a.rgba[i] != none->rgba[i];
         return n;
     };
     EXPECT_GT(changed(*all), 50u);
@@ -344,9 +350,14 @@ bool growFirstSphere(Scene& scene) {
     return false;
 }
 
-TEST_F(Render, UpdateValuesChangesTheImageToTheNewScene) {
-    Scene scene = loadOrDie(scenePath("snowman.json"));
-    auto renderer = Renderer::create(context(), scene);
+class UpdateValues : public GpuTest, public ::testing::WithParamInterface<bool> {};
+
+TEST_P(UpdateValues, ChangesTheImageToTheNewScene) {
+    const bool inlineValues = GetParam();
+    Scene scene = loadOrDie(scenePath("csg_part.json"));
+    RendererOptions rendererOptions;
+    rendererOptions.inlineValues = inlineValues;
+    auto renderer = Renderer::create(context(), scene, rendererOptions);
     ASSERT_TRUE(renderer) << renderer.error().str();
     Evaluator before(scene);
     RenderOptions options;
@@ -357,30 +368,45 @@ TEST_F(Render, UpdateValuesChangesTheImageToTheNewScene) {
 
     ASSERT_TRUE(growFirstSphere(scene));
     scene.nodes[0].color = glm::vec3(0.9f, 0.1f, 0.1f);
+    const detail::ShaderCacheStats statsBefore = detail::shaderCacheStats();
     auto updated = (*renderer)->updateValues(scene);
     ASSERT_TRUE(updated) << updated.error().str();
     auto second = (*renderer)->render(options);
     ASSERT_TRUE(second);
+    const detail::ShaderCacheStats statsAfter = detail::shaderCacheStats();
     EXPECT_NE(first->rgba, second->rgba);
+    // Values in a buffer: an upload only, no compile and not even a cache lookup.
+    const uint64_t lookups = [](const detail::ShaderCacheStats& s) {
+        return s.compiles + s.memoryHits + s.diskHits;
+    }(statsAfter) - [](const detail::ShaderCacheStats& s) {
+        return s.compiles + s.memoryHits + s.diskHits;
+    }(statsBefore);
+    EXPECT_EQ(lookups, inlineValues ? 1u : 0u);
 
     // The new image is the new scene's: its hit mask agrees with CPU tracing of the new values.
     Evaluator after(scene);
     const auto& info = (*renderer)->lastPixelInfo();
     detail::RayCamera rc = detail::makeRayCamera(*options.camera, kSize, kSize);
-    detail::ClipVolume clip = detail::makeClipVolume(after, rc.eye);
+    detail::ClipVolume clipBefore = detail::makeClipVolume(before, rc.eye);
+    detail::ClipVolume clipAfter = detail::makeClipVolume(after, rc.eye);
     size_t agree = 0, changed = 0;
     for (uint32_t y = 0; y < kSize; ++y)
         for (uint32_t x = 0; x < kSize; ++x) {
             glm::vec3 dir = detail::rayDirection(rc, x + 0.5f, y + 0.5f, kSize, kSize);
-            bool hitAfter = traceCpu(after, rc, clip, dir).t >= 0;
-            bool hitBefore =
-                traceCpu(before, rc, detail::makeClipVolume(before, rc.eye), dir).t >= 0;
+            bool hitAfter = traceCpu(after, rc, clipAfter, dir).t >= 0;
+            bool hitBefore = traceCpu(before, rc, clipBefore, dir).t >= 0;
             agree += hitAfter == (info[size_t(y) * kSize + x].depth >= 0);
             changed += hitAfter != hitBefore;
         }
     EXPECT_GT(changed, 20u) << "the edit should change the silhouette";
     EXPECT_GE(agree / double(kSize * kSize), 0.995);
 }
+
+INSTANTIATE_TEST_SUITE_P(Render, UpdateValues, ::testing::Values(true, false),
+                         [](const ::testing::TestParamInfo<bool>& param) {
+                             return param.param ? std::string("InlineValues")
+                                                : std::string("BufferValues");
+                         });
 
 TEST_F(Render, UpdateValuesRefusesStructuralChanges) {
     Scene scene = loadOrDie(scenePath("csg_part.json"));
@@ -442,7 +468,8 @@ Image decodePng(const fs::path& path) {
 
 Image gradient(uint32_t w, uint32_t h) {
     Image image{w, h, std::vector<uint8_t>(size_t(w) * h * 4)};
-    for (size_t i = 0; i < image.rgba.size(); ++i) image.rgba[i] = uint8_t(i * 7 + i / 13);
+    for (size_t i = 0; i < image.rgba.size(); ++i)
+        image.rgba[i] = uint8_t(i * 7 + i / 13);
     return image;
 }
 
@@ -466,7 +493,8 @@ TEST_F(Png, WritesARenderAtomicallyAndReplacesWholeFiles) {
     EXPECT_EQ(back.height, 5u);
     EXPECT_EQ(back.rgba, small.rgba);
     size_t files = 0;
-    for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) ++files;
+    for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir))
+        ++files;
     EXPECT_EQ(files, 1u) << "no temporary file may be left behind";
 
     // A real render round-trips exactly.
@@ -508,7 +536,8 @@ TEST_F(ContextTest, DeviceOverrideByNameOrIndex) {
     std::string name = context().deviceName();
     ASSERT_FALSE(name.empty());
     std::string upper = name.substr(0, std::min<size_t>(name.size(), 6));
-    for (char& c : upper) c = char(std::toupper(static_cast<unsigned char>(c)));
+    for (char& c : upper)
+        c = char(std::toupper(static_cast<unsigned char>(c)));
     options.device = upper; // a case-insensitive part of the name
     auto byName = Context::create(options);
     ASSERT_TRUE(byName) << byName.error().str();
@@ -522,7 +551,9 @@ TEST_F(ContextTest, DeviceOverrideByNameOrIndex) {
     EXPECT_FALSE(Context::create(options));
 }
 
-TEST_F(ContextTest, ValidationIsOnInTests) { EXPECT_TRUE(context().validationEnabled()); }
+TEST_F(ContextTest, ValidationIsOnInTests) {
+    EXPECT_TRUE(context().validationEnabled());
+}
 
 } // namespace
 } // namespace sdfcsg::test

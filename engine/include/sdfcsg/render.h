@@ -54,7 +54,8 @@ struct RendererOptions {
 class Renderer {
   public:
     // Generates, compiles and builds the pipeline for this scene; the pipeline is ready to run
-    // (drivers that compile on first use have done so) when this returns.
+    // (drivers that compile on first use have done so) when this returns. `context` must
+    // outlive the renderer.
     static Result<std::unique_ptr<Renderer>> create(Context& context, const Scene& scene,
                                                     const RendererOptions& options = {});
     ~Renderer();
