@@ -34,6 +34,8 @@ layout(std140, set = 0, binding = SDFCSG_BINDING_FRAME) uniform Frame {
     uvec4 size;      // width, height, mode, flags
     uvec4 counts;    // aa, light count, node count, selected node
     FrameLight lights[SDFCSG_MAX_LIGHTS];
+    uvec4 surfaceBoxCount; // x: boxes that hold every surface (0: use the clip box alone)
+    vec4 surfaceBoxes[2 * SDFCSG_MAX_CLIP_BOXES]; // min, max pairs
 } frame;
 
 layout(std430, set = 0, binding = SDFCSG_BINDING_PIXELS) writeonly buffer Pixels {
@@ -105,6 +107,15 @@ Trace trace(vec3 ro, vec3 rd) {
 
     Trace r = Trace(-1.0, 0u, vec3(0.0), 1.0, vec4(1.0));
     vec2 range = clipRay(frame.clipMin.xyz, frame.clipMax.xyz, ro, rd);
+    if (frame.surfaceBoxCount.x > 0u) {
+        // Start at the first entry into a box that holds surfaces, end at the last exit.
+        vec2 parts = vec2(1.0e30, -1.0e30);
+        for (uint i = 0u; i < frame.surfaceBoxCount.x; ++i) {
+            vec2 b = clipRay(frame.surfaceBoxes[2u * i].xyz, frame.surfaceBoxes[2u * i + 1u].xyz, ro, rd);
+            if (b.x <= b.y) parts = vec2(min(parts.x, b.x), max(parts.y, b.y));
+        }
+        range = vec2(max(range.x, parts.x), min(range.y, parts.y));
+    }
     float tFar = min(range.y, frame.clipMin.w);
     uint phase = range.x > tFar ? kDone : kMarch;
     vec3 origin = ro, dir = rd;
@@ -201,6 +212,18 @@ Trace trace(vec3 ro, vec3 rd) {
             vec3 t0 = (frame.clipMin.xyz - p) * inv, t1 = (frame.clipMax.xyz - p) * inv;
             vec3 far = max(t0, t1);
             shadowEnd = min(min(far.x, far.y), min(far.z, shadowReach));
+            if (frame.surfaceBoxCount.x > 0u) {
+                // Nothing can shadow beyond the last exit from the boxes that hold surfaces.
+                float lastExit = 0.0;
+                for (uint i = 0u; i < frame.surfaceBoxCount.x; ++i) {
+                    vec3 a = (frame.surfaceBoxes[2u * i].xyz - p) * inv;
+                    vec3 b = (frame.surfaceBoxes[2u * i + 1u].xyz - p) * inv;
+                    vec3 lo = min(a, b), hi = max(a, b);
+                    float tOut = min(min(hi.x, hi.y), hi.z);
+                    if (max(max(lo.x, lo.y), lo.z) <= tOut) lastExit = max(lastExit, tOut);
+                }
+                shadowEnd = min(shadowEnd, lastExit);
+            }
             t = 2.0 * eps;
             // A light behind the surface needs no shadow (Lambert is zero): end it at once.
             tap = dot(r.n, dir) > 0.0 ? 0 : kShadowSteps;

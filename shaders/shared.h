@@ -19,6 +19,7 @@
 #define SDFCSG_PROBE_GROUP_X 64
 
 #define SDFCSG_MAX_LIGHTS 4
+#define SDFCSG_MAX_CLIP_BOXES 8 // boxes that hold every surface; rays skip the space outside them
 #define SDFCSG_MAX_STEPS 256
 
 #define SDFCSG_MODE_SHADED 0

@@ -5,6 +5,7 @@
 
 #include "sdfcsg/eval.h"
 #include "sdfcsg/scene.h"
+#include "shared.h"
 
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
@@ -13,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <vector>
 
 namespace sdfcsg::detail {
 
@@ -56,11 +58,33 @@ inline float hitEpsilon(const RayCamera& rc, float t) {
     return std::max(kMinHitEpsilon, 0.5f * t * rc.footprint);
 }
 
+// Boxes that together hold every surface of the scene, at most SDFCSG_MAX_CLIP_BOXES: the root's
+// operands when it is a sharp union of finite parts (neighbours in the file grouped together when
+// there are more), else none (the clip volume alone). A ray starts at its first entry into any
+// of them and ends at its last exit, so rays that pass between the parts cost no steps.
+inline std::vector<Aabb> surfaceBoxes(const Evaluator& evaluator) {
+    const FlatNode& root = evaluator.nodes()[0];
+    if (root.kind != NodeKind::Union || root.smooth > 0.0f) return {};
+    const size_t n = root.children.size();
+    const size_t groups = std::min<size_t>(n, SDFCSG_MAX_CLIP_BOXES);
+    std::vector<Aabb> boxes(groups);
+    for (size_t i = 0; i < n; ++i) {
+        const Aabb& b = evaluator.nodes()[root.children[i]].bounds;
+        if (!b.finite()) return {};
+        Aabb& g = boxes[i * groups / n];
+        g.min = glm::min(g.min, b.min);
+        g.max = glm::max(g.max, b.max);
+    }
+    return boxes;
+}
+
 // The part of space rays are traced in: the scene's bounds, cut to a cube around the eye whose
-// half size is the far distance (planes make bounds infinite).
+// half size is the far distance (planes make bounds infinite), and within it the boxes that hold
+// the surfaces.
 struct ClipVolume {
     Aabb box;
-    float far; // no ray goes beyond this t
+    float far;               // no ray goes beyond this t
+    std::vector<Aabb> parts; // surfaceBoxes(); empty: the box alone
 };
 
 // Bounds of the finite primitives: what a camera looks at and what "far" is measured against.
@@ -84,6 +108,7 @@ inline ClipVolume makeClipVolume(const Evaluator& evaluator, glm::vec3 eye) {
     clip.box = evaluator.bounds();
     clip.box.min = glm::max(clip.box.min, eye - glm::vec3(clip.far));
     clip.box.max = glm::min(clip.box.max, eye + glm::vec3(clip.far));
+    clip.parts = surfaceBoxes(evaluator);
     return clip;
 }
 
@@ -97,6 +122,24 @@ inline bool clipRay(const Aabb& box, glm::vec3 origin, glm::vec3 dir, float& tNe
     glm::vec3 lo = glm::min(t0, t1), hi = glm::max(t0, t1);
     tNear = std::max(std::max(lo.x, lo.y), std::max(lo.z, 0.0f));
     tFar = std::min(std::min(hi.x, hi.y), hi.z);
+    return tNear <= tFar;
+}
+
+// The interval of a ray that is traced, as trace() in shaders/raymarch.comp computes it: inside
+// the clip box, from the first entry into a surface box to the last exit. False when empty.
+inline bool rayInterval(const ClipVolume& clip, glm::vec3 origin, glm::vec3 dir, float& tNear,
+                        float& tFar) {
+    clipRay(clip.box, origin, dir, tNear, tFar);
+    if (!clip.parts.empty()) {
+        float first = 1.0e30f, last = -1.0e30f;
+        for (const Aabb& part : clip.parts) {
+            float a, b;
+            if (clipRay(part, origin, dir, a, b)) first = std::min(first, a), last = std::max(last, b);
+        }
+        tNear = std::max(tNear, first);
+        tFar = std::min(tFar, last);
+    }
+    tFar = std::min(tFar, clip.far);
     return tNear <= tFar;
 }
 

@@ -37,8 +37,11 @@ struct FrameUniform {
     glm::uvec4 size;     // width, height, mode, flags
     glm::uvec4 counts;   // aa, lights, nodes, selected
     FrameLight lights[SDFCSG_MAX_LIGHTS];
+    glm::uvec4 surfaceBoxCount; // x
+    glm::vec4 surfaceBoxes[2 * SDFCSG_MAX_CLIP_BOXES]; // min, max pairs
 };
-static_assert(sizeof(FrameUniform) == 11 * 16 + SDFCSG_MAX_LIGHTS * 48);
+static_assert(sizeof(FrameUniform) ==
+              12 * 16 + SDFCSG_MAX_LIGHTS * 48 + SDFCSG_MAX_CLIP_BOXES * 32);
 static_assert(SDFCSG_MAX_LIGHTS == 4, "raymarch.comp reads the lights into four locals");
 
 constexpr detail::Binding kBindings[] = {
@@ -114,6 +117,11 @@ struct Renderer::Impl {
         module = VK_NULL_HANDLE;
     }
 
+    bool defaultSkipping() const {
+        return ctx.properties.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU;
+    }
+
+    // The pipeline for a skipping choice, created and warmed up on first use.
     VkPipeline pipeline(bool skipping) {
         VkPipeline& p = pipelines[skipping ? 1 : 0];
         if (!p) {
@@ -197,6 +205,12 @@ struct Renderer::Impl {
         f.forward = glm::vec4(rc.forward, detail::kMinHitEpsilon);
         f.clipMin = glm::vec4(clip.box.min, clip.far);
         f.clipMax = glm::vec4(clip.box.max, 0.0f);
+        const std::vector<Aabb>& boxes = clip.parts;
+        f.surfaceBoxCount.x = uint32_t(boxes.size());
+        for (size_t i = 0; i < boxes.size(); ++i) {
+            f.surfaceBoxes[2 * i] = glm::vec4(boxes[i].min, 0.0f);
+            f.surfaceBoxes[2 * i + 1] = glm::vec4(boxes[i].max, 0.0f);
+        }
         f.background = glm::vec4(scene.background, 0.0f);
         f.sky = glm::vec4(scene.background * scene.background, 0.0f); // gamma 2, as the kernel
         const float size = std::max(glm::length(finite.max - finite.min), 1e-3f);
@@ -270,7 +284,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene
     r.nodes = *nodes;
     r.uploadNodes();
     if (auto reserved = r.reserve(64 * 64); !reserved) return reserved.error();
-    r.pipeline(true);
+    r.pipeline(r.defaultSkipping());
     return std::unique_ptr<Renderer>(new Renderer(std::move(impl)));
 }
 
@@ -286,7 +300,7 @@ Status Renderer::updateValues(const Scene& scene) {
             r.scene = std::move(previous);
             return built.error();
         }
-        r.pipeline(true);
+        r.pipeline(r.defaultSkipping());
     }
     r.evaluator = std::make_unique<Evaluator>(scene);
     r.uploadNodes(); // no render is in flight: render() waits for its fence
@@ -318,7 +332,7 @@ Result<Image> Renderer::render(const RenderOptions& options) {
     Camera camera = options.camera   ? *options.camera
                     : r.scene.camera ? *r.scene.camera
                                      : frameCamera(*r.evaluator, aspect);
-    VkPipeline pipeline = r.pipeline(options.boundsSkipping); // may submit its warm-up
+    VkPipeline pipeline = r.pipeline(options.boundsSkipping.value_or(r.defaultSkipping()));
     FrameUniform f = r.frameUniform(options, camera);
     detail::uploadBuffer(r.ctx, r.frame, &f, sizeof(f));
 

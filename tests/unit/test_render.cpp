@@ -44,9 +44,7 @@ CpuHit traceCpu(const Evaluator& ev, const detail::RayCamera& rc, const detail::
                 glm::vec3 dir) {
     CpuHit hit;
     float tNear, tFar;
-    if (!detail::clipRay(clip.box, rc.eye, dir, tNear, tFar)) return hit;
-    tFar = std::min(tFar, clip.far);
-    if (tNear > tFar) return hit;
+    if (!detail::rayInterval(clip, rc.eye, dir, tNear, tFar)) return hit;
     float t = tNear;
     for (uint32_t i = 0; i < SDFCSG_MAX_STEPS; ++i) {
         hit.steps = i + 1;
@@ -166,6 +164,7 @@ TEST_P(SceneRender, BoundsSkippingDoesNotChangeTheImage) {
     ASSERT_TRUE(renderer) << renderer.error().str();
     RenderOptions options;
     options.width = 96, options.height = 72;
+    options.boundsSkipping = true;
     auto on = (*renderer)->render(options);
     ASSERT_TRUE(on);
     std::vector<PixelInfo> infoOn = (*renderer)->lastPixelInfo();

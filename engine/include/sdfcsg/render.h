@@ -26,7 +26,10 @@ struct RenderOptions {
     uint32_t aa = 1;              // N x N samples per pixel
     bool shadows = true;
     bool ambientOcclusion = true;
-    bool boundsSkipping = true;   // skip operands whose bounds cannot change the result
+    // Skip operands whose bounds cannot change the result (the image is the same either way).
+    // Unset: on for GPUs, off for CPU devices such as lavapipe, which execute both sides of
+    // every branch in their SIMD lanes, so the bounds tests only add work there.
+    std::optional<bool> boundsSkipping;
     BoxOverlay boxes = BoxOverlay::None;
     int selectedNode = -1;        // for BoxOverlay::Selected
 };
