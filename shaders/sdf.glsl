@@ -70,36 +70,38 @@ float sdCapsule(vec3 p, vec3 a, vec3 b, float r) {
 // -smin(-a, -b). Once the operands differ by k or more the blend factor is exactly 0 or 1, so
 // those cases return an operand unchanged: this makes bounds skipping exact in floating point
 // (the skipped operand could not have changed a single bit) and gives k = 0 the sharp operator
-// without a division, ties going to the first operand. The vec4 forms carry colour in rgb and
-// the distance in w; colour blends by the same factor. Difference(a, b) = max(a, -b).
+// (ties go to the first operand). Selects rather than branches: both sides are a few
+// instructions, and every branch costs CPU drivers (lavapipe) compile time. The vec4 forms carry
+// colour in rgb and the distance in w; colour blends by the same factor.
+// Difference(a, b) = max(a, -b).
 float opUnion(float a, float b, float k) {
-    if (b - a >= k) return a;
-    if (a - b >= k) return b;
-    float h = 0.5 + 0.5 * (b - a) / k;
-    return mix(b, a, h) - k * h * (1.0 - h);
+    float h = clamp(0.5 + 0.5 * (b - a) / max(k, 1e-30), 0.0, 1.0);
+    float blend = mix(b, a, h) - k * h * (1.0 - h);
+    float r = (a - b >= k) ? b : blend;
+    return (b - a >= k) ? a : r;
 }
 
 float opIntersection(float a, float b, float k) {
-    if (a - b >= k) return a;
-    if (b - a >= k) return b;
-    float h = 0.5 - 0.5 * (b - a) / k;
-    return mix(b, a, h) + k * h * (1.0 - h);
+    float h = clamp(0.5 - 0.5 * (b - a) / max(k, 1e-30), 0.0, 1.0);
+    float blend = mix(b, a, h) + k * h * (1.0 - h);
+    float r = (b - a >= k) ? b : blend;
+    return (a - b >= k) ? a : r;
 }
 
 float opDifference(float a, float b, float k) { return opIntersection(a, -b, k); }
 
 vec4 opUnion(vec4 a, vec4 b, float k) {
-    if (b.w - a.w >= k) return a;
-    if (a.w - b.w >= k) return b;
-    float h = 0.5 + 0.5 * (b.w - a.w) / k;
-    return vec4(mix(b.rgb, a.rgb, h), mix(b.w, a.w, h) - k * h * (1.0 - h));
+    float h = clamp(0.5 + 0.5 * (b.w - a.w) / max(k, 1e-30), 0.0, 1.0);
+    vec4 blend = vec4(mix(b.rgb, a.rgb, h), mix(b.w, a.w, h) - k * h * (1.0 - h));
+    vec4 r = (a.w - b.w >= k) ? b : blend;
+    return (b.w - a.w >= k) ? a : r;
 }
 
 vec4 opIntersection(vec4 a, vec4 b, float k) {
-    if (a.w - b.w >= k) return a;
-    if (b.w - a.w >= k) return b;
-    float h = 0.5 - 0.5 * (b.w - a.w) / k;
-    return vec4(mix(b.rgb, a.rgb, h), mix(b.w, a.w, h) + k * h * (1.0 - h));
+    float h = clamp(0.5 - 0.5 * (b.w - a.w) / max(k, 1e-30), 0.0, 1.0);
+    vec4 blend = vec4(mix(b.rgb, a.rgb, h), mix(b.w, a.w, h) + k * h * (1.0 - h));
+    vec4 r = (b.w - a.w >= k) ? b : blend;
+    return (a.w - b.w >= k) ? a : r;
 }
 
 vec4 opDifference(vec4 a, vec4 b, float k) { return opIntersection(a, vec4(b.rgb, -b.w), k); }

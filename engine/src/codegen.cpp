@@ -17,9 +17,9 @@ namespace sdfcsg {
 namespace {
 
 // glslang finds each literal by a linear search through all earlier ones, so inlining every
-// value makes compiling quadratic: 2000 inlined spheres take seconds. Larger scenes read their
-// values from the node buffer even when inlining is asked for.
-constexpr size_t kInlineLimit = 256;
+// value makes compiling quadratic: 1000 inlined spheres take about 3 s, 2000 more than 5 s.
+// Larger scenes read their values from the node buffer even when inlining is asked for.
+constexpr size_t kInlineLimit = 1024;
 
 // How a primitive's kernel is called: its function in sdf.glsl and the arguments after the local
 // point, as (first kernel-parameter slot, component count). Must match sdf::evalPrimitive.
@@ -56,7 +56,8 @@ void appendFloat(std::string& out, float v) {
 
 // Comments must stay on one line and pure ASCII (a trailing backslash would splice lines).
 void appendCommentText(std::string& out, std::string_view text) {
-    for (char c : text.substr(0, 120)) out += (c >= 0x20 && c < 0x7f && c != '\\') ? c : '?';
+    for (char c : text.substr(0, 120))
+        out += (c >= 0x20 && c < 0x7f && c != '\\') ? c : '?';
 }
 
 // Node i as a uint expression (see nodeIndex in nodes.glsl).
@@ -66,7 +67,9 @@ std::string indexExpr(uint32_t i) {
 }
 
 // Where the value of kernel-parameter slot `first` lives: p0/p1 and the component letters.
-std::string_view paramVector(int first) { return first < 4 ? "p0" : "p1"; }
+std::string_view paramVector(int first) {
+    return first < 4 ? "p0" : "p1";
+}
 std::string_view swizzle(int first, int count) {
     return std::string_view("xyzw").substr(size_t(first % 4), size_t(count));
 }
@@ -89,7 +92,8 @@ class Emitter {
     void helpers() {
         if (lit_) return;
         std::array<bool, kNodeKindCount> used{};
-        for (const Node& n : scene_.nodes) used[size_t(n.kind)] = true;
+        for (const Node& n : scene_.nodes)
+            used[size_t(n.kind)] = true;
         for (int k = 0; k <= int(NodeKind::Capsule); ++k) {
             if (!used[size_t(k)]) continue;
             const Call& call = kCalls[k];
@@ -177,17 +181,22 @@ class Emitter {
     void comment(uint32_t i) {
         const Node& n = scene_.nodes[i];
         out_ += "; // ";
-        if (!n.name.empty()) appendCommentText(out_, n.name);
-        else if (!n.path.empty()) appendCommentText(out_, n.path);
-        else out_ += "node " + std::to_string(i);
+        if (!n.name.empty())
+            appendCommentText(out_, n.name);
+        else if (!n.path.empty())
+            appendCommentText(out_, n.path);
+        else
+            out_ += "node " + std::to_string(i);
         out_ += " (";
         out_ += kindInfo(n.kind).name;
         out_ += ")\n";
     }
 
     void smooth(uint32_t op) {
-        if (lit_) appendFloat(out_, (*lit_)[op].bmin.w);
-        else out_ += "nodeSmooth(" + indexExpr(op) + ")";
+        if (lit_)
+            appendFloat(out_, (*lit_)[op].bmin.w);
+        else
+            out_ += "nodeSmooth(" + indexExpr(op) + ")";
     }
 
     void leaf(uint32_t i) {
@@ -249,7 +258,8 @@ class Emitter {
     // operand can change the running value.
     void guard(uint32_t op, uint32_t child, uint32_t depth) {
         indent(depth);
-        out_ += scene_.nodes[op].kind == NodeKind::Union ? "if (unionNeeds(" : "if (differenceNeeds(";
+        out_ +=
+            scene_.nodes[op].kind == NodeKind::Union ? "if (unionNeeds(" : "if (differenceNeeds(";
         if (lit_) {
             out_ += "boundsDistance(";
             appendVector(out_, &(*lit_)[child].bmin.x, 3);

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <type_traits>
 
 namespace sdfcsg {
 
@@ -40,7 +41,9 @@ namespace {
 
 constexpr glm::vec3 kDefaultColor{0.8f, 0.8f, 0.8f};
 
-bool isOperation(NodeKind kind) { return kindInfo(kind).operation; }
+bool isOperation(NodeKind kind) {
+    return kindInfo(kind).operation;
+}
 
 // cos and sin of an angle in degrees, exact for multiples of 90 so that quarter turns keep
 // boxes axis-aligned to the last bit.
@@ -76,7 +79,9 @@ Aabb outwardBox(glm::dvec3 lo, glm::dvec3 hi) {
     return box;
 }
 
-Aabb infiniteBox() { return Aabb{glm::vec3(-INFINITY), glm::vec3(INFINITY)}; }
+Aabb infiniteBox() {
+    return Aabb{glm::vec3(-INFINITY), glm::vec3(INFINITY)};
+}
 
 float volume(const Aabb& b) {
     glm::vec3 e = b.max - b.min;
@@ -92,21 +97,26 @@ glm::vec3 localPoint(const FlatNode& n, glm::vec3 p) {
 }
 
 // The value types of sceneDistance (float) and sceneSample (vec4: colour, distance in w).
-float leaf(const FlatNode& n, glm::vec3 p, float*) {
-    return sdf::evalPrimitive(n.kind, localPoint(n, p), n.params) * n.scale;
+template <class V> V leaf(const FlatNode& n, glm::vec3 p) {
+    float d = sdf::evalPrimitive(n.kind, localPoint(n, p), n.params) * n.scale;
+    if constexpr (std::is_same_v<V, float>)
+        return d;
+    else
+        return glm::vec4(n.color, d);
 }
-glm::vec4 leaf(const FlatNode& n, glm::vec3 p, glm::vec4*) {
-    return glm::vec4(n.color, leaf(n, p, static_cast<float*>(nullptr)));
+template <class V> float dist(const V& v) {
+    if constexpr (std::is_same_v<V, float>)
+        return v;
+    else
+        return v.w;
 }
-float dist(float v) { return v; }
-float dist(const glm::vec4& v) { return v.w; }
 
 // The generated code's walk, iteratively: a frame per open operation holds the running fold
 // and the next child to visit. Operand i > 0 of a union is skipped when its bounds lie at least
 // k beyond the running value, a subtrahend when they lie at least k beyond its negation; with
 // sdf.glsl's exact operator ends, the skipped operand could not have changed the result.
-template <class V> V evaluate(const std::vector<FlatNode>& nodes, uint32_t root, glm::vec3 p,
-                              bool skipping) {
+template <class V>
+V evaluate(const std::vector<FlatNode>& nodes, uint32_t root, glm::vec3 p, bool skipping) {
     struct Frame {
         uint32_t node, next;
         V acc;
@@ -121,7 +131,7 @@ template <class V> V evaluate(const std::vector<FlatNode>& nodes, uint32_t root,
             current = n.children[0];
             continue;
         }
-        V value = leaf(n, p, static_cast<V*>(nullptr));
+        V value = leaf<V>(n, p);
         // Deliver the value to the enclosing operations until one has another child to visit.
         for (;;) {
             if (stack.empty()) return value;
@@ -163,7 +173,8 @@ Evaluator::Evaluator(const Scene& scene) {
     // Pass 1, parents first: transforms (accumulated in double), colours, parameters.
     struct Acc {
         glm::dmat3 toLocal{1.0}, toWorld{1.0};
-        glm::dvec3 offset{0.0}, origin{0.0}; // local = toLocal*p + offset; world = toWorld*l + origin
+        glm::dvec3 offset{0.0},
+            origin{0.0}; // local = toLocal*p + offset; world = toWorld*l + origin
         double scale = 1.0;
     };
     const Acc identity;
@@ -171,7 +182,8 @@ Evaluator::Evaluator(const Scene& scene) {
     std::vector<uint32_t> parent(count, UINT32_MAX);
     for (size_t i = 0; i < count; ++i) {
         const Node& src = scene.nodes[i];
-        for (uint32_t c : src.children) parent[c] = uint32_t(i);
+        for (uint32_t c : src.children)
+            parent[c] = uint32_t(i);
         const bool hasParent = parent[i] != UINT32_MAX;
         const Acc& up = hasParent ? acc[parent[i]] : identity;
         const FlatNode* upNode = hasParent ? &nodes_[parent[i]] : nullptr;
@@ -240,9 +252,13 @@ Evaluator::Evaluator(const Scene& scene) {
     }
 }
 
-float Evaluator::distance(glm::vec3 p) const { return distance(p, 0); }
+float Evaluator::distance(glm::vec3 p) const {
+    return distance(p, 0);
+}
 
-Sample Evaluator::sample(glm::vec3 p) const { return sample(p, 0); }
+Sample Evaluator::sample(glm::vec3 p) const {
+    return sample(p, 0);
+}
 
 float Evaluator::distance(glm::vec3 p, uint32_t node) const {
     if (node >= nodes_.size()) return INFINITY; // an empty scene is empty space

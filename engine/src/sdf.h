@@ -21,10 +21,16 @@ using glm::abs, glm::clamp, glm::dot, glm::length, glm::max, glm::min, glm::mix,
 using glm::vec2, glm::vec3, glm::vec4;
 using std::sqrt;
 
-inline float dot2(vec2 v) { return dot(v, v); }
-inline float dot2(vec3 v) { return dot(v, v); }
+inline float dot2(vec2 v) {
+    return dot(v, v);
+}
+inline float dot2(vec3 v) {
+    return dot(v, v);
+}
 
-inline float sdSphere(vec3 p, float r) { return length(p) - r; }
+inline float sdSphere(vec3 p, float r) {
+    return length(p) - r;
+}
 
 inline float sdBox(vec3 p, vec3 b) {
     vec3 q = abs(p) - b;
@@ -36,7 +42,9 @@ inline float sdRoundBox(vec3 p, vec3 b, float r) {
     return length(max(q, 0.0f)) + min(max(q.x, max(q.y, q.z)), 0.0f) - r;
 }
 
-inline float sdPlane(vec3 p, vec3 n, float offset) { return dot(p, n) - offset; }
+inline float sdPlane(vec3 p, vec3 n, float offset) {
+    return dot(p, n) - offset;
+}
 
 inline float sdTriangularPrism(vec3 p, float hw, float h, float hl) {
     vec2 q = vec2(hw, h);
@@ -76,33 +84,35 @@ inline float sdCapsule(vec3 p, vec3 a, vec3 b, float r) {
 }
 
 inline float opUnion(float a, float b, float k) {
-    if (b - a >= k) return a;
-    if (a - b >= k) return b;
-    float h = 0.5f + 0.5f * (b - a) / k;
-    return mix(b, a, h) - k * h * (1.0f - h);
+    float h = clamp(0.5f + 0.5f * (b - a) / max(k, 1e-30f), 0.0f, 1.0f);
+    float blend = mix(b, a, h) - k * h * (1.0f - h);
+    float r = (a - b >= k) ? b : blend;
+    return (b - a >= k) ? a : r;
 }
 
 inline float opIntersection(float a, float b, float k) {
-    if (a - b >= k) return a;
-    if (b - a >= k) return b;
-    float h = 0.5f - 0.5f * (b - a) / k;
-    return mix(b, a, h) + k * h * (1.0f - h);
+    float h = clamp(0.5f - 0.5f * (b - a) / max(k, 1e-30f), 0.0f, 1.0f);
+    float blend = mix(b, a, h) + k * h * (1.0f - h);
+    float r = (b - a >= k) ? b : blend;
+    return (a - b >= k) ? a : r;
 }
 
-inline float opDifference(float a, float b, float k) { return opIntersection(a, -b, k); }
+inline float opDifference(float a, float b, float k) {
+    return opIntersection(a, -b, k);
+}
 
 inline vec4 opUnion(vec4 a, vec4 b, float k) {
-    if (b.w - a.w >= k) return a;
-    if (a.w - b.w >= k) return b;
-    float h = 0.5f + 0.5f * (b.w - a.w) / k;
-    return vec4(mix(vec3(b), vec3(a), h), mix(b.w, a.w, h) - k * h * (1.0f - h));
+    float h = clamp(0.5f + 0.5f * (b.w - a.w) / max(k, 1e-30f), 0.0f, 1.0f);
+    vec4 blend = vec4(mix(vec3(b), vec3(a), h), mix(b.w, a.w, h) - k * h * (1.0f - h));
+    vec4 r = (a.w - b.w >= k) ? b : blend;
+    return (b.w - a.w >= k) ? a : r;
 }
 
 inline vec4 opIntersection(vec4 a, vec4 b, float k) {
-    if (a.w - b.w >= k) return a;
-    if (b.w - a.w >= k) return b;
-    float h = 0.5f - 0.5f * (b.w - a.w) / k;
-    return vec4(mix(vec3(b), vec3(a), h), mix(b.w, a.w, h) + k * h * (1.0f - h));
+    float h = clamp(0.5f - 0.5f * (b.w - a.w) / max(k, 1e-30f), 0.0f, 1.0f);
+    vec4 blend = vec4(mix(vec3(b), vec3(a), h), mix(b.w, a.w, h) + k * h * (1.0f - h));
+    vec4 r = (b.w - a.w >= k) ? b : blend;
+    return (a.w - b.w >= k) ? a : r;
 }
 
 inline vec4 opDifference(vec4 a, vec4 b, float k) {
@@ -125,67 +135,94 @@ inline vec4 opDifference(vec4 a, vec4 b, float k) {
 using Params = std::array<float, kMaxParams>;
 
 inline Params kernelParams(NodeKind kind, const Params& v) {
-    Params k{};
     switch (kind) {
-    case NodeKind::Sphere: k[0] = v[0]; break;
-    case NodeKind::Box: k = {0.5f * v[0], 0.5f * v[1], 0.5f * v[2]}; break;
+    case NodeKind::Sphere:
+        return {v[0]};
+    case NodeKind::Box:
+        return {0.5f * v[0], 0.5f * v[1], 0.5f * v[2]};
     case NodeKind::RoundBox: {
         vec3 b = 0.5f * vec3(v[0], v[1], v[2]);
-        k = {b.x, b.y, b.z, min(v[3], min(b.x, min(b.y, b.z)))};
-        break;
+        return {b.x, b.y, b.z, min(v[3], min(b.x, min(b.y, b.z)))};
     }
     case NodeKind::Plane: {
         vec3 n = vec3(v[0], v[1], v[2]);
         float len = length(n);
         n = len > 0.0f ? n / len : vec3(0.0f, 1.0f, 0.0f);
-        k = {n.x, n.y, n.z, v[3]};
-        break;
+        return {n.x, n.y, n.z, v[3]};
     }
-    case NodeKind::TriangularPrism: k = {0.5f * v[0], v[1], 0.5f * v[2]}; break;
-    case NodeKind::Torus: k = {v[0], v[1]}; break;
-    case NodeKind::Cylinder: k = {v[0], 0.5f * v[1]}; break;
-    case NodeKind::Cone: k = {v[0], 0.5f * v[1], v[2]}; break;
-    case NodeKind::Capsule: k = {v[0], v[1], v[2], v[6], v[3], v[4], v[5]}; break;
-    default: k[0] = v[0]; break; // operations: the local smooth radius
+    case NodeKind::TriangularPrism:
+        return {0.5f * v[0], v[1], 0.5f * v[2]};
+    case NodeKind::Torus:
+        return {v[0], v[1]};
+    case NodeKind::Cylinder:
+        return {v[0], 0.5f * v[1]};
+    case NodeKind::Cone:
+        return {v[0], 0.5f * v[1], v[2]};
+    case NodeKind::Capsule:
+        return {v[0], v[1], v[2], v[6], v[3], v[4], v[5]};
+    default:
+        return {v[0]}; // operations: the smooth radius, in their local units
     }
-    return k;
 }
 
 // Local distance of a primitive, given its kernel parameters.
 inline float evalPrimitive(NodeKind kind, vec3 p, const Params& k) {
     switch (kind) {
-    case NodeKind::Sphere: return sdSphere(p, k[0]);
-    case NodeKind::Box: return sdBox(p, vec3(k[0], k[1], k[2]));
-    case NodeKind::RoundBox: return sdRoundBox(p, vec3(k[0], k[1], k[2]), k[3]);
-    case NodeKind::Plane: return sdPlane(p, vec3(k[0], k[1], k[2]), k[3]);
-    case NodeKind::TriangularPrism: return sdTriangularPrism(p, k[0], k[1], k[2]);
-    case NodeKind::Torus: return sdTorus(p, k[0], k[1]);
-    case NodeKind::Cylinder: return sdCylinder(p, k[0], k[1]);
-    case NodeKind::Cone: return sdCone(p, k[0], k[1], k[2]);
+    case NodeKind::Sphere:
+        return sdSphere(p, k[0]);
+    case NodeKind::Box:
+        return sdBox(p, vec3(k[0], k[1], k[2]));
+    case NodeKind::RoundBox:
+        return sdRoundBox(p, vec3(k[0], k[1], k[2]), k[3]);
+    case NodeKind::Plane:
+        return sdPlane(p, vec3(k[0], k[1], k[2]), k[3]);
+    case NodeKind::TriangularPrism:
+        return sdTriangularPrism(p, k[0], k[1], k[2]);
+    case NodeKind::Torus:
+        return sdTorus(p, k[0], k[1]);
+    case NodeKind::Cylinder:
+        return sdCylinder(p, k[0], k[1]);
+    case NodeKind::Cone:
+        return sdCone(p, k[0], k[1], k[2]);
     case NodeKind::Capsule:
         return sdCapsule(p, vec3(k[0], k[1], k[2]), vec3(k[4], k[5], k[6]), k[3]);
-    default: return 0.0f;
+    default:
+        return 0.0f;
     }
 }
 
 // Exact local bounding box of a primitive: lo/hi corners; false for the (unbounded) plane.
 inline bool localBounds(NodeKind kind, const Params& k, vec3& lo, vec3& hi) {
     switch (kind) {
-    case NodeKind::Sphere: hi = vec3(k[0]); break;
+    case NodeKind::Sphere:
+        hi = vec3(k[0]);
+        break;
     case NodeKind::Box:
-    case NodeKind::RoundBox: hi = vec3(k[0], k[1], k[2]); break;
-    case NodeKind::Plane: return false;
-    case NodeKind::TriangularPrism: hi = vec3(k[0], 0.5f * k[1], k[2]); break;
-    case NodeKind::Torus: hi = vec3(k[0] + k[1], k[1], k[0] + k[1]); break;
-    case NodeKind::Cylinder: hi = vec3(k[0], k[1], k[0]); break;
-    case NodeKind::Cone: hi = vec3(max(k[0], k[2]), k[1], max(k[0], k[2])); break;
+    case NodeKind::RoundBox:
+        hi = vec3(k[0], k[1], k[2]);
+        break;
+    case NodeKind::Plane:
+        return false;
+    case NodeKind::TriangularPrism:
+        hi = vec3(k[0], 0.5f * k[1], k[2]);
+        break;
+    case NodeKind::Torus:
+        hi = vec3(k[0] + k[1], k[1], k[0] + k[1]);
+        break;
+    case NodeKind::Cylinder:
+        hi = vec3(k[0], k[1], k[0]);
+        break;
+    case NodeKind::Cone:
+        hi = vec3(max(k[0], k[2]), k[1], max(k[0], k[2]));
+        break;
     case NodeKind::Capsule: {
         vec3 a(k[0], k[1], k[2]), b(k[4], k[5], k[6]);
         lo = min(a, b) - k[3];
         hi = max(a, b) + k[3];
         return true;
     }
-    default: return false;
+    default:
+        return false;
     }
     lo = -hi;
     return true;

@@ -40,7 +40,8 @@ struct Hash {
     uint64_t h = 0xcbf29ce484222325ull;
     void add(const void* data, size_t size) {
         auto* p = static_cast<const unsigned char*>(data);
-        for (size_t i = 0; i < size; ++i) h = (h ^ p[i]) * 0x100000001b3ull;
+        for (size_t i = 0; i < size; ++i)
+            h = (h ^ p[i]) * 0x100000001b3ull;
     }
     void add(std::string_view s) {
         uint64_t n = s.size();
@@ -188,7 +189,8 @@ Result<std::vector<uint32_t>> runGlslang(std::string_view kernel, std::string_vi
     Includer includer(scene);
     auto failure = [&](const char* what, const char* log) {
         std::string message = std::string(what) + "\n" + log;
-        while (!message.empty() && message.back() == '\n') message.pop_back();
+        while (!message.empty() && message.back() == '\n')
+            message.pop_back();
         return Error::message(ErrorKind::Shader, name, std::move(message));
     };
     if (!shader.parse(GetDefaultResources(), 450, ENoProfile, false, false, messages, includer))

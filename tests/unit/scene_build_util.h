@@ -53,19 +53,34 @@ inline Tree leaf(NodeKind kind, std::initializer_list<float> params) {
     Tree t;
     t.kind = kind;
     int i = 0;
-    for (float v : params) t.params[size_t(i++)] = v;
+    for (float v : params)
+        t.params[size_t(i++)] = v;
     return t;
 }
-inline Tree sphere(float r) { return leaf(NodeKind::Sphere, {r}); }
-inline Tree box(float x, float y, float z) { return leaf(NodeKind::Box, {x, y, z}); }
+inline Tree sphere(float r) {
+    return leaf(NodeKind::Sphere, {r});
+}
+inline Tree box(float x, float y, float z) {
+    return leaf(NodeKind::Box, {x, y, z});
+}
 inline Tree roundBox(float x, float y, float z, float r) {
     return leaf(NodeKind::RoundBox, {x, y, z, r});
 }
-inline Tree plane(glm::vec3 n, float offset) { return leaf(NodeKind::Plane, {n.x, n.y, n.z, offset}); }
-inline Tree prism(float w, float h, float l) { return leaf(NodeKind::TriangularPrism, {w, h, l}); }
-inline Tree torus(float major, float minor) { return leaf(NodeKind::Torus, {major, minor}); }
-inline Tree cylinder(float r, float h) { return leaf(NodeKind::Cylinder, {r, h}); }
-inline Tree cone(float r, float h, float top = 0.0f) { return leaf(NodeKind::Cone, {r, h, top}); }
+inline Tree plane(glm::vec3 n, float offset) {
+    return leaf(NodeKind::Plane, {n.x, n.y, n.z, offset});
+}
+inline Tree prism(float w, float h, float l) {
+    return leaf(NodeKind::TriangularPrism, {w, h, l});
+}
+inline Tree torus(float major, float minor) {
+    return leaf(NodeKind::Torus, {major, minor});
+}
+inline Tree cylinder(float r, float h) {
+    return leaf(NodeKind::Cylinder, {r, h});
+}
+inline Tree cone(float r, float h, float top = 0.0f) {
+    return leaf(NodeKind::Cone, {r, h, top});
+}
 inline Tree capsule(glm::vec3 a, glm::vec3 b, float r) {
     return leaf(NodeKind::Capsule, {a.x, a.y, a.z, b.x, b.y, b.z, r});
 }
@@ -76,7 +91,9 @@ inline Tree op(NodeKind kind, std::vector<Tree> children, float smooth = 0.0f) {
     t.children = std::move(children);
     return t;
 }
-inline Tree unite(std::vector<Tree> c, float k = 0.0f) { return op(NodeKind::Union, std::move(c), k); }
+inline Tree unite(std::vector<Tree> c, float k = 0.0f) {
+    return op(NodeKind::Union, std::move(c), k);
+}
 inline Tree intersect(std::vector<Tree> c, float k = 0.0f) {
     return op(NodeKind::Intersection, std::move(c), k);
 }
@@ -140,17 +157,29 @@ inline Scene randomScene(uint32_t seed, int count, int maxDepth = 6, bool planes
     auto primitive = [&]() {
         Tree t;
         switch (pick(planes ? 9 : 8)) {
-        case 0: t = sphere(uni(0.2f, 1.0f)); break;
-        case 1: t = box(uni(0.2f, 2), uni(0.2f, 2), uni(0.2f, 2)); break;
+        case 0:
+            t = sphere(uni(0.2f, 1.0f));
+            break;
+        case 1:
+            t = box(uni(0.2f, 2), uni(0.2f, 2), uni(0.2f, 2));
+            break;
         case 2: {
             float x = uni(0.3f, 2), y = uni(0.3f, 2), z = uni(0.3f, 2);
             t = roundBox(x, y, z, uni(0.0f, 0.5f) * std::min(x, std::min(y, z)));
             break;
         }
-        case 3: t = prism(uni(0.3f, 2), uni(0.3f, 2), uni(0.3f, 2)); break;
-        case 4: t = torus(uni(0.4f, 1.0f), uni(0.1f, 0.35f)); break;
-        case 5: t = cylinder(uni(0.2f, 1), uni(0.3f, 2)); break;
-        case 6: t = cone(uni(0.2f, 1), uni(0.3f, 2), pick(2) ? 0.0f : uni(0.0f, 1.0f)); break;
+        case 3:
+            t = prism(uni(0.3f, 2), uni(0.3f, 2), uni(0.3f, 2));
+            break;
+        case 4:
+            t = torus(uni(0.4f, 1.0f), uni(0.1f, 0.35f));
+            break;
+        case 5:
+            t = cylinder(uni(0.2f, 1), uni(0.3f, 2));
+            break;
+        case 6:
+            t = cone(uni(0.2f, 1), uni(0.3f, 2), pick(2) ? 0.0f : uni(0.0f, 1.0f));
+            break;
         case 7:
             t = capsule({uni(-1, 1), uni(-1, 1), uni(-1, 1)}, {uni(-1, 1), uni(-1, 1), uni(-1, 1)},
                         uni(0.1f, 0.5f));
@@ -169,23 +198,26 @@ inline Scene randomScene(uint32_t seed, int count, int maxDepth = 6, bool planes
         if (depth >= maxDepth || budget <= 1 || pick(3) == 0) return primitive();
         int n = 1 + pick(4);
         std::vector<Tree> children;
-        for (int i = 0; i < n && budget > 0; ++i) children.push_back(self(self, depth + 1));
-        static constexpr NodeKind kinds[] = {NodeKind::Union, NodeKind::Union, NodeKind::Intersection,
-                                             NodeKind::Difference};
+        for (int i = 0; i < n && budget > 0; ++i)
+            children.push_back(self(self, depth + 1));
+        static constexpr NodeKind kinds[] = {NodeKind::Union, NodeKind::Union,
+                                             NodeKind::Intersection, NodeKind::Difference};
         Tree t = op(kinds[pick(4)], std::move(children), pick(2) ? 0.0f : uni(0.05f, 0.6f));
         transform(t);
         return t;
     };
     std::vector<Tree> top;
-    while (budget > 0) top.push_back(build(build, 1));
-    return makeScene(unite(std::move(top), uni(0.0f, 0.3f)), "<random " + std::to_string(seed) + ">");
+    while (budget > 0)
+        top.push_back(build(build, 1));
+    return makeScene(unite(std::move(top), uni(0.0f, 0.3f)),
+                     "<random " + std::to_string(seed) + ">");
 }
 
 // The bundled scenes, assets/scenes/*.json, sorted by name.
 inline std::vector<std::filesystem::path> bundledScenePaths() {
     std::vector<std::filesystem::path> paths;
-    for (const auto& entry :
-         std::filesystem::directory_iterator(std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes"))
+    for (const auto& entry : std::filesystem::directory_iterator(
+             std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes"))
         if (entry.path().extension() == ".json") paths.push_back(entry.path());
     std::sort(paths.begin(), paths.end());
     return paths;

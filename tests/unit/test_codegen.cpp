@@ -33,7 +33,8 @@ double seconds(std::chrono::steady_clock::time_point since) {
 std::vector<std::string> lines(const std::string& text) {
     std::vector<std::string> out;
     std::istringstream in(text);
-    for (std::string line; std::getline(in, line);) out.push_back(line);
+    for (std::string line; std::getline(in, line);)
+        out.push_back(line);
     return out;
 }
 
@@ -58,8 +59,10 @@ class CacheDir {
         setenv("SDFCSG_CACHE_DIR", value.c_str(), 1);
     }
     ~CacheDir() {
-        if (old_) setenv("SDFCSG_CACHE_DIR", old_->c_str(), 1);
-        else unsetenv("SDFCSG_CACHE_DIR");
+        if (old_)
+            setenv("SDFCSG_CACHE_DIR", old_->c_str(), 1);
+        else
+            unsetenv("SDFCSG_CACHE_DIR");
     }
 
   private:
@@ -68,7 +71,8 @@ class CacheDir {
 
 std::vector<Scene> testScenes() {
     std::vector<Scene> scenes = {primitiveGallery()};
-    for (uint32_t seed = 1; seed <= 3; ++seed) scenes.push_back(randomScene(seed, 50, 6, true));
+    for (uint32_t seed = 1; seed <= 3; ++seed)
+        scenes.push_back(randomScene(seed, 50, 6, true));
     return scenes;
 }
 
@@ -103,7 +107,8 @@ TEST(Codegen, OneCommentedLinePerNode) {
 
 TEST(Codegen, NamesCannotBreakTheCode) {
     // A trailing backslash would splice the next line into the comment; newlines would end it.
-    Scene scene = makeScene(unite({sphere(1).named("evil\\"), box(1, 1, 1).named("two\nlines */ \xc3\xa9")}));
+    Scene scene =
+        makeScene(unite({sphere(1).named("evil\\"), box(1, 1, 1).named("two\nlines */ \xc3\xa9")}));
     std::string glsl = generateSceneGlsl(scene);
     EXPECT_EQ(glsl.find('\\'), std::string::npos);
     EXPECT_NE(glsl.find("// two?lines */ ?? (box)"), std::string::npos) << glsl;
@@ -158,10 +163,10 @@ TEST(Codegen, BundledScenesCompile) {
                 auto start = std::chrono::steady_clock::now();
                 auto spirv = compileKernel(kernel, glsl);
                 ASSERT_TRUE(spirv) << path << " " << kernel << ": " << spirv.error().str();
-                std::printf("%-18s %3zu nodes %-6s %-14s %6zu B GLSL -> %6zu B SPIR-V in %5.1f ms\n",
-                            path.stem().c_str(), scene->nodes.size(),
-                            inlineParams ? "inline" : "buffer", kernel, glsl.size(),
-                            spirv->size() * 4, seconds(start) * 1000);
+                std::printf(
+                    "%-18s %3zu nodes %-6s %-14s %6zu B GLSL -> %6zu B SPIR-V in %5.1f ms\n",
+                    path.stem().c_str(), scene->nodes.size(), inlineParams ? "inline" : "buffer",
+                    kernel, glsl.size(), spirv->size() * 4, seconds(start) * 1000);
             }
         }
     }
@@ -206,10 +211,12 @@ TEST(Codegen, SizeAndCompileTimeAreLinear) {
 
     // Also nested 64 deep (the parser's limit), each level smoothly blended.
     Tree deep = sphere(0.5f);
-    for (int i = 0; i < 63; ++i) deep = unite({sphere(0.5f).at(0.1f * float(i), 0, 0), deep}, 0.1f);
+    for (int i = 0; i < 63; ++i)
+        deep = unite({sphere(0.5f).at(0.1f * float(i), 0, 0), deep}, 0.1f);
     std::string nested = generateSceneGlsl(makeScene(deep));
     size_t text = 0; // without indentation, which grows with depth (at most 64 levels)
-    for (const std::string& line : lines(nested)) text += line.size() - std::min(line.size(), line.find_first_not_of(' '));
+    for (const std::string& line : lines(nested))
+        text += line.size() - std::min(line.size(), line.find_first_not_of(' '));
     EXPECT_LT(text, 2u * 127 * 300);
 
     CacheDir off("off");
@@ -224,8 +231,17 @@ TEST(Codegen, SizeAndCompileTimeAreLinear) {
     EXPECT_TRUE(compileKernel("probe.comp", nested));
 }
 
+// Past 1024 nodes inlining would make glslang quadratic; such scenes read the buffer.
+TEST(Codegen, HugeScenesAreNotInlined) {
+    CodegenOptions inl;
+    inl.inlineParams = true;
+    EXPECT_EQ(generateSceneGlsl(smoothChain(1000), inl).find("nodes["), std::string::npos);
+    EXPECT_NE(generateSceneGlsl(smoothChain(1100), inl).find("nodes["), std::string::npos);
+}
+
 TEST(Codegen, CompileErrorsComeBackWithTheLog) {
-    auto broken = compileKernel("probe.comp", "float sceneDistance(vec3 p) { return undefinedThing; }\n");
+    auto broken =
+        compileKernel("probe.comp", "float sceneDistance(vec3 p) { return undefinedThing; }\n");
     ASSERT_FALSE(broken);
     EXPECT_EQ(broken.error().kind, ErrorKind::Shader);
     std::string log = broken.error().str();
@@ -247,7 +263,8 @@ TEST(Codegen, SpirvIsCachedInMemoryAndOnDisk) {
     CacheDir cacheDir(dir.string());
     // A scene no other test (or earlier run) compiles.
     std::string glsl = generateSceneGlsl(randomScene(99, 30));
-    glsl += "// " + std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) + "\n";
+    glsl +=
+        "// " + std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) + "\n";
 
     auto before = detail::shaderCacheStats();
     auto first = compileKernel("probe.comp", glsl);
@@ -263,7 +280,8 @@ TEST(Codegen, SpirvIsCachedInMemoryAndOnDisk) {
 
     // A new process would find it on disk.
     std::vector<fs::path> files;
-    for (const auto& entry : fs::directory_iterator(dir)) files.push_back(entry.path());
+    for (const auto& entry : fs::directory_iterator(dir))
+        files.push_back(entry.path());
     ASSERT_EQ(files.size(), 1u) << "one entry, no temporary files left behind";
     EXPECT_EQ(files[0].extension(), ".spv");
     detail::clearShaderMemoryCache();
@@ -275,7 +293,8 @@ TEST(Codegen, SpirvIsCachedInMemoryAndOnDisk) {
 
     // A damaged entry is ignored, recompiled and replaced.
     for (int damage = 0; damage < 2; ++damage) {
-        if (damage == 0) fs::resize_file(files[0], fs::file_size(files[0]) / 2);
+        if (damage == 0)
+            fs::resize_file(files[0], fs::file_size(files[0]) / 2);
         else {
             std::fstream f(files[0], std::ios::in | std::ios::out | std::ios::binary);
             f.seekg(100);

@@ -25,7 +25,8 @@ std::vector<glm::vec3> randomPoints(uint32_t seed, int count, float reach) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<float> u(-reach, reach);
     std::vector<glm::vec3> points;
-    for (int i = 0; i < count; ++i) points.push_back({u(rng), u(rng), u(rng)});
+    for (int i = 0; i < count; ++i)
+        points.push_back({u(rng), u(rng), u(rng)});
     return points;
 }
 
@@ -59,7 +60,8 @@ TEST(Eval, NestedTransformsCompose) {
     Scene scene = makeScene(outer);
     Evaluator eval(scene);
 
-    glm::dmat4 toWorld = modelMatrix(scene.nodes[0].transform) * modelMatrix(scene.nodes[1].transform);
+    glm::dmat4 toWorld =
+        modelMatrix(scene.nodes[0].transform) * modelMatrix(scene.nodes[1].transform);
     glm::dmat4 toLocal = glm::inverse(toWorld);
     const double scale = 1.6 * 0.7;
     for (glm::vec3 p : randomPoints(1, 2000, 4.0f)) {
@@ -120,7 +122,8 @@ TEST(Eval, SmoothUnionBlendsDistanceAndColour) {
     EXPECT_EQ(red.color, glm::vec3(1, 0, 0));
     // Part way: colour weights follow the distance blend factor h.
     glm::vec3 p(-0.3f, 0.2f, 0);
-    float a = glm::length(p - glm::vec3(-2.4f, 0, 0)) - 2, b = glm::length(p - glm::vec3(2.4f, 0, 0)) - 2;
+    float a = glm::length(p - glm::vec3(-2.4f, 0, 0)) - 2,
+          b = glm::length(p - glm::vec3(2.4f, 0, 0)) - 2;
     float h = std::clamp(0.5f + 0.5f * (b - a) / 1.0f, 0.0f, 1.0f);
     Sample s = eval.sample(p);
     EXPECT_NEAR(s.distance, b + (a - b) * h - h * (1 - h), 1e-5f);
@@ -129,7 +132,8 @@ TEST(Eval, SmoothUnionBlendsDistanceAndColour) {
 }
 
 TEST(Eval, DifferenceCutTakesTheSubtrahendsColour) {
-    Scene scene = makeScene(subtract({box(2, 2, 2).colored(1, 0, 0), sphere(0.8f).at(1, 1, 1).colored(0, 1, 0)}));
+    Scene scene = makeScene(
+        subtract({box(2, 2, 2).colored(1, 0, 0), sphere(0.8f).at(1, 1, 1).colored(0, 1, 0)}));
     Evaluator eval(scene);
     // On the spherical cut, inside the box: green. On an untouched face: red.
     glm::vec3 cut = glm::vec3(1) - glm::normalize(glm::vec3(1)) * 0.8f;
@@ -165,12 +169,13 @@ std::vector<Scene> bundledScenes() {
 std::vector<Scene> boundsScenes() {
     std::vector<Scene> scenes = bundledScenes();
     scenes.push_back(primitiveGallery());
-    for (uint32_t seed = 1; seed <= 12; ++seed) scenes.push_back(randomScene(seed, 40, 5, seed % 3 == 0));
+    for (uint32_t seed = 1; seed <= 12; ++seed)
+        scenes.push_back(randomScene(seed, 40, 5, seed % 3 == 0));
     return scenes;
 }
 
-// The bounds promise: a node's value at p is at least its box's signed distance to p. Checked for every
-// node of every scene, at random points around it.
+// The bounds promise: a node's value at p is at least its box's signed distance to p. Checked for
+// every node of every scene, at random points around it.
 TEST(Eval, BoundsAreLowerBounds) {
     for (const Scene& scene : boundsScenes()) {
         SCOPED_TRACE(scene.file);
@@ -213,7 +218,8 @@ TEST(Eval, BoundsContainTheSurface) {
                 }
                 if (std::abs(eval.distance(p, i)) >= 1e-5f) continue;
                 ++projected;
-                EXPECT_LE(box.distance(p), 1e-4f) << "node " << i << " surface point outside its box";
+                EXPECT_LE(box.distance(p), 1e-4f)
+                    << "node " << i << " surface point outside its box";
             }
         }
         EXPECT_GT(projected, 20 * int(eval.nodes().size()));
@@ -221,7 +227,8 @@ TEST(Eval, BoundsContainTheSurface) {
 }
 
 TEST(Eval, PrimitiveBoundsAreTight) {
-    Scene scene = makeScene(unite({box(2, 4, 6).at(1, 0, 0), sphere(1).at(0, 5, 0), plane({0, 1, 0}, 0)}));
+    Scene scene =
+        makeScene(unite({box(2, 4, 6).at(1, 0, 0), sphere(1).at(0, 5, 0), plane({0, 1, 0}, 0)}));
     Evaluator eval(scene);
     const Aabb& b = eval.nodes()[1].bounds;
     EXPECT_NEAR(b.min.x, 0.0f, 1e-4f);
@@ -238,7 +245,8 @@ TEST(Eval, PrimitiveBoundsAreTight) {
 // Skipping never changes a single bit of the result.
 TEST(Eval, SkippingGivesIdenticalValues) {
     std::vector<Scene> scenes = bundledScenes();
-    for (uint32_t seed = 20; seed < 40; ++seed) scenes.push_back(randomScene(seed, 60, 6, seed % 2 == 0));
+    for (uint32_t seed = 20; seed < 40; ++seed)
+        scenes.push_back(randomScene(seed, 60, 6, seed % 2 == 0));
     for (const Scene& scene : scenes) {
         Evaluator on(scene), off(scene);
         off.setBoundsSkipping(false);
@@ -308,7 +316,8 @@ TEST(Eval, FrameCameraSeesTheWholeScene) {
             // Every corner of the scene's box is in view; with a plane making that infinite,
             // every corner of every finite primitive's box.
             std::vector<Aabb> boxes;
-            if (eval.bounds().finite()) boxes.push_back(eval.bounds());
+            if (eval.bounds().finite())
+                boxes.push_back(eval.bounds());
             else
                 for (const FlatNode& n : eval.nodes())
                     if (!kindInfo(n.kind).operation && n.bounds.finite()) boxes.push_back(n.bounds);

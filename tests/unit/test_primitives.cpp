@@ -54,7 +54,8 @@ struct Polytope {
 
     double signedDistance(dvec3 p) const {
         dvec3 centre(0.0);
-        for (dvec3 v : vertices) centre += v;
+        for (dvec3 v : vertices)
+            centre += v;
         centre /= double(vertices.size());
         double outside = INFINITY, planeMax = -INFINITY;
         for (const auto& f : faces) {
@@ -63,7 +64,8 @@ struct Polytope {
             if (dot(n, centre - a) > 0) n = -n; // outward
             planeMax = std::max(planeMax, dot(n, p - a));
             for (size_t i = 1; i + 1 < f.size(); ++i) {
-                dvec3 q = closestOnTriangle(p, a, vertices[size_t(f[i])], vertices[size_t(f[i + 1])]);
+                dvec3 q =
+                    closestOnTriangle(p, a, vertices[size_t(f[i])], vertices[size_t(f[i + 1])]);
                 outside = std::min(outside, length(p - q));
             }
         }
@@ -76,7 +78,8 @@ Polytope boxPolytope(dvec3 h) {
     Polytope poly;
     for (int i = 0; i < 8; ++i)
         poly.vertices.push_back({i & 1 ? h.x : -h.x, i & 2 ? h.y : -h.y, i & 4 ? h.z : -h.z});
-    poly.faces = {{0, 1, 3, 2}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 3, 7, 5}};
+    poly.faces = {{0, 1, 3, 2}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                  {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 3, 7, 5}};
     return poly;
 }
 
@@ -122,8 +125,10 @@ double minimise(const std::function<double(double)>& f, double lo, double hi, in
     double step = (hi - lo) / grid, a = std::max(lo, best - step), b = std::min(hi, best + step);
     for (int i = 0; i < 200; ++i) {
         double m1 = a + (b - a) / 3, m2 = b - (b - a) / 3;
-        if (f(m1) < f(m2)) b = m2;
-        else a = m1;
+        if (f(m1) < f(m2))
+            b = m2;
+        else
+            a = m1;
     }
     return std::min(bestValue, f(0.5 * (a + b)));
 }
@@ -133,9 +138,9 @@ double minimise(const std::function<double(double)>& f, double lo, double hi, in
 struct Case {
     std::string label;
     NodeKind kind;
-    sdf::Params params;                      // table values: full sizes
-    std::function<double(dvec3)> truth;      // exact signed distance
-    double size;                             // rough extent, for sampling and tolerances
+    sdf::Params params;                 // table values: full sizes
+    std::function<double(dvec3)> truth; // exact signed distance
+    double size;                        // rough extent, for sampling and tolerances
 };
 
 std::vector<Case> cases() {
@@ -145,36 +150,42 @@ std::vector<Case> cases() {
         out.push_back({std::move(label), kind, params, std::move(truth), size});
     };
     for (double r : {0.5, 1.7})
-        add("sphere " + std::to_string(r), NodeKind::Sphere, {float(r)},
+        add(
+            "sphere " + std::to_string(r), NodeKind::Sphere, {float(r)},
             [r](dvec3 p) { return length(p) - r; }, r);
     for (dvec3 s : {dvec3(1, 2, 3), dvec3(0.2, 1.5, 0.4)}) {
         Polytope poly = boxPolytope(s / 2.0);
-        add("box", NodeKind::Box, {float(s.x), float(s.y), float(s.z)},
+        add(
+            "box", NodeKind::Box, {float(s.x), float(s.y), float(s.z)},
             [poly](dvec3 p) { return poly.signedDistance(p); }, length(s) / 2);
     }
     for (double r : {0.0, 0.15, 0.29}) {
         dvec3 s(1.2, 0.6, 2.0);
         // The rounded box is the inner box grown by r (a Minkowski sum with a ball).
         Polytope inner = boxPolytope(s / 2.0 - r);
-        add("round_box r=" + std::to_string(r), NodeKind::RoundBox,
+        add(
+            "round_box r=" + std::to_string(r), NodeKind::RoundBox,
             {float(s.x), float(s.y), float(s.z), float(r)},
             [inner, r](dvec3 p) { return inner.signedDistance(p) - r; }, length(s) / 2);
     }
     {
         dvec3 n = normalize(dvec3(0.3, 1.0, -0.2));
-        add("plane", NodeKind::Plane, {0.3f, 1.0f, -0.2f, 0.4f},
+        add(
+            "plane", NodeKind::Plane, {0.3f, 1.0f, -0.2f, 0.4f},
             [n](dvec3 p) { return dot(p, n) - 0.4; }, 2.0);
     }
     for (dvec3 whl : {dvec3(2, 1, 3), dvec3(0.5, 2, 0.8), dvec3(3, 0.3, 1)}) {
         Polytope poly = prismPolytope(whl.x, whl.y, whl.z);
-        add("triangular_prism", NodeKind::TriangularPrism,
+        add(
+            "triangular_prism", NodeKind::TriangularPrism,
             {float(whl.x), float(whl.y), float(whl.z)},
             [poly](dvec3 p) { return poly.signedDistance(p); }, length(whl) / 2);
     }
     for (dvec2 rr : {dvec2(1.0, 0.25), dvec2(0.6, 0.5)}) {
         double major = rr.x, minor = rr.y;
         // Distance to the core circle, minimised over its angle.
-        add("torus", NodeKind::Torus, {float(major), float(minor)},
+        add(
+            "torus", NodeKind::Torus, {float(major), float(minor)},
             [major, minor](dvec3 p) {
                 auto f = [&](double a) {
                     return length(p - dvec3(major * std::cos(a), 0, major * std::sin(a)));
@@ -185,8 +196,11 @@ std::vector<Case> cases() {
     }
     for (dvec2 rh : {dvec2(0.5, 2.0), dvec2(1.5, 0.4)}) {
         double r = rh.x, hh = rh.y / 2;
-        add("cylinder", NodeKind::Cylinder, {float(rh.x), float(rh.y)},
-            [r, hh](dvec3 p) { return revolvedDistance(p, {{0, -hh}, {r, -hh}, {r, hh}, {0, hh}}); },
+        add(
+            "cylinder", NodeKind::Cylinder, {float(rh.x), float(rh.y)},
+            [r, hh](dvec3 p) {
+                return revolvedDistance(p, {{0, -hh}, {r, -hh}, {r, hh}, {0, hh}});
+            },
             std::max(r, hh));
     }
     struct ConeCase {
@@ -196,20 +210,23 @@ std::vector<Case> cases() {
         double hh = c.h / 2;
         std::vector<dvec2> profile = {{0, -hh}, {c.r1, -hh}, {c.r2, hh}, {0, hh}};
         if (c.r2 == 0) profile.pop_back(); // apex on the axis
-        add("cone", NodeKind::Cone, {float(c.r1), float(c.h), float(c.r2)},
+        add(
+            "cone", NodeKind::Cone, {float(c.r1), float(c.h), float(c.r2)},
             [profile](dvec3 p) { return revolvedDistance(p, profile); }, std::max(c.r1, hh));
     }
     {
         dvec3 a(-0.5, 0.2, 0.1), b(0.7, -0.4, 0.6);
         double r = 0.3;
-        add("capsule", NodeKind::Capsule,
+        add(
+            "capsule", NodeKind::Capsule,
             {float(a.x), float(a.y), float(a.z), float(b.x), float(b.y), float(b.z), float(r)},
             [a, b, r](dvec3 p) {
                 auto f = [&](double t) { return length(p - (a + (b - a) * t)); };
                 return minimise(f, 0, 1, 64) - r;
             },
             1.0);
-        add("capsule (a == b)", NodeKind::Capsule, {0.1f, 0.2f, 0.3f, 0.1f, 0.2f, 0.3f, 0.5f},
+        add(
+            "capsule (a == b)", NodeKind::Capsule, {0.1f, 0.2f, 0.3f, 0.1f, 0.2f, 0.3f, 0.5f},
             [](dvec3 p) { return length(p - dvec3(0.1, 0.2, 0.3)) - 0.5; }, 0.5);
     }
     return out;
@@ -232,7 +249,8 @@ std::vector<glm::vec3> samplePoints(double size, uint32_t seed) {
 
 TEST(Primitives, EveryKindHasACase) {
     std::vector<bool> seen(kNodeKindCount, false);
-    for (const Case& c : cases()) seen[size_t(c.kind)] = true;
+    for (const Case& c : cases())
+        seen[size_t(c.kind)] = true;
     for (const KindInfo& k : nodeKinds())
         EXPECT_TRUE(k.operation || seen[size_t(k.kind)]) << k.name << " has no test case";
 }

@@ -22,8 +22,8 @@ struct CodegenOptions {
     // false: numeric parameters, transforms and bounds are read from the node buffer, so
     // changing a value needs no recompile (the viewer). true: they are baked in as literals,
     // which the driver's compiler folds (fastest for one-off headless renders). Scenes of more
-    // than 256 nodes always read the buffer: glslang's time grows with the square of the number
-    // of distinct literals.
+    // than 1024 nodes always read the buffer: glslang's time grows with the square of the
+    // number of distinct literals.
     bool inlineParams = false;
 };
 
