@@ -34,8 +34,9 @@ layout(std140, set = 0, binding = SDFCSG_BINDING_FRAME) uniform Frame {
     uvec4 size;      // width, height, mode, flags
     uvec4 counts;    // aa, light count, node count, selected node
     FrameLight lights[SDFCSG_MAX_LIGHTS];
-    uvec4 surfaceBoxCount; // x: boxes that hold every surface (0: use the clip box alone)
-    vec4 surfaceBoxes[2 * SDFCSG_MAX_CLIP_BOXES]; // min, max pairs
+    uvec4 surfaceBoxCount; // x: regions that hold every surface (0: use the clip box alone)
+    // Pairs: a box (min, w = 0; max), or a half-space dot(p, n) < offset (n, w = 1; offset, ...).
+    vec4 surfaceBoxes[2 * SDFCSG_MAX_CLIP_BOXES];
 } frame;
 
 layout(std430, set = 0, binding = SDFCSG_BINDING_PIXELS) writeonly buffer Pixels {
@@ -69,6 +70,16 @@ vec2 clipRay(vec3 bmin, vec3 bmax, vec3 ro, vec3 rd) {
     vec3 t1 = (bmax - ro) * inv;
     vec3 lo = min(t0, t1), hi = max(t0, t1);
     return vec2(max(max(lo.x, lo.y), max(lo.z, 0.0)), min(min(hi.x, hi.y), hi.z));
+}
+
+// Entry and exit of a ray in surface part i (see Frame); misses when x > y.
+vec2 partInterval(uint i, vec3 ro, vec3 rd) {
+    vec4 a = frame.surfaceBoxes[2u * i], b = frame.surfaceBoxes[2u * i + 1u];
+    if (a.w == 0.0) return clipRay(a.xyz, b.xyz, ro, rd);
+    float dn = dot(rd, a.xyz), on = dot(ro, a.xyz);
+    float tPlane = (b.x - on) / (abs(dn) < 1.0e-20 ? 1.0e-20 : dn);
+    if (on < b.x) return vec2(0.0, dn > 0.0 ? tPlane : 1.0e30);
+    return dn < 0.0 ? vec2(tPlane, 1.0e30) : vec2(1.0, 0.0);
 }
 
 // All scene evaluations of a sample go through one call of sceneDistance in one loop, driven by
@@ -111,7 +122,7 @@ Trace trace(vec3 ro, vec3 rd) {
         // Start at the first entry into a box that holds surfaces, end at the last exit.
         vec2 parts = vec2(1.0e30, -1.0e30);
         for (uint i = 0u; i < frame.surfaceBoxCount.x; ++i) {
-            vec2 b = clipRay(frame.surfaceBoxes[2u * i].xyz, frame.surfaceBoxes[2u * i + 1u].xyz, ro, rd);
+            vec2 b = partInterval(i, ro, rd);
             if (b.x <= b.y) parts = vec2(min(parts.x, b.x), max(parts.y, b.y));
         }
         range = vec2(max(range.x, parts.x), min(range.y, parts.y));
@@ -216,11 +227,8 @@ Trace trace(vec3 ro, vec3 rd) {
                 // Nothing can shadow beyond the last exit from the boxes that hold surfaces.
                 float lastExit = 0.0;
                 for (uint i = 0u; i < frame.surfaceBoxCount.x; ++i) {
-                    vec3 a = (frame.surfaceBoxes[2u * i].xyz - p) * inv;
-                    vec3 b = (frame.surfaceBoxes[2u * i + 1u].xyz - p) * inv;
-                    vec3 lo = min(a, b), hi = max(a, b);
-                    float tOut = min(min(hi.x, hi.y), hi.z);
-                    if (max(max(lo.x, lo.y), lo.z) <= tOut) lastExit = max(lastExit, tOut);
+                    vec2 b = partInterval(i, p, dir);
+                    if (b.x <= b.y) lastExit = max(lastExit, b.y);
                 }
                 shadowEnd = min(shadowEnd, lastExit);
             }

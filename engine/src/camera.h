@@ -8,6 +8,7 @@
 #include "shared.h"
 
 #include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
 #include <glm/trigonometric.hpp>
 #include <glm/vec3.hpp>
 
@@ -58,24 +59,50 @@ inline float hitEpsilon(const RayCamera& rc, float t) {
     return std::max(kMinHitEpsilon, 0.5f * t * rc.footprint);
 }
 
-// Boxes that together hold every surface of the scene, at most SDFCSG_MAX_CLIP_BOXES: the root's
-// operands when it is a sharp union of finite parts (neighbours in the file grouped together when
-// there are more), else none (the clip volume alone). A ray starts at its first entry into any
-// of them and ends at its last exit, so rays that pass between the parts cost no steps.
-inline std::vector<Aabb> surfaceBoxes(const Evaluator& evaluator) {
+// A region that holds surfaces: a box, or the half-space dot(p, normal) < offset of a plane.
+struct SurfacePart {
+    bool halfSpace = false;
+    Aabb box;
+    glm::vec3 normal{0.0f};
+    float offset = 0.0f;
+};
+
+// Regions that together hold every surface of the scene, at most SDFCSG_MAX_CLIP_BOXES: when the
+// root is a sharp union, the boxes of its finite operands (neighbours in the file grouped
+// together when there are more) and the half-spaces of its planes; else none (the clip volume
+// alone). A ray starts at its first entry into any of them and ends at its last exit, so rays
+// that pass between the parts, or above a ground plane, cost no steps.
+inline std::vector<SurfacePart> surfaceParts(const Evaluator& evaluator) {
     const FlatNode& root = evaluator.nodes()[0];
     if (root.kind != NodeKind::Union || root.smooth > 0.0f) return {};
-    const size_t n = root.children.size();
-    const size_t groups = std::min<size_t>(n, SDFCSG_MAX_CLIP_BOXES);
-    std::vector<Aabb> boxes(groups);
-    for (size_t i = 0; i < n; ++i) {
-        const Aabb& b = evaluator.nodes()[root.children[i]].bounds;
-        if (!b.finite()) return {};
-        Aabb& g = boxes[i * groups / n];
-        g.min = glm::min(g.min, b.min);
-        g.max = glm::max(g.max, b.max);
+    std::vector<SurfacePart> planes;
+    std::vector<const Aabb*> finite;
+    for (uint32_t child : root.children) {
+        const FlatNode& node = evaluator.nodes()[child];
+        if (node.bounds.finite()) {
+            finite.push_back(&node.bounds);
+        } else if (node.kind == NodeKind::Plane) {
+            // local = toLocal * p + offset and the solid is dot(local, n) < k3.
+            glm::vec3 n(node.params[0], node.params[1], node.params[2]);
+            SurfacePart part;
+            part.halfSpace = true;
+            part.normal = glm::transpose(node.toLocal) * n;
+            part.offset = node.params[3] - glm::dot(node.offset, n);
+            planes.push_back(part);
+        } else {
+            return {};
+        }
     }
-    return boxes;
+    if (planes.size() >= SDFCSG_MAX_CLIP_BOXES || (finite.empty() && planes.empty())) return {};
+    const size_t groups = std::min(finite.size(), SDFCSG_MAX_CLIP_BOXES - planes.size());
+    std::vector<SurfacePart> parts(groups);
+    for (size_t i = 0; i < finite.size(); ++i) {
+        Aabb& g = parts[i * groups / finite.size()].box;
+        g.min = glm::min(g.min, finite[i]->min);
+        g.max = glm::max(g.max, finite[i]->max);
+    }
+    parts.insert(parts.end(), planes.begin(), planes.end());
+    return parts;
 }
 
 // The part of space rays are traced in: the scene's bounds, cut to a cube around the eye whose
@@ -84,7 +111,7 @@ inline std::vector<Aabb> surfaceBoxes(const Evaluator& evaluator) {
 struct ClipVolume {
     Aabb box;
     float far;               // no ray goes beyond this t
-    std::vector<Aabb> parts; // surfaceBoxes(); empty: the box alone
+    std::vector<SurfacePart> parts; // surfaceParts(); empty: the box alone
 };
 
 // Bounds of the finite primitives: what a camera looks at and what "far" is measured against.
@@ -108,7 +135,7 @@ inline ClipVolume makeClipVolume(const Evaluator& evaluator, glm::vec3 eye) {
     clip.box = evaluator.bounds();
     clip.box.min = glm::max(clip.box.min, eye - glm::vec3(clip.far));
     clip.box.max = glm::min(clip.box.max, eye + glm::vec3(clip.far));
-    clip.parts = surfaceBoxes(evaluator);
+    clip.parts = surfaceParts(evaluator);
     return clip;
 }
 
@@ -125,6 +152,20 @@ inline bool clipRay(const Aabb& box, glm::vec3 origin, glm::vec3 dir, float& tNe
     return tNear <= tFar;
 }
 
+// Entry and exit of a ray in a surface part, as partInterval() in shaders/raymarch.comp.
+inline bool partInterval(const SurfacePart& part, glm::vec3 origin, glm::vec3 dir, float& tIn,
+                         float& tOut) {
+    if (!part.halfSpace) return clipRay(part.box, origin, dir, tIn, tOut);
+    float dn = glm::dot(dir, part.normal), on = glm::dot(origin, part.normal);
+    float tPlane = (part.offset - on) / (std::abs(dn) < 1e-20f ? 1e-20f : dn);
+    if (on < part.offset) {
+        tIn = 0.0f, tOut = dn > 0.0f ? tPlane : 1.0e30f;
+    } else {
+        tIn = dn < 0.0f ? tPlane : 1.0f, tOut = dn < 0.0f ? 1.0e30f : 0.0f;
+    }
+    return tIn <= tOut;
+}
+
 // The interval of a ray that is traced, as trace() in shaders/raymarch.comp computes it: inside
 // the clip box, from the first entry into a surface box to the last exit. False when empty.
 inline bool rayInterval(const ClipVolume& clip, glm::vec3 origin, glm::vec3 dir, float& tNear,
@@ -132,9 +173,10 @@ inline bool rayInterval(const ClipVolume& clip, glm::vec3 origin, glm::vec3 dir,
     clipRay(clip.box, origin, dir, tNear, tFar);
     if (!clip.parts.empty()) {
         float first = 1.0e30f, last = -1.0e30f;
-        for (const Aabb& part : clip.parts) {
+        for (const SurfacePart& part : clip.parts) {
             float a, b;
-            if (clipRay(part, origin, dir, a, b)) first = std::min(first, a), last = std::max(last, b);
+            if (partInterval(part, origin, dir, a, b))
+                first = std::min(first, a), last = std::max(last, b);
         }
         tNear = std::max(tNear, first);
         tFar = std::min(tFar, last);

@@ -38,7 +38,7 @@ struct FrameUniform {
     glm::uvec4 counts;   // aa, lights, nodes, selected
     FrameLight lights[SDFCSG_MAX_LIGHTS];
     glm::uvec4 surfaceBoxCount; // x
-    glm::vec4 surfaceBoxes[2 * SDFCSG_MAX_CLIP_BOXES]; // min, max pairs
+    glm::vec4 surfaceBoxes[2 * SDFCSG_MAX_CLIP_BOXES]; // surface parts, as in raymarch.comp
 };
 static_assert(sizeof(FrameUniform) ==
               12 * 16 + SDFCSG_MAX_LIGHTS * 48 + SDFCSG_MAX_CLIP_BOXES * 32);
@@ -205,11 +205,13 @@ struct Renderer::Impl {
         f.forward = glm::vec4(rc.forward, detail::kMinHitEpsilon);
         f.clipMin = glm::vec4(clip.box.min, clip.far);
         f.clipMax = glm::vec4(clip.box.max, 0.0f);
-        const std::vector<Aabb>& boxes = clip.parts;
-        f.surfaceBoxCount.x = uint32_t(boxes.size());
-        for (size_t i = 0; i < boxes.size(); ++i) {
-            f.surfaceBoxes[2 * i] = glm::vec4(boxes[i].min, 0.0f);
-            f.surfaceBoxes[2 * i + 1] = glm::vec4(boxes[i].max, 0.0f);
+        f.surfaceBoxCount.x = uint32_t(clip.parts.size());
+        for (size_t i = 0; i < clip.parts.size(); ++i) {
+            const detail::SurfacePart& part = clip.parts[i];
+            f.surfaceBoxes[2 * i] = part.halfSpace ? glm::vec4(part.normal, 1.0f)
+                                                   : glm::vec4(part.box.min, 0.0f);
+            f.surfaceBoxes[2 * i + 1] = part.halfSpace ? glm::vec4(part.offset, 0.0f, 0.0f, 0.0f)
+                                                       : glm::vec4(part.box.max, 0.0f);
         }
         f.background = glm::vec4(scene.background, 0.0f);
         f.sky = glm::vec4(scene.background * scene.background, 0.0f); // gamma 2, as the kernel
