@@ -2,14 +2,31 @@
 // and any message the layer reports during a test fails that test.
 #pragma once
 
+#include "scene_build_util.h"
+
 #include <sdfcsg/sdfcsg.h>
 
 #include <gtest/gtest.h>
+
+#define STB_IMAGE_IMPLEMENTATION
+#define STB_IMAGE_STATIC
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#pragma GCC diagnostic ignored "-Wunused-function"
+#pragma GCC diagnostic ignored "-Wshadow"
+#pragma GCC diagnostic ignored "-Wsign-compare"
+#endif
+#include <stb/stb_image.h>
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
 
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -59,15 +76,18 @@ class GpuTest : public ::testing::Test {
     uint32_t messagesBefore_ = 0;
 };
 
-// Every bundled scene, sorted by name.
-inline std::vector<std::filesystem::path> bundledScenes() {
-    std::vector<std::filesystem::path> paths;
-    for (const auto& entry : std::filesystem::directory_iterator(
-             std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes"))
-        if (entry.path().extension() == ".json") paths.push_back(entry.path());
-    std::sort(paths.begin(), paths.end());
-    return paths;
+// Reads a PNG back as RGBA8 (what writePng wrote); nullopt if unreadable.
+inline std::optional<Image> readPng(const std::filesystem::path& path) {
+    int w = 0, h = 0, n = 0;
+    stbi_uc* data = stbi_load(path.string().c_str(), &w, &h, &n, 4);
+    if (!data) return std::nullopt;
+    Image image{uint32_t(w), uint32_t(h), std::vector<uint8_t>(data, data + size_t(w) * h * 4)};
+    stbi_image_free(data);
+    return image;
 }
+
+// Every bundled scene, sorted by name.
+inline std::vector<std::filesystem::path> bundledScenes() { return bundledScenePaths(); }
 
 // Test names for TEST_P over scene paths: the file stem.
 inline std::string sceneTestName(const ::testing::TestParamInfo<std::filesystem::path>& info) {

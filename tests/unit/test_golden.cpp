@@ -3,20 +3,6 @@
 // SDFCSG_TEST_OUTPUT_DIR/golden; SDFCSG_UPDATE_GOLDEN=1 rewrites the goldens instead.
 #include "gpu_test.h"
 
-#define STB_IMAGE_IMPLEMENTATION
-#define STB_IMAGE_STATIC
-#if defined(__GNUC__)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
-#pragma GCC diagnostic ignored "-Wunused-function"
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Wsign-compare"
-#endif
-#include <stb/stb_image.h>
-#if defined(__GNUC__)
-#pragma GCC diagnostic pop
-#endif
-
 #include <cstdio>
 #include <cstdlib>
 #include <optional>
@@ -62,15 +48,6 @@ std::string caseName(const GoldenCase& c) {
 // Readable test names and failure messages instead of a byte dump.
 void PrintTo(const GoldenCase& c, std::ostream* os) {
     *os << caseName(c);
-}
-
-std::optional<Image> readPng(const fs::path& path) {
-    int w = 0, h = 0, n = 0;
-    stbi_uc* data = stbi_load(path.string().c_str(), &w, &h, &n, 4);
-    if (!data) return std::nullopt;
-    Image image{uint32_t(w), uint32_t(h), std::vector<uint8_t>(data, data + size_t(w) * h * 4)};
-    stbi_image_free(data);
-    return image;
 }
 
 class Golden : public GpuTest, public ::testing::WithParamInterface<GoldenCase> {};

@@ -5,20 +5,6 @@
 #include "shader_compile.h"
 #include "shared.h"
 
-#define STB_IMAGE_IMPLEMENTATION
-#define STB_IMAGE_STATIC
-#if defined(__GNUC__)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
-#pragma GCC diagnostic ignored "-Wunused-function"
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Wsign-compare"
-#endif
-#include <stb/stb_image.h>
-#if defined(__GNUC__)
-#pragma GCC diagnostic pop
-#endif
-
 #include <glm/common.hpp>
 #include <glm/exponential.hpp>
 #include <glm/geometric.hpp>
@@ -454,17 +440,6 @@ TEST(RenderMode, ParsesTheFourNames) {
 
 class Png : public GpuTest {};
 
-Image decodePng(const fs::path& path) {
-    int w = 0, h = 0, n = 0;
-    stbi_uc* data = stbi_load(path.string().c_str(), &w, &h, &n, 4);
-    Image image;
-    if (!data) return image;
-    image.width = uint32_t(w), image.height = uint32_t(h);
-    image.rgba.assign(data, data + size_t(w) * h * 4);
-    stbi_image_free(data);
-    return image;
-}
-
 Image gradient(uint32_t w, uint32_t h) {
     Image image{w, h, std::vector<uint8_t>(size_t(w) * h * 4)};
     for (size_t i = 0; i < image.rgba.size(); ++i)
@@ -487,7 +462,7 @@ TEST_F(Png, WritesARenderAtomicallyAndReplacesWholeFiles) {
     Image small = gradient(7, 5);
     auto written = writePng(small, out);
     ASSERT_TRUE(written) << written.error().str();
-    Image back = decodePng(out);
+    Image back = readPng(out).value_or(Image{});
     EXPECT_EQ(back.width, 7u);
     EXPECT_EQ(back.height, 5u);
     EXPECT_EQ(back.rgba, small.rgba);
@@ -505,7 +480,7 @@ TEST_F(Png, WritesARenderAtomicallyAndReplacesWholeFiles) {
     auto image = (*renderer)->render(options);
     ASSERT_TRUE(image);
     ASSERT_TRUE(writePng(*image, out));
-    back = decodePng(out);
+    back = readPng(out).value_or(Image{});
     EXPECT_EQ(back.width, 64u);
     EXPECT_EQ(back.rgba, image->rgba);
 }
