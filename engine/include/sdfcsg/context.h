@@ -3,6 +3,9 @@
 // No window and no surface extensions. Any device with a compute queue is acceptable,
 // CPU devices (Mesa lavapipe) included; a discrete GPU is preferred, then integrated, virtual,
 // CPU. SDFCSG_DEVICE=<index or part of the name> overrides the choice.
+//
+// Threads: a Context and the Renderers made from it share one queue and command pool, so use
+// them from one thread at a time (or give each thread its own Context).
 #pragma once
 
 #include "sdfcsg/error.h"
