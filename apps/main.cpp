@@ -21,7 +21,7 @@ namespace {
 // Exit codes, documented in the README.
 enum Exit : int {
     kOk = 0,
-    kInvalidScene = 1, // the scene failed to parse or validate
+    kInvalidScene = 1, // the scene failed to parse or validate, or a limit was exceeded
     kUsage = 2,        // bad command line
     kIo = 3,           // a file could not be read or written
     kGpu = 4,          // no usable Vulkan device, or a shader failed to compile
@@ -144,8 +144,8 @@ Commands:
   schema    print the JSON Schema of the scene format
   bench     measure frame times and compile times on the bundled scenes
 
-'sdfcsg COMMAND --help' describes a command. Exit codes: 0 success, 1 invalid scene,
-2 bad command line, 3 file read or write failure, 4 Vulkan or shader failure.
+'sdfcsg COMMAND --help' describes a command. Exit codes: 0 success, 1 invalid scene or a
+limit exceeded, 2 bad command line, 3 file read or write failure, 4 Vulkan or shader failure.
 )";
 
 const char* kRenderHelp = R"(Usage: sdfcsg render SCENE -o OUT.png [options]
