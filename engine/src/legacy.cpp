@@ -389,16 +389,16 @@ Scene convertLegacy(dom::object top, const Limits& limits, Problems& problems) {
     };
     std::vector<Frame> stack;
     std::vector<Operand> operands;
+    auto tooManyNodes = [&](const std::string& path) {
+        problems.add(path,
+                     "too many nodes: a scene may have at most " + std::to_string(limits.maxNodes) +
+                         " (a node used by several operations counts once per use)",
+                     ErrorKind::Limit);
+        return false;
+    };
     auto emit = [&](Operand o, std::optional<uint32_t> parent, uint32_t depth) {
         const std::string path = nodePath(o.legacy);
-        if (scene.nodes.size() >= limits.maxNodes) {
-            problems.add(path,
-                         "too many nodes: a scene may have at most " +
-                             std::to_string(limits.maxNodes) +
-                             " (a node used by several operations counts once per use)",
-                         ErrorKind::Limit);
-            return false;
-        }
+        if (scene.nodes.size() >= limits.maxNodes) return tooManyNodes(path);
         Node node = convert(nodes[o.legacy], o.legacy);
         if (!node.color) node.color = o.color;
         if (!finiteNode(node)) {
@@ -416,14 +416,8 @@ Scene convertLegacy(dom::object top, const Limits& limits, Problems& problems) {
                          ErrorKind::Limit);
             return false;
         }
-        if (!flatOperands(nodes, o.legacy, limits.maxNodes - scene.nodes.size(), operands)) {
-            problems.add(path,
-                         "too many nodes: a scene may have at most " +
-                             std::to_string(limits.maxNodes) +
-                             " (a node used by several operations counts once per use)",
-                         ErrorKind::Limit);
-            return false;
-        }
+        if (!flatOperands(nodes, o.legacy, limits.maxNodes - scene.nodes.size(), operands))
+            return tooManyNodes(path);
         stack.push_back({index, depth + 1, operands});
         return true;
     };
