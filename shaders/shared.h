@@ -18,6 +18,31 @@
 
 #define SDFCSG_PROBE_GROUP_X 64
 
+// Mesh extraction (engine/src/mesh.cpp, shaders/mesh_*.comp). The grid's samples are split into
+// bricks of SDFCSG_MESH_BRICK^3; a brick also reads the samples one step past its far faces, so
+// it holds SDFCSG_MESH_BRICK_SAMPLES^3 values and owns the cells and edges that start at its own
+// samples.
+#define SDFCSG_MESH_BRICK 8
+#define SDFCSG_MESH_BRICK_SAMPLES 9
+#define SDFCSG_MESH_BRICK_BLOCK 729      // SDFCSG_MESH_BRICK_SAMPLES^3
+#define SDFCSG_MESH_BRICK_EDGES 1536     // 3 edges per owned sample
+#define SDFCSG_MESH_GROUP_X 64           // cull, sample and vertex passes
+#define SDFCSG_MESH_NO_BRICK 0xffffffffu // brick map entry of a skipped brick
+
+#define SDFCSG_BINDING_MESH_GRID 0     // uniform MeshGrid: origin, cell size, counts
+#define SDFCSG_BINDING_MESH_TABLES 2   // readonly uint[]: marching-cubes tables
+#define SDFCSG_BINDING_MESH_ACTIVE 3   // uint[]: linear index of each active brick (its slot)
+#define SDFCSG_BINDING_MESH_MAP 4      // uint[]: per grid brick, 1 when active (cull pass writes),
+                                       // then its slot or SDFCSG_MESH_NO_BRICK (host writes)
+#define SDFCSG_BINDING_MESH_SAMPLES 5  // float[]: the block of each brick of the batch
+#define SDFCSG_BINDING_MESH_META 6     // uint[]: per active brick and owned sample, packed
+#define SDFCSG_BINDING_MESH_COUNTS 7   // uvec2[]: per active brick, vertices and triangles
+#define SDFCSG_BINDING_MESH_BASES 8    // uvec2[]: per active brick, first vertex and triangle
+#define SDFCSG_BINDING_MESH_EDGES 9    // uint[]: crossed edges of each brick of the batch
+#define SDFCSG_BINDING_MESH_VERTICES 10 // float[]: 9 per vertex: position, normal, colour
+#define SDFCSG_BINDING_MESH_INDICES 11  // uint[]: 3 per triangle
+#define SDFCSG_BINDING_MESH_STATUS 12   // uint[2]: surface cut, brick skipped wrongly
+
 #define SDFCSG_MAX_LIGHTS 4
 #define SDFCSG_MAX_CLIP_BOXES 8 // boxes that hold every surface; rays skip the space outside them
 #define SDFCSG_MAX_STEPS 256
@@ -37,5 +62,10 @@
 
 // Specialization constant ids.
 #define SDFCSG_SPEC_BOUNDS_SKIPPING 0
+#define SDFCSG_SPEC_MESH_PASS 1 // mesh_field.comp: which pass (SDFCSG_MESH_PASS_*)
+
+#define SDFCSG_MESH_PASS_CULL 0
+#define SDFCSG_MESH_PASS_SAMPLE 1
+#define SDFCSG_MESH_PASS_VERTICES 2
 
 #endif

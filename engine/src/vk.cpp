@@ -59,7 +59,7 @@ uint32_t findMemoryType(const VkPhysicalDeviceMemoryProperties& props, uint32_t 
 
 Error outOfMemory(VkDeviceSize size, VkResult result) {
     char text[160];
-    std::snprintf(text, sizeof(text), "cannot allocate a %.1f MiB buffer (%s); try a smaller image",
+    std::snprintf(text, sizeof(text), "cannot allocate a %.1f MiB buffer (%s)",
                   double(size) / (1024.0 * 1024.0), vkResultName(result));
     return Error::message(ErrorKind::Limit, "<vulkan>", text);
 }
@@ -102,6 +102,11 @@ Result<Buffer> createBuffer(Context::Impl& ctx, VkDeviceSize size, VkBufferUsage
             type = findMemoryType(props, requirements.memoryTypeBits,
                                   VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT,
                                   VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
+        break;
+    case MemoryUse::Device:
+        type = findMemoryType(props, requirements.memoryTypeBits,
+                              VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0);
+        if (type == UINT32_MAX) type = findMemoryType(props, requirements.memoryTypeBits, 0, 0);
         break;
     case MemoryUse::Staging:
         type =

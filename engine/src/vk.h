@@ -56,7 +56,9 @@ namespace detail {
 enum class MemoryUse {
     Upload,   // written by the host every frame, read by shaders (uniforms, node data)
     Readback, // written by shaders, read by the host; device-local where that is also mappable
-    Staging,  // transfer target for Readback buffers that turned out not to be mappable
+    Staging,  // transfer target for Readback buffers that turned out not to be mappable; also
+              // storage the shaders write and the host reads in place (host visible, cached)
+    Device,   // used by shaders alone; device-local where there is such memory
 };
 
 struct Buffer {
