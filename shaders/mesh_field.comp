@@ -2,7 +2,11 @@
 // The mesh-extraction passes that evaluate the scene, one kernel specialised three ways:
 //   cull:     one invocation per brick; marks the bricks that may hold surface. The field is
 //             1-Lipschitz, so a brick whose centre value exceeds its half-diagonal holds none.
-//   sample:   one invocation per value of each brick's block of the batch.
+//   classify: one workgroup per brick of the batch, one invocation per z-plane (mesh_rows.glsl).
+//             Samples the brick's block, finds the crossed edges and the cells the surface
+//             passes through, numbers the brick's vertices (by sample, then axis) and counts
+//             its triangles. The brick's record keeps, per owned row, the number of its first
+//             vertex and its crossed edges, then the block's signs, for the triangle pass.
 //   vertices: one workgroup per brick of the batch, one invocation per crossed edge; places the
 //             vertex on the edge (linear estimate, then regula falsi on the field), and gives it
 //             the field's normal (four-tap tetrahedral differences) and the scene's colour.
@@ -13,8 +17,10 @@
 #include "nodes.glsl"
 #include "scene.glsl"
 #include "mesh_common.glsl"
+#include "mesh_rows.glsl"
+#include "mesh_tables.glsl"
 
-layout(local_size_x = SDFCSG_MESH_GROUP_X) in;
+layout(local_size_x_id = SDFCSG_SPEC_MESH_GROUP) in;
 
 layout(constant_id = SDFCSG_SPEC_MESH_PASS) const uint kPass = SDFCSG_MESH_PASS_CULL;
 
@@ -26,15 +32,19 @@ layout(std430, set = 0, binding = SDFCSG_BINDING_MESH_SAMPLES) buffer MeshSample
     float samples[];
 };
 
-layout(std430, set = 0, binding = SDFCSG_BINDING_MESH_COUNTS) readonly buffer MeshCounts {
+layout(std430, set = 0, binding = SDFCSG_BINDING_MESH_COUNTS) buffer MeshCounts {
     uvec2 counts[];
+};
+
+layout(std430, set = 0, binding = SDFCSG_BINDING_MESH_RECORDS) writeonly buffer MeshRecords {
+    uint records[];
 };
 
 layout(std430, set = 0, binding = SDFCSG_BINDING_MESH_BASES) readonly buffer MeshBases {
     uvec2 bases[];
 };
 
-layout(std430, set = 0, binding = SDFCSG_BINDING_MESH_EDGES) readonly buffer MeshEdges {
+layout(std430, set = 0, binding = SDFCSG_BINDING_MESH_EDGES) buffer MeshEdges {
     uint edges[];
 };
 
@@ -57,16 +67,69 @@ void cull() {
         status[0] = 1u;
 }
 
-void sampleBlock() {
-    uint i = gl_GlobalInvocationID.x;
-    if (i >= push.count * SDFCSG_MESH_BRICK_BLOCK) return;
-    uint slot = push.first + i / SDFCSG_MESH_BRICK_BLOCK;
-    uint local = i % SDFCSG_MESH_BRICK_BLOCK;
-    uvec3 l = uvec3(local % SDFCSG_MESH_BRICK_SAMPLES,
-                    (local / SDFCSG_MESH_BRICK_SAMPLES) % SDFCSG_MESH_BRICK_SAMPLES,
-                    local / (SDFCSG_MESH_BRICK_SAMPLES * SDFCSG_MESH_BRICK_SAMPLES));
-    uvec3 s = brickCoords(activeBricks[slot]) * SDFCSG_MESH_BRICK + l;
-    samples[i] = sceneDistance(samplePosition(s));
+// The owned samples of the row starting at grid sample s0 that lie on the grid's boundary,
+// over x.
+uint boundarySamples(uvec3 s0) {
+    if (s0.y > grid.cells.y || s0.z > grid.cells.z) return 0u;
+    uint inGrid = lowBits(min(grid.cells.x - s0.x + 1u, SDFCSG_MESH_BRICK)); // s0.x <= cells.x
+    if (s0.y == 0u || s0.y == grid.cells.y || s0.z == 0u || s0.z == grid.cells.z) return inGrid;
+    uint ends = s0.x == 0u ? 1u : 0u;
+    if (grid.cells.x - s0.x < SDFCSG_MESH_BRICK) ends |= 1u << (grid.cells.x - s0.x);
+    return ends & inGrid;
+}
+
+void classify() {
+    uint batchSlot = gl_WorkGroupID.x;
+    if (batchSlot >= push.count) return; // uniform in the workgroup
+    uint slot = push.first + batchSlot;
+    uint block = batchSlot * SDFCSG_MESH_BRICK_BLOCK;
+    uint record = slot * SDFCSG_MESH_RECORD;
+    uvec3 brick = brickCoords(activeBricks[slot]) * SDFCSG_MESH_BRICK;
+    uint plane = gl_LocalInvocationID.x;
+
+    for (uint r = plane; r < kSignRows; r += SDFCSG_MESH_BRICK) {
+        uvec3 s = brick + uvec3(0u, r % kSide, r / kSide);
+        uint bits = 0u;
+        for (uint x = 0u; x < kSide; ++x) {
+            float d = sceneDistance(samplePosition(s + uvec3(x, 0u, 0u)));
+            samples[block + r * kSide + x] = d;
+            if (d < 0.0) bits |= 1u << x;
+        }
+        insideRows[r] = bits;
+        records[record + kRecordSigns + r] = bits;
+    }
+    barrier();
+
+    // First walk: counts. Second walk: vertex numbers, records and the edge list.
+    uint planeTotal = 0u; // vertices | triangles << 16
+    bool cut = false;
+    for (uint y = 0u; y < SDFCSG_MESH_BRICK; ++y) {
+        uvec3 s0 = brick + uvec3(0u, y, plane);
+        Row row = rowAt(s0, y, plane);
+        planeTotal += bitCount(row.crossed.x) + bitCount(row.crossed.y) + bitCount(row.crossed.z);
+        for (uint cells = row.cells; cells != 0u; cells &= cells - 1u)
+            planeTotal += triangleCountOf(cellCase(findLSB(cells), y, plane)) << 16;
+        cut = cut || (insideRows[y + kSide * plane] & boundarySamples(s0)) != 0u;
+    }
+    if (cut) status[0] = 1u;
+
+    uint total;
+    uint next = planePrefix(planeTotal, total) & 0xffffu; // brick-local number of the next vertex
+    for (uint y = 0u; y < SDFCSG_MESH_BRICK; ++y) {
+        Row row = rowAt(brick + uvec3(0u, y, plane), y, plane);
+        uint r = y + SDFCSG_MESH_BRICK * plane;
+        records[record + 2u * r] = next;
+        records[record + 2u * r + 1u] = row.crossed.x | row.crossed.y << 8 | row.crossed.z << 16;
+        for (uint any = row.crossed.x | row.crossed.y | row.crossed.z; any != 0u;
+             any &= any - 1u) {
+            uint x = findLSB(any);
+            for (uint axis = 0u; axis < 3u; ++axis)
+                if ((row.crossed[axis] & (1u << x)) != 0u)
+                    edges[batchSlot * SDFCSG_MESH_BRICK_EDGES + next++] =
+                        ownedIndex(uvec3(x, y, plane)) * 3u + axis;
+        }
+    }
+    if (plane == 0u) counts[slot] = uvec2(total & 0xffffu, total >> 16);
 }
 
 vec3 normalAt(vec3 p, vec3 edgeDirection) {
@@ -128,6 +191,6 @@ void placeVertices() {
 
 void main() {
     if (kPass == SDFCSG_MESH_PASS_CULL) cull();
-    else if (kPass == SDFCSG_MESH_PASS_SAMPLE) sampleBlock();
+    else if (kPass == SDFCSG_MESH_PASS_CLASSIFY) classify();
     else placeVertices();
 }

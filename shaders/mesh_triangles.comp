@@ -1,13 +1,15 @@
 #version 450
 // Mesh extraction, triangle pass: one workgroup per brick of the batch, one invocation per
-// z-plane of the brick (see mesh_scan.glsl). Emits the cell's triangles from the marching-cubes table; each corner is the vertex of a
-// crossed edge, numbered by the brick that owns the edge's lower sample (this one or a
-// neighbour): that brick's first vertex + the edge's number within it (see mesh_classify.comp).
+// z-plane of the brick (see mesh_rows.glsl). Emits the triangles of the brick's cells from the
+// marching-cubes table. Each corner is the vertex of a crossed edge, numbered by the brick that
+// owns the edge's lower sample (this one or a neighbour): that brick's first vertex, plus the
+// number of its row's first vertex, plus the crossed edges before it in the row (see the
+// classify pass in mesh_field.comp).
 #extension GL_GOOGLE_include_directive : require
 
 #include "shared.h"
 #include "mesh_common.glsl"
-#include "mesh_scan.glsl"
+#include "mesh_rows.glsl"
 #include "mesh_tables.glsl"
 
 layout(local_size_x = SDFCSG_MESH_BRICK) in;
@@ -16,8 +18,8 @@ layout(std430, set = 0, binding = SDFCSG_BINDING_MESH_MAP) readonly buffer MeshM
     uint map[];
 };
 
-layout(std430, set = 0, binding = SDFCSG_BINDING_MESH_META) readonly buffer MeshMeta {
-    uint meta[];
+layout(std430, set = 0, binding = SDFCSG_BINDING_MESH_RECORDS) readonly buffer MeshRecords {
+    uint records[];
 };
 
 layout(std430, set = 0, binding = SDFCSG_BINDING_MESH_BASES) readonly buffer MeshBases {
@@ -28,10 +30,8 @@ layout(std430, set = 0, binding = SDFCSG_BINDING_MESH_INDICES) writeonly buffer 
     uint indices[];
 };
 
-const uint kOwned = SDFCSG_MESH_BRICK * SDFCSG_MESH_BRICK * SDFCSG_MESH_BRICK;
-
 uint vertexIndex(uint slot, uvec3 brick, uvec3 l, uint edge) {
-    uint info = tables[1288u + edge];
+    uint info = tables[1280u + edge];
     uint axis = info >> 3;
     uvec3 o = l + offsetBits(info);
     uvec3 next = uvec3(greaterThanEqual(o, uvec3(SDFCSG_MESH_BRICK)));
@@ -44,27 +44,40 @@ uint vertexIndex(uint slot, uvec3 brick, uvec3 l, uint edge) {
         return 0u;
     }
     o -= next * SDFCSG_MESH_BRICK;
-    uint m = meta[owner * kOwned + o.x + SDFCSG_MESH_BRICK * (o.y + SDFCSG_MESH_BRICK * o.z)];
-    uint crossed = (m >> 11) & 7u;
-    return bases[owner].x + (m & 0x7ffu) + bitCount(crossed & ((1u << axis) - 1u));
+    uint row = owner * SDFCSG_MESH_RECORD + 2u * (o.y + SDFCSG_MESH_BRICK * o.z);
+    uint crossed = records[row + 1u];
+    uint before = lowBits(o.x);
+    uint earlier = crossed & (before * 0x10101u); // edges of earlier samples, all axes
+    uint here = (crossed >> o.x) & 0x10101u;   // this sample's x, y, z edges
+    uint axesBefore = axis == 0u ? 0u : axis == 1u ? 1u : 0x101u;
+    return bases[owner].x + records[row] + bitCount(earlier) + bitCount(here & axesBefore);
 }
 
 void main() {
     if (gl_WorkGroupID.x >= push.count) return; // uniform in the workgroup
     uint slot = push.first + gl_WorkGroupID.x;
-    uvec3 brick = brickCoords(activeBricks[slot]);
-    const uint kPlane = SDFCSG_MESH_BRICK * SDFCSG_MESH_BRICK;
+    uvec3 b = brickCoords(activeBricks[slot]);
+    uvec3 brick = b * SDFCSG_MESH_BRICK;
+    uint plane = gl_LocalInvocationID.x;
+    for (uint r = plane; r < kSignRows; r += SDFCSG_MESH_BRICK)
+        insideRows[r] = records[slot * SDFCSG_MESH_RECORD + kRecordSigns + r];
+    barrier();
+
     uint planeTotal = 0u;
-    for (uint i = 0u; i < kPlane; ++i)
-        planeTotal += triangleCountOf((meta[slot * kOwned + ownedIndex(planeSample(i))] >> 14) & 0xffu);
+    for (uint y = 0u; y < SDFCSG_MESH_BRICK; ++y)
+        for (uint cells = rowAt(brick + uvec3(0u, y, plane), y, plane).cells; cells != 0u;
+             cells &= cells - 1u)
+            planeTotal += triangleCountOf(cellCase(findLSB(cells), y, plane));
     uint total;
     uint next = bases[slot].y - push.triangleBase + planePrefix(planeTotal, total);
-    for (uint i = 0u; i < kPlane; ++i) {
-        uvec3 l = planeSample(i);
-        uint cellCase = (meta[slot * kOwned + ownedIndex(l)] >> 14) & 0xffu;
-        uint triangles = triangleCountOf(cellCase);
-        for (uint k = 0u; k < 3u * triangles; ++k)
-            indices[next * 3u + k] = vertexIndex(slot, brick, l, triangleEdge(cellCase, k));
-        next += triangles;
-    }
+    for (uint y = 0u; y < SDFCSG_MESH_BRICK; ++y)
+        for (uint cells = rowAt(brick + uvec3(0u, y, plane), y, plane).cells; cells != 0u;
+             cells &= cells - 1u) {
+            uvec3 l = uvec3(findLSB(cells), y, plane);
+            uint c = cellCase(l.x, y, plane);
+            uint triangles = triangleCountOf(c);
+            for (uint k = 0u; k < 3u * triangles; ++k)
+                indices[next * 3u + k] = vertexIndex(slot, b, l, triangleEdge(c, k));
+            next += triangles;
+        }
 }

@@ -26,7 +26,8 @@
 #define SDFCSG_MESH_BRICK_SAMPLES 9
 #define SDFCSG_MESH_BRICK_BLOCK 729      // SDFCSG_MESH_BRICK_SAMPLES^3
 #define SDFCSG_MESH_BRICK_EDGES 1536     // 3 edges per owned sample
-#define SDFCSG_MESH_GROUP_X 64           // cull, sample and vertex passes
+#define SDFCSG_MESH_GROUP_X 64           // cull and vertex passes
+#define SDFCSG_MESH_RECORD 209           // 2 * 8 * 8 + 9 * 9
 #define SDFCSG_MESH_NO_BRICK 0xffffffffu // brick map entry of a skipped brick
 
 #define SDFCSG_BINDING_MESH_GRID 0     // uniform MeshGrid: origin, cell size, counts
@@ -35,7 +36,9 @@
 #define SDFCSG_BINDING_MESH_MAP 4      // uint[]: per grid brick, 1 when active (cull pass writes),
                                        // then its slot or SDFCSG_MESH_NO_BRICK (host writes)
 #define SDFCSG_BINDING_MESH_SAMPLES 5  // float[]: the block of each brick of the batch
-#define SDFCSG_BINDING_MESH_META 6     // uint[]: per active brick and owned sample, packed
+#define SDFCSG_BINDING_MESH_RECORDS 6  // uint[]: per active brick, SDFCSG_MESH_RECORD words:
+                                       // per owned row, first vertex and crossed edges; then
+                                       // the signs of the block, a word per row
 #define SDFCSG_BINDING_MESH_COUNTS 7   // uvec2[]: per active brick, vertices and triangles
 #define SDFCSG_BINDING_MESH_BASES 8    // uvec2[]: per active brick, first vertex and triangle
 #define SDFCSG_BINDING_MESH_EDGES 9    // uint[]: crossed edges of each brick of the batch
@@ -62,10 +65,11 @@
 
 // Specialization constant ids.
 #define SDFCSG_SPEC_BOUNDS_SKIPPING 0
-#define SDFCSG_SPEC_MESH_PASS 1 // mesh_field.comp: which pass (SDFCSG_MESH_PASS_*)
+#define SDFCSG_SPEC_MESH_PASS 1  // mesh_field.comp: which pass (SDFCSG_MESH_PASS_*)
+#define SDFCSG_SPEC_MESH_GROUP 2 // mesh_field.comp: workgroup size of that pass
 
 #define SDFCSG_MESH_PASS_CULL 0
-#define SDFCSG_MESH_PASS_SAMPLE 1
+#define SDFCSG_MESH_PASS_CLASSIFY 1
 #define SDFCSG_MESH_PASS_VERTICES 2
 
 #endif

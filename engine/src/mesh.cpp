@@ -3,9 +3,9 @@
 // Per extraction:
 //   cull       one value per brick of the grid (shaders/mesh_field.comp); the host compacts the
 //              bricks that may hold surface into a list of slots and a map from brick to slot.
-//   sample     per batch of active bricks, the brick's block of field values;
-//   classify   crossed edges, cell cases, brick-local vertex numbers, counts per brick; the host
-//              turns the counts into each brick's first vertex and triangle;
+//   classify   per batch of active bricks, the brick's block of field values, its crossed
+//              edges and brick-local vertex numbers, and its counts; the host turns the counts
+//              into each brick's first vertex and triangle;
 //   vertices   one vertex per crossed edge, on the surface, with normal and colour;
 //   triangles  after every batch is classified (a cell's edges may belong to a later brick),
 //              the index triples, from the marching-cubes table.
@@ -36,12 +36,11 @@ using detail::Buffer;
 using detail::MemoryUse;
 
 constexpr uint32_t kBrick = SDFCSG_MESH_BRICK;
-constexpr uint32_t kOwned = kBrick * kBrick * kBrick;
 constexpr uint32_t kBatchBricks = 4096;      // bricks sampled and classified per submission
 constexpr uint32_t kMaxGroups = 65535;       // the minimum maxComputeWorkGroupCount[0]
-constexpr uint64_t kMaxActive = 1u << 21;    // slots * kOwned must fit a uint32_t index
-// Bytes each active brick holds for the whole extraction: slot, map entry, meta, counts, bases.
-constexpr uint64_t kBytesPerActive = 4 + kOwned * 4 + 8 + 8;
+constexpr uint64_t kMaxActive = 1u << 22; // slots * SDFCSG_MESH_RECORD fits a uint32_t index
+// Bytes each active brick holds for the whole extraction: slot, record, counts, bases.
+constexpr uint64_t kBytesPerActive = 4 + SDFCSG_MESH_RECORD * 4 + 8 + 8;
 // Bytes of the per-batch working buffers: samples and crossed edges.
 constexpr uint64_t kBytesPerBatchBrick = 4 * (SDFCSG_MESH_BRICK_BLOCK + SDFCSG_MESH_BRICK_EDGES);
 constexpr uint64_t kBytesPerVertex = 9 * 4 * 2; // GPU output and host mesh
@@ -67,7 +66,7 @@ constexpr detail::Binding kBindings[] = {
     {SDFCSG_BINDING_MESH_ACTIVE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
     {SDFCSG_BINDING_MESH_MAP, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
     {SDFCSG_BINDING_MESH_SAMPLES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-    {SDFCSG_BINDING_MESH_META, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+    {SDFCSG_BINDING_MESH_RECORDS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
     {SDFCSG_BINDING_MESH_COUNTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
     {SDFCSG_BINDING_MESH_BASES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
     {SDFCSG_BINDING_MESH_EDGES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
@@ -77,19 +76,26 @@ constexpr detail::Binding kBindings[] = {
 };
 constexpr size_t kBindingCount = std::size(kBindings);
 
-// The layout that shaders/mesh_tables.glsl reads.
+// The layout that shaders/mesh_tables.glsl reads. The kernels number a cell's corners
+// canonically (bit ox + 2 oy + 4 oz for the corner at offset (ox, oy, oz)), so the cases are
+// renumbered from the table's corner order.
 std::vector<uint32_t> packTables() {
-    std::vector<uint32_t> t(1300, 0);
-    for (int c = 0; c < 256; ++c) {
-        t[c] = detail::kTriCount[c];
-        for (int k = 0; k < 3 * detail::kTriCount[c]; ++k)
-            t[256 + c * 4 + k / 4] |= uint32_t(uint8_t(detail::kTriTable[c][k])) << (8 * (k % 4));
-    }
     auto bits = [](const int* o) { return uint32_t(o[0] | o[1] << 1 | o[2] << 2); };
-    for (int c = 0; c < 8; ++c)
-        t[1280 + c] = bits(detail::kCornerOffset[c]);
+    uint32_t cornerAt[8]; // table corner at each canonical position
+    for (uint32_t c = 0; c < 8; ++c)
+        cornerAt[bits(detail::kCornerOffset[c])] = c;
+    std::vector<uint32_t> t(1292, 0);
+    for (uint32_t canonical = 0; canonical < 256; ++canonical) {
+        uint32_t c = 0;
+        for (uint32_t k = 0; k < 8; ++k)
+            if (canonical & (1u << k)) c |= 1u << cornerAt[k];
+        t[canonical] = detail::kTriCount[c];
+        for (int k = 0; k < 3 * detail::kTriCount[c]; ++k)
+            t[256 + canonical * 4 + k / 4] |= uint32_t(uint8_t(detail::kTriTable[c][k]))
+                                              << (8 * (k % 4));
+    }
     for (int e = 0; e < 12; ++e)
-        t[1288 + e] =
+        t[1280 + e] =
             bits(detail::kCornerOffset[detail::kEdgeCorners[e][0]]) | detail::kEdgeAxis[e] << 3;
     return t;
 }
@@ -181,11 +187,11 @@ struct Mesher::Impl {
     Context::Impl& ctx;
     std::unique_ptr<Evaluator> evaluator;
 
-    VkShaderModule modules[3] = {}; // field, classify, triangles
+    VkShaderModule modules[2] = {}; // field (cull, classify, vertices), triangles
     VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
     VkPipelineLayout pipelineLayout = VK_NULL_HANDLE;
-    VkPipeline cull = VK_NULL_HANDLE, sample = VK_NULL_HANDLE, vertices = VK_NULL_HANDLE,
-               classify = VK_NULL_HANDLE, triangles = VK_NULL_HANDLE;
+    VkPipeline cull = VK_NULL_HANDLE, classify = VK_NULL_HANDLE, vertices = VK_NULL_HANDLE,
+               triangles = VK_NULL_HANDLE;
     VkDescriptorPool pool = VK_NULL_HANDLE;
     VkDescriptorSet set = VK_NULL_HANDLE;
 
@@ -198,7 +204,7 @@ struct Mesher::Impl {
         vkDeviceWaitIdle(ctx.device);
         for (Buffer& b : buffers)
             detail::destroyBuffer(ctx, b);
-        for (VkPipeline p : {cull, sample, vertices, classify, triangles})
+        for (VkPipeline p : {cull, classify, vertices, triangles})
             if (p) vkDestroyPipeline(ctx.device, p, nullptr);
         for (VkShaderModule m : modules)
             if (m) vkDestroyShaderModule(ctx.device, m, nullptr);
@@ -309,7 +315,7 @@ struct Mesher::Impl {
     // Every pipeline runs once on an empty batch, so drivers that compile on first use (llvmpipe)
     // have done so before the first extraction is timed.
     void warmUp() {
-        for (VkPipeline p : {cull, sample, vertices, classify, triangles}) {
+        for (VkPipeline p : {cull, classify, vertices, triangles}) {
             VkCommandBuffer cmd = begin(p);
             dispatch(cmd, MeshPush{}, 1);
             detail::submitAndWait(ctx);
@@ -334,8 +340,8 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
     CodegenOptions codegen;
     codegen.inlineParams = true;
     const std::string sceneGlsl = generateSceneGlsl(scene, codegen);
-    const char* kernels[] = {"mesh_field.comp", "mesh_classify.comp", "mesh_triangles.comp"};
-    for (int i = 0; i < 3; ++i) {
+    const char* kernels[] = {"mesh_field.comp", "mesh_triangles.comp"};
+    for (int i = 0; i < 2; ++i) {
         auto spirv = compileKernel(kernels[i], i == 0 ? std::string_view(sceneGlsl) : "");
         if (!spirv) return spirv.error();
         m.modules[i] = detail::createShaderModule(m.ctx, *spirv);
@@ -347,16 +353,16 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
 
     // Bounds tests pay off only where branches are real (see RenderOptions::boundsSkipping).
     const uint32_t skipping = m.ctx.properties.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU;
-    auto field = [&](uint32_t pass) {
+    auto field = [&](uint32_t pass, uint32_t group) {
         detail::SpecConstant spec[] = {{SDFCSG_SPEC_BOUNDS_SKIPPING, skipping},
-                                       {SDFCSG_SPEC_MESH_PASS, pass}};
+                                       {SDFCSG_SPEC_MESH_PASS, pass},
+                                       {SDFCSG_SPEC_MESH_GROUP, group}};
         return detail::createComputePipeline(m.ctx, m.modules[0], m.pipelineLayout, spec);
     };
-    m.cull = field(SDFCSG_MESH_PASS_CULL);
-    m.sample = field(SDFCSG_MESH_PASS_SAMPLE);
-    m.vertices = field(SDFCSG_MESH_PASS_VERTICES);
-    m.classify = detail::createComputePipeline(m.ctx, m.modules[1], m.pipelineLayout, {});
-    m.triangles = detail::createComputePipeline(m.ctx, m.modules[2], m.pipelineLayout, {});
+    m.cull = field(SDFCSG_MESH_PASS_CULL, SDFCSG_MESH_GROUP_X);
+    m.classify = field(SDFCSG_MESH_PASS_CLASSIFY, SDFCSG_MESH_BRICK);
+    m.vertices = field(SDFCSG_MESH_PASS_VERTICES, SDFCSG_MESH_GROUP_X);
+    m.triangles = detail::createComputePipeline(m.ctx, m.modules[1], m.pipelineLayout, {});
 
     std::vector<detail::GpuNode> nodes = detail::packNodes(*m.evaluator);
     std::vector<uint32_t> tables = packTables();
@@ -427,8 +433,8 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
     if (g.brickCount >= SDFCSG_MESH_NO_BRICK || mapBytes > options.memoryBudget)
         return overBudget(g, "its brick map", mapBytes, options.memoryBudget);
 
-    // Progress: the cull counts one unit, each batch three (sample, classify, vertices) and one
-    // for its triangles.
+    // Progress: the cull counts one unit, each batch two (classify, vertices) and one for its
+    // triangles.
     double progressTotal = 1, progressDone = 0;
     auto progress = [&](double units) {
         progressDone += units;
@@ -473,7 +479,7 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
     const uint32_t activeCount = uint32_t(active.size());
     const uint32_t batches = (activeCount + kBatchBricks - 1) / kBatchBricks;
     const uint32_t batchBricks = std::min(activeCount, kBatchBricks);
-    progressTotal += 4.0 * batches;
+    progressTotal += 3.0 * batches;
     if (!progress(1)) return cancelled;
 
     // Known once the bricks are culled: what the bricks hold for the whole extraction.
@@ -484,7 +490,7 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
                           fixedBytes, options.memoryBudget);
     detail::uploadBuffer(ctx, buffer(SDFCSG_BINDING_MESH_MAP), map.data(), map.size() * 4);
     for (auto [binding, bytes] : {std::pair{SDFCSG_BINDING_MESH_ACTIVE, activeCount * 4ull},
-                                  {SDFCSG_BINDING_MESH_META, activeCount * uint64_t(kOwned) * 4},
+                                  {SDFCSG_BINDING_MESH_RECORDS, activeCount * uint64_t(SDFCSG_MESH_RECORD) * 4},
                                   {SDFCSG_BINDING_MESH_COUNTS, activeCount * 8ull},
                                   {SDFCSG_BINDING_MESH_BASES, activeCount * 8ull},
                                   {SDFCSG_BINDING_MESH_SAMPLES,
@@ -505,15 +511,7 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
         push.count = std::min(kBatchBricks, activeCount - push.first);
 
         t0 = Clock::now();
-        VkCommandBuffer cmd = begin(sample);
-        dispatch(cmd, push,
-                 detail::groupCount(push.count * SDFCSG_MESH_BRICK_BLOCK, SDFCSG_MESH_GROUP_X));
-        finish(cmd);
-        stage("sample", t0);
-        if (!progress(1)) return cancelled;
-
-        t0 = Clock::now();
-        cmd = begin(classify);
+        VkCommandBuffer cmd = begin(classify);
         dispatch(cmd, push, push.count);
         finish(cmd);
         const glm::uvec2* counts = mapped<glm::uvec2>(SDFCSG_BINDING_MESH_COUNTS);
