@@ -7,7 +7,9 @@
 #include "sdfcsg/compile.h"
 
 #include "gpu_nodes.h"
+#include "primitive_lists.h"
 
+#include <algorithm>
 #include <array>
 #include <charconv>
 #include <string>
@@ -85,15 +87,30 @@ void appendVector(std::string& out, const float* v, int count) {
 
 class Emitter {
   public:
-    Emitter(const Scene& scene, std::string& out, const std::vector<detail::GpuNode>* literals)
-        : scene_(scene), out_(out), lit_(literals) {}
+    Emitter(const Scene& scene, std::string& out, const std::vector<detail::GpuNode>* literals,
+            std::vector<detail::PrimitiveList> lists)
+        : scene_(scene), out_(out), lit_(literals), lists_(std::move(lists)),
+          operands_(scene.nodes.size()) {
+        std::vector<bool> listed(scene.nodes.size(), false);
+        for (const detail::PrimitiveList& list : lists_)
+            for (uint32_t m : list.members)
+                listed[m] = true;
+        for (uint32_t i = 0; i < scene.nodes.size(); ++i)
+            for (uint32_t c : scene.nodes[i].children)
+                if (!listed[c]) operands_[i].push_back(c);
+    }
 
-    // The buffer-mode wrappers, e.g. `float boxNode(uint i, vec3 p)`, for the kinds in use.
+    // The buffer-mode wrappers, e.g. `float boxNode(uint i, vec3 p)`, for the kinds in use (with
+    // values inlined, for the kinds in primitive lists only).
     void helpers() {
-        if (lit_) return;
         std::array<bool, kNodeKindCount> used{};
-        for (const Node& n : scene_.nodes)
-            used[size_t(n.kind)] = true;
+        if (lit_)
+            for (const detail::PrimitiveList& list : lists_)
+                used[size_t(list.kind)] = true;
+        else
+            for (const Node& n : scene_.nodes)
+                used[size_t(n.kind)] = true;
+        if (std::find(used.begin(), used.end(), true) == used.end()) return;
         for (int k = 0; k <= int(NodeKind::Capsule); ++k) {
             if (!used[size_t(k)]) continue;
             const Call& call = kCalls[k];
@@ -119,21 +136,28 @@ class Emitter {
         out_ += sample ? "vec4 sceneSample(vec3 p) {\n" : "float sceneDistance(vec3 p) {\n";
         struct Frame {
             uint32_t node, next, depth;
+            bool declared; // the operation's variable exists before its first inline operand
         };
         std::vector<Frame> stack;
         uint32_t current = 0, depth = 0;
         for (;;) {
             const Node& n = scene_.nodes[current];
             if (kindInfo(n.kind).operation) {
-                stack.push_back({current, 1, depth});
-                current = n.children[0];
-                ++depth;
-                continue;
+                const bool declared = openLists(current, depth);
+                const std::vector<uint32_t>& operands = operands_[current];
+                if (!operands.empty()) {
+                    stack.push_back({current, 1, depth, declared});
+                    if (declared) guard(current, operands[0], depth);
+                    current = operands[0];
+                    ++depth;
+                    continue;
+                }
+            } else {
+                indent(depth);
+                declare(current);
+                leaf(current);
+                comment(current);
             }
-            indent(depth);
-            declare(current);
-            leaf(current);
-            comment(current);
             // Fold the finished value into the enclosing operations; descend into the next child.
             for (;;) {
                 if (stack.empty()) {
@@ -144,8 +168,9 @@ class Emitter {
                 }
                 Frame& f = stack.back();
                 const Node& op = scene_.nodes[f.node];
-                const uint32_t child = op.children[f.next - 1];
-                if (f.next == 1) {
+                const std::vector<uint32_t>& operands = operands_[f.node];
+                const uint32_t child = operands[f.next - 1];
+                if (f.next == 1 && !f.declared) {
                     indent(f.depth);
                     declare(f.node);
                     var(child);
@@ -153,8 +178,8 @@ class Emitter {
                 } else {
                     fold(f.node, child, f.depth);
                 }
-                if (f.next < op.children.size()) {
-                    current = op.children[f.next++];
+                if (f.next < operands.size()) {
+                    current = operands[f.next++];
                     depth = f.depth + 1;
                     if (op.kind != NodeKind::Intersection) guard(f.node, current, f.depth);
                     break;
@@ -166,6 +191,42 @@ class Emitter {
 
   private:
     void indent(uint32_t depth) { out_.append(4 * (depth + 1), ' '); }
+
+    // For a union with primitive lists: declares its variable as "nothing" and folds in each
+    // list's operands in a loop over the kernel's list for the current region. Returns whether
+    // it did.
+    bool openLists(uint32_t op, uint32_t depth) {
+        bool opened = false;
+        for (size_t g = 0; g < lists_.size(); ++g) {
+            const detail::PrimitiveList& list = lists_[g];
+            if (list.unionNode != op) continue;
+            if (!opened) {
+                indent(depth);
+                declare(op);
+                out_ += sample_ ? "vec4(0.0, 0.0, 0.0, 1e30)" : "1e30";
+                comment(op);
+                opened = true;
+            }
+            const std::string k = "k" + std::to_string(g);
+            indent(depth + 1);
+            out_ += "for (uint " + k + " = sceneListBegin(" + std::to_string(g) + "u); " + k +
+                    " < sceneListEnd(" + std::to_string(g) + "u); ++" + k + ") { // " +
+                    std::to_string(list.members.size()) + " " +
+                    std::string(kindInfo(list.kind).name) + " operands, those near the region\n";
+            indent(depth + 2);
+            var(op);
+            out_ += " = opUnion(";
+            var(op);
+            out_ += ", ";
+            const std::string call = std::string(kCalls[int(list.kind)].helper) +
+                                     "(sceneList[" + k + "], p)";
+            out_ += sample_ ? "withColor(sceneList[" + k + "], " + call + ")" : call;
+            out_ += ", 0.0);\n";
+            indent(depth + 1);
+            out_ += "}\n";
+        }
+        return opened;
+    }
 
     void var(uint32_t i) {
         out_ += sample_ ? 's' : 'd';
@@ -300,6 +361,8 @@ class Emitter {
     const Scene& scene_;
     std::string& out_;
     const std::vector<detail::GpuNode>* lit_; // null: values come from the node buffer
+    std::vector<detail::PrimitiveList> lists_;
+    std::vector<std::vector<uint32_t>> operands_; // per operation, those not in a list
     bool sample_ = false;
 };
 
@@ -319,10 +382,13 @@ std::string generateSceneGlsl(const Scene& scene, const CodegenOptions& options)
                "vec4 sceneSample(vec3 p) { return vec4(0.0, 0.0, 0.0, 1e30); }\n";
         return out;
     }
+    Evaluator evaluator(scene);
     std::vector<detail::GpuNode> literals;
-    if (inlined) literals = detail::packNodes(Evaluator(scene));
+    if (inlined) literals = detail::packNodes(evaluator);
     out.reserve(out.size() + scene.nodes.size() * (inlined ? 500 : 200));
-    Emitter emitter(scene, out, inlined ? &literals : nullptr);
+    Emitter emitter(scene, out, inlined ? &literals : nullptr,
+                    options.primitiveLists ? detail::primitiveLists(scene, evaluator)
+                                           : std::vector<detail::PrimitiveList>{});
     emitter.helpers();
     emitter.function(false);
     out += '\n';

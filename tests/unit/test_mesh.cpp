@@ -1,0 +1,319 @@
+// The GPU mesher (engine/src/mesh.cpp) by the properties of its meshes: analytic volume and area,
+// topology, vertices on the surface, outward normals, closed and manifold meshes of the bundled
+// scenes, equality with the CPU reference (mesh_reference.h), repeatability, and its errors.
+#include "gpu_test.h"
+#include "mesh_checks.h"
+#include "mesh_reference.h"
+
+#include <numbers>
+
+namespace sdfcsg::test {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+Scene sceneFrom(std::string_view json) {
+    auto scene = parseScene(json, "<test>");
+    if (!scene) {
+        ADD_FAILURE() << scene.error().str();
+        return Scene{};
+    }
+    return *scene;
+}
+
+const char* const kSphere = R"({"version": 1, "root": {"type": "sphere", "radius": 1}})";
+
+class MeshTest : public GpuTest {
+  protected:
+    // Extracts with a fresh mesher; fails the test and returns an empty mesh on error.
+    Mesh extract(const Scene& scene, const MeshOptions& options, MeshStats* stats = nullptr) {
+        auto mesh = extractMesh(context(), scene, options, stats);
+        if (!mesh) {
+            ADD_FAILURE() << mesh.error().str();
+            return Mesh{};
+        }
+        return *mesh;
+    }
+};
+
+TEST_F(MeshTest, SphereHasTheAnalyticVolumeAndArea) {
+    const Scene scene = sceneFrom(kSphere);
+    MeshOptions options;
+    options.resolution = 128;
+    MeshStats stats;
+    const Mesh mesh = extract(scene, options, &stats);
+    const MeshProperties m = measureMesh(mesh);
+    SCOPED_TRACE(m.str());
+    EXPECT_EQ(std::max(stats.cells.x, std::max(stats.cells.y, stats.cells.z)), 128u);
+    EXPECT_EQ(stats.vertices, mesh.vertexCount());
+    EXPECT_EQ(stats.triangles, mesh.triangleCount());
+    EXPECT_FALSE(stats.surfaceCut);
+    EXPECT_TRUE(m.closedManifold());
+    EXPECT_EQ(m.euler, 2);
+    EXPECT_EQ(m.referencedVertices, m.vertices);
+    EXPECT_NEAR(m.volume, 4.0 / 3.0 * kPi, 0.01 * 4.0 / 3.0 * kPi);
+    EXPECT_NEAR(m.area, 4.0 * kPi, 0.01 * 4.0 * kPi);
+
+    const Evaluator evaluator(scene);
+    EXPECT_LE(maxSurfaceDistance(mesh, evaluator), 0.1f * stats.voxelSize);
+    const NormalProperties normals = checkNormals(mesh);
+    EXPECT_EQ(normals.notUnit, 0u) << normals.str();
+    EXPECT_EQ(normals.inward, 0u) << normals.str();
+    for (size_t i = 0; i < mesh.vertexCount(); ++i)
+        ASSERT_NEAR(glm::dot(mesh.normals[i], mesh.positions[i]), 1.0f, 1e-3f)
+            << "vertex " << i << ": the normal of a unit sphere at p is p";
+}
+
+TEST_F(MeshTest, TorusHasEulerCharacteristicZero) {
+    const Scene scene = sceneFrom(R"({"version": 1, "root": {"type": "torus",
+        "major_radius": 0.7, "minor_radius": 0.25, "rotate": [30, 0, 20]}})");
+    MeshOptions options;
+    options.resolution = 64;
+    MeshStats stats;
+    const Mesh mesh = extract(scene, options, &stats);
+    const MeshProperties m = measureMesh(mesh);
+    SCOPED_TRACE(m.str());
+    EXPECT_FALSE(stats.surfaceCut);
+    EXPECT_TRUE(m.closedManifold());
+    EXPECT_EQ(m.euler, 0);
+    const double volume = 2 * kPi * kPi * 0.7 * 0.25 * 0.25;
+    EXPECT_NEAR(m.volume, volume, 0.02 * volume);
+    EXPECT_LE(maxSurfaceDistance(mesh, Evaluator(scene)), 0.1f * stats.voxelSize);
+    const NormalProperties normals = checkNormals(mesh);
+    EXPECT_EQ(normals.notUnit, 0u) << normals.str();
+    EXPECT_EQ(normals.inward, 0u) << normals.str();
+}
+
+// Every bundled scene at the default resolution: closed and manifold where the surface fits the
+// bounds; scenes with a ground plane reach the bounds, say so, and are still manifold.
+class BundledSceneMesh : public GpuTest,
+                         public ::testing::WithParamInterface<std::filesystem::path> {};
+
+TEST_P(BundledSceneMesh, IsClosedManifoldWhereTheSurfaceFitsTheBounds) {
+    const Scene scene = loadOrDie(GetParam());
+    const Evaluator evaluator(scene);
+    MeshStats stats;
+    auto mesh = extractMesh(context(), scene, {}, &stats);
+    ASSERT_TRUE(mesh) << mesh.error().str();
+    const MeshProperties m = measureMesh(*mesh);
+    SCOPED_TRACE(m.str());
+    EXPECT_GT(m.triangles, 1000u);
+    EXPECT_EQ(m.badTriangles, 0u);
+    EXPECT_EQ(m.nonManifoldEdges, 0u);
+    EXPECT_EQ(m.misorientedEdges, 0u);
+    EXPECT_EQ(m.referencedVertices, m.vertices);
+    if (evaluator.bounds().finite()) {
+        EXPECT_FALSE(stats.surfaceCut) << "the default bounds hold the whole solid";
+        EXPECT_EQ(m.boundaryEdges, 0u);
+        EXPECT_GT(m.volume, 0.0);
+    } else {
+        EXPECT_TRUE(stats.surfaceCut) << "a ground plane reaches the bounds";
+        EXPECT_GT(m.boundaryEdges, 0u);
+    }
+    // Each vertex lies on a grid edge that the surface crosses, so within a voxel of it. (Closer
+    // on smooth surfaces; where the field bends along the edge, as in a crease between two
+    // operands, two refinement steps leave a vertex up to a third of a voxel off.)
+    EXPECT_LE(maxSurfaceDistance(*mesh, evaluator), stats.voxelSize);
+    const NormalProperties normals = checkNormals(*mesh);
+    EXPECT_EQ(normals.notUnit, 0u) << normals.str();
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, BundledSceneMesh, ::testing::ValuesIn(bundledScenes()),
+                         sceneTestName);
+
+// The GPU result against the CPU reference on the grid the GPU reports: same counts, same
+// vertices (positions, normals, colours) within float tolerance, same oriented triangles.
+void expectMatchesReference(Context& context, const Scene& scene, const std::string& label) {
+    SCOPED_TRACE(label);
+    MeshOptions options;
+    options.resolution = 32;
+    MeshStats stats;
+    auto mesh = extractMesh(context, scene, options, &stats);
+    ASSERT_TRUE(mesh) << mesh.error().str();
+    const Evaluator evaluator(scene);
+    const ReferenceGrid grid = gridOf(stats);
+    const ReferenceMesh reference = referenceMesh(evaluator, grid, options.refineSteps);
+    EXPECT_EQ(stats.surfaceCut, reference.surfaceCut);
+    ASSERT_GT(reference.mesh.triangleCount(), 0u);
+    const MeshComparison diff = compareMeshes(*mesh, reference.mesh, 1e-3f * grid.voxelSize);
+    if (!diff.same()) {
+        // Float differences between the two evaluators can flip a sample that lies within a
+        // rounding error of the surface; name such samples to tell that apart from a real bug.
+        size_t nearZero = 0;
+        for (uint32_t z = 0; z <= grid.cells.z; ++z)
+            for (uint32_t y = 0; y <= grid.cells.y; ++y)
+                for (uint32_t x = 0; x <= grid.cells.x; ++x)
+                    if (std::abs(evaluator.distance(grid.origin +
+                                                    glm::vec3(x, y, z) * grid.voxelSize)) < 1e-6f)
+                        ++nearZero;
+        ADD_FAILURE() << "GPU vs reference: " << diff.str() << " (" << nearZero
+                      << " samples within 1e-6 of the surface)";
+    }
+}
+
+TEST_F(MeshTest, MatchesTheCpuReference) {
+    for (const char* name : {"csg_part.json", "smooth_blend.json", "snowman.json"})
+        expectMatchesReference(
+            context(), loadOrDie(std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes" / name),
+            name);
+    expectMatchesReference(context(), sceneFrom(R"({"version": 1, "root": {
+        "type": "difference", "smooth": 0.1, "children": [
+          {"type": "round_box", "size": [1.6, 1.2, 1.4], "radius": 0.2, "rotate": [10, 20, 30],
+           "color": [0.9, 0.3, 0.2]},
+          {"type": "torus", "major_radius": 0.5, "minor_radius": 0.2, "translate": [0, 0.6, 0],
+           "color": [0.2, 0.3, 0.9]},
+          {"type": "capsule", "a": [-1, -0.3, 0.7], "b": [1, 0.2, 0.6], "radius": 0.25}]}})"),
+                           "difference with smooth blend");
+    expectMatchesReference(context(), randomScene(11, 16), "random scene 11");
+}
+
+// Sharp unions of many primitives of one kind are evaluated per brick over the primitives near
+// it (engine/src/primitive_lists.h); the mesh must not change.
+TEST_F(MeshTest, PrimitiveListsMatchTheCpuReference) {
+    expectMatchesReference(
+        context(), loadOrDie(std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes/mesh_b.json"),
+        "mesh_b.json");
+    std::string children;
+    for (int i = 0; i < 12; ++i) {
+        float a = 0.52f * float(i);
+        char text[400];
+        std::snprintf(text, sizeof text,
+                      R"({"type": "sphere", "radius": %.3f, "translate": [%.3f, %.3f, 0.1]},
+                         {"type": "box", "size": [0.3, 0.2, %.3f], "rotate": [0, %d, 15],
+                          "translate": [%.3f, -0.4, %.3f], "color": [0.2, %.2f, 0.5]},)",
+                      0.15f + 0.02f * float(i % 3), std::cos(a), std::sin(a), 0.2f + 0.05f * float(i % 4),
+                      i * 30, 0.9f * std::cos(a), 0.9f * std::sin(a), 0.05f * float(i));
+        children += text;
+    }
+    expectMatchesReference(context(), sceneFrom(R"({"version": 1, "root": {
+        "type": "difference", "children": [
+          {"type": "union", "color": [0.8, 0.7, 0.1], "children": [)" + children +
+                                                R"( {"type": "torus", "major_radius": 0.9, "minor_radius": 0.1}]},
+          {"type": "cylinder", "radius": 0.3, "height": 3}]}})"),
+                           "nested union of spheres and boxes");
+}
+
+// The mesh is the same, bit for bit, every time: positions, attributes and order.
+TEST_F(MeshTest, RepeatedExtractionsAreIdentical) {
+    const Scene scene =
+        loadOrDie(std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes/csg_part.json");
+    auto mesher = Mesher::create(context(), scene);
+    ASSERT_TRUE(mesher) << mesher.error().str();
+    MeshOptions options;
+    options.resolution = 48;
+    auto first = (*mesher)->extract(options);
+    ASSERT_TRUE(first) << first.error().str();
+    ASSERT_GT(first->triangleCount(), 0u);
+    for (int run = 1; run < 20; ++run) {
+        MeshStats stats;
+        auto mesh = (*mesher)->extract(options, &stats);
+        ASSERT_TRUE(mesh) << "run " << run << ": " << mesh.error().str();
+        ASSERT_EQ(mesh->positions, first->positions) << "run " << run;
+        ASSERT_EQ(mesh->normals, first->normals) << "run " << run;
+        ASSERT_EQ(mesh->colors, first->colors) << "run " << run;
+        ASSERT_EQ(mesh->indices, first->indices) << "run " << run;
+        EXPECT_EQ(stats.vertices, first->vertexCount());
+    }
+}
+
+TEST_F(MeshTest, BoundsThatCutTheSurfaceAreReported) {
+    const Scene scene = sceneFrom(kSphere);
+    MeshOptions options;
+    options.resolution = 40;
+    options.bounds = Aabb{glm::vec3(0.2f, -1.5f, -1.5f), glm::vec3(1.5f, 1.5f, 1.5f)};
+    MeshStats stats;
+    const Mesh mesh = extract(scene, options, &stats);
+    const MeshProperties m = measureMesh(mesh);
+    EXPECT_TRUE(stats.surfaceCut);
+    EXPECT_GT(m.boundaryEdges, 0u) << m.str();
+    EXPECT_EQ(m.nonManifoldEdges, 0u) << m.str();
+    EXPECT_EQ(m.misorientedEdges, 0u) << m.str();
+    for (const glm::vec3& p : mesh.positions)
+        ASSERT_GE(p.x, stats.bounds.min.x);
+    EXPECT_LE(stats.bounds.min.x, 0.2f) << "the grid covers at least the requested bounds";
+    EXPECT_GE(stats.bounds.max.x, 1.5f);
+
+    // Bounds around the whole solid: closed, nothing cut.
+    options.bounds = Aabb{glm::vec3(-1.2f), glm::vec3(1.3f)};
+    const Mesh whole = extract(scene, options, &stats);
+    EXPECT_FALSE(stats.surfaceCut);
+    EXPECT_TRUE(measureMesh(whole).closedManifold()) << measureMesh(whole).str();
+}
+
+// Bounds wholly inside the solid hold no surface at all, yet the solid fills the boundary: the
+// caller must learn that the (empty) mesh is cut, not that the region is empty space.
+TEST_F(MeshTest, BoundsInsideTheSolidAreReportedAsCut) {
+    const Scene scene = sceneFrom(kSphere);
+    MeshOptions options;
+    options.resolution = 40;
+    options.bounds = Aabb{glm::vec3(-0.3f), glm::vec3(0.3f)};
+    MeshStats stats;
+    const Mesh mesh = extract(scene, options, &stats);
+    EXPECT_EQ(mesh.triangleCount(), 0u);
+    EXPECT_TRUE(stats.surfaceCut);
+}
+
+TEST_F(MeshTest, GridsTooLargeForTheMemoryBudgetFailBeforeWork) {
+    const Scene scene = sceneFrom(kSphere);
+    auto mesher = Mesher::create(context(), scene);
+    ASSERT_TRUE(mesher) << mesher.error().str();
+    MeshOptions options;
+    options.bounds = Aabb{glm::vec3(-1.0f), glm::vec3(1.0f)};
+    // 4096^3 cells are 513^3 bricks of 8^3 whose map alone takes 8 bytes a brick.
+    options.resolution = 4096;
+    options.memoryBudget = size_t(1) << 30;
+    MeshStats stats;
+    auto mesh = (*mesher)->extract(options, &stats);
+    ASSERT_FALSE(mesh);
+    EXPECT_EQ(mesh.error().kind, ErrorKind::Limit);
+    EXPECT_EQ(mesh.error().diagnostics.at(0).message,
+              "a grid of 4096 x 4096 x 4096 cells needs 1030.0 MiB for its brick map, more than "
+              "the memory budget of 1024.0 MiB; lower the resolution or narrow the bounds");
+
+    // The default budget; far more bricks than a map can number.
+    options.resolution = 1u << 16;
+    options.memoryBudget = MeshOptions{}.memoryBudget;
+    mesh = (*mesher)->extract(options, &stats);
+    ASSERT_FALSE(mesh);
+    EXPECT_EQ(mesh.error().kind, ErrorKind::Limit);
+    EXPECT_EQ(mesh.error().diagnostics.at(0).message,
+              "a grid of 65536 x 65536 x 65536 cells needs 4195840.2 MiB for its brick map, "
+              "more than the memory budget of 4096.0 MiB; lower the resolution or narrow the "
+              "bounds");
+
+    // The mesher still works afterwards.
+    options.resolution = 16;
+    auto small = (*mesher)->extract(options);
+    ASSERT_TRUE(small) << small.error().str();
+    EXPECT_TRUE(measureMesh(*small).closedManifold());
+}
+
+TEST_F(MeshTest, BadOptionsAreUsageErrors) {
+    const Scene scene = sceneFrom(kSphere);
+    auto mesher = Mesher::create(context(), scene);
+    ASSERT_TRUE(mesher) << mesher.error().str();
+    MeshOptions options;
+    options.resolution = 0;
+    auto mesh = (*mesher)->extract(options);
+    ASSERT_FALSE(mesh);
+    EXPECT_EQ(mesh.error().kind, ErrorKind::Usage);
+    EXPECT_EQ(mesh.error().diagnostics.at(0).message, "the resolution must be at least 1");
+
+    options = MeshOptions{};
+    options.bounds = Aabb{glm::vec3(1.0f), glm::vec3(-1.0f)};
+    mesh = (*mesher)->extract(options);
+    ASSERT_FALSE(mesh);
+    EXPECT_EQ(mesh.error().kind, ErrorKind::Usage);
+    EXPECT_EQ(mesh.error().diagnostics.at(0).message,
+              "the bounds must be finite with min < max on every axis");
+
+    options = MeshOptions{};
+    options.voxelSize = -0.5f;
+    mesh = (*mesher)->extract(options);
+    ASSERT_FALSE(mesh);
+    EXPECT_EQ(mesh.error().kind, ErrorKind::Usage);
+    EXPECT_EQ(mesh.error().diagnostics.at(0).message, "the voxel size must be a positive number");
+}
+
+} // namespace
+} // namespace sdfcsg::test

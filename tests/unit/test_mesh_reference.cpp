@@ -1,0 +1,491 @@
+// The marching-cubes tables (engine/src/mc_tables.h) and the CPU reference mesher
+// (mesh_reference.h) on their own, without a GPU: every table case is checked against the rule
+// that makes meshes closed and manifold, and meshes of known solids have the right volume, area,
+// topology and orientation.
+#include "mc_tables.h"
+#include "mesh_checks.h"
+#include "mesh_reference.h"
+#include "scene_build_util.h"
+
+#include <gtest/gtest.h>
+
+#include <glm/common.hpp>
+#include <glm/vector_relational.hpp>
+
+#include <array>
+#include <map>
+#include <numbers>
+#include <random>
+#include <set>
+#include <utility>
+
+namespace sdfcsg::test {
+namespace {
+
+using detail::kCornerOffset;
+using detail::kEdgeAxis;
+using detail::kEdgeCorners;
+using detail::kTriCount;
+using detail::kTriTable;
+
+constexpr double kPi = std::numbers::pi;
+
+// ---------------------------------------------------------------------------------------------
+// The tables, case by case.
+
+glm::ivec3 cornerOffset(int c) {
+    return {kCornerOffset[c][0], kCornerOffset[c][1], kCornerOffset[c][2]};
+}
+
+// The edge between two corners, or -1.
+int edgeBetween(int a, int b) {
+    for (int e = 0; e < 12; ++e)
+        if ((kEdgeCorners[e][0] == a && kEdgeCorners[e][1] == b) ||
+            (kEdgeCorners[e][0] == b && kEdgeCorners[e][1] == a))
+            return e;
+    return -1;
+}
+
+// Face (axis, side) of the cube: its corners in cyclic order.
+std::array<int, 4> faceCorners(int axis, int side) {
+    const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+    std::array<int, 4> corners{};
+    const int uw[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    for (int i = 0; i < 4; ++i)
+        for (int c = 0; c < 8; ++c) {
+            const glm::ivec3 o = cornerOffset(c);
+            if (o[axis] == side && o[u] == uw[i][0] && o[w] == uw[i][1]) corners[size_t(i)] = c;
+        }
+    return corners;
+}
+
+bool edgeOnFace(int e, int axis, int side) {
+    return kEdgeAxis[e] != axis && kCornerOffset[kEdgeCorners[e][0]][axis] == side;
+}
+
+bool shareFace(int e1, int e2) {
+    for (int axis = 0; axis < 3; ++axis)
+        for (int side = 0; side < 2; ++side)
+            if (edgeOnFace(e1, axis, side) && edgeOnFace(e2, axis, side)) return true;
+    return false;
+}
+
+bool inside(int cellCase, int corner) {
+    return (cellCase >> corner) & 1;
+}
+
+// Directed edges (vertex on edge a -> vertex on edge b) of case c's triangles, with their uses.
+std::map<std::pair<int, int>, int> directedEdges(int c) {
+    std::map<std::pair<int, int>, int> uses;
+    for (int t = 0; t < kTriCount[c]; ++t)
+        for (int i = 0; i < 3; ++i)
+            ++uses[{kTriTable[c][3 * t + i], kTriTable[c][3 * t + (i + 1) % 3]}];
+    return uses;
+}
+
+// Directed edges used by one triangle of the cell and not in reverse: where the cell's surface
+// meets its faces.
+std::set<std::pair<int, int>> boundarySegments(int c) {
+    auto uses = directedEdges(c);
+    std::set<std::pair<int, int>> out;
+    for (const auto& [edge, count] : uses)
+        if (count == 1 && !uses.count({edge.second, edge.first})) out.insert(edge);
+    return out;
+}
+
+TEST(MarchingCubesTable, EdgesRunFromTheirLowerCornerAlongTheirAxis) {
+    for (int e = 0; e < 12; ++e) {
+        const glm::ivec3 step = cornerOffset(kEdgeCorners[e][1]) - cornerOffset(kEdgeCorners[e][0]);
+        glm::ivec3 unit(0);
+        unit[kEdgeAxis[e]] = 1;
+        EXPECT_EQ(step, unit) << "edge " << e;
+    }
+    std::set<std::array<int, 3>> offsets;
+    for (int c = 0; c < 8; ++c) {
+        for (int i = 0; i < 3; ++i)
+            EXPECT_TRUE(kCornerOffset[c][i] == 0 || kCornerOffset[c][i] == 1);
+        offsets.insert({kCornerOffset[c][0], kCornerOffset[c][1], kCornerOffset[c][2]});
+    }
+    EXPECT_EQ(offsets.size(), 8u) << "the corners are the cube's eight corners";
+}
+
+TEST(MarchingCubesTable, CountsMatchTheTerminators) {
+    for (int c = 0; c < 256; ++c) {
+        ASSERT_LE(kTriCount[c], 5) << "case " << c;
+        for (int i = 0; i < 16; ++i) {
+            if (i < 3 * kTriCount[c]) {
+                EXPECT_TRUE(kTriTable[c][i] >= 0 && kTriTable[c][i] < 12)
+                    << "case " << c << " entry " << i;
+            } else {
+                EXPECT_EQ(kTriTable[c][i], -1) << "case " << c << " entry " << i;
+            }
+        }
+    }
+    EXPECT_EQ(kTriCount[0], 0);
+    EXPECT_EQ(kTriCount[255], 0);
+}
+
+TEST(MarchingCubesTable, EveryCaseUsesExactlyItsCrossedEdges) {
+    for (int c = 0; c < 256; ++c) {
+        std::set<int> used(kTriTable[c], kTriTable[c] + 3 * kTriCount[c]);
+        for (int e = 0; e < 12; ++e) {
+            const bool crossed = inside(c, kEdgeCorners[e][0]) != inside(c, kEdgeCorners[e][1]);
+            EXPECT_EQ(used.count(e) == 1, crossed) << "case " << c << " edge " << e;
+        }
+        for (int t = 0; t < kTriCount[c]; ++t) {
+            const int8_t* v = &kTriTable[c][3 * t];
+            EXPECT_TRUE(v[0] != v[1] && v[1] != v[2] && v[2] != v[0])
+                << "case " << c << " triangle " << t;
+        }
+    }
+}
+
+// Within a cell, the triangles form disks: each interior diagonal is used twice in opposite
+// directions and joins two vertices that share no cube face (so no other cell holds it), and the
+// boundary is exactly the face segments: on each face the crossed edges paired up, and on an
+// ambiguous face each inside corner cut off by its own segment.
+TEST(MarchingCubesTable, CellSurfacesMeetTheFacesByTheFixedRule) {
+    for (int c = 0; c < 256; ++c) {
+        auto uses = directedEdges(c);
+        std::set<std::set<int>> segments;
+        for (const auto& [edge, count] : uses) {
+            EXPECT_EQ(count, 1) << "case " << c << ": edge " << edge.first << "->" << edge.second
+                                << " used twice in the same direction";
+            if (uses.count({edge.second, edge.first})) {
+                EXPECT_FALSE(shareFace(edge.first, edge.second))
+                    << "case " << c << ": diagonal " << edge.first << "-" << edge.second
+                    << " lies on a cube face, where the neighbour cell could use it too";
+            } else {
+                EXPECT_TRUE(shareFace(edge.first, edge.second))
+                    << "case " << c << ": open edge " << edge.first << "-" << edge.second
+                    << " is not on a cube face";
+                segments.insert({edge.first, edge.second});
+            }
+        }
+        std::set<std::set<int>> expected;
+        for (int axis = 0; axis < 3; ++axis)
+            for (int side = 0; side < 2; ++side) {
+                const auto f = faceCorners(axis, side);
+                auto at = [&](int i) { return f[size_t((i + 4) % 4)]; };
+                int count = 0;
+                for (int i = 0; i < 4; ++i)
+                    count += inside(c, at(i));
+                const bool ambiguous = count == 2 && inside(c, at(0)) == inside(c, at(2));
+                if (ambiguous) {
+                    for (int i = 0; i < 4; ++i)
+                        if (inside(c, at(i)))
+                            expected.insert(
+                                {edgeBetween(at(i - 1), at(i)), edgeBetween(at(i), at(i + 1))});
+                } else if (count > 0 && count < 4) {
+                    std::set<int> crossed;
+                    for (int i = 0; i < 4; ++i)
+                        if (inside(c, at(i)) != inside(c, at(i + 1)))
+                            crossed.insert(edgeBetween(at(i), at(i + 1)));
+                    expected.insert(crossed);
+                }
+            }
+        EXPECT_EQ(segments, expected) << "case " << c;
+    }
+}
+
+// Two cells that share a face agree on its segments and run them in opposite directions, for
+// every pair of cases that agree on the shared samples.
+TEST(MarchingCubesTable, NeighbouringCellsJoinWithOppositeDirections) {
+    for (int axis = 0; axis < 3; ++axis) {
+        const auto upper = faceCorners(axis, 1), lower = faceCorners(axis, 0);
+        auto edgeKey = [&](int e, int shift) {
+            glm::ivec3 o = cornerOffset(kEdgeCorners[e][0]);
+            o[axis] -= shift;
+            return std::array<int, 4>{o.x, o.y, o.z, kEdgeAxis[e]};
+        };
+        for (int c = 0; c < 256; ++c)
+            for (int far = 0; far < 16; ++far) {
+                // The neighbour above: its lower face holds this cell's upper-face samples.
+                int n = 0;
+                for (size_t i = 0; i < 4; ++i) {
+                    if (inside(c, upper[i])) n |= 1 << lower[i];
+                    if ((far >> i) & 1) n |= 1 << upper[i];
+                }
+                std::set<std::pair<std::array<int, 4>, std::array<int, 4>>> mine, theirs;
+                for (const auto& [a, b] : boundarySegments(c))
+                    if (edgeOnFace(a, axis, 1) && edgeOnFace(b, axis, 1))
+                        mine.insert({edgeKey(b, 1), edgeKey(a, 1)}); // reversed
+                for (const auto& [a, b] : boundarySegments(n))
+                    if (edgeOnFace(a, axis, 0) && edgeOnFace(b, axis, 0))
+                        theirs.insert({edgeKey(a, 0), edgeKey(b, 0)});
+                ASSERT_EQ(mine, theirs) << "axis " << axis << ", case " << c << " below case " << n;
+            }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The reference mesher on fields and scenes.
+
+// A grid of cubic cells, `cells` along the longest axis, covering `box` grown by `margin` cells
+// and shifted by `shift` cells, so that no sample falls exactly on a surface of simple shapes.
+ReferenceGrid gridAround(const Aabb& box, uint32_t cells, float margin = 1.5f,
+                         glm::vec3 shift = glm::vec3(0.137f, 0.291f, 0.223f)) {
+    const glm::vec3 size = box.max - box.min;
+    const float longest = std::max(size.x, std::max(size.y, size.z));
+    const float h = longest / float(cells - 2.0f * margin);
+    ReferenceGrid grid;
+    grid.voxelSize = h;
+    grid.origin = box.min - margin * h + (shift - 0.5f) * h;
+    grid.cells = glm::uvec3(glm::ceil((size + 2.0f * margin * h) / h)) + 1u;
+    return grid;
+}
+
+TEST(MeshReference, SphereHasTheAnalyticVolumeAndArea) {
+    const Evaluator evaluator(makeScene(sphere(1.0f)));
+    const ReferenceGrid grid = gridAround(evaluator.bounds(), 128);
+    const ReferenceMesh result = referenceMesh(evaluator, grid);
+    const MeshProperties m = measureMesh(result.mesh);
+    SCOPED_TRACE(m.str());
+    EXPECT_FALSE(result.surfaceCut);
+    EXPECT_TRUE(m.closedManifold());
+    EXPECT_EQ(m.euler, 2);
+    EXPECT_EQ(m.referencedVertices, m.vertices);
+    EXPECT_NEAR(m.volume, 4.0 / 3.0 * kPi, 0.01 * 4.0 / 3.0 * kPi);
+    EXPECT_NEAR(m.area, 4.0 * kPi, 0.01 * 4.0 * kPi);
+    EXPECT_LE(maxSurfaceDistance(result.mesh, evaluator), 0.1f * grid.voxelSize);
+    const NormalProperties normals = checkNormals(result.mesh);
+    EXPECT_EQ(normals.notUnit, 0u) << normals.str();
+    EXPECT_EQ(normals.inward, 0u) << normals.str();
+    EXPECT_GT(normals.worstDot, 0.9) << normals.str();
+    for (size_t i = 0; i < result.mesh.vertexCount(); i += 97)
+        ASSERT_NEAR(glm::dot(result.mesh.normals[i], result.mesh.positions[i]), 1.0f, 1e-3f)
+            << "the normal of a unit sphere at p is p";
+}
+
+TEST(MeshReference, TorusHasEulerCharacteristicZero) {
+    const Evaluator evaluator(makeScene(torus(0.7f, 0.25f).rotated(30, 0, 20)));
+    const ReferenceMesh result = referenceMesh(evaluator, gridAround(evaluator.bounds(), 64));
+    const MeshProperties m = measureMesh(result.mesh);
+    SCOPED_TRACE(m.str());
+    EXPECT_FALSE(result.surfaceCut);
+    EXPECT_TRUE(m.closedManifold());
+    EXPECT_EQ(m.euler, 0);
+    const double volume = 2 * kPi * kPi * 0.7 * 0.25 * 0.25;
+    EXPECT_NEAR(m.volume, volume, 0.02 * volume);
+}
+
+TEST(MeshReference, RefinementMovesVerticesOntoTheSurface) {
+    // A smooth union's field bends between the two spheres, so the linear estimate misses the
+    // surface; refinement closes in.
+    const Evaluator evaluator(
+        makeScene(unite({sphere(0.6f), sphere(0.5f).at(0.7f, 0.1f, 0)}, 0.3f)));
+    const ReferenceGrid grid = gridAround(evaluator.bounds(), 24);
+    const float linear = maxSurfaceDistance(referenceMesh(evaluator, grid, 0).mesh, evaluator);
+    const float refined = maxSurfaceDistance(referenceMesh(evaluator, grid, 2).mesh, evaluator);
+    EXPECT_LT(refined, linear);
+    EXPECT_LT(refined, 0.01f * grid.voxelSize);
+}
+
+// Every case inside a closed neighbourhood: the cell's eight samples set by the case, all other
+// samples outside.
+TEST(MeshReference, EveryCaseAloneGivesAClosedMesh) {
+    ReferenceGrid grid;
+    grid.cells = glm::uvec3(3);
+    for (int c = 1; c < 256; ++c) {
+        auto field = [&](glm::vec3 p) {
+            const glm::ivec3 s(glm::round(p));
+            const glm::ivec3 o = s - 1;
+            if (glm::any(glm::lessThan(o, glm::ivec3(0))) ||
+                glm::any(glm::greaterThan(o, glm::ivec3(1))))
+                return 1.0f;
+            for (int k = 0; k < 8; ++k)
+                if (cornerOffset(k) == o) return inside(c, k) ? -1.0f : 1.0f;
+            return 1.0f;
+        };
+        // Only samples are ever at integer points; refinement and normals are off the grid and
+        // see the rounded sample's value, which keeps every sign test on the grid.
+        const ReferenceMesh result = referenceMeshOf(
+            field, [](glm::vec3) { return glm::vec3(0.0f); }, grid, 0);
+        const MeshProperties m = measureMesh(result.mesh);
+        EXPECT_TRUE(m.closedManifold()) << "case " << c << ": " << m.str();
+        EXPECT_GT(m.volume, 0.0) << "case " << c << ": " << m.str();
+        EXPECT_FALSE(result.surfaceCut);
+    }
+}
+
+// Trilinear interpolation of random values on the grid's samples: every cell gets an arbitrary
+// case, and its neighbours whatever they happen to share with it.
+struct RandomField {
+    glm::uvec3 size;
+    std::vector<float> values;
+
+    RandomField(uint32_t seed, uint32_t cells, float insideFraction) : size(cells + 1) {
+        std::mt19937 rng(seed);
+        std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+        values.resize(size_t(size.x) * size.y * size.z);
+        for (uint32_t z = 0; z < size.z; ++z)
+            for (uint32_t y = 0; y < size.y; ++y)
+                for (uint32_t x = 0; x < size.x; ++x) {
+                    const bool edge =
+                        x == 0 || y == 0 || z == 0 || x == cells || y == cells || z == cells;
+                    const float magnitude = 0.05f + uni(rng);
+                    const bool in = !edge && uni(rng) < insideFraction;
+                    values[(size_t(z) * size.y + y) * size.x + x] = in ? -magnitude : magnitude;
+                }
+    }
+    float at(glm::ivec3 s) const {
+        s = glm::clamp(s, glm::ivec3(0), glm::ivec3(size) - 1);
+        return values[(size_t(s.z) * size.y + size_t(s.y)) * size.x + size_t(s.x)];
+    }
+    float operator()(glm::vec3 p) const {
+        const glm::vec3 f = glm::floor(p);
+        const glm::vec3 t = p - f;
+        const glm::ivec3 s(f);
+        float sum = 0;
+        for (int k = 0; k < 8; ++k) {
+            const glm::ivec3 o = cornerOffset(k);
+            const float w = (o.x ? t.x : 1 - t.x) * (o.y ? t.y : 1 - t.y) * (o.z ? t.z : 1 - t.z);
+            sum += w * at(s + o);
+        }
+        return sum;
+    }
+};
+
+TEST(MeshReference, RandomFieldsGiveClosedManifoldMeshes) {
+    ReferenceGrid grid;
+    grid.cells = glm::uvec3(12);
+    size_t triangles = 0;
+    for (uint32_t seed = 1; seed <= 60; ++seed) {
+        const float fraction = 0.2f + 0.6f * float(seed % 5) / 4.0f;
+        const RandomField field(seed, 12, fraction);
+        const ReferenceMesh result = referenceMeshOf(
+            field, [](glm::vec3) { return glm::vec3(0.0f); }, grid, 2);
+        const MeshProperties m = measureMesh(result.mesh);
+        triangles += m.triangles;
+        EXPECT_TRUE(m.closedManifold()) << "seed " << seed << ": " << m.str();
+        EXPECT_GT(m.volume, 0.0) << "seed " << seed << ": " << m.str();
+        EXPECT_EQ(m.euler % 2, 0) << "seed " << seed << ": " << m.str();
+        EXPECT_EQ(m.referencedVertices, m.vertices) << "seed " << seed;
+        EXPECT_FALSE(result.surfaceCut);
+    }
+    EXPECT_GT(triangles, 60u * 1000u) << "the fields should be busy";
+}
+
+TEST(MeshReference, RandomSphereUnionsGiveClosedManifoldMeshes) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+    for (int trial = 0; trial < 8; ++trial) {
+        std::vector<Tree> spheres;
+        for (int i = 0; i < 12; ++i)
+            spheres.push_back(sphere(0.1f + 0.3f * uni(rng))
+                                  .at(uni(rng) * 2 - 1, uni(rng) * 2 - 1, uni(rng) * 2 - 1));
+        const Evaluator evaluator(makeScene(unite(std::move(spheres), trial % 2 ? 0.2f : 0.0f)));
+        const ReferenceGrid grid = gridAround(evaluator.bounds(), 20 + 3 * uint32_t(trial));
+        const ReferenceMesh result = referenceMesh(evaluator, grid);
+        const MeshProperties m = measureMesh(result.mesh);
+        EXPECT_FALSE(result.surfaceCut) << "trial " << trial;
+        EXPECT_TRUE(m.closedManifold()) << "trial " << trial << ": " << m.str();
+        EXPECT_GT(m.volume, 0.0) << "trial " << trial << ": " << m.str();
+        EXPECT_LE(maxSurfaceDistance(result.mesh, evaluator), 0.1f * grid.voxelSize)
+            << "trial " << trial;
+    }
+}
+
+TEST(MeshReference, RandomScenesGiveClosedManifoldMeshes) {
+    for (uint32_t seed = 1; seed <= 8; ++seed) {
+        const Evaluator evaluator(randomScene(seed, 12));
+        ASSERT_TRUE(evaluator.bounds().finite()) << "seed " << seed;
+        if (evaluator.bounds().empty()) continue;
+        const ReferenceMesh result = referenceMesh(evaluator, gridAround(evaluator.bounds(), 32));
+        const MeshProperties m = measureMesh(result.mesh);
+        EXPECT_FALSE(result.surfaceCut) << "seed " << seed;
+        EXPECT_TRUE(m.closedManifold()) << "seed " << seed << ": " << m.str();
+        EXPECT_GE(m.volume, 0.0) << "seed " << seed << ": " << m.str();
+        const NormalProperties normals = checkNormals(result.mesh);
+        EXPECT_EQ(normals.notUnit, 0u) << "seed " << seed << ": " << normals.str();
+    }
+}
+
+TEST(MeshReference, BoundsThatCutTheSurfaceLeaveItOpenAndSaySo) {
+    const Evaluator evaluator(makeScene(box(2, 2, 2)));
+    Aabb cut;
+    cut.min = glm::vec3(0.3f, -1.5f, -1.5f);
+    cut.max = glm::vec3(1.5f, 1.5f, 1.5f);
+    const ReferenceMesh result = referenceMesh(evaluator, gridAround(cut, 24, 0.0f));
+    const MeshProperties m = measureMesh(result.mesh);
+    EXPECT_TRUE(result.surfaceCut);
+    EXPECT_GT(m.boundaryEdges, 0u) << m.str();
+    EXPECT_EQ(m.nonManifoldEdges, 0u) << m.str();
+    EXPECT_EQ(m.misorientedEdges, 0u) << m.str();
+}
+
+// The checks themselves: a tetrahedron, and comparisons that must and must not match.
+Mesh tetrahedron() {
+    Mesh mesh;
+    mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    mesh.normals = {glm::normalize(glm::vec3(-1)), {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    mesh.colors.assign(4, glm::vec3(0.5f));
+    mesh.indices = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+    return mesh;
+}
+
+TEST(MeshChecks, MeasureATetrahedron) {
+    const MeshProperties m = measureMesh(tetrahedron());
+    EXPECT_TRUE(m.closedManifold()) << m.str();
+    EXPECT_EQ(m.edges, 6u);
+    EXPECT_EQ(m.euler, 2);
+    EXPECT_NEAR(m.volume, 1.0 / 6.0, 1e-9);
+    EXPECT_NEAR(m.area, 1.5 + std::sqrt(3.0) / 2.0, 1e-6);
+
+    Mesh flipped = tetrahedron();
+    std::swap(flipped.indices[1], flipped.indices[2]);
+    const MeshProperties f = measureMesh(flipped);
+    EXPECT_EQ(f.misorientedEdges, 3u) << f.str();
+    EXPECT_FALSE(f.closedManifold());
+
+    Mesh open = tetrahedron();
+    open.indices.resize(9);
+    const MeshProperties o = measureMesh(open);
+    EXPECT_EQ(o.boundaryEdges, 3u) << o.str();
+    EXPECT_EQ(o.referencedVertices, 4u);
+
+    Mesh fin = tetrahedron();
+    fin.positions.push_back({1, 1, 1});
+    fin.normals.push_back({0, 0, 1});
+    fin.colors.push_back({0, 0, 0});
+    fin.indices.insert(fin.indices.end(), {1, 2, 4});
+    EXPECT_EQ(measureMesh(fin).nonManifoldEdges, 1u);
+}
+
+TEST(MeshChecks, CompareIgnoresOrderButNotOrientation) {
+    const Mesh a = tetrahedron();
+    Mesh b;
+    const uint32_t order[4] = {2, 3, 0, 1}; // b's vertex i is a's vertex order[i]
+    uint32_t inverse[4];
+    for (uint32_t i = 0; i < 4; ++i) {
+        b.positions.push_back(a.positions[order[i]] + glm::vec3(1e-6f));
+        b.normals.push_back(a.normals[order[i]]);
+        b.colors.push_back(a.colors[order[i]]);
+        inverse[order[i]] = i;
+    }
+    for (int t = 3; t >= 0; --t) // reversed triangle order, each rotated
+        for (int i = 0; i < 3; ++i)
+            b.indices.push_back(inverse[a.indices[size_t(3 * t + (i + 1) % 3)]]);
+    EXPECT_TRUE(compareMeshes(a, b, 1e-4f).same()) << compareMeshes(a, b, 1e-4f).str();
+
+    Mesh flipped = b;
+    std::swap(flipped.indices[0], flipped.indices[1]);
+    EXPECT_EQ(compareMeshes(a, flipped, 1e-4f).unmatchedTriangles, 2u);
+
+    Mesh moved = b;
+    moved.positions[0].x += 0.01f;
+    EXPECT_EQ(compareMeshes(a, moved, 1e-4f).unmatchedVertices, 1u);
+
+    Mesh recoloured = b;
+    recoloured.colors[3] = glm::vec3(1.0f);
+    EXPECT_EQ(compareMeshes(a, recoloured, 1e-4f).colorMismatches, 1u);
+
+    const NormalProperties normals = checkNormals(a);
+    EXPECT_EQ(normals.inward, 0u) << normals.str();
+    Mesh inward = a;
+    inward.normals[3] = -inward.normals[3];
+    EXPECT_EQ(checkNormals(inward).inward, 1u);
+}
+
+} // namespace
+} // namespace sdfcsg::test
