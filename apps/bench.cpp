@@ -1,5 +1,6 @@
 // sdfcsg bench: median frame times with and without bounds skipping, and the time from scene
-// JSON to a ready pipeline, for every scene in a folder.
+// JSON to a ready pipeline, for every scene in a folder; with --mesh, median mesh extraction
+// times per stage at several resolutions instead.
 #include "bench.h"
 
 #include "shader_compile.h"
@@ -8,6 +9,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -23,6 +25,7 @@ namespace {
 namespace fs = std::filesystem;
 
 const char* kHelp = R"(Usage: sdfcsg bench [--scenes DIR] [--width W] [--height H] [--frames N]
+       sdfcsg bench --mesh [--scenes DIR] [--resolutions 128,256,512] [--runs N]
 
 For every scene (*.json) in DIR (default assets/scenes), prints the median milliseconds per
 frame in shaded mode with and without bounding-box skipping (after two warm-up frames; a frame
@@ -36,6 +39,13 @@ Options:
   --width W      image width (default 1280)
   --height H     image height (default 720)
   --frames N     timed frames per measurement (default 5)
+
+With --mesh, prints for every scene and resolution the median seconds of each stage of mesh
+extraction and of the whole (from a compiled scene to an indexed mesh in host memory), over
+--runs extractions (default 3) after one warm-up per scene. The resolution is the number of
+cells along the longest axis of the bounds: the scene's finite bounds plus a margin, except
+for the reference scenes mesh_a and mesh_b, which are meshed in the bounds their benchmark
+defines.
 )";
 
 using Clock = std::chrono::steady_clock;
@@ -105,9 +115,176 @@ struct Row {
     double skip = 0, noSkip = 0, cold = 0, warm = 0;
 };
 
+// The reference scenes of the mesh benchmark come with bounds of their own; every other scene
+// is meshed in its default bounds. (The scene format has no field for meshing bounds.)
+struct ReferenceBounds {
+    const char* scene; // file stem
+    Aabb bounds;
+};
+const ReferenceBounds kReferenceBounds[] = {
+    {"mesh_a", {glm::vec3(-1.1f), glm::vec3(1.1f)}},
+    {"mesh_b", {glm::vec3(-1.0f), glm::vec3(1.0f)}},
+};
+
+bool parseList(const char* s, std::vector<uint32_t>& out) {
+    out.clear();
+    std::string text = s;
+    size_t start = 0;
+    for (size_t i = 0; i <= text.size(); ++i)
+        if (i == text.size() || text[i] == ',') {
+            uint32_t v = 0;
+            if (!parseCount(text.substr(start, i - start).c_str(), 1, 1u << 16, v)) return false;
+            out.push_back(v);
+            start = i + 1;
+        }
+    return !out.empty();
+}
+
+struct MeshRow {
+    std::string scene;
+    uint32_t resolution = 0;
+    glm::uvec3 cells{0};
+    uint64_t triangles = 0;
+    std::vector<double> stages; // median seconds, in the order of the stage names
+    double total = 0;
+};
+
+int runMeshBench(int argc, char** argv) {
+    fs::path dir = "assets/scenes";
+    std::vector<uint32_t> resolutions = {128, 256, 512};
+    uint32_t runs = 3;
+    for (int i = 0; i < argc; ++i) {
+        std::string_view a = argv[i];
+        bool ok = true;
+        if (a == "--mesh")
+            continue;
+        else if (i + 1 < argc && a == "--scenes")
+            dir = argv[++i];
+        else if (i + 1 < argc && a == "--resolutions")
+            ok = parseList(argv[++i], resolutions);
+        else if (i + 1 < argc && a == "--runs")
+            ok = parseCount(argv[++i], 1, 1000, runs);
+        else
+            ok = false;
+        if (!ok) {
+            std::fprintf(stderr, "sdfcsg bench: bad argument '%s'\nTry 'sdfcsg bench --help'.\n",
+                         argv[i]);
+            return 2;
+        }
+    }
+    std::vector<fs::path> scenes;
+    std::error_code ec;
+    for (const auto& entry : fs::directory_iterator(dir, ec))
+        if (entry.path().extension() == ".json") scenes.push_back(entry.path());
+    if (ec || scenes.empty()) {
+        std::fprintf(stderr, "sdfcsg bench: no scenes (*.json) in %s\n", dir.string().c_str());
+        return 3;
+    }
+    std::sort(scenes.begin(), scenes.end());
+    auto context = Context::create();
+    if (!context) {
+        std::fprintf(stderr, "%s\n", context.error().str().c_str());
+        return 4;
+    }
+    std::printf("device: %s, median of %u extraction%s (1 warm-up per scene)\n",
+                (*context)->deviceName().c_str(), runs, runs == 1 ? "" : "s");
+
+    std::vector<std::string> stageNames; // in the order the mesher reports them
+    std::vector<MeshRow> rows;
+    int status = 0;
+    for (const fs::path& path : scenes) {
+        const std::string name = path.stem().string();
+        auto failed = [&](const Error& e) {
+            std::fprintf(stderr, "%s: %s\n", path.string().c_str(), e.str().c_str());
+            status = e.kind == ErrorKind::Io ? 3 : e.kind == ErrorKind::Limit ? 1 : 4;
+        };
+        auto scene = loadScene(path);
+        if (!scene) {
+            failed(scene.error());
+            break;
+        }
+        auto mesher = Mesher::create(**context, *scene);
+        if (!mesher) {
+            failed(mesher.error());
+            break;
+        }
+        MeshOptions options;
+        for (const ReferenceBounds& r : kReferenceBounds)
+            if (name == r.scene) options.bounds = r.bounds;
+        options.resolution = resolutions.front();
+        if (auto warm = (*mesher)->extract(options); !warm) {
+            failed(warm.error());
+            break;
+        }
+        for (uint32_t resolution : resolutions) {
+            options.resolution = resolution;
+            MeshRow row;
+            row.scene = name;
+            row.resolution = resolution;
+            std::vector<std::vector<double>> stageTimes;
+            std::vector<double> totals;
+            for (uint32_t run = 0; run < runs && status == 0; ++run) {
+                MeshStats stats;
+                auto mesh = (*mesher)->extract(options, &stats);
+                if (!mesh) {
+                    failed(mesh.error());
+                    break;
+                }
+                row.cells = stats.cells;
+                row.triangles = stats.triangles;
+                totals.push_back(stats.totalSeconds);
+                for (const MeshStats::Stage& stage : stats.stages) {
+                    auto it = std::find(stageNames.begin(), stageNames.end(), stage.name);
+                    const size_t k = size_t(it - stageNames.begin());
+                    if (it == stageNames.end()) stageNames.push_back(stage.name);
+                    if (stageTimes.size() <= k) stageTimes.resize(k + 1);
+                    stageTimes[k].push_back(stage.seconds);
+                }
+            }
+            if (status != 0) break;
+            for (const auto& times : stageTimes) // NaN: the stage did not run for this scene
+                row.stages.push_back(times.empty() ? std::nan("") : median(times));
+            row.total = median(totals);
+            std::fprintf(stderr, "  %s at %u done\n", name.c_str(), resolution);
+            rows.push_back(row);
+        }
+        if (status != 0) break;
+    }
+
+    std::printf("\n%-16s %5s %16s %10s", "scene", "res", "cells", "triangles");
+    for (const std::string& stage : stageNames)
+        std::printf(" %*s", int(std::max<size_t>(stage.size(), 8)), stage.c_str());
+    std::printf(" %8s\n", "total s");
+    for (const MeshRow& r : rows) {
+        const std::string cells = std::to_string(r.cells.x) + "x" + std::to_string(r.cells.y) +
+                                  "x" + std::to_string(r.cells.z);
+        std::printf("%-16s %5u %16s %10llu", r.scene.c_str(), r.resolution, cells.c_str(),
+                    static_cast<unsigned long long>(r.triangles));
+        for (size_t k = 0; k < stageNames.size(); ++k) {
+            const int width = int(std::max<size_t>(stageNames[k].size(), 8));
+            if (k < r.stages.size() && !std::isnan(r.stages[k]))
+                std::printf(" %*.3f", width, r.stages[k]);
+            else
+                std::printf(" %*s", width, "-");
+        }
+        std::printf(" %8.3f\n", r.total);
+    }
+    std::printf(
+        "\nSeconds, median per stage and in total, from a compiled scene to an indexed mesh "
+        "in host memory. res: cells along the longest axis of the bounds.\n");
+    return status;
+}
+
 } // namespace
 
 int runBench(int argc, char** argv) {
+    for (int i = 0; i < argc; ++i)
+        if (std::string_view(argv[i]) == "--mesh") {
+            for (int j = 0; j < argc; ++j)
+                if (std::string_view(argv[j]) == "--help" || std::string_view(argv[j]) == "-h")
+                    return std::fputs(kHelp, stdout), 0;
+            return runMeshBench(argc, argv);
+        }
     fs::path dir = "assets/scenes";
     uint32_t width = 1280, height = 720, frames = 5;
     for (int i = 0; i < argc; ++i) {

@@ -1,10 +1,12 @@
-// sdfcsg bench: frame times and JSON-to-pipeline times on the bundled scenes.
+// sdfcsg bench: frame times and JSON-to-pipeline times on the bundled scenes; with --mesh, mesh
+// extraction times per stage at several resolutions.
 #pragma once
 
 namespace sdfcsg::app {
 
-// `sdfcsg bench [--scenes DIR] [--width W] [--height H] [--frames N]`; argv holds the arguments
-// after "bench". Prints a table to stdout; returns a process exit code.
+// `sdfcsg bench [--scenes DIR] [--width W] [--height H] [--frames N]` or
+// `sdfcsg bench --mesh [--scenes DIR] [--resolutions 128,256,512] [--runs N]`; argv holds the
+// arguments after "bench". Prints a table to stdout; returns a process exit code.
 int runBench(int argc, char** argv);
 
 } // namespace sdfcsg::app

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -15,6 +16,9 @@
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include <sys/resource.h>
+#include <unistd.h>
 
 namespace {
 
@@ -138,11 +142,12 @@ Usage: sdfcsg COMMAND [ARGS...]
 
 Commands:
   render    ray-march a scene to a PNG image
+  mesh      extract a triangle mesh (PLY, OBJ, STL or glTF binary)
   validate  check scene files and list every problem found
   glsl      print the GLSL a scene compiles to
   convert   convert a scene (e.g. the legacy format) to the current format
   schema    print the JSON Schema of the scene format
-  bench     measure frame times and compile times on the bundled scenes
+  bench     measure frame, compile and meshing times on the bundled scenes
 
 'sdfcsg COMMAND --help' describes a command. Exit codes: 0 success, 1 invalid scene or a
 limit exceeded, 2 bad command line, 3 file read or write failure, 4 Vulkan or shader failure.
@@ -234,6 +239,171 @@ int cmdRender(int argc, char** argv) {
     auto image = (*renderer)->render(options);
     if (!image) return fail(image.error());
     if (auto written = sdfcsg::writePng(*image, out); !written) return fail(written.error());
+    return kOk;
+}
+
+const char* kMeshHelp = R"(Usage: sdfcsg mesh SCENE -o OUT.(ply|obj|stl|glb) [options]
+
+Extracts a triangle mesh of SCENE by marching cubes in Vulkan compute passes and writes it
+(atomically) in the format that OUT's extension names: binary PLY with normals and colours,
+OBJ with normals and colours ("v x y z r g b"), binary STL for printing, or glTF 2.0 binary.
+The mesh is indexed, and closed and manifold wherever the surface lies inside the bounds;
+where the bounds cut the surface it is open, and a note says so.
+
+Options:
+  -o, --output FILE      output mesh (required): .ply, .obj, .stl or .glb
+  --resolution N         cells along the longest axis of the bounds (default 128)
+  --voxel-size H         cell edge length in scene units, instead of --resolution
+  --bounds X0,Y0,Z0,X1,Y1,Z1
+                         region to mesh (default: the scene's finite bounds plus a margin
+                         of a few cells)
+  --stats                print the grid, brick and mesh sizes, the time per stage and the
+                         peak memory
+  --device NAME          Vulkan device: index or part of its name (also SDFCSG_DEVICE)
+  --validation           enable the Vulkan validation layer
+)";
+
+bool parseBounds(const std::string& s, sdfcsg::Aabb& out) {
+    std::vector<float> values;
+    size_t start = 0;
+    for (size_t i = 0; i <= s.size(); ++i)
+        if (i == s.size() || s[i] == ',') {
+            float v = 0;
+            if (!parseFloat(s.substr(start, i - start), v)) return false;
+            values.push_back(v);
+            start = i + 1;
+        }
+    if (values.size() != 6) return false;
+    out.min = {values[0], values[1], values[2]};
+    out.max = {values[3], values[4], values[5]};
+    return out.min.x < out.max.x && out.min.y < out.max.y && out.min.z < out.max.z;
+}
+
+// A one-line bar on a terminal, redrawn when the whole percentage changes.
+class ProgressBar {
+  public:
+    bool update(float fraction) {
+        const int percent = int(std::clamp(fraction, 0.0f, 1.0f) * 100.0f);
+        if (percent == shown_) return true;
+        shown_ = percent;
+        constexpr int kWidth = 40;
+        const int filled = percent * kWidth / 100;
+        std::fprintf(stderr, "\rmeshing [%.*s%*s] %3d%%", filled,
+                     "########################################", kWidth - filled, "", percent);
+        std::fflush(stderr);
+        return true;
+    }
+    ~ProgressBar() {
+        if (shown_ >= 0) std::fprintf(stderr, "\r%60s\r", "");
+    }
+
+  private:
+    int shown_ = -1;
+};
+
+std::string mebibytes(double bytes) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.1f MiB", bytes / (1024.0 * 1024.0));
+    return text;
+}
+
+void printMeshStats(const sdfcsg::MeshStats& stats, double compileSeconds, double writeSeconds) {
+    const auto& b = stats.bounds;
+    std::printf("grid:      %u x %u x %u cells of %g, over [%g, %g, %g] .. [%g, %g, %g]\n",
+                stats.cells.x, stats.cells.y, stats.cells.z, stats.voxelSize, b.min.x, b.min.y,
+                b.min.z, b.max.x, b.max.y, b.max.z);
+    std::printf("bricks:    %llu active of %llu (%.1f%%)\n",
+                static_cast<unsigned long long>(stats.activeBricks),
+                static_cast<unsigned long long>(stats.bricks),
+                stats.bricks ? 100.0 * double(stats.activeBricks) / double(stats.bricks) : 0.0);
+    std::printf("mesh:      %llu vertices, %llu triangles\n",
+                static_cast<unsigned long long>(stats.vertices),
+                static_cast<unsigned long long>(stats.triangles));
+    std::printf("surface:   %s\n", stats.surfaceCut ? "cut by the bounds (the mesh is open there)"
+                                                    : "inside the bounds (the mesh is closed)");
+    std::printf("time:      %-12s %8.3f s\n", "compile", compileSeconds);
+    for (const auto& stage : stats.stages)
+        std::printf("           %-12s %8.3f s\n", stage.name.c_str(), stage.seconds);
+    std::printf("           %-12s %8.3f s (compiled scene to mesh in memory)\n", "extraction",
+                stats.totalSeconds);
+    std::printf("           %-12s %8.3f s\n", "write", writeSeconds);
+    // ru_maxrss is in KiB on Linux.
+    rusage usage{};
+    ::getrusage(RUSAGE_SELF, &usage);
+    std::printf("memory:    %s peak working set (buffers and mesh), %s peak process RSS\n",
+                mebibytes(double(stats.peakBytes)).c_str(),
+                mebibytes(double(usage.ru_maxrss) * 1024.0).c_str());
+}
+
+int cmdMesh(int argc, char** argv) {
+    using Clock = std::chrono::steady_clock;
+    auto secondsSince = [](Clock::time_point t0) {
+        return std::chrono::duration<double>(Clock::now() - t0).count();
+    };
+    Args args("mesh", argc, argv,
+              {"-o", "--output", "--resolution", "--voxel-size", "--bounds", "--device"},
+              {"--stats", "--validation", "--help", "-h"});
+    if (args.has("--help") || args.has("-h")) return std::fputs(kMeshHelp, stdout), kOk;
+    if (!args.error.empty()) return usageError("mesh", args.error);
+    if (args.positional.size() != 1) return usageError("mesh", "expected one SCENE file");
+    std::string out = args.get("-o", args.get("--output"));
+    if (out.empty()) return usageError("mesh", "missing -o OUT.(ply|obj|stl|glb)");
+    auto format = sdfcsg::meshFormatFromPath(out);
+    if (!format)
+        return usageError("mesh",
+                          "the output must end in .ply, .obj, .stl or .glb, got '" + out + "'");
+
+    sdfcsg::MeshOptions options;
+    if (args.has("--resolution") && args.has("--voxel-size"))
+        return usageError("mesh", "give --resolution or --voxel-size, not both");
+    if (args.has("--resolution") &&
+        !parseUint(args.get("--resolution"), 1, 1u << 24, options.resolution))
+        return usageError("mesh", "--resolution expects an integer in 1..16777216");
+    if (args.has("--voxel-size")) {
+        float h = 0;
+        if (!parseFloat(args.get("--voxel-size"), h) || h <= 0.0f)
+            return usageError("mesh", "--voxel-size expects a positive number");
+        options.voxelSize = h;
+    }
+    if (args.has("--bounds")) {
+        sdfcsg::Aabb bounds;
+        if (!parseBounds(args.get("--bounds"), bounds))
+            return usageError("mesh", "--bounds expects X0,Y0,Z0,X1,Y1,Z1 with X0 < X1, Y0 < Y1 "
+                                      "and Z0 < Z1");
+        options.bounds = bounds;
+    }
+
+    auto scene = load(args.positional[0]);
+    if (!scene) return fail(scene.error());
+    sdfcsg::ContextOptions contextOptions;
+    contextOptions.device = args.get("--device");
+    if (args.has("--validation")) contextOptions.validation = 1;
+    auto context = sdfcsg::Context::create(contextOptions);
+    if (!context) return fail(context.error());
+    auto t0 = Clock::now();
+    auto mesher = sdfcsg::Mesher::create(**context, *scene);
+    if (!mesher) return fail(mesher.error());
+    const double compileSeconds = secondsSince(t0);
+
+    sdfcsg::MeshStats stats;
+    auto mesh = [&] {
+        ProgressBar bar; // erased again when the extraction ends
+        if (::isatty(STDERR_FILENO))
+            options.progress = [&bar](float fraction) { return bar.update(fraction); };
+        return (*mesher)->extract(options, &stats);
+    }();
+    if (!mesh) return fail(mesh.error());
+    t0 = Clock::now();
+    if (auto written = sdfcsg::writeMesh(*mesh, out, *format); !written)
+        return fail(written.error());
+    const double writeSeconds = secondsSince(t0);
+
+    if (args.has("--stats")) printMeshStats(stats, compileSeconds, writeSeconds);
+    if (mesh->triangleCount() == 0)
+        std::fprintf(stderr, "note: no surface lies inside the bounds; %s holds an empty mesh\n",
+                     out.c_str());
+    else if (stats.surfaceCut && !args.has("--stats"))
+        std::fprintf(stderr, "note: the bounds cut the surface, so the mesh is open there\n");
     return kOk;
 }
 
@@ -343,8 +513,9 @@ int main(int argc, char** argv) {
         return kOk;
     }
     const std::pair<std::string_view, std::function<int(int, char**)>> commands[] = {
-        {"render", cmdRender},   {"validate", cmdValidate}, {"glsl", cmdGlsl},
-        {"convert", cmdConvert}, {"schema", cmdSchema},     {"bench", sdfcsg::app::runBench},
+        {"render", cmdRender},   {"mesh", cmdMesh},     {"validate", cmdValidate},
+        {"glsl", cmdGlsl},       {"convert", cmdConvert}, {"schema", cmdSchema},
+        {"bench", sdfcsg::app::runBench},
     };
     for (auto& [name, run] : commands)
         if (command == name) return run(argc - 2, argv + 2);

@@ -27,7 +27,7 @@ expect_text() { # expect_text NAME FILE TEXT: FILE holds TEXT as a whole line
     fi
 }
 
-for c in render validate glsl convert schema bench; do
+for c in render mesh validate glsl convert schema bench; do
     check "$c --help" 0 "$bin" "$c" --help
     grep -q "^Usage: sdfcsg $c" out.txt || { echo "FAIL $c --help text"; failures=$((failures + 1)); }
 done
@@ -52,6 +52,49 @@ check "render house" 0 "$bin" render "$src/assets/scenes/house.json" -o house.pn
     { echo "FAIL house.png is not a PNG"; failures=$((failures + 1)); }
 check "render to a missing directory" 3 "$bin" render "$src/assets/scenes/house.json" -o no/such/dir.png --width 8 --height 8
 ls | grep -q '\.tmp-' && { echo "FAIL a temporary file was left behind"; failures=$((failures + 1)); }
+
+# Meshes: every format, with counts that agree with --stats; exit codes; no temporaries.
+mesh_a="$src/assets/scenes/mesh_a.json"
+box=-1.1,-1.1,-1.1,1.1,1.1,1.1
+for f in ply obj stl glb; do
+    check "mesh $f" 0 "$bin" mesh "$mesh_a" -o "part.$f" --resolution 24 --bounds $box --stats
+    expect_text "mesh $f closed" out.txt "surface:   inside the bounds (the mesh is closed)"
+    grep '^mesh:' out.txt >"counts.$f.txt"
+done
+for f in obj stl glb; do
+    cmp -s counts.ply.txt "counts.$f.txt" || { echo "FAIL mesh counts differ between ply and $f"; failures=$((failures + 1)); }
+done
+vertices=$(sed 's/^mesh: *\([0-9]*\) vertices.*/\1/' counts.ply.txt)
+triangles=$(sed 's/.*, \([0-9]*\) triangles$/\1/' counts.ply.txt)
+[ "${triangles:-0}" -gt 100 ] || { echo "FAIL mesh --stats reports no triangles"; failures=$((failures + 1)); }
+[ "$(head -n 1 part.ply)" = "ply" ] && grep -aqx "element vertex $vertices" part.ply &&
+    grep -aqx "element face $triangles" part.ply ||
+    { echo "FAIL part.ply header does not match the stats"; failures=$((failures + 1)); }
+[ "$(grep -c '^v ' part.obj)" -eq "$vertices" ] && [ "$(grep -c '^vn ' part.obj)" -eq "$vertices" ] &&
+    [ "$(grep -c '^f ' part.obj)" -eq "$triangles" ] ||
+    { echo "FAIL part.obj counts do not match the stats"; failures=$((failures + 1)); }
+[ "$(wc -c < part.stl)" -eq $((84 + 50 * triangles)) ] ||
+    { echo "FAIL part.stl size does not match the stats"; failures=$((failures + 1)); }
+[ "$(head -c 4 part.glb)" = "glTF" ] && [ "$(wc -c < part.glb)" -eq "$(od -An -tu4 -j8 -N4 part.glb | tr -d ' ')" ] ||
+    { echo "FAIL part.glb header"; failures=$((failures + 1)); }
+check "mesh cut by the bounds" 0 "$bin" mesh "$mesh_a" -o cut.stl --resolution 16 --bounds 0,0,0,1,1,1 --stats
+expect_text "mesh cut stats" out.txt "surface:   cut by the bounds (the mesh is open there)"
+check "mesh nothing in the bounds" 0 "$bin" mesh "$mesh_a" -o empty.glb --resolution 8 --bounds 5,5,5,6,6,6
+[ "$(head -c 4 empty.glb)" = "glTF" ] || { echo "FAIL empty.glb is not a GLB"; failures=$((failures + 1)); }
+check "mesh voxel size" 0 "$bin" mesh "$mesh_a" -o voxel.ply --voxel-size 0.1
+check "mesh usage" 2 "$bin" mesh "$mesh_a"
+check "mesh bad extension" 2 "$bin" mesh "$mesh_a" -o part.txt
+expect_text "mesh bad extension message" err.txt "sdfcsg mesh: the output must end in .ply, .obj, .stl or .glb, got 'part.txt'"
+check "mesh bad bounds" 2 "$bin" mesh "$mesh_a" -o bad.ply --bounds 1,1,1,0,0,0
+check "mesh short bounds" 2 "$bin" mesh "$mesh_a" -o bad.ply --bounds 0,0,0,1,1
+check "mesh resolution and voxel size" 2 "$bin" mesh "$mesh_a" -o bad.ply --resolution 8 --voxel-size 0.1
+check "mesh bad resolution" 2 "$bin" mesh "$mesh_a" -o bad.ply --resolution 0
+check "mesh missing scene" 3 "$bin" mesh does-not-exist.json -o bad.ply
+check "mesh bad scene" 1 "$bin" mesh bad.json -o bad.ply
+check "mesh too large for memory" 1 "$bin" mesh "$mesh_a" -o bad.ply --resolution 100000
+check "mesh to a missing directory" 3 "$bin" mesh "$mesh_a" -o no/such/dir.ply --resolution 8
+[ ! -e bad.ply ] || { echo "FAIL a failed mesh left an output"; failures=$((failures + 1)); }
+ls | grep -q '\.tmp-' && { echo "FAIL mesh left a temporary file behind"; failures=$((failures + 1)); }
 
 check "glsl" 0 "$bin" glsl "$src/assets/scenes/csg_part.json"
 grep -q "float sceneDistance(vec3 p)" out.txt || { echo "FAIL glsl has no sceneDistance"; failures=$((failures + 1)); }

@@ -170,6 +170,21 @@ TEST_F(MeshTest, MatchesTheCpuReference) {
 // Sharp unions of many primitives of one kind are evaluated per brick over the primitives near
 // it (engine/src/primitive_lists.h); the mesh must not change.
 TEST_F(MeshTest, PrimitiveListsMatchTheCpuReference) {
+    {
+        // Reference scene B: 64 separate spheres (the slab between the layers touches none).
+        MeshOptions options;
+        options.bounds = Aabb{glm::vec3(-1.0f), glm::vec3(1.0f)};
+        options.resolution = 96;
+        auto mesh = extractMesh(
+            context(),
+            loadOrDie(std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes/mesh_b.json"),
+            options);
+        ASSERT_TRUE(mesh) << mesh.error().str();
+        const MeshProperties m = measureMesh(*mesh);
+        EXPECT_EQ(m.euler, 2 * 64) << m.str();
+        const double volume = 64.0 * 4.0 / 3.0 * std::numbers::pi * 0.12 * 0.12 * 0.12;
+        EXPECT_NEAR(m.volume, volume, 0.03 * volume) << m.str();
+    }
     expectMatchesReference(
         context(), loadOrDie(std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes/mesh_b.json"),
         "mesh_b.json");
