@@ -24,6 +24,20 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// The scenes (*.json) in `dir`, sorted; empty, with a message, when there are none.
+std::vector<fs::path> findScenes(const fs::path& dir) {
+    std::vector<fs::path> scenes;
+    std::error_code ec;
+    for (const auto& entry : fs::directory_iterator(dir, ec))
+        if (entry.path().extension() == ".json") scenes.push_back(entry.path());
+    if (ec || scenes.empty()) {
+        std::fprintf(stderr, "sdfcsg bench: no scenes (*.json) in %s\n", dir.string().c_str());
+        return {};
+    }
+    std::sort(scenes.begin(), scenes.end());
+    return scenes;
+}
+
 const char* kHelp = R"(Usage: sdfcsg bench [--scenes DIR] [--width W] [--height H] [--frames N]
        sdfcsg bench --mesh [--scenes DIR] [--resolutions 128,256,512] [--runs N]
 
@@ -172,15 +186,8 @@ int runMeshBench(int argc, char** argv) {
             return 2;
         }
     }
-    std::vector<fs::path> scenes;
-    std::error_code ec;
-    for (const auto& entry : fs::directory_iterator(dir, ec))
-        if (entry.path().extension() == ".json") scenes.push_back(entry.path());
-    if (ec || scenes.empty()) {
-        std::fprintf(stderr, "sdfcsg bench: no scenes (*.json) in %s\n", dir.string().c_str());
-        return 3;
-    }
-    std::sort(scenes.begin(), scenes.end());
+    std::vector<fs::path> scenes = findScenes(dir);
+    if (scenes.empty()) return 3;
     auto context = Context::create();
     if (!context) {
         std::fprintf(stderr, "%s\n", context.error().str().c_str());
@@ -311,15 +318,9 @@ int runBench(int argc, char** argv) {
         }
     }
 
-    std::vector<fs::path> scenes;
     std::error_code ec;
-    for (const auto& entry : fs::directory_iterator(dir, ec))
-        if (entry.path().extension() == ".json") scenes.push_back(entry.path());
-    if (ec || scenes.empty()) {
-        std::fprintf(stderr, "sdfcsg bench: no scenes (*.json) in %s\n", dir.string().c_str());
-        return 3;
-    }
-    std::sort(scenes.begin(), scenes.end());
+    std::vector<fs::path> scenes = findScenes(dir);
+    if (scenes.empty()) return 3;
 
     auto context = Context::create();
     if (!context) {
