@@ -1,6 +1,7 @@
 // sdfcsg: the command-line tool. A thin layer over the engine library: argument parsing,
 // messages and exit codes live here, everything else in sdfcsg::engine.
 #include "bench.h"
+#include "generate.h"
 
 #include <sdfcsg/sdfcsg.h>
 
@@ -29,6 +30,7 @@ enum Exit : int {
     kUsage = 2,        // bad command line
     kIo = 3,           // a file could not be read or written
     kGpu = 4,          // no usable Vulkan device, or a shader failed to compile
+    kRemote = 5,       // the language model endpoint failed, refused or answered unusably
 };
 
 int exitCode(const sdfcsg::Error& e) {
@@ -40,6 +42,7 @@ int exitCode(const sdfcsg::Error& e) {
     case sdfcsg::ErrorKind::Usage: return kUsage;
     case sdfcsg::ErrorKind::Shader:
     case sdfcsg::ErrorKind::Vulkan: return kGpu;
+    case sdfcsg::ErrorKind::Remote: return kRemote;
     }
     return kGpu;
 }
@@ -148,9 +151,13 @@ Commands:
   convert   convert a scene (e.g. the legacy format) to the current format
   schema    print the JSON Schema of the scene format
   bench     measure frame, compile and meshing times on the bundled scenes
+  generate  describe a scene in plain language and have a language model write it
+  edit      change a scene by a plain-language instruction, through a language model
+  eval-prompts  run a list of prompts through generate and report validity and cost
 
 'sdfcsg COMMAND --help' describes a command. Exit codes: 0 success, 1 invalid scene or a
-limit exceeded, 2 bad command line, 3 file read or write failure, 4 Vulkan or shader failure.
+limit exceeded, 2 bad command line, 3 file read or write failure, 4 Vulkan or shader failure,
+5 language model endpoint failure.
 )";
 
 const char* kRenderHelp = R"(Usage: sdfcsg render SCENE -o OUT.png [options]
@@ -516,6 +523,9 @@ int main(int argc, char** argv) {
         {"render", cmdRender},   {"mesh", cmdMesh},     {"validate", cmdValidate},
         {"glsl", cmdGlsl},       {"convert", cmdConvert}, {"schema", cmdSchema},
         {"bench", sdfcsg::app::runBench},
+        {"generate", sdfcsg::app::runGenerate},
+        {"edit", sdfcsg::app::runEdit},
+        {"eval-prompts", sdfcsg::app::runEvalPrompts},
     };
     for (auto& [name, run] : commands)
         if (command == name) return run(argc - 2, argv + 2);

@@ -1,4 +1,4 @@
-// Shader files embedded at build time by cmake/EmbedFiles.cmake.
+// Files embedded at build time by cmake/EmbedFiles.cmake.
 #pragma once
 
 #include <span>
@@ -12,5 +12,7 @@ struct EmbeddedFile {
 };
 
 std::span<const EmbeddedFile> embeddedShaders();
+// The bundled scenes that the language model prompt shows as examples (assets/scenes/).
+std::span<const EmbeddedFile> embeddedExampleScenes();
 
 } // namespace sdfcsg::detail

@@ -108,5 +108,41 @@ cmp -s converted.json again.json || { echo "FAIL convert is not idempotent"; fai
 check "schema" 0 "$bin" schema -o schema.json
 cmp -s schema.json "$src/assets/scene.schema.json" || { echo "FAIL schema differs from assets/scene.schema.json"; failures=$((failures + 1)); }
 
+# Scenes from a language model, without a network: the prompt, the request, and a recorded
+# conversation (a scene that loads after one repair round) replayed.
+for c in generate edit eval-prompts; do
+    check "$c --help" 0 "$bin" "$c" --help
+    grep -q "^Usage: sdfcsg $c" out.txt || { echo "FAIL $c --help text"; failures=$((failures + 1)); }
+done
+recording="$src/tests/data/llm/snowman.recording.json"
+export no_proxy=127.0.0.1,localhost
+llm="--base-url http://127.0.0.1:9/v1 --model test-model"
+check "generate --print-prompt" 0 "$bin" generate "a red sphere" --print-prompt
+expect_text "generate prompt request" out.txt "Request: a red sphere"
+check "generate --dry-run" 0 env SDFCSG_LLM_API_KEY=sk-cli-secret "$bin" generate "a red sphere" $llm --dry-run
+expect_text "generate --dry-run url" out.txt "POST http://127.0.0.1:9/v1/chat/completions"
+grep -q "sk-cli-secret" out.txt err.txt && { echo "FAIL --dry-run printed the API key"; failures=$((failures + 1)); }
+check "generate usage" 2 "$bin" generate -o x.json
+check "generate record and replay" 2 "$bin" generate "x" -o x.json --record a --replay b
+check "generate bad base URL" 2 "$bin" generate "x" -o x.json --base-url localhost:9 --model m
+check "generate unreachable" 5 "$bin" generate "x" -o x.json $llm --timeout 5
+[ ! -e x.json ] || { echo "FAIL a failed generate left an output"; failures=$((failures + 1)); }
+check "generate replay" 0 "$bin" generate "A snowman" -o snow.json $llm --replay "$recording" --render snow.png
+grep -q "^snow.json: 8 nodes, valid after 1 repair round (json_schema, 2 requests, 8000 + 600 tokens" err.txt ||
+    { echo "FAIL generate summary"; cat err.txt; failures=$((failures + 1)); }
+check "generated scene validates" 0 "$bin" validate snow.json
+[ "$(head -c 8 snow.png | od -An -tx1 | tr -d ' \n')" = "89504e470d0a1a0a" ] ||
+    { echo "FAIL snow.png is not a PNG"; failures=$((failures + 1)); }
+check "generate replay without repairs" 1 "$bin" generate "A snowman" -o bad-snow.json $llm --replay "$recording" --max-repairs 0
+expect_text "generate problems" err.txt "answer: root.children[1].radius: expected a positive number, got -0.6"
+[ ! -e bad-snow.json ] || { echo "FAIL an invalid answer was written"; failures=$((failures + 1)); }
+check "edit replay" 0 "$bin" edit snow.json "make the hat red" -o edited.json $llm --replay "$recording"
+printf '# one prompt\n\nA snowman\n' >prompts.txt
+check "eval-prompts replay" 0 "$bin" eval-prompts prompts.txt --out eval $llm --replay "$recording"
+expect_text "eval first try" eval/report.txt "first-try validity: 0 of 1 (0%)"
+expect_text "eval after repair" eval/report.txt "validity after repair: 1 of 1 (100%)"
+[ -s eval/01.json ] && [ -s eval/01.png ] && [ -s eval/contact-sheet.png ] ||
+    { echo "FAIL eval-prompts outputs"; ls eval; failures=$((failures + 1)); }
+
 echo "$passed passed, $failures failed"
 [ "$failures" -eq 0 ]

@@ -22,7 +22,8 @@ struct Diagnostic {
     std::string str() const;
 };
 
-enum class ErrorKind { Io, Syntax, Validation, Limit, Shader, Vulkan, Usage };
+// Remote: an HTTP service (a language model endpoint) failed, refused or answered unusably.
+enum class ErrorKind { Io, Syntax, Validation, Limit, Shader, Vulkan, Usage, Remote };
 
 struct Error {
     ErrorKind kind = ErrorKind::Validation;

@@ -10,6 +10,7 @@
 #include "sdfcsg/error.h"
 #include "sdfcsg/eval.h"
 #include "sdfcsg/export.h"
+#include "sdfcsg/generate.h"
 #include "sdfcsg/io.h"
 #include "sdfcsg/mesh.h"
 #include "sdfcsg/nodes.h"

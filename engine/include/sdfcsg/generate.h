@@ -1,0 +1,147 @@
+// sdfcsg: scenes from plain language, through any OpenAI-compatible endpoint or Ollama.
+//
+// generateScene() sends a prompt made from the node kind table (the grammar, every kind with its
+// units and defaults, composition rules, and examples taken from the bundled scenes), asks for
+// structured output where the server offers it, and validates the answer with parseScene(), the
+// same validator as for files. When the answer does not load, the validator's exact list of
+// problems goes back into the conversation with a request for a corrected scene, for a number of
+// rounds. A scene that does not load is never returned.
+//
+// Model output is untrusted: it is parsed under Limits (size, node count, nesting), and a scene
+// names no files, so an answer cannot make the program read or write anything. The API key is
+// sent in the Authorization header only; it is never printed, logged or recorded.
+#pragma once
+
+#include "sdfcsg/error.h"
+#include "sdfcsg/scene.h"
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace sdfcsg {
+
+enum class LlmApi {
+    Auto,   // Ollama's native API when the base URL's port is 11434, else OpenAI's
+    OpenAI, // POST {base}/chat/completions (OpenAI, llama.cpp server, vLLM, ...)
+    Ollama, // POST {base}/api/chat; its OpenAI-compatible endpoint cuts prompts at 2048 tokens
+};
+
+// How the answer is asked for. Generation starts with JsonSchema and falls back when the server
+// rejects it: to JsonObject (any JSON), then to Text (code fences and <think> blocks stripped).
+enum class OutputMode { JsonSchema, JsonObject, Text };
+std::string_view outputModeName(OutputMode mode); // "json_schema", "json_object", "text"
+
+struct LlmConfig {
+    std::string baseUrl; // e.g. "https://api.openai.com/v1", "http://localhost:11434"
+    std::string apiKey;  // may be empty (local servers)
+    std::string model;   // empty: "gpt-4o-mini" on api.openai.com, an error elsewhere
+    LlmApi api = LlmApi::Auto;
+    double timeoutSeconds = 300; // per request, the whole answer included
+    double connectTimeoutSeconds = 15;
+    int maxRetries = 4;               // on HTTP 429 and 5xx
+    double retryBaseSeconds = 1;      // back-off before the first retry, doubled for each next
+    double maxRetryDelaySeconds = 60; // caps Retry-After and the back-off
+    uint32_t maxTokens = 8192;        // answer length limit
+    std::optional<float> temperature = 0.2f; // unset: the server's default
+    uint32_t contextTokens = 16384; // Ollama's options.num_ctx (its default is far too small)
+};
+
+// Settings from the environment: OPENAI_BASE_URL and OPENAI_API_KEY, overridden by
+// SDFCSG_LLM_BASE_URL, SDFCSG_LLM_API_KEY and SDFCSG_LLM_MODEL; SDFCSG_LLM_API ("openai" or
+// "ollama") forces the API. The base URL defaults to https://api.openai.com/v1.
+LlmConfig llmConfigFromEnvironment();
+
+// One HTTP exchange, as recorded and replayed. It holds no headers, so never the API key.
+struct HttpExchange {
+    std::string url;
+    std::string request; // request body
+    long status = 0;
+    std::string retryAfter; // the response's Retry-After header, if any
+    std::string response;   // response body
+};
+// A recording as JSON ({"version": 1, "exchanges": [...]}), and back.
+std::string recordingToJson(std::span<const HttpExchange> exchanges);
+Result<std::vector<HttpExchange>> parseRecording(std::string_view json,
+                                                 std::string_view file = "<recording>");
+
+struct GenerateProgress {
+    std::string message;  // "asking gpt-4o (json_schema)", "HTTP 429; retrying in 2 s", ...
+    double seconds = 0;   // time since the current request was sent
+    bool waiting = false; // a periodic update while an answer is awaited (message unchanged)
+};
+
+struct GenerateOptions {
+    LlmConfig llm;
+    int maxRepairs = 3; // correction rounds after the first answer
+    OutputMode firstMode = OutputMode::JsonSchema;
+    // Applied to every answer. Tighter than for files: a generated scene is small.
+    Limits limits{1u << 20, 2048, 32};
+    // Non-empty: the JSON of a scene to change (`sdfcsg edit`); the request says how.
+    std::string currentScene;
+    std::function<void(const GenerateProgress&)> progress;
+    // Waits between retries; unset: the calling thread sleeps. Tests and replays pass their own.
+    std::function<void(double seconds)> sleep;
+    std::vector<HttpExchange>* record = nullptr;       // every exchange is appended here
+    const std::vector<HttpExchange>* replay = nullptr; // answers from here, in order; no network
+};
+
+struct GenerateStats {
+    OutputMode mode = OutputMode::JsonSchema; // the mode of the last request
+    int requests = 0;                         // HTTP requests, retries and resends included
+    int answers = 0; // answers received: the first, then one per repair round
+    bool firstTryValid = false;
+    bool valid = false;
+    uint64_t promptTokens = 0, completionTokens = 0; // summed, as the server reports them
+    double seconds = 0;
+};
+
+struct Generated {
+    Scene scene;
+    std::string json;                 // toJson(scene): what `sdfcsg generate` writes
+    std::vector<Diagnostic> warnings; // sceneSanityWarnings(scene)
+};
+
+// Asks the model for a scene matching `request` (or, with options.currentScene, for that scene
+// changed as `request` says). Errors: Usage (no model, bad URL), Remote (HTTP and network
+// failures, refusals, answers cut off at the token limit), Validation (no answer loaded within
+// options.maxRepairs rounds; the diagnostics are the last answer's problems). `stats`, when
+// given, is filled in either case.
+Result<Generated> generateScene(std::string_view request, const GenerateOptions& options,
+                                GenerateStats* stats = nullptr);
+
+// The system prompt: the format reference, the composition rules and the examples.
+std::string sceneSystemPrompt();
+// The first user message for a request (and, when editing, the current scene).
+std::string sceneUserPrompt(std::string_view request, std::string_view currentScene = {});
+// The message that asks for a corrected scene, quoting the validator's problems.
+std::string sceneRepairPrompt(const Error& problems);
+
+// The scene JSON Schema in the form that strict structured output accepts (OpenAI's strict
+// json_schema; Ollama's format), derived from sceneJsonSchema(): every object lists all its
+// keys as required and allows no others, optional keys are nullable instead (null members are
+// dropped before validation), oneOf becomes anyOf, const becomes enum, and value bounds
+// (minimum, minItems, pattern, defaults, ...) are left to the validator. Compact JSON.
+std::string sceneLlmSchema();
+
+// The first request generateScene() would send, for --dry-run: the URL and the body.
+struct LlmRequest {
+    std::string url;
+    std::string body;
+};
+Result<LlmRequest> firstLlmRequest(std::string_view request, const GenerateOptions& options);
+
+// The JSON object in a model's answer: <think>...</think> blocks and text around a fenced code
+// block or around the outermost braces removed.
+std::string extractJson(std::string_view answer);
+
+// Cheap geometric checks of a valid scene: an empty solid, a difference that removes nothing,
+// parts of the top-level union that touch none of the others, absurd bounds. Each names the
+// node's JSON path.
+std::vector<Diagnostic> sceneSanityWarnings(const Scene& scene);
+
+} // namespace sdfcsg

@@ -1,0 +1,656 @@
+// Scene generation against a loopback HTTP server inside the test process, which answers each
+// request with the next scripted response and keeps what it received: success, the answer
+// shapes, the repair loop, the server's rejections and the client's fallbacks, retries,
+// timeouts, Ollama's native API, the request body, where the key goes, and record/replay.
+#include <sdfcsg/generate.h>
+
+#include "json_writer.h"
+
+#include <gtest/gtest.h>
+
+#include <httplib.h>
+#include <simdjson.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdlib>
+#include <deque>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+using namespace sdfcsg;
+using detail::jsonQuote;
+
+namespace {
+
+constexpr const char* kKey = "sk-test-5ecret-k3y-0123456789";
+const std::string kSphere = R"({"version": 1, "root": {"type": "sphere", "radius": 1}})";
+const std::string kBadSphere = R"({"version": 1, "root": {"type": "sphere", "radius": -1}})";
+const std::string kRepairText =
+    "Your scene does not load. The validator reported:\n"
+    "- root.radius: expected a positive number, got -1\n"
+    "Answer with the whole corrected scene as one JSON object, and nothing else.";
+
+struct Scripted {
+    int status = 200;
+    std::string body;
+    std::string retryAfter;
+    bool hang = false; // answer only once the test releases the server
+};
+
+struct Received {
+    std::string path;
+    std::string body;
+    httplib::Headers headers;
+};
+
+class FakeServer {
+  public:
+    FakeServer() {
+        // A proxy from the environment must not stand between the client and the loopback.
+        ::setenv("no_proxy", "127.0.0.1,localhost", 1);
+        server_.Post(".*", [this](const httplib::Request& req, httplib::Response& res) {
+            Scripted next{500, R"({"error": {"message": "no scripted response left"}})"};
+            {
+                std::unique_lock lock(mutex_);
+                received_.push_back({req.path, req.body, req.headers});
+                if (!script_.empty()) {
+                    next = script_.front();
+                    script_.pop_front();
+                }
+                if (next.hang)
+                    released_.wait_for(lock, std::chrono::seconds(20), [this] { return release_; });
+            }
+            res.status = next.status;
+            if (!next.retryAfter.empty()) res.set_header("Retry-After", next.retryAfter);
+            res.set_content(next.body, "application/json");
+        });
+        port_ = server_.bind_to_any_port("127.0.0.1");
+        thread_ = std::thread([this] { server_.listen_after_bind(); });
+        while (!server_.is_running())
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    ~FakeServer() {
+        release();
+        server_.stop();
+        thread_.join();
+    }
+    void script(std::vector<Scripted> responses) {
+        std::lock_guard lock(mutex_);
+        script_.assign(responses.begin(), responses.end());
+    }
+    void release() {
+        std::lock_guard lock(mutex_);
+        release_ = true;
+        released_.notify_all();
+    }
+    std::vector<Received> received() {
+        std::lock_guard lock(mutex_);
+        return received_;
+    }
+    std::string url(const std::string& path = "/v1") const {
+        return "http://127.0.0.1:" + std::to_string(port_) + path;
+    }
+
+  private:
+    httplib::Server server_;
+    std::thread thread_;
+    int port_ = 0;
+    std::mutex mutex_;
+    std::condition_variable released_;
+    bool release_ = false;
+    std::deque<Scripted> script_;
+    std::vector<Received> received_;
+};
+
+// An OpenAI Chat Completions answer.
+Scripted openAi(const std::string& content, const std::string& finish = "stop") {
+    return {200, R"({"id": "x", "object": "chat.completion", "choices": [{"index": 0, "message":
+        {"role": "assistant", "content": )" +
+                     jsonQuote(content) + R"(, "refusal": null}, "finish_reason": ")" + finish +
+                     R"("}], "usage": {"prompt_tokens": 100, "completion_tokens": 20}})"};
+}
+
+Scripted openAiError(int status, const std::string& message, const std::string& param = "",
+                     const std::string& code = "") {
+    auto orNull = [](const std::string& s) { return s.empty() ? "null" : jsonQuote(s); };
+    return {status, R"({"error": {"message": )" + jsonQuote(message) +
+                        R"(, "type": "invalid_request_error", "param": )" + orNull(param) +
+                        R"(, "code": )" + orNull(code) + "}}"};
+}
+
+struct Fixture : ::testing::Test {
+    FakeServer server;
+    std::vector<double> sleeps;
+    std::vector<std::string> progress;
+
+    GenerateOptions options() {
+        GenerateOptions o;
+        o.llm.baseUrl = server.url();
+        o.llm.model = "test-model";
+        o.llm.apiKey = kKey;
+        o.llm.timeoutSeconds = 20;
+        o.llm.retryBaseSeconds = 0.5;
+        o.sleep = [this](double s) { sleeps.push_back(s); };
+        o.progress = [this](const GenerateProgress& p) {
+            if (!p.waiting) progress.push_back(p.message);
+        };
+        return o;
+    }
+
+    // The parsed body of the n-th request the server received.
+    simdjson::dom::element body(size_t n) {
+        auto received = server.received();
+        EXPECT_GT(received.size(), n);
+        bodies_.push_back(received.at(n).body);
+        return parsers_.emplace_back().parse(bodies_.back());
+    }
+
+  private:
+    std::deque<std::string> bodies_;
+    std::deque<simdjson::dom::parser> parsers_;
+};
+
+std::string_view lastMessage(simdjson::dom::element body) {
+    simdjson::dom::array messages = body["messages"];
+    std::string_view content = messages.at(messages.size() - 1)["content"];
+    return content;
+}
+
+bool has(simdjson::dom::element object, std::string_view key) {
+    simdjson::dom::element e;
+    return object[key].get(e) == simdjson::SUCCESS;
+}
+
+} // namespace
+
+TEST_F(Fixture, FirstTrySuccess) {
+    server.script({openAi(kSphere)});
+    GenerateStats stats;
+    auto g = generateScene("a sphere", options(), &stats);
+    ASSERT_TRUE(g) << g.error().str();
+    EXPECT_EQ(g->scene.nodes.size(), 1u);
+    EXPECT_EQ(g->json, toJson(*parseScene(kSphere)));
+    EXPECT_TRUE(g->warnings.empty());
+    EXPECT_TRUE(stats.valid);
+    EXPECT_TRUE(stats.firstTryValid);
+    EXPECT_EQ(stats.answers, 1);
+    EXPECT_EQ(stats.requests, 1);
+    EXPECT_EQ(stats.mode, OutputMode::JsonSchema);
+    EXPECT_EQ(stats.promptTokens, 100u);
+    EXPECT_EQ(stats.completionTokens, 20u);
+    ASSERT_EQ(server.received().size(), 1u);
+    EXPECT_EQ(server.received()[0].path, "/v1/chat/completions");
+    EXPECT_EQ(progress, std::vector<std::string>{"asking test-model (json_schema)"});
+}
+
+TEST_F(Fixture, FencedAndThinkWrappedAnswers) {
+    server.script({openAi("<think>A sphere {radius 1}, in ```json```?</think>\nHere:\n```json\n" +
+                          kSphere + "\n```\nDone."),
+                   openAi("Sure, here it is: " + kSphere)});
+    EXPECT_TRUE(generateScene("a sphere", options()));
+    EXPECT_TRUE(generateScene("a sphere", options()));
+}
+
+TEST_F(Fixture, NullMembersAreDropped) {
+    // What strict structured output sends for optional keys.
+    server.script({openAi(R"({"version": 1, "name": null, "camera": null, "root": {"type":
+        "union", "smooth": null, "color": null, "children": [{"type": "sphere", "radius": 1,
+        "translate": null, "name": "ball"}]}})")});
+    auto g = generateScene("a ball", options());
+    ASSERT_TRUE(g) << g.error().str();
+    EXPECT_EQ(g->scene.nodes[1].name, "ball");
+}
+
+TEST_F(Fixture, InvalidJsonThenRepaired) {
+    const std::string broken = R"({"version": 1, "root": {"type": "sphere", "radius": 1})";
+    server.script({openAi(broken), openAi(kSphere)});
+    GenerateStats stats;
+    auto g = generateScene("a sphere", options(), &stats);
+    ASSERT_TRUE(g) << g.error().str();
+    EXPECT_FALSE(stats.firstTryValid);
+    EXPECT_EQ(stats.answers, 2);
+    auto second = body(1);
+    simdjson::dom::array messages = second["messages"];
+    ASSERT_EQ(messages.size(), 4u);
+    std::string_view role = messages.at(2)["role"], content = messages.at(2)["content"];
+    EXPECT_EQ(role, "assistant");
+    EXPECT_EQ(content, broken);
+    auto problems = parseScene(broken, "answer");
+    ASSERT_FALSE(problems);
+    EXPECT_EQ(lastMessage(second), sceneRepairPrompt(problems.error()));
+    EXPECT_NE(lastMessage(second).find("- line 1, column "), std::string_view::npos);
+}
+
+TEST_F(Fixture, SemanticallyInvalidThenRepaired) {
+    server.script({openAi(kBadSphere), openAi(kSphere)});
+    GenerateStats stats;
+    ASSERT_TRUE(generateScene("a sphere", options(), &stats));
+    EXPECT_EQ(stats.answers, 2);
+    EXPECT_EQ(lastMessage(body(1)), kRepairText);
+    EXPECT_EQ(progress[1], "the answer does not load (1 problem); asking for a correction");
+    EXPECT_EQ(progress[2], "asking test-model for a correction, round 1 of 3 (json_schema)");
+}
+
+TEST_F(Fixture, RepairLimitReached) {
+    server.script({openAi(kBadSphere), openAi(kBadSphere), openAi(kBadSphere), openAi(kSphere)});
+    GenerateOptions o = options();
+    o.maxRepairs = 2;
+    GenerateStats stats;
+    auto g = generateScene("a sphere", o, &stats);
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().kind, ErrorKind::Validation);
+    EXPECT_EQ(g.error().str(),
+              "answer: no answer loaded after 2 repair rounds; the last one's problems:\n"
+              "answer: root.radius: expected a positive number, got -1");
+    EXPECT_EQ(stats.answers, 3);
+    EXPECT_FALSE(stats.valid);
+    EXPECT_EQ(server.received().size(), 3u);
+}
+
+TEST_F(Fixture, UntrustedAnswerLimits) {
+    // Too many nodes, and a key that would name a file: both refused by the validator.
+    std::string many = R"({"version": 1, "root": {"type": "union", "children": [)";
+    for (int i = 0; i < 10; ++i)
+        many += std::string(i ? "," : "") + R"({"type": "sphere", "radius": 1})";
+    many += "]}}";
+    server.script({openAi(many), openAi(R"({"version": 1, "include": "/etc/passwd", "root":
+        {"type": "sphere", "radius": 1}})")});
+    GenerateOptions o = options();
+    o.maxRepairs = 1;
+    o.limits.maxNodes = 5;
+    auto g = generateScene("spheres", o);
+    ASSERT_FALSE(g);
+    EXPECT_NE(lastMessage(body(1)).find("nodes"), std::string_view::npos);
+    EXPECT_NE(g.error().str().find("unknown key \"include\""), std::string::npos)
+        << g.error().str();
+}
+
+TEST_F(Fixture, FinishReasonLength) {
+    server.script({openAi(R"({"version": 1, "root": {"type": "uni)", "length")});
+    auto g = generateScene("a sphere", options());
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().kind, ErrorKind::Remote);
+    EXPECT_EQ(g.error().str(), server.url() + "/chat/completions: the answer was cut off at the "
+                                              "token limit (8192 tokens); ask for a simpler scene "
+                                              "or raise the limit");
+}
+
+TEST_F(Fixture, Refusal) {
+    server.script({{200, R"({"choices": [{"index": 0, "message": {"role": "assistant",
+        "content": null, "refusal": "I'm sorry, I can't help with that."}, "finish_reason":
+        "stop"}]})"}});
+    auto g = generateScene("something", options());
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().kind, ErrorKind::Remote);
+    EXPECT_EQ(g.error().diagnostics[0].message,
+              "the model refused: I'm sorry, I can't help with that.");
+}
+
+TEST_F(Fixture, ResponseFormatRejectedThenJsonMode) {
+    server.script({openAiError(400,
+                               "Invalid parameter: 'response_format' of type 'json_schema' is not "
+                               "supported with this model.",
+                               "response_format"),
+                   openAi(kSphere)});
+    GenerateStats stats;
+    ASSERT_TRUE(generateScene("a sphere", options(), &stats));
+    EXPECT_EQ(stats.mode, OutputMode::JsonObject);
+    std::string_view first = body(0)["response_format"]["type"];
+    std::string_view second = body(1)["response_format"]["type"];
+    EXPECT_EQ(first, "json_schema");
+    EXPECT_EQ(second, "json_object");
+    EXPECT_EQ(progress[1], "the server rejects json_schema output; falling back to json_object");
+}
+
+TEST_F(Fixture, JsonModeRejectedThenText) {
+    // llama.cpp-style error objects, without a param.
+    server.script(
+        {{400,
+          R"({"error": {"code": 400, "message": "Unsupported response_format type: json_schema", "type": "invalid_request_error"}})"},
+         {400,
+          R"({"error": {"code": 400, "message": "'response_format' must be one of 'text'", "type": "invalid_request_error"}})"},
+         openAi("```json\n" + kSphere + "\n```")});
+    GenerateStats stats;
+    ASSERT_TRUE(generateScene("a sphere", options(), &stats));
+    EXPECT_EQ(stats.mode, OutputMode::Text);
+    EXPECT_EQ(stats.requests, 3);
+    EXPECT_FALSE(has(body(2), "response_format"));
+}
+
+TEST_F(Fixture, MaxTokensRejectedThenResent) {
+    server.script({openAiError(400,
+                               "Unsupported parameter: 'max_tokens' is not supported with this "
+                               "model. Use 'max_completion_tokens' instead.",
+                               "max_tokens", "unsupported_parameter"),
+                   openAiError(400,
+                               "Unsupported value: 'temperature' does not support 0.2 with this "
+                               "model. Only the default (1) value is supported.",
+                               "temperature", "unsupported_value"),
+                   openAi(kSphere)});
+    GenerateStats stats;
+    ASSERT_TRUE(generateScene("a sphere", options(), &stats));
+    EXPECT_EQ(stats.requests, 3);
+    EXPECT_TRUE(has(body(0), "max_tokens"));
+    EXPECT_TRUE(has(body(0), "temperature"));
+    EXPECT_FALSE(has(body(1), "max_tokens"));
+    EXPECT_EQ(uint64_t(body(1)["max_completion_tokens"]), 8192u);
+    EXPECT_TRUE(has(body(1), "temperature"));
+    EXPECT_FALSE(has(body(2), "temperature"));
+    EXPECT_TRUE(has(body(2), "max_completion_tokens"));
+    std::string_view mode = body(2)["response_format"]["type"];
+    EXPECT_EQ(mode, "json_schema");
+}
+
+TEST_F(Fixture, Unauthorized) {
+    server.script({openAiError(401,
+                               "Incorrect API key provided: sk-test-****6789. You can find your "
+                               "API key at https://platform.openai.com/account/api-keys.",
+                               "", "invalid_api_key")});
+    auto g = generateScene("a sphere", options());
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().kind, ErrorKind::Remote);
+    EXPECT_EQ(g.error().str(), server.url() +
+                                   "/chat/completions: HTTP 401: Incorrect API key provided: "
+                                   "[redacted]. You can find your API key at "
+                                   "https://platform.openai.com/account/api-keys. (check "
+                                   "SDFCSG_LLM_API_KEY or OPENAI_API_KEY)");
+    EXPECT_EQ(server.received().size(), 1u); // not retried
+}
+
+TEST_F(Fixture, RateLimitedHonoursRetryAfter) {
+    server.script(
+        {{429, R"({"error": {"message": "Rate limit reached", "code": "rate_limit_exceeded"}})",
+          "3"},
+         {429, R"({"error": {"message": "Rate limit reached"}})"},
+         {429, R"({"error": {"message": "Rate limit reached"}})", "120"},
+         openAi(kSphere)});
+    GenerateStats stats;
+    ASSERT_TRUE(generateScene("a sphere", options(), &stats));
+    EXPECT_EQ(stats.requests, 4);
+    // Retry-After, then the back-off (0.5 s doubled once), then Retry-After capped at 60 s.
+    EXPECT_EQ(sleeps, (std::vector<double>{3.0, 1.0, 60.0}));
+    EXPECT_EQ(progress[1], "HTTP 429: Rate limit reached; retrying in 3 s (attempt 2 of 5)");
+}
+
+TEST_F(Fixture, QuotaExhaustedIsNotRetried) {
+    server.script({openAiError(429, "You exceeded your current quota.", "", "insufficient_quota")});
+    auto g = generateScene("a sphere", options());
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().diagnostics[0].message, "HTTP 429: You exceeded your current quota.");
+    EXPECT_TRUE(sleeps.empty());
+}
+
+TEST_F(Fixture, ServerErrorThenSuccess) {
+    server.script({{500, R"({"error": {"message": "The server had an error"}})"}, openAi(kSphere)});
+    GenerateStats stats;
+    ASSERT_TRUE(generateScene("a sphere", options(), &stats));
+    EXPECT_EQ(stats.requests, 2);
+    EXPECT_EQ(sleeps, std::vector<double>{0.5});
+}
+
+TEST_F(Fixture, ServerErrorsGiveUp) {
+    server.script(
+        {{503, "Service Unavailable"}, {502, "Bad Gateway"}, {503, "Service Unavailable"}});
+    GenerateOptions o = options();
+    o.llm.maxRetries = 2;
+    auto g = generateScene("a sphere", o);
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().diagnostics[0].message,
+              "HTTP 503: Service Unavailable (gave up after 3 attempts)");
+    EXPECT_EQ(sleeps, (std::vector<double>{0.5, 1.0}));
+}
+
+TEST_F(Fixture, Timeout) {
+    server.script({{200, "{}", "", true}});
+    GenerateOptions o = options();
+    o.llm.timeoutSeconds = 0.3;
+    auto g = generateScene("a sphere", o);
+    server.release();
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().kind, ErrorKind::Remote);
+    EXPECT_EQ(g.error().str(), server.url() + "/chat/completions: no complete answer within "
+                                              "0.3 s (the request timeout)");
+}
+
+TEST_F(Fixture, ConnectionRefused) {
+    GenerateOptions o = options();
+    o.llm.baseUrl = "http://127.0.0.1:1/v1";
+    auto g = generateScene("a sphere", o);
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().kind, ErrorKind::Remote);
+    EXPECT_TRUE(
+        g.error().str().starts_with("http://127.0.0.1:1/v1/chat/completions: request failed: "))
+        << g.error().str();
+}
+
+TEST_F(Fixture, OllamaNativeApi) {
+    server.script({{200, R"({"model": "test-model", "created_at": "2025-01-01T00:00:00Z",
+        "message": {"role": "assistant", "content": )" +
+                             jsonQuote(kSphere) + R"(}, "done": true,
+        "done_reason": "stop", "prompt_eval_count": 321, "eval_count": 45})"}});
+    GenerateOptions o = options();
+    o.llm.baseUrl = server.url("");
+    o.llm.api = LlmApi::Ollama;
+    GenerateStats stats;
+    auto g = generateScene("a sphere", o, &stats);
+    ASSERT_TRUE(g) << g.error().str();
+    EXPECT_EQ(stats.promptTokens, 321u);
+    EXPECT_EQ(stats.completionTokens, 45u);
+    EXPECT_EQ(server.received()[0].path, "/api/chat");
+    auto request = body(0);
+    EXPECT_FALSE(bool(request["stream"]));
+    EXPECT_EQ(uint64_t(request["options"]["num_ctx"]), 16384u);
+    EXPECT_EQ(uint64_t(request["options"]["num_predict"]), 8192u);
+    EXPECT_TRUE(request["format"].is_object());
+    EXPECT_FALSE(has(request, "response_format"));
+    EXPECT_FALSE(has(request, "max_tokens"));
+
+    // Ollama's error shape, and its default port chosen automatically (its /v1 cuts prompts).
+    server.script({{400, R"({"error": "invalid format: expected \"json\" or a JSON schema"})"},
+                   {200, R"({"message": {"role": "assistant", "content": )" + jsonQuote(kSphere) +
+                             R"(}, "done": true, "done_reason": "stop"})"}});
+    ASSERT_TRUE(generateScene("a sphere", o, &stats));
+    std::string_view format = body(2)["format"];
+    EXPECT_EQ(format, "json");
+    GenerateOptions detected;
+    detected.llm.baseUrl = "http://localhost:11434/v1/";
+    detected.llm.model = "qwen2.5";
+    auto r = firstLlmRequest("a sphere", detected);
+    ASSERT_TRUE(r);
+    EXPECT_EQ(r->url, "http://localhost:11434/api/chat");
+}
+
+TEST_F(Fixture, EditSendsTheCurrentScene) {
+    server.script({openAi(kSphere)});
+    GenerateOptions o = options();
+    o.currentScene = toJson(*parseScene(kSphere));
+    ASSERT_TRUE(generateScene("make it bigger", o));
+    EXPECT_EQ(lastMessage(body(0)), sceneUserPrompt("make it bigger", o.currentScene));
+    EXPECT_TRUE(
+        lastMessage(body(0)).starts_with("Here is the current scene:\n{\n  \"version\": 1"));
+}
+
+TEST_F(Fixture, RequestBodyGolden) {
+    server.script({openAi(kSphere)});
+    ASSERT_TRUE(generateScene("a red sphere", options()));
+    std::string golden =
+        R"({"model":"test-model","messages":[{"role":"system","content":SYSTEM},)"
+        R"({"role":"user","content":"Request: a red sphere"}],"temperature":0.2,"max_tokens":8192,)"
+        R"("response_format":{"type":"json_schema","json_schema":{"name":"sdfcsg_scene",)"
+        R"("strict":true,"schema":SCHEMA}}})";
+    golden.replace(golden.find("SYSTEM"), 6, jsonQuote(sceneSystemPrompt()));
+    golden.replace(golden.find("SCHEMA"), 6, sceneLlmSchema());
+    EXPECT_EQ(server.received()[0].body, golden);
+    auto preview = firstLlmRequest("a red sphere", options());
+    ASSERT_TRUE(preview);
+    EXPECT_EQ(preview->body, golden);
+    EXPECT_EQ(preview->url, server.url() + "/chat/completions");
+}
+
+TEST_F(Fixture, KeyOnlyInTheAuthorizationHeader) {
+    server.script(
+        {{500, R"({"error": {"message": "oops"}})"}, openAi(kBadSphere), openAi(kSphere)});
+    std::vector<HttpExchange> recording;
+    GenerateOptions o = options();
+    o.record = &recording;
+    std::vector<std::string> all;
+    o.progress = [&](const GenerateProgress& p) { all.push_back(p.message); };
+    ASSERT_TRUE(generateScene("a sphere", o));
+    auto received = server.received();
+    ASSERT_EQ(received.size(), 3u);
+    for (const Received& r : received) {
+        EXPECT_EQ(r.body.find(kKey), std::string::npos);
+        EXPECT_EQ(r.path.find(kKey), std::string::npos);
+        int authorizations = 0;
+        for (const auto& [name, value] : r.headers) {
+            if (name == "Authorization") {
+                ++authorizations;
+                EXPECT_EQ(value, std::string("Bearer ") + kKey);
+            } else {
+                EXPECT_EQ(value.find(kKey), std::string::npos) << name;
+            }
+        }
+        EXPECT_EQ(authorizations, 1);
+    }
+    EXPECT_EQ(recordingToJson(recording).find(kKey), std::string::npos);
+    for (const std::string& m : all)
+        EXPECT_EQ(m.find(kKey), std::string::npos) << m;
+
+    // No key, no header (local servers).
+    server.script({openAi(kSphere)});
+    o.llm.apiKey.clear();
+    ASSERT_TRUE(generateScene("a sphere", o));
+    EXPECT_FALSE(server.received().back().headers.count("Authorization"));
+}
+
+TEST_F(Fixture, RecordReplayRoundTrip) {
+    server.script({{429, R"({"error": {"message": "slow down"}})", "1"},
+                   openAi(kBadSphere),
+                   openAi(kSphere)});
+    std::vector<HttpExchange> recorded;
+    GenerateOptions o = options();
+    o.record = &recorded;
+    GenerateStats live;
+    auto first = generateScene("a sphere", o, &live);
+    ASSERT_TRUE(first) << first.error().str();
+    ASSERT_EQ(recorded.size(), 3u);
+    EXPECT_EQ(recorded[0].status, 429);
+    EXPECT_EQ(recorded[0].retryAfter, "1");
+    EXPECT_EQ(recorded[2].request, server.received()[2].body);
+
+    const std::string json = recordingToJson(recorded);
+    auto parsed = parseRecording(json, "rec.json");
+    ASSERT_TRUE(parsed) << parsed.error().str();
+    EXPECT_EQ(recordingToJson(*parsed), json);
+
+    // The replay reaches no server: the URL points at a closed port.
+    GenerateOptions r = options();
+    r.llm.baseUrl = "http://127.0.0.1:1/v1";
+    r.replay = &*parsed;
+    sleeps.clear();
+    GenerateStats replayed;
+    auto again = generateScene("a sphere", r, &replayed);
+    ASSERT_TRUE(again) << again.error().str();
+    EXPECT_EQ(again->json, first->json);
+    EXPECT_EQ(replayed.requests, live.requests);
+    EXPECT_EQ(replayed.answers, live.answers);
+    EXPECT_EQ(replayed.promptTokens, live.promptTokens);
+    EXPECT_TRUE(sleeps.empty()); // a replay does not wait
+    EXPECT_EQ(server.received().size(), 3u);
+
+    // A replay that runs out says so.
+    std::vector<HttpExchange> shorter(parsed->begin(), parsed->begin() + 2);
+    r.replay = &shorter;
+    auto cut = generateScene("a sphere", r);
+    ASSERT_FALSE(cut);
+    EXPECT_EQ(cut.error().diagnostics[0].message,
+              "the recording holds 2 exchanges, and a further request was made");
+
+    auto bad = parseRecording(R"({"version": 1, "exchanges": [{"url": "x"}]})", "rec.json");
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error().str(), "rec.json: exchanges[0]: expected an object with url, request, "
+                                 "status, retry_after and response");
+}
+
+TEST(GenerateConfig, Usage) {
+    GenerateOptions o;
+    o.llm.baseUrl = "localhost:8080";
+    o.llm.model = "m";
+    auto bad = firstLlmRequest("x", o);
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error().kind, ErrorKind::Usage);
+    EXPECT_EQ(bad.error().diagnostics[0].message,
+              "the base URL must start with http:// or https://, got \"localhost:8080\"");
+    o.llm.baseUrl = "http://localhost:8080/v1";
+    o.llm.model.clear();
+    auto noModel = generateScene("x", o);
+    ASSERT_FALSE(noModel);
+    EXPECT_EQ(noModel.error().diagnostics[0].message,
+              "no model given: set SDFCSG_LLM_MODEL or pass --model");
+    o.llm.baseUrl = "https://api.openai.com/v1";
+    auto openai = firstLlmRequest("x", o);
+    ASSERT_TRUE(openai);
+    EXPECT_NE(openai->body.find(R"("model":"gpt-4o-mini")"), std::string::npos);
+}
+
+TEST(GenerateConfig, Environment) {
+    // Restored afterwards, for the live test in this process.
+    const char* names[] = {"OPENAI_BASE_URL",     "OPENAI_API_KEY",     "SDFCSG_LLM_MODEL",
+                           "SDFCSG_LLM_BASE_URL", "SDFCSG_LLM_API_KEY", "SDFCSG_LLM_API"};
+    std::vector<std::optional<std::string>> saved;
+    for (const char* name : names)
+        saved.push_back(std::getenv(name) ? std::optional<std::string>(std::getenv(name))
+                                          : std::nullopt);
+    ::setenv("OPENAI_BASE_URL", "http://openai.example/v1", 1);
+    ::setenv("OPENAI_API_KEY", "openai-key", 1);
+    ::setenv("SDFCSG_LLM_MODEL", "some-model", 1);
+    ::unsetenv("SDFCSG_LLM_BASE_URL");
+    ::unsetenv("SDFCSG_LLM_API_KEY");
+    ::unsetenv("SDFCSG_LLM_API");
+    LlmConfig c = llmConfigFromEnvironment();
+    EXPECT_EQ(c.baseUrl, "http://openai.example/v1");
+    EXPECT_EQ(c.apiKey, "openai-key");
+    EXPECT_EQ(c.model, "some-model");
+    EXPECT_EQ(c.api, LlmApi::Auto);
+    ::setenv("SDFCSG_LLM_BASE_URL", "http://local:8080/v1", 1);
+    ::setenv("SDFCSG_LLM_API_KEY", "local-key", 1);
+    ::setenv("SDFCSG_LLM_API", "ollama", 1);
+    c = llmConfigFromEnvironment();
+    EXPECT_EQ(c.baseUrl, "http://local:8080/v1");
+    EXPECT_EQ(c.apiKey, "local-key");
+    EXPECT_EQ(c.api, LlmApi::Ollama);
+    for (size_t i = 0; i < saved.size(); ++i) {
+        if (saved[i])
+            ::setenv(names[i], saved[i]->c_str(), 1);
+        else
+            ::unsetenv(names[i]);
+    }
+}
+
+// Against a real endpoint, only on request: SDFCSG_LLM_LIVE=1 with SDFCSG_LLM_BASE_URL or
+// OPENAI_BASE_URL, or an API key for api.openai.com.
+TEST(GenerateLive, OriginalPrompt) {
+    const char* live = std::getenv("SDFCSG_LLM_LIVE");
+    LlmConfig config = llmConfigFromEnvironment();
+    const bool configured = std::getenv("SDFCSG_LLM_BASE_URL") || std::getenv("OPENAI_BASE_URL") ||
+                            !config.apiKey.empty();
+    if (!live || std::string(live) != "1" || !configured)
+        GTEST_SKIP() << "set SDFCSG_LLM_LIVE=1 and an endpoint (SDFCSG_LLM_BASE_URL, "
+                        "SDFCSG_LLM_MODEL, SDFCSG_LLM_API_KEY) to run";
+    GenerateOptions options;
+    options.llm = config;
+    GenerateStats stats;
+    auto g = generateScene("A snowman with three stacked spheres, red round nose and a top "
+                           "black hat",
+                           options, &stats);
+    ASSERT_TRUE(g) << g.error().str();
+    EXPECT_GE(g->scene.nodes.size(), 4u);
+    std::printf("live: %s, %d answers, %llu + %llu tokens, %.1f s\n",
+                std::string(outputModeName(stats.mode)).c_str(), stats.answers,
+                static_cast<unsigned long long>(stats.promptTokens),
+                static_cast<unsigned long long>(stats.completionTokens), stats.seconds);
+}
