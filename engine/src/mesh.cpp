@@ -206,8 +206,9 @@ struct Mesher::Impl {
     Buffer buffers[kBindingCount];
 
     explicit Impl(Context::Impl& c) : ctx(c) {}
+    // No work of this mesher is pending between calls (submitAndWait() waits for it), and the
+    // device may be busy with other threads' work: nothing to wait for.
     ~Impl() {
-        vkDeviceWaitIdle(ctx.device);
         for (Buffer& b : buffers)
             detail::destroyBuffer(ctx, b);
         for (VkPipeline p : {cull, classify, vertices, triangles})
@@ -252,7 +253,6 @@ struct Mesher::Impl {
                                        : VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
         auto made = detail::createBuffer(ctx, bytes, usage, memoryUse(binding));
         if (!made) return made.error();
-        vkDeviceWaitIdle(ctx.device);
         detail::destroyBuffer(ctx, b);
         b = *made;
         writeDescriptors();

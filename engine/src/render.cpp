@@ -85,9 +85,10 @@ struct Renderer::Impl {
     std::vector<PixelInfo> lastInfo;
 
     explicit Impl(Context::Impl& c) : ctx(c) {}
+    // No work of this renderer is pending between calls (submitAndWait() waits for it), and the
+    // device may be busy with other threads' work: nothing to wait for.
     ~Impl() {
         VkDevice device = ctx.device;
-        vkDeviceWaitIdle(device);
         for (Buffer* b : {&frame, &nodes, &pixels, &info, &pixelsStaging, &infoStaging})
             detail::destroyBuffer(ctx, *b);
         destroyKernel();

@@ -277,6 +277,7 @@ void writeDescriptorSet(Context::Impl& ctx, VkDescriptorSet set, std::span<const
 }
 
 VkCommandBuffer beginCommands(Context::Impl& ctx) {
+    ctx.submitMutex.lock(); // until submitAndWait(), in this thread
     VK_CHECK(vkResetCommandPool(ctx.device, ctx.commandPool, 0));
     VkCommandBufferBeginInfo info = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     info.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
@@ -292,6 +293,7 @@ void submitAndWait(Context::Impl& ctx) {
     VK_CHECK(vkResetFences(ctx.device, 1, &ctx.fence));
     VK_CHECK(vkQueueSubmit(ctx.queue, 1, &submit, ctx.fence));
     VK_CHECK(vkWaitForFences(ctx.device, 1, &ctx.fence, VK_TRUE, UINT64_MAX));
+    ctx.submitMutex.unlock();
 }
 
 void recordReadback(VkCommandBuffer cmd, const Buffer& buffer, const Buffer* staging) {

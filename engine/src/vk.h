@@ -14,6 +14,7 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <mutex>
 #include <span>
 #include <string>
 
@@ -45,6 +46,9 @@ struct Context::Impl {
     VkCommandPool commandPool = VK_NULL_HANDLE;
     VkCommandBuffer commandBuffer = VK_NULL_HANDLE; // reused by submitAndWait()
     VkFence fence = VK_NULL_HANDLE;
+    // Held from beginCommands() to submitAndWait(): the command buffer, its pool, the fence and
+    // the queue are shared by every Renderer and Mesher of the context, whatever their thread.
+    std::mutex submitMutex;
     bool validation = false;
     std::atomic<uint32_t> validationMessages{0};
 
@@ -105,9 +109,10 @@ VkDescriptorSet allocateDescriptorSet(Context::Impl& ctx, VkDescriptorPool pool,
 void writeDescriptorSet(Context::Impl& ctx, VkDescriptorSet set, std::span<const Binding> bindings,
                         std::span<const Buffer* const> buffers);
 
-// Begins the context's command buffer for a one-shot submission.
+// Begins the context's command buffer for a one-shot submission, taking the context's submit
+// lock: record, then call submitAndWait() from the same thread with no early return between.
 VkCommandBuffer beginCommands(Context::Impl& ctx);
-// Ends, submits and waits on the fence.
+// Ends, submits, waits on the fence and releases the submit lock.
 void submitAndWait(Context::Impl& ctx);
 
 // Shader writes -> host reads: records the barrier and, when `buffer` is not mappable, a copy

@@ -4,8 +4,11 @@
 // CPU devices (Mesa lavapipe) included; a discrete GPU is preferred, then integrated, virtual,
 // CPU. SDFCSG_DEVICE=<index or part of the name> overrides the choice.
 //
-// Threads: a Context and the Renderers made from it share one queue and command pool, so use
-// them from one thread at a time (or give each thread its own Context).
+// Threads: a Context may be shared. Renderers and Meshers made from one Context can be used
+// from different threads at the same time (say, meshing in the background while a viewer
+// renders); their GPU submissions take turns on the context's queue. Each Renderer or Mesher
+// is used by one thread at a time. Scene loading, code generation, compileKernel() and the
+// Evaluator's const methods are safe to call from any thread.
 #pragma once
 
 #include "sdfcsg/error.h"
