@@ -3,6 +3,8 @@
 // validated by the engine before anything is written.
 #include "generate.h"
 
+#include "cli.h"
+
 #include <sdfcsg/sdfcsg.h>
 
 #include <algorithm>
@@ -26,39 +28,6 @@ namespace sdfcsg::app {
 namespace {
 
 namespace fs = std::filesystem;
-
-// Exit codes, as in main.cpp and the README.
-enum Exit : int { kOk = 0, kInvalid = 1, kUsage = 2, kIo = 3, kGpu = 4, kRemote = 5 };
-
-int exitCode(const Error& e) {
-    switch (e.kind) {
-    case ErrorKind::Io:
-        return kIo;
-    case ErrorKind::Syntax:
-    case ErrorKind::Validation:
-    case ErrorKind::Limit:
-        return kInvalid;
-    case ErrorKind::Usage:
-        return kUsage;
-    case ErrorKind::Shader:
-    case ErrorKind::Vulkan:
-        return kGpu;
-    case ErrorKind::Remote:
-        return kRemote;
-    }
-    return kGpu;
-}
-
-int fail(const Error& e) {
-    std::fprintf(stderr, "%s\n", e.str().c_str());
-    return exitCode(e);
-}
-
-int usageError(std::string_view command, const std::string& message) {
-    std::fprintf(stderr, "sdfcsg %.*s: %s\nTry 'sdfcsg %.*s --help'.\n", int(command.size()),
-                 command.data(), message.c_str(), int(command.size()), command.data());
-    return kUsage;
-}
 
 // Positional arguments, and options that take a value (the last one given wins) or not.
 struct Args {

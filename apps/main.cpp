@@ -1,6 +1,7 @@
 // sdfcsg: the command-line tool. A thin layer over the engine library: argument parsing,
 // messages and exit codes live here, everything else in sdfcsg::engine.
 #include "bench.h"
+#include "cli.h"
 #include "generate.h"
 
 #include <sdfcsg/sdfcsg.h>
@@ -23,40 +24,7 @@
 
 namespace {
 
-// Exit codes, documented in the README.
-enum Exit : int {
-    kOk = 0,
-    kInvalidScene = 1, // the scene failed to parse or validate, or a limit was exceeded
-    kUsage = 2,        // bad command line
-    kIo = 3,           // a file could not be read or written
-    kGpu = 4,          // no usable Vulkan device, or a shader failed to compile
-    kRemote = 5,       // the language model endpoint failed, refused or answered unusably
-};
-
-int exitCode(const sdfcsg::Error& e) {
-    switch (e.kind) {
-    case sdfcsg::ErrorKind::Io: return kIo;
-    case sdfcsg::ErrorKind::Syntax:
-    case sdfcsg::ErrorKind::Validation:
-    case sdfcsg::ErrorKind::Limit: return kInvalidScene;
-    case sdfcsg::ErrorKind::Usage: return kUsage;
-    case sdfcsg::ErrorKind::Shader:
-    case sdfcsg::ErrorKind::Vulkan: return kGpu;
-    case sdfcsg::ErrorKind::Remote: return kRemote;
-    }
-    return kGpu;
-}
-
-int fail(const sdfcsg::Error& e) {
-    std::fprintf(stderr, "%s\n", e.str().c_str());
-    return exitCode(e);
-}
-
-int usageError(const std::string& command, const std::string& message) {
-    std::fprintf(stderr, "sdfcsg %s: %s\nTry 'sdfcsg %s --help'.\n", command.c_str(),
-                 message.c_str(), command.c_str());
-    return kUsage;
-}
+using namespace sdfcsg::app;
 
 // A minimal option reader: positional arguments, and options that take a value.
 struct Args {
@@ -181,6 +149,30 @@ Options:
   --validation          enable the Vulkan validation layer
 )";
 
+// A one-line bar on a terminal, redrawn when the whole percentage changes.
+class ProgressBar {
+  public:
+    explicit ProgressBar(const char* label) : label_(label) {}
+    bool update(float fraction) {
+        const int percent = int(std::clamp(fraction, 0.0f, 1.0f) * 100.0f);
+        if (percent == shown_) return true;
+        shown_ = percent;
+        constexpr int kWidth = 40;
+        const int filled = percent * kWidth / 100;
+        std::fprintf(stderr, "\r%s [%.*s%*s] %3d%%", label_, filled,
+                     "########################################", kWidth - filled, "", percent);
+        std::fflush(stderr);
+        return true;
+    }
+    ~ProgressBar() {
+        if (shown_ >= 0) std::fprintf(stderr, "\r%60s\r", "");
+    }
+
+  private:
+    const char* label_;
+    int shown_ = -1;
+};
+
 int cmdRender(int argc, char** argv) {
     Args args("render", argc, argv,
               {"-o", "--output", "--width", "--height", "--mode", "--eye", "--target", "--fov",
@@ -241,9 +233,15 @@ int cmdRender(int argc, char** argv) {
     if (args.has("--validation")) contextOptions.validation = 1;
     auto context = sdfcsg::Context::create(contextOptions);
     if (!context) return fail(context.error());
+    catchInterrupts();
     auto renderer = sdfcsg::Renderer::create(**context, *scene);
     if (!renderer) return fail(renderer.error());
-    auto image = (*renderer)->render(options);
+    auto image = [&] {
+        ProgressBar bar("rendering"); // erased again when the render ends
+        const bool tty = ::isatty(STDERR_FILENO);
+        options.progress = [&](float done) { return (!tty || bar.update(done)) && !interrupted(); };
+        return (*renderer)->render(options);
+    }();
     if (!image) return fail(image.error());
     if (auto written = sdfcsg::writePng(*image, out); !written) return fail(written.error());
     return kOk;
@@ -285,28 +283,6 @@ bool parseBounds(const std::string& s, sdfcsg::Aabb& out) {
     out.max = {values[3], values[4], values[5]};
     return out.min.x < out.max.x && out.min.y < out.max.y && out.min.z < out.max.z;
 }
-
-// A one-line bar on a terminal, redrawn when the whole percentage changes.
-class ProgressBar {
-  public:
-    bool update(float fraction) {
-        const int percent = int(std::clamp(fraction, 0.0f, 1.0f) * 100.0f);
-        if (percent == shown_) return true;
-        shown_ = percent;
-        constexpr int kWidth = 40;
-        const int filled = percent * kWidth / 100;
-        std::fprintf(stderr, "\rmeshing [%.*s%*s] %3d%%", filled,
-                     "########################################", kWidth - filled, "", percent);
-        std::fflush(stderr);
-        return true;
-    }
-    ~ProgressBar() {
-        if (shown_ >= 0) std::fprintf(stderr, "\r%60s\r", "");
-    }
-
-  private:
-    int shown_ = -1;
-};
 
 std::string mebibytes(double bytes) {
     char text[32];
@@ -387,6 +363,7 @@ int cmdMesh(int argc, char** argv) {
     if (args.has("--validation")) contextOptions.validation = 1;
     auto context = sdfcsg::Context::create(contextOptions);
     if (!context) return fail(context.error());
+    catchInterrupts();
     auto t0 = Clock::now();
     auto mesher = sdfcsg::Mesher::create(**context, *scene);
     if (!mesher) return fail(mesher.error());
@@ -394,9 +371,9 @@ int cmdMesh(int argc, char** argv) {
 
     sdfcsg::MeshStats stats;
     auto mesh = [&] {
-        ProgressBar bar; // erased again when the extraction ends
-        if (::isatty(STDERR_FILENO))
-            options.progress = [&bar](float fraction) { return bar.update(fraction); };
+        ProgressBar bar("meshing"); // erased again when the extraction ends
+        const bool tty = ::isatty(STDERR_FILENO);
+        options.progress = [&](float done) { return (!tty || bar.update(done)) && !interrupted(); };
         return (*mesher)->extract(options, &stats);
     }();
     if (!mesh) return fail(mesh.error());

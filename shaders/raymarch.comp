@@ -39,6 +39,11 @@ layout(std140, set = 0, binding = SDFCSG_BINDING_FRAME) uniform Frame {
     vec4 surfaceBoxes[2 * SDFCSG_MAX_CLIP_BOXES];
 } frame;
 
+// The first row of the band this dispatch computes (engine/src/render.cpp).
+layout(push_constant) uniform Band {
+    uint firstRow;
+} band;
+
 layout(std430, set = 0, binding = SDFCSG_BINDING_PIXELS) writeonly buffer Pixels {
     uint pixels[];
 };
@@ -325,7 +330,7 @@ uint packColor(vec3 c) {
 }
 
 void main() {
-    uvec2 pixel = gl_GlobalInvocationID.xy;
+    uvec2 pixel = gl_GlobalInvocationID.xy + uvec2(0u, band.firstRow);
     if (any(greaterThanEqual(pixel, frame.size.xy))) return;
     uint index = pixel.y * frame.size.x + pixel.x;
     uint aa = max(frame.counts.x, 1u);

@@ -483,7 +483,7 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
         progressDone += units;
         return !options.progress || options.progress(float(progressDone / progressTotal));
     };
-    const Error cancelled = usage("cancelled");
+    const Error cancelled = Error::message(ErrorKind::Cancelled, "<mesh>", "cancelled");
 
     MeshGrid gridUniform;
     gridUniform.origin = glm::vec4(g.origin, g.h);

@@ -3,6 +3,8 @@
 // own stack, so hostile nesting cannot overflow the C++ stack.
 #include "sdfcsg/scene.h"
 
+#include "sdfcsg/eval.h"
+
 #include "json_syntax.h"
 #include "json_writer.h"
 #include "legacy.h"
@@ -13,7 +15,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cfloat>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 
 namespace sdfcsg {
@@ -409,6 +413,46 @@ std::optional<dom::array> SceneReader::readNode(element value, std::string path,
     return array;
 }
 
+bool finite(glm::vec3 v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+// Each value is within single precision on its own, but the renderer works in every node's local
+// units: scales multiply down the tree and translations are divided by them, and a product beyond
+// single precision would put inf into the generated code and the node buffer. Reports the first
+// such node; its descendants inherit the problem.
+void checkCombinedTransforms(const Scene& scene, Problems& problems) {
+    const Evaluator evaluator(scene);
+    std::vector<double> scale(scene.nodes.size(), 1.0); // the parent's, until multiplied
+    for (size_t i = 0; i < scene.nodes.size(); ++i) {
+        const Node& node = scene.nodes[i];
+        scale[i] *= node.transform.scale;
+        for (uint32_t c : node.children)
+            scale[c] = scale[i];
+        const FlatNode& f = evaluator.nodes()[i];
+        if (std::isfinite(f.scale) && f.scale > 0.0f && finite(f.toLocal[0]) &&
+            finite(f.toLocal[1]) && finite(f.toLocal[2]) && finite(f.offset) &&
+            std::isfinite(f.smooth))
+            continue;
+        char product[32]; // the product of floats, to the digits that matter here
+        std::snprintf(product, sizeof product, "%.3g", scale[i]);
+        const std::string combined =
+            std::string("the scales of this node and the operations above it multiply to ") +
+            product;
+        if (scale[i] > FLT_MAX)
+            problems.add(node.path, combined + ", beyond single precision (about 3.4e+38)");
+        else if (scale[i] < FLT_MIN)
+            problems.add(node.path, combined + ", too small for single precision (about 1.2e-38)");
+        else if (!std::isfinite(f.smooth))
+            problems.add(node.path, "smooth times the scales above it is beyond single precision "
+                                    "(about 3.4e+38)");
+        else
+            problems.add(node.path, "the translation of this node, in the units of the scales "
+                                    "above it, is beyond single precision (about 3.4e+38)");
+        return;
+    }
+}
+
 } // namespace
 
 Result<Scene> parseScene(std::string_view json, std::string_view file, const Limits& limits) {
@@ -427,6 +471,7 @@ Result<Scene> parseScene(std::string_view json, std::string_view file, const Lim
     Problems problems(fileName);
     Scene scene = isLegacyScene(top) ? convertLegacy(asObject(top), limits, problems)
                                      : SceneReader(limits, problems).read(top);
+    if (problems.empty()) checkCombinedTransforms(scene, problems);
     if (!problems.empty()) return problems.error();
     scene.file = fileName;
     return scene;

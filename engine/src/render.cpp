@@ -64,6 +64,9 @@ Error usage(std::string text) {
     return Error::message(ErrorKind::Usage, "<render>", std::move(text));
 }
 
+// Pixels per submission (see Renderer::render).
+constexpr uint32_t kBandPixels = 1u << 16;
+
 } // namespace
 
 struct Renderer::Impl {
@@ -143,6 +146,9 @@ struct Renderer::Impl {
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p);
         vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipelineLayout, 0, 1, &set, 0,
                                 nullptr);
+        const uint32_t firstRow = 0;
+        vkCmdPushConstants(cmd, pipelineLayout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof firstRow,
+                           &firstRow);
         vkCmdDispatch(cmd, 1, 1, 1);
         detail::submitAndWait(ctx);
     }
@@ -272,7 +278,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene
 
     if (auto built = r.buildKernel(); !built) return built.error();
     r.setLayout = detail::createDescriptorSetLayout(r.ctx, kBindings);
-    r.pipelineLayout = detail::createPipelineLayout(r.ctx, r.setLayout, 0);
+    r.pipelineLayout = detail::createPipelineLayout(r.ctx, r.setLayout, sizeof(uint32_t));
     r.pool = detail::createDescriptorPool(r.ctx, kBindings);
     r.set = detail::allocateDescriptorSet(r.ctx, r.pool, r.setLayout);
 
@@ -339,14 +345,30 @@ Result<Image> Renderer::render(const RenderOptions& options) {
     FrameUniform f = r.frameUniform(options, camera);
     detail::uploadBuffer(r.ctx, r.frame, &f, sizeof(f));
 
-    VkCommandBuffer cmd = detail::beginCommands(r.ctx);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r.pipelineLayout, 0, 1, &r.set, 0,
-                            nullptr);
-    vkCmdDispatch(cmd, groupsX, groupsY, 1);
-    detail::recordReadback(cmd, r.pixels, &r.pixelsStaging);
-    detail::recordReadback(cmd, r.info, &r.infoStaging);
-    detail::submitAndWait(r.ctx);
+    // Bands of whole workgroup rows, about kBandPixels each: a heavy scene or a huge image never
+    // becomes one long dispatch (GPU drivers reset a device whose work runs for seconds), and
+    // the caller can follow progress and stop between bands.
+    const uint32_t bandGroups = std::max(1u, kBandPixels / (options.width * SDFCSG_RAYMARCH_GROUP_Y));
+    for (uint32_t firstGroup = 0; firstGroup < groupsY; firstGroup += bandGroups) {
+        const uint32_t groups = std::min(bandGroups, groupsY - firstGroup);
+        const uint32_t firstRow = firstGroup * SDFCSG_RAYMARCH_GROUP_Y;
+        VkCommandBuffer cmd = detail::beginCommands(r.ctx);
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r.pipelineLayout, 0, 1,
+                                &r.set, 0, nullptr);
+        vkCmdPushConstants(cmd, r.pipelineLayout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof firstRow,
+                           &firstRow);
+        vkCmdDispatch(cmd, groupsX, groups, 1);
+        const bool last = firstGroup + groups == groupsY;
+        if (last) {
+            detail::recordReadback(cmd, r.pixels, &r.pixelsStaging);
+            detail::recordReadback(cmd, r.info, &r.infoStaging);
+        }
+        detail::submitAndWait(r.ctx);
+        const float done = float(firstGroup + groups) / float(groupsY);
+        if (options.progress && !options.progress(done) && !last)
+            return Error::message(ErrorKind::Cancelled, "<render>", "cancelled");
+    }
 
     Image image;
     image.width = options.width;

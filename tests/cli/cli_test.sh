@@ -144,5 +144,30 @@ expect_text "eval after repair" eval/report.txt "validity after repair: 1 of 1 (
 [ -s eval/01.json ] && [ -s eval/01.png ] && [ -s eval/contact-sheet.png ] ||
     { echo "FAIL eval-prompts outputs"; ls eval; failures=$((failures + 1)); }
 
+# Ctrl-C: long work stops at its next progress check (or, before the handler is installed, the
+# signal ends the process), exits 130 and leaves neither the output nor a temporary behind. Each
+# job takes half a minute or more uninterrupted, so the signal always comes in the middle.
+interrupt() { # interrupt NAME OUTPUT COMMAND...: sends SIGINT a second after the start
+    name=$1 output=$2
+    shift 2
+    # A background job of a script starts with SIGINT ignored: restore the default first.
+    env --default-signal=INT "$@" >out.txt 2>err.txt &
+    pid=$!
+    sleep 1
+    kill -INT "$pid"
+    wait "$pid"
+    rc=$?
+    if [ "$rc" -ne 130 ] || [ -e "$output" ] || ls | grep -q '\.tmp-'; then
+        echo "FAIL $name: exit $rc, expected 130 and no output"; ls; cat err.txt
+        failures=$((failures + 1))
+    else
+        passed=$((passed + 1))
+    fi
+}
+interrupt "mesh interrupted" big.ply "$bin" mesh "$src/assets/scenes/house.json" -o big.ply \
+    --resolution 2048
+interrupt "render interrupted" big.png "$bin" render "$src/assets/scenes/house.json" -o big.png \
+    --width 4096 --height 4096 --aa 2
+
 echo "$passed passed, $failures failed"
 [ "$failures" -eq 0 ]

@@ -1,6 +1,7 @@
 # Installs the built engine into a private prefix, builds tests/consumer/project against it
 # with find_package(sdfcsg), runs the result and checks the PNG it writes.
-# Inputs: BUILD_DIR, SOURCE_DIR, WORK_DIR, GENERATOR.
+# Inputs: BUILD_DIR, SOURCE_DIR, WORK_DIR, GENERATOR, CXX, and SANITIZERS when the library was
+# built with them (the consumer then links their runtimes, with the same compiler).
 file(REMOVE_RECURSE ${WORK_DIR})
 function(run)
     execute_process(COMMAND ${ARGV} RESULT_VARIABLE rc)
@@ -8,9 +9,13 @@ function(run)
         message(FATAL_ERROR "failed (${rc}): ${ARGV}")
     endif()
 endfunction()
+set(sanitizer_args "")
+if(SANITIZERS)
+    set(sanitizer_args -DCMAKE_CXX_COMPILER=${CXX} -DCMAKE_EXE_LINKER_FLAGS=-fsanitize=${SANITIZERS})
+endif()
 run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${WORK_DIR}/prefix)
 run(${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/consumer/project -B ${WORK_DIR}/build -G ${GENERATOR}
-    -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix)
+    -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix ${sanitizer_args})
 run(${CMAKE_COMMAND} --build ${WORK_DIR}/build)
 run(${WORK_DIR}/build/consumer ${SOURCE_DIR}/assets/scenes/csg_part.json ${WORK_DIR}/out.png)
 file(READ ${WORK_DIR}/out.png header LIMIT 8 HEX)

@@ -231,6 +231,58 @@ TEST_F(MeshTest, RepeatedExtractionsAreIdentical) {
     }
 }
 
+// Progress climbs to 1; a callback that returns false stops the extraction, which can then run
+// again from the start.
+TEST_F(MeshTest, ProgressEndsAtOneAndFalseCancels) {
+    const Scene scene = sceneFrom(kSphere);
+    auto mesher = Mesher::create(context(), scene);
+    ASSERT_TRUE(mesher) << mesher.error().str();
+    MeshOptions options;
+    options.resolution = 40;
+    std::vector<float> reported;
+    options.progress = [&](float done) {
+        reported.push_back(done);
+        return true;
+    };
+    auto mesh = (*mesher)->extract(options);
+    ASSERT_TRUE(mesh) << mesh.error().str();
+    ASSERT_FALSE(reported.empty());
+    EXPECT_TRUE(std::is_sorted(reported.begin(), reported.end()));
+    EXPECT_FLOAT_EQ(reported.back(), 1.0f);
+
+    options.progress = [](float) { return false; };
+    auto stopped = (*mesher)->extract(options);
+    ASSERT_FALSE(stopped);
+    EXPECT_EQ(stopped.error().kind, ErrorKind::Cancelled);
+    EXPECT_EQ(stopped.error().str(), "<mesh>: cancelled");
+
+    options.progress = nullptr;
+    auto again = (*mesher)->extract(options);
+    ASSERT_TRUE(again) << again.error().str();
+    EXPECT_EQ(again->indices, mesh->indices);
+}
+
+// Default bounds follow the solid, not every primitive: what a difference subtracts reaches far
+// beyond the part (reference scene A's holes are 4 long, the part 1.5 wide).
+TEST_F(MeshTest, DefaultBoundsHugTheSolid) {
+    const Scene scene = sceneFrom(R"({"version": 1, "root": {"type": "difference", "children": [
+        {"type": "intersection", "children": [{"type": "sphere", "radius": 1},
+                                              {"type": "box", "size": [1.5, 1.5, 1.5]}]},
+        {"type": "cylinder", "radius": 0.5, "height": 4, "rotate": [0, 0, 90]},
+        {"type": "cylinder", "radius": 0.5, "height": 4}]}})");
+    MeshOptions options;
+    options.resolution = 64;
+    MeshStats stats;
+    const Mesh mesh = extract(scene, options, &stats);
+    EXPECT_FALSE(stats.surfaceCut);
+    const float margin = 2.0f * stats.voxelSize; // the margin of 2 cells at resolution 64
+    for (int a = 0; a < 3; ++a) {
+        EXPECT_NEAR(stats.bounds.min[a], -0.75f - margin, 0.5f * stats.voxelSize) << "axis " << a;
+        EXPECT_NEAR(stats.bounds.max[a], 0.75f + margin, 0.5f * stats.voxelSize) << "axis " << a;
+    }
+    EXPECT_TRUE(measureMesh(mesh).closedManifold());
+}
+
 TEST_F(MeshTest, BoundsThatCutTheSurfaceAreReported) {
     const Scene scene = sceneFrom(kSphere);
     MeshOptions options;

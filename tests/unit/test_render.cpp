@@ -429,6 +429,42 @@ TEST_F(Render, RejectsBadOptions) {
     EXPECT_EQ(huge.error().kind, ErrorKind::Limit);
 }
 
+// A render is computed in bands of rows; the caller follows them and may stop between two.
+TEST_F(Render, ReportsProgressPerBandAndStopsWhenAsked) {
+    Scene scene = loadOrDie(scenePath("csg_part.json"));
+    auto renderer = Renderer::create(context(), scene);
+    ASSERT_TRUE(renderer) << renderer.error().str();
+    RenderOptions options;
+    options.width = 256;
+    options.height = 600; // three bands of 65536 pixels or fewer
+    auto whole = (*renderer)->render(options);
+    ASSERT_TRUE(whole) << whole.error().str();
+
+    std::vector<float> reported;
+    options.progress = [&](float done) {
+        reported.push_back(done);
+        return true;
+    };
+    auto banded = (*renderer)->render(options);
+    ASSERT_TRUE(banded) << banded.error().str();
+    EXPECT_EQ(banded->rgba, whole->rgba);
+    ASSERT_EQ(reported.size(), 3u);
+    EXPECT_TRUE(std::is_sorted(reported.begin(), reported.end()));
+    EXPECT_LT(reported.front(), 1.0f);
+    EXPECT_EQ(reported.back(), 1.0f);
+
+    reported.clear();
+    options.progress = [&](float done) {
+        reported.push_back(done);
+        return false;
+    };
+    auto stopped = (*renderer)->render(options);
+    ASSERT_FALSE(stopped);
+    EXPECT_EQ(stopped.error().kind, ErrorKind::Cancelled);
+    EXPECT_EQ(stopped.error().str(), "<render>: cancelled");
+    EXPECT_EQ(reported.size(), 1u);
+}
+
 TEST(RenderMode, ParsesTheFourNames) {
     EXPECT_EQ(parseRenderMode("shaded"), RenderMode::Shaded);
     EXPECT_EQ(parseRenderMode("normals"), RenderMode::Normals);

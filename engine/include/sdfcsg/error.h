@@ -23,7 +23,8 @@ struct Diagnostic {
 };
 
 // Remote: an HTTP service (a language model endpoint) failed, refused or answered unusably.
-enum class ErrorKind { Io, Syntax, Validation, Limit, Shader, Vulkan, Usage, Remote };
+// Cancelled: a progress callback asked long work (a render, a mesh extraction) to stop.
+enum class ErrorKind { Io, Syntax, Validation, Limit, Shader, Vulkan, Usage, Remote, Cancelled };
 
 struct Error {
     ErrorKind kind = ErrorKind::Validation;

@@ -54,7 +54,7 @@ struct MeshOptions {
     // needs more fails with ErrorKind::Limit before the heavy work starts.
     size_t memoryBudget = size_t(4) << 30;
     // Called from the calling thread with the fraction done (0..1), at least once per batch of
-    // bricks; returning false cancels the extraction (ErrorKind::Usage, "cancelled").
+    // bricks; returning false cancels the extraction (ErrorKind::Cancelled).
     std::function<bool(float)> progress;
 };
 

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string_view>
@@ -32,6 +33,10 @@ struct RenderOptions {
     std::optional<bool> boundsSkipping;
     BoxOverlay boxes = BoxOverlay::None;
     int selectedNode = -1;        // for BoxOverlay::Selected
+    // The image is computed in bands of rows, one submission each, so no single dispatch runs
+    // for long. Called after each band with the fraction done; returning false stops the
+    // render (ErrorKind::Cancelled).
+    std::function<bool(float)> progress;
 };
 
 // Tightly packed 8-bit RGBA, rows top to bottom.
