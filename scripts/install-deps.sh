@@ -5,7 +5,8 @@ PACKAGES="build-essential cmake ninja-build pkg-config git
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers
   glslang-dev glslang-tools spirv-tools
   libglm-dev libsimdjson-dev libstb-dev libgtest-dev
-  libcurl4-openssl-dev libcpp-httplib-dev"
+  libcurl4-openssl-dev libcpp-httplib-dev
+  libglfw3-dev libimgui-dev xvfb xauth"
 missing=""
 for p in $PACKAGES; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"

@@ -1,0 +1,74 @@
+#include "document.h"
+
+#include <sdfcsg/io.h>
+
+#include <system_error>
+
+namespace sdfcsg::viewer {
+
+FileStamp stampOf(const std::filesystem::path& path) {
+    std::error_code ec;
+    FileStamp stamp;
+    stamp.time = std::filesystem::last_write_time(path, ec);
+    if (ec) return {};
+    stamp.size = std::filesystem::file_size(path, ec);
+    if (ec) return {};
+    stamp.exists = true;
+    return stamp;
+}
+
+bool FileWatcher::poll() {
+    if (path_.empty()) return false;
+    FileStamp now = stampOf(path_);
+    if (now == seen_) return false;
+    seen_ = now;
+    // A file being replaced is briefly absent; its reappearance is the change to report.
+    return now.exists;
+}
+
+Status Document::open(const std::filesystem::path& path) {
+    auto scene = loadScene(path);
+    // Watch the file whatever happened, so fixing it on disk loads it.
+    path_ = path;
+    watcher_ = FileWatcher(path);
+    if (!scene) {
+        error_ = scene.error();
+        ++version_;
+        return scene.error();
+    }
+    error_.reset();
+    history_.reset(std::move(*scene));
+    loaded_ = true;
+    ++version_;
+    return Ok{};
+}
+
+bool Document::pollReload() {
+    if (!watcher_.poll()) return false;
+    auto scene = loadScene(path_);
+    ++version_;
+    if (!scene) {
+        error_ = scene.error();
+        return true;
+    }
+    error_.reset();
+    // A reload is one more step, so an edit made outside can be undone like one made here.
+    history_.endMerge();
+    history_.push(std::move(*scene));
+    loaded_ = true;
+    return true;
+}
+
+Status Document::save(const std::filesystem::path& path) {
+    auto written = writeFileAtomic(path, toJson(scene()));
+    if (!written) return written;
+    if (path != path_) {
+        path_ = path;
+        watcher_ = FileWatcher(path);
+    } else {
+        watcher_.acknowledge();
+    }
+    return Ok{};
+}
+
+} // namespace sdfcsg::viewer

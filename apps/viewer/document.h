@@ -1,0 +1,73 @@
+// The scene file the viewer shows: loading, saving, and reloading when it changes on disk.
+// An invalid file never replaces the scene on screen: the last good scene stays, and the
+// errors are kept for the error panel.
+#pragma once
+
+#include "history.h"
+
+#include <sdfcsg/error.h>
+#include <sdfcsg/scene.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+
+namespace sdfcsg::viewer {
+
+// What identifies a version of a file without reading it.
+struct FileStamp {
+    bool exists = false;
+    std::filesystem::file_time_type time{};
+    uintmax_t size = 0;
+    bool operator==(const FileStamp&) const = default;
+};
+FileStamp stampOf(const std::filesystem::path& path);
+
+// Reports changes of one file, by polling (portable, and a scene file is one stat per poll).
+class FileWatcher {
+  public:
+    FileWatcher() = default;
+    explicit FileWatcher(std::filesystem::path path)
+        : path_(std::move(path)), seen_(stampOf(path_)) {}
+    // True once per change since the last poll (or the last acknowledge).
+    bool poll();
+    // Takes the file as it is now as seen (after the viewer writes it itself).
+    void acknowledge() { seen_ = stampOf(path_); }
+    const std::filesystem::path& path() const { return path_; }
+
+  private:
+    std::filesystem::path path_;
+    FileStamp seen_;
+};
+
+class Document {
+  public:
+    // Loads a file; on failure the current scene stays and error() holds the problems.
+    Status open(const std::filesystem::path& path);
+    // Reloads if the file changed on disk; true when something changed (scene or error).
+    bool pollReload();
+    // Writes the current scene as JSON, atomically, and takes that version as seen.
+    Status save(const std::filesystem::path& path);
+    Status save() { return save(path_); }
+
+    const Scene& scene() const { return history_.current(); }
+    History& history() { return history_; }
+    const std::filesystem::path& path() const { return path_; }
+    // Problems of the last load or reload; cleared by the next load that succeeds.
+    const std::optional<Error>& error() const { return error_; }
+    // True once a scene has loaded; before that scene() is empty.
+    bool loaded() const { return loaded_; }
+    // Counts every change of scene(), so users can tell whether they are up to date.
+    uint64_t version() const { return version_; }
+    void touch() { ++version_; }
+
+  private:
+    std::filesystem::path path_;
+    FileWatcher watcher_;
+    History history_;
+    std::optional<Error> error_;
+    bool loaded_ = false;
+    uint64_t version_ = 0;
+};
+
+} // namespace sdfcsg::viewer

@@ -1,0 +1,224 @@
+#include "edit.h"
+
+#include <algorithm>
+#include <charconv>
+#include <string>
+
+namespace sdfcsg::viewer {
+
+namespace {
+
+Error usage(const Scene& scene, uint32_t node, std::string message) {
+    return Error(ErrorKind::Usage,
+                 Diagnostic{scene.file, scene.nodes[node].path, std::move(message)});
+}
+
+Error badNode(const Scene& scene, uint32_t node) {
+    return Error::message(ErrorKind::Usage, scene.file,
+                          "no node " + std::to_string(node) + " (the scene has " +
+                              std::to_string(scene.nodes.size()) + ")");
+}
+
+// Sizes a new or converted primitive starts with: about a unit across, so it is visible next
+// to the bundled scenes.
+void defaultParams(Node& node) {
+    const KindInfo& info = kindInfo(node.kind);
+    node.params.fill(0.0f);
+    for (const ParamInfo& p : info.params) {
+        float v[3] = {p.fallback[0], p.fallback[1], p.fallback[2]};
+        if (p.required) {
+            float x = p.check == Check::NonNegative ? 0.1f : 0.5f;
+            if (p.name == "minor_radius") x = 0.15f;
+            if (p.name == "size" || p.name == "height" || p.name == "length" || p.name == "width")
+                x = 1.0f;
+            v[0] = v[1] = v[2] = x;
+            if (p.name == "a") v[0] = 0.0f, v[1] = -0.5f, v[2] = 0.0f;
+            if (p.name == "b") v[0] = 0.0f, v[1] = 0.5f, v[2] = 0.0f;
+            if (p.type == ValueType::Number && p.name == "radius" && node.kind == NodeKind::Capsule)
+                v[0] = 0.2f;
+        }
+        int n = p.type == ValueType::Vec3 ? 3 : 1;
+        for (int k = 0; k < n; ++k)
+            node.params[p.slot + k] = v[k];
+    }
+}
+
+const ParamInfo* findParam(NodeKind kind, std::string_view name) {
+    for (const ParamInfo& p : kindInfo(kind).params)
+        if (p.name == name) return &p;
+    return nullptr;
+}
+
+// Visits the subtree in depth-first order.
+template <class F> void forSubtree(const Scene& scene, uint32_t node, F&& f) {
+    std::vector<uint32_t> stack{node};
+    while (!stack.empty()) {
+        uint32_t n = stack.back();
+        stack.pop_back();
+        f(n);
+        for (auto it = scene.nodes[n].children.rbegin(); it != scene.nodes[n].children.rend(); ++it)
+            stack.push_back(*it);
+    }
+}
+
+// The index the loader gives a node: its place in depth-first order from the root.
+uint32_t loadedIndex(const Scene& scene, uint32_t node) {
+    uint32_t order = 0, found = 0;
+    forSubtree(scene, 0, [&](uint32_t n) {
+        if (n == node) found = order;
+        ++order;
+    });
+    return found;
+}
+
+} // namespace
+
+bool sameStructure(const Scene& a, const Scene& b) {
+    if (a.nodes.size() != b.nodes.size()) return false;
+    for (size_t i = 0; i < a.nodes.size(); ++i)
+        if (a.nodes[i].kind != b.nodes[i].kind || a.nodes[i].children != b.nodes[i].children)
+            return false;
+    return true;
+}
+
+std::string nodeLabel(const Scene& scene, uint32_t node) {
+    const Node& n = scene.nodes[node];
+    std::string kind(kindInfo(n.kind).name);
+    return n.name.empty() ? kind : n.name + " (" + kind + ")";
+}
+
+int parentOf(const Scene& scene, uint32_t node) {
+    for (uint32_t i = 0; i < scene.nodes.size(); ++i)
+        for (uint32_t c : scene.nodes[i].children)
+            if (c == node) return int(i);
+    return -1;
+}
+
+std::optional<uint32_t> findNode(const Scene& scene, std::string_view nameOrIndex) {
+    for (uint32_t i = 0; i < scene.nodes.size(); ++i)
+        if (scene.nodes[i].name == nameOrIndex) return i;
+    uint32_t index = 0;
+    auto [end, ec] =
+        std::from_chars(nameOrIndex.data(), nameOrIndex.data() + nameOrIndex.size(), index);
+    if (ec == std::errc() && end == nameOrIndex.data() + nameOrIndex.size() &&
+        index < scene.nodes.size())
+        return index;
+    return std::nullopt;
+}
+
+Result<Scene> revalidate(const Scene& scene) {
+    auto parsed = parseScene(toJson(scene), scene.file);
+    if (parsed) parsed->file = scene.file;
+    return parsed;
+}
+
+Result<Scene> setValue(const Scene& scene, uint32_t node, std::string_view key,
+                       std::span<const float> values) {
+    if (node >= scene.nodes.size()) return badNode(scene, node);
+    Scene edited = scene;
+    Node& n = edited.nodes[node];
+    auto expect = [&](size_t count) -> std::optional<Error> {
+        if (values.size() == count) return std::nullopt;
+        return usage(scene, node,
+                     std::string(key) + ": expected " + std::to_string(count) +
+                         (count == 1 ? " number" : " numbers") + ", got " +
+                         std::to_string(values.size()));
+    };
+    if (key == "translate" || key == "rotate") {
+        if (auto e = expect(3)) return *e;
+        (key == "translate" ? n.transform.translate : n.transform.rotate) =
+            glm::vec3(values[0], values[1], values[2]);
+    } else if (key == "scale") {
+        if (auto e = expect(1)) return *e;
+        n.transform.scale = values[0];
+    } else if (key == "color") {
+        if (values.empty()) {
+            n.color.reset();
+        } else {
+            if (auto e = expect(3)) return *e;
+            n.color = glm::vec3(values[0], values[1], values[2]);
+        }
+    } else if (const ParamInfo* p = findParam(n.kind, key)) {
+        if (auto e = expect(p->type == ValueType::Vec3 ? 3 : 1)) return *e;
+        std::copy(values.begin(), values.end(), n.params.begin() + p->slot);
+    } else {
+        std::string known = "translate, rotate, scale, color";
+        for (const ParamInfo& q : kindInfo(n.kind).params)
+            known += ", " + std::string(q.name);
+        return usage(scene, node,
+                     "a " + std::string(kindInfo(n.kind).name) + " has no value \"" +
+                         std::string(key) + "\" (it has " + known + ")");
+    }
+    return revalidate(edited);
+}
+
+Result<Scene> addChild(const Scene& scene, uint32_t parent, NodeKind kind, uint32_t* newIndex) {
+    if (parent >= scene.nodes.size()) return badNode(scene, parent);
+    if (!kindInfo(scene.nodes[parent].kind).operation)
+        return usage(scene, parent, "only an operation can take children");
+    Scene edited = scene;
+    Node child;
+    child.kind = kind;
+    defaultParams(child);
+    edited.nodes.push_back(child);
+    edited.nodes[parent].children.push_back(uint32_t(edited.nodes.size() - 1));
+    if (kindInfo(kind).operation) { // an operation needs an operand
+        Node leaf;
+        leaf.kind = NodeKind::Sphere;
+        defaultParams(leaf);
+        edited.nodes.push_back(leaf);
+        edited.nodes[edited.nodes.size() - 2].children.push_back(uint32_t(edited.nodes.size() - 1));
+    }
+    if (newIndex) *newIndex = loadedIndex(edited, edited.nodes[parent].children.back());
+    return revalidate(edited);
+}
+
+Result<Scene> removeNode(const Scene& scene, uint32_t node) {
+    if (node >= scene.nodes.size()) return badNode(scene, node);
+    int parent = parentOf(scene, node);
+    if (parent < 0) return usage(scene, node, "the root cannot be removed");
+    if (scene.nodes[parent].children.size() == 1)
+        return usage(scene, node,
+                     "an operation needs at least one child; remove the operation instead");
+    // Unlinking is enough: toJson writes only what the root reaches.
+    Scene edited = scene;
+    auto& siblings = edited.nodes[parent].children;
+    siblings.erase(std::find(siblings.begin(), siblings.end(), node));
+    return revalidate(edited);
+}
+
+Result<Scene> changeKind(const Scene& scene, uint32_t node, NodeKind kind) {
+    if (node >= scene.nodes.size()) return badNode(scene, node);
+    Scene edited = scene;
+    Node& n = edited.nodes[node];
+    bool wasOperation = kindInfo(n.kind).operation;
+    if (wasOperation != kindInfo(kind).operation)
+        return usage(scene, node,
+                     std::string(wasOperation ? "an operation" : "a primitive") +
+                         " can only become another " + (wasOperation ? "operation" : "primitive"));
+    Node old = n;
+    n.kind = kind;
+    defaultParams(n);
+    for (const ParamInfo& p : kindInfo(kind).params)
+        if (const ParamInfo* q = findParam(old.kind, p.name); q && q->type == p.type)
+            std::copy_n(old.params.begin() + q->slot, p.type == ValueType::Vec3 ? 3 : 1,
+                        n.params.begin() + p.slot);
+    return revalidate(edited);
+}
+
+Result<Scene> moveNode(const Scene& scene, uint32_t node, int delta, uint32_t* newIndex) {
+    if (node >= scene.nodes.size()) return badNode(scene, node);
+    int parent = parentOf(scene, node);
+    if (parent < 0) return usage(scene, node, "the root has no siblings");
+    Scene edited = scene;
+    auto& siblings = edited.nodes[parent].children;
+    int from = int(std::find(siblings.begin(), siblings.end(), node) - siblings.begin());
+    int to = std::clamp(from + delta, 0, int(siblings.size()) - 1);
+    uint32_t moved = siblings[from];
+    siblings.erase(siblings.begin() + from);
+    siblings.insert(siblings.begin() + to, moved);
+    if (newIndex) *newIndex = loadedIndex(edited, node);
+    return revalidate(edited);
+}
+
+} // namespace sdfcsg::viewer

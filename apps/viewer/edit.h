@@ -1,0 +1,54 @@
+// Edits of a scene in memory, as the viewer's inspector and command scripts make them. Every
+// edit returns a new scene that has been through the loader's validation (the scene is written
+// to JSON and parsed back), so an edit can never leave an invalid scene behind, and node indices
+// are renumbered in the loader's order (a parent before its children, depth first).
+#pragma once
+
+#include <sdfcsg/error.h>
+#include <sdfcsg/scene.h>
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+
+namespace sdfcsg::viewer {
+
+// Same node count, kinds and children: values may differ, so a renderer compiled for one can
+// take the other's values with updateValues() instead of a recompile.
+bool sameStructure(const Scene& a, const Scene& b);
+
+// "name (kind)", or the kind alone for an unnamed node.
+std::string nodeLabel(const Scene& scene, uint32_t node);
+
+// The parent of a node, or -1 for the root.
+int parentOf(const Scene& scene, uint32_t node);
+
+// A node by name (first in file order) or by index; nullopt if there is none.
+std::optional<uint32_t> findNode(const Scene& scene, std::string_view nameOrIndex);
+
+// Validates through the loader: parseScene(toJson(scene)).
+Result<Scene> revalidate(const Scene& scene);
+
+// Sets one value of a node: a parameter of its kind ("radius", "size", "smooth", ...),
+// "translate", "rotate" or "scale", or "color" (no values: inherit the parent's colour again).
+// Errors name the key and what it expects.
+Result<Scene> setValue(const Scene& scene, uint32_t node, std::string_view key,
+                       std::span<const float> values);
+
+// Structural edits (a renderer must recompile after these).
+// Adds a node of `kind` with default sizes as the last child of an operation (an operation gets
+// a sphere to operate on). *newIndex receives the new node's index.
+Result<Scene> addChild(const Scene& scene, uint32_t parent, NodeKind kind,
+                       uint32_t* newIndex = nullptr);
+// Removes a node and its subtree; the root and an operation's only child cannot be removed.
+Result<Scene> removeNode(const Scene& scene, uint32_t node);
+// Turns a primitive into another primitive (parameters of the same name are kept, the others
+// get defaults) or an operation into another operation.
+Result<Scene> changeKind(const Scene& scene, uint32_t node, NodeKind kind);
+// Moves a node among its siblings by `delta` places (the first child of a difference is what
+// the others are cut from, so order matters). *newIndex receives the node's index afterwards.
+Result<Scene> moveNode(const Scene& scene, uint32_t node, int delta, uint32_t* newIndex = nullptr);
+
+} // namespace sdfcsg::viewer

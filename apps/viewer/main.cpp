@@ -1,0 +1,1006 @@
+// sdfcsg-viewer: an interactive window over the engine. The engine renders on a background
+// thread (RenderWorker) into host images; this file handles input, the ImGui panels, and hands
+// the images to the Presenter. Everything that can be tested without a window lives in the
+// other files of this folder.
+#include "document.h"
+#include "edit.h"
+#include "orbit_camera.h"
+#include "picking.h"
+#include "presenter.h"
+#include "raster.h"
+#include "script.h"
+#include "workers.h"
+
+#include <sdfcsg/export.h>
+#include <sdfcsg/io.h>
+
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <imgui_impl_glfw.h>
+#include <imgui_impl_vulkan.h>
+
+#include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <deque>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+using namespace sdfcsg;
+using namespace sdfcsg::viewer;
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: sdfcsg-viewer [SCENE] [--size WxH] [--screenshot OUT.png --frames N]\n"
+    "                     [--script FILE] [--no-ui]\n"
+    "  --size WxH         window size in pixels (default 1280x720)\n"
+    "  --screenshot OUT   after N frames and the full-resolution image, write the window to\n"
+    "                     OUT (PNG) and exit\n"
+    "  --frames N         frames to draw before the screenshot (default 1)\n"
+    "  --script FILE      run viewer commands from FILE (see apps/viewer/script.h), then exit\n"
+    "  --no-ui            hide the panels (H toggles them)\n";
+
+struct Args {
+    fs::path scene;
+    fs::path screenshot;
+    int frames = 1;
+    int width = 1280, height = 720;
+    fs::path script;
+    bool noUi = false;
+};
+
+bool parseArgs(int argc, char** argv, Args& args, std::string& error) {
+    for (int i = 1; i < argc; ++i) {
+        std::string a = argv[i];
+        auto value = [&](std::string& out) {
+            if (i + 1 >= argc) {
+                error = a + ": expected a value";
+                return false;
+            }
+            out = argv[++i];
+            return true;
+        };
+        std::string v;
+        if (a == "--help" || a == "-h") {
+            std::fputs(kUsage, stdout);
+            std::exit(0);
+        } else if (a == "--size") {
+            if (!value(v)) return false;
+            if (std::sscanf(v.c_str(), "%dx%d", &args.width, &args.height) != 2 ||
+                args.width < 16 || args.height < 16 || args.width > 8192 || args.height > 8192) {
+                error = "--size: expected WxH between 16x16 and 8192x8192, got \"" + v + "\"";
+                return false;
+            }
+        } else if (a == "--screenshot") {
+            if (!value(v)) return false;
+            args.screenshot = v;
+        } else if (a == "--frames") {
+            if (!value(v)) return false;
+            args.frames = std::atoi(v.c_str());
+            if (args.frames < 1) {
+                error = "--frames: expected a positive number, got \"" + v + "\"";
+                return false;
+            }
+        } else if (a == "--script") {
+            if (!value(v)) return false;
+            args.script = v;
+        } else if (a == "--no-ui") {
+            args.noUi = true;
+        } else if (!a.empty() && a[0] == '-') {
+            error = "unknown option " + a;
+            return false;
+        } else if (args.scene.empty()) {
+            args.scene = a;
+        } else {
+            error = "more than one scene given";
+            return false;
+        }
+    }
+    return true;
+}
+
+double now() {
+    using namespace std::chrono;
+    return duration<double>(steady_clock::now().time_since_epoch()).count();
+}
+
+// Everything a rendered image depends on; an image is current when its key equals the wanted one.
+struct ViewKey {
+    uint64_t sceneVersion = 0;
+    Camera camera;
+    RenderMode mode = RenderMode::Shaded;
+    bool shadows = true, ao = true;
+    BoxOverlay boxes = BoxOverlay::None;
+    int selected = -1;
+    uint32_t width = 0, height = 0;
+    bool mesh = false, wireframe = false;
+    bool operator==(const ViewKey& o) const {
+        return sceneVersion == o.sceneVersion && camera.eye == o.camera.eye &&
+               camera.target == o.camera.target && camera.fov == o.camera.fov && mode == o.mode &&
+               shadows == o.shadows && ao == o.ao && boxes == o.boxes && selected == o.selected &&
+               width == o.width && height == o.height && mesh == o.mesh && wireframe == o.wireframe;
+    }
+};
+
+struct Viewer {
+    GLFWwindow* window = nullptr;
+    PresenterPtr presenter;
+    std::unique_ptr<Context> context;
+    std::unique_ptr<RenderWorker> renderer;
+    std::unique_ptr<MeshWorker> mesher;
+    Document doc;
+    std::shared_ptr<const Scene> scene; // doc.scene() as handed to the workers
+    uint64_t sceneVersion = ~0ull;
+    std::unique_ptr<Evaluator> evaluator; // of `scene`, for picking and framing
+
+    OrbitCamera camera;
+    RenderMode mode = RenderMode::Shaded;
+    bool shadows = true, ao = true, grid = false, showUi = true;
+    BoxOverlay boxes = BoxOverlay::Selected;
+    int selected = -1;
+
+    // Images.
+    uint64_t nextJob = 1;
+    ViewKey submitted, shown; // what the worker was last asked for / what is on screen
+    bool haveSubmitted = false, haveShown = false;
+    std::vector<std::pair<uint64_t, ViewKey>> jobs; // id -> key of jobs in flight
+    RenderOutput last;                              // the image on screen, with its depths
+    double lastInteraction = -1.0;
+    float scale = 0.5f; // preview resolution while the camera moves
+    double renderMs = 0.0, compileMs = 0.0;
+    std::optional<Error> renderError;
+
+    // Mouse.
+    bool pressed[3] = {false, false, false};
+    double pressX = 0, pressY = 0, lastX = 0, lastY = 0;
+    bool dragged = false;
+
+    // Mesh mode.
+    std::optional<Mesh> mesh;
+    MeshStats meshStats;
+    bool meshView = false, wireframe = false;
+    int meshResolution = 128;
+    bool customBounds = false;
+    float boundsMin[3] = {-1, -1, -1}, boundsMax[3] = {1, 1, 1};
+    std::string meshMessage;
+    char exportPath[512] = "mesh.glb";
+
+    // Files.
+    char openPath[512] = "";
+    char savePath[512] = "";
+    char shotPath[512] = "viewer.png";
+    std::vector<std::string> recent;
+    fs::path browseDir = fs::current_path();
+    bool browserOpen = false;
+    std::string status;
+
+    // Automation.
+    std::deque<Command> script;
+    std::string scriptFile;
+    fs::path pendingShot; // waiting for the current full image, then written
+    bool exitAfterShot = false;
+    int framesLeft = 0;
+    int settledFrames = 0; // frames in a row that showed the current full image
+    int exitCode = 0;
+    double waitStart = 0;
+};
+
+float aspectOf(const Viewer& v) {
+    int w = 1, h = 1;
+    glfwGetFramebufferSize(v.window, &w, &h);
+    return h > 0 ? float(w) / float(h) : 1.0f;
+}
+
+void resetCamera(Viewer& v) {
+    if (!v.evaluator) return;
+    Camera c = v.scene->camera ? *v.scene->camera : frameCamera(*v.evaluator, aspectOf(v));
+    v.camera = orbitFromCamera(c);
+}
+
+void frameSelection(Viewer& v) {
+    if (!v.evaluator) return;
+    Aabb box;
+    if (v.selected >= 0 && v.selected < int(v.evaluator->nodes().size()))
+        box = v.evaluator->nodes()[v.selected].bounds;
+    if (box.empty() || !box.finite()) {
+        // The finite primitives: planes would make the whole scene unbounded.
+        for (const FlatNode& n : v.evaluator->nodes())
+            if (!kindInfo(n.kind).operation && n.bounds.finite() && !n.bounds.empty())
+                box.min = glm::min(box.min, n.bounds.min),
+                box.max = glm::max(box.max, n.bounds.max);
+    }
+    frameBox(v.camera, box, aspectOf(v));
+    v.lastInteraction = now();
+}
+
+void addRecent(Viewer& v, const fs::path& path) {
+    std::string p = path.string();
+    v.recent.erase(std::remove(v.recent.begin(), v.recent.end(), p), v.recent.end());
+    v.recent.insert(v.recent.begin(), p);
+    if (v.recent.size() > 10) v.recent.resize(10);
+}
+
+// Hands the document's scene to the workers when it changed.
+void syncScene(Viewer& v) {
+    if (!v.doc.loaded() || v.sceneVersion == v.doc.version()) return;
+    bool first = !v.scene;
+    v.scene = std::make_shared<const Scene>(v.doc.scene());
+    v.sceneVersion = v.doc.version();
+    v.evaluator = std::make_unique<Evaluator>(*v.scene);
+    if (v.selected >= int(v.scene->nodes.size())) v.selected = -1;
+    if (first) resetCamera(v);
+}
+
+void openFile(Viewer& v, const fs::path& path) {
+    bool hadScene = v.doc.loaded();
+    auto opened = v.doc.open(path);
+    std::snprintf(v.savePath, sizeof v.savePath, "%s", path.string().c_str());
+    if (opened) {
+        addRecent(v, path);
+        v.selected = -1;
+        v.scene.reset(); // the camera is reset for a new file
+        v.mesh.reset();
+        v.status = "opened " + path.string();
+    } else {
+        v.status = "could not open " + path.string();
+        (void)hadScene;
+    }
+}
+
+// Applies an edit's outcome: a new undo step, or the error in the status line.
+bool commit(Viewer& v, Result<Scene> edited, std::string mergeKey = {}) {
+    if (!edited) {
+        v.status = edited.error().str();
+        return false;
+    }
+    v.doc.history().push(std::move(*edited), std::move(mergeKey));
+    v.doc.touch();
+    return true;
+}
+
+void undo(Viewer& v) {
+    if (v.doc.history().undo()) v.doc.touch();
+}
+void redo(Viewer& v) {
+    if (v.doc.history().redo()) v.doc.touch();
+}
+
+void save(Viewer& v, const fs::path& path) {
+    auto saved = v.doc.save(path);
+    v.status = saved ? "saved " + path.string() : saved.error().str();
+    if (saved) addRecent(v, path);
+}
+
+// ---- Rendering -------------------------------------------------------------------------------
+
+ViewKey wantedKey(Viewer& v, bool full) {
+    ViewKey k;
+    k.sceneVersion = v.sceneVersion;
+    k.camera = toCamera(v.camera);
+    k.mode = v.mode;
+    k.shadows = v.shadows;
+    k.ao = v.ao;
+    k.boxes = v.boxes;
+    k.selected = v.boxes == BoxOverlay::None ? -1 : v.selected;
+    int w = 1, h = 1;
+    glfwGetFramebufferSize(v.window, &w, &h);
+    float s = full ? 1.0f : v.scale;
+    k.width = std::max(1u, uint32_t(std::lround(float(w) * s)));
+    k.height = std::max(1u, uint32_t(std::lround(float(h) * s)));
+    k.mesh = v.meshView && v.mesh;
+    k.wireframe = k.mesh && v.wireframe;
+    return k;
+}
+
+bool moving(const Viewer& v) {
+    return now() - v.lastInteraction < 0.3;
+}
+
+void updateImage(Viewer& v) {
+    if (auto out = v.renderer->take()) {
+        auto job =
+            std::find_if(v.jobs.begin(), v.jobs.end(), [&](auto& j) { return j.first == out->id; });
+        ViewKey key = job != v.jobs.end() ? job->second : ViewKey{};
+        v.jobs.erase(v.jobs.begin(), job == v.jobs.end() ? job : job + 1);
+        v.renderError = out->error;
+        if (out->compileSeconds > 0) v.compileMs = out->compileSeconds * 1000.0;
+        if (!out->image.rgba.empty()) {
+            v.renderMs = out->renderSeconds * 1000.0;
+            bool full = key.width == wantedKey(v, true).width;
+            if (!full) // aim previews at about 80 ms
+                v.scale = previewScale(
+                    out->renderSeconds, uint64_t(key.width) * key.height,
+                    uint64_t(wantedKey(v, true).width) * wantedKey(v, true).height, 0.08);
+            setImage(*v.presenter, out->image);
+            v.last = std::move(*out);
+            // A failed compile shows the last good scene: its image is not the wanted one.
+            v.shown = key;
+            if (v.last.scene && v.last.error) v.shown.sceneVersion = ~0ull;
+            v.haveShown = true;
+        }
+    }
+    if (!v.scene) return;
+    ViewKey want = wantedKey(v, !moving(v));
+    if (want.mesh) {
+        if (!v.haveShown || !(v.shown == want)) {
+            RasterOptions o;
+            o.width = want.width;
+            o.height = want.height;
+            o.camera = want.camera;
+            o.wireframe = want.wireframe;
+            o.background = v.scene->background;
+            setImage(*v.presenter, rasterize(*v.mesh, o));
+            v.shown = want;
+            v.haveShown = true;
+            v.haveSubmitted = false;
+        }
+        return;
+    }
+    if (v.haveSubmitted && v.submitted == want) return;
+    if (v.haveShown && v.shown == want) return;
+    // While a render runs, wait: a newer job replaces the queued one anyway.
+    if (!v.renderer->idle() && v.haveSubmitted) return;
+    RenderJob job;
+    job.scene = v.scene;
+    job.sceneVersion = v.sceneVersion;
+    job.id = v.nextJob++;
+    job.options.width = want.width;
+    job.options.height = want.height;
+    job.options.camera = want.camera;
+    job.options.mode = want.mode;
+    job.options.shadows = want.shadows;
+    job.options.ambientOcclusion = want.ao;
+    job.options.boxes =
+        want.selected < 0 && want.boxes == BoxOverlay::Selected ? BoxOverlay::None : want.boxes;
+    job.options.selectedNode = want.selected;
+    v.jobs.emplace_back(job.id, want);
+    v.renderer->submit(std::move(job));
+    v.submitted = want;
+    v.haveSubmitted = true;
+}
+
+// The full-resolution image of the current state is on screen.
+bool settled(Viewer& v) {
+    return v.scene && v.haveShown && v.shown == wantedKey(v, true) && v.renderer->idle();
+}
+
+// ---- Input -----------------------------------------------------------------------------------
+
+void pick(Viewer& v, double x, double y) {
+    if (!v.last.scene || v.last.image.rgba.empty() || !v.evaluator || (v.meshView && v.mesh))
+        return;
+    int w = 1, h = 1;
+    glfwGetFramebufferSize(v.window, &w, &h);
+    int ww = 1, wh = 1;
+    glfwGetWindowSize(v.window, &ww, &wh);
+    // Window coordinates -> image pixels (the image fills the window).
+    float ix = float(x) * float(w) / float(ww) * float(v.last.image.width) / float(w);
+    float iy = float(y) * float(h) / float(wh) * float(v.last.image.height) / float(h);
+    auto p = pickPoint(*v.last.options.camera, v.last.image.width, v.last.image.height,
+                       v.last.pixels, ix, iy);
+    if (!p) {
+        v.selected = -1;
+        return;
+    }
+    Evaluator shown(*v.last.scene);
+    v.selected = nearestPrimitive(shown, *p);
+    if (v.selected >= int(v.scene->nodes.size())) v.selected = -1;
+}
+
+void handleInput(Viewer& v) {
+    ImGuiIO& io = ImGui::GetIO();
+    double x, y;
+    glfwGetCursorPos(v.window, &x, &y);
+    int ww = 1, wh = 1;
+    glfwGetWindowSize(v.window, &ww, &wh);
+    for (int b = 0; b < 3; ++b) {
+        bool down = glfwGetMouseButton(v.window, b) == GLFW_PRESS;
+        if (down && !v.pressed[b] && !io.WantCaptureMouse) {
+            v.pressed[b] = true;
+            v.pressX = v.lastX = x, v.pressY = v.lastY = y;
+            v.dragged = false;
+        } else if (!down && v.pressed[b]) {
+            v.pressed[b] = false;
+            if (b == 0 && !v.dragged) pick(v, x, y);
+        }
+    }
+    double dx = x - v.lastX, dy = y - v.lastY;
+    if (std::hypot(x - v.pressX, y - v.pressY) > 3.0) v.dragged = true;
+    bool shift = glfwGetKey(v.window, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS ||
+                 glfwGetKey(v.window, GLFW_KEY_RIGHT_SHIFT) == GLFW_PRESS;
+    if ((dx != 0 || dy != 0) && v.dragged) {
+        if (v.pressed[0] && !shift) {
+            orbit(v.camera, -float(dx) * 0.008f, float(dy) * 0.008f);
+            v.lastInteraction = now();
+        } else if (v.pressed[1] || v.pressed[2] || (v.pressed[0] && shift)) {
+            pan(v.camera, float(dx) / float(wh), float(dy) / float(wh));
+            v.lastInteraction = now();
+        }
+    }
+    v.lastX = x, v.lastY = y;
+    if (!io.WantCaptureMouse && io.MouseWheel != 0.0f) {
+        zoom(v.camera, std::pow(0.9f, io.MouseWheel));
+        v.lastInteraction = now();
+    }
+    if (io.WantCaptureKeyboard) return;
+    bool ctrl = io.KeyCtrl;
+    auto pressedKey = [&](int key) {
+        return ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey(key)));
+    };
+    (void)pressedKey;
+    auto held = [&](int key) { return glfwGetKey(v.window, key) == GLFW_PRESS; };
+    float step = float(io.DeltaTime) * 1.5f;
+    if (held(GLFW_KEY_LEFT) || held(GLFW_KEY_RIGHT) || held(GLFW_KEY_UP) || held(GLFW_KEY_DOWN)) {
+        float h = (held(GLFW_KEY_LEFT) ? 1.0f : 0.0f) - (held(GLFW_KEY_RIGHT) ? 1.0f : 0.0f);
+        float vv = (held(GLFW_KEY_UP) ? 1.0f : 0.0f) - (held(GLFW_KEY_DOWN) ? 1.0f : 0.0f);
+        if (shift)
+            pan(v.camera, -h * step * 0.3f, vv * step * 0.3f);
+        else
+            orbit(v.camera, h * step, -vv * step);
+        v.lastInteraction = now();
+    }
+    if (held(GLFW_KEY_EQUAL) || held(GLFW_KEY_KP_ADD) || held(GLFW_KEY_PAGE_UP)) {
+        zoom(v.camera, 1.0f - step * 0.5f);
+        v.lastInteraction = now();
+    }
+    if (held(GLFW_KEY_MINUS) || held(GLFW_KEY_KP_SUBTRACT) || held(GLFW_KEY_PAGE_DOWN)) {
+        zoom(v.camera, 1.0f + step * 0.5f);
+        v.lastInteraction = now();
+    }
+    auto hit = [&](int key) { return ImGui::IsKeyPressed(key, false); };
+    if (ctrl && hit(GLFW_KEY_Z)) shift ? redo(v) : undo(v);
+    if (ctrl && hit(GLFW_KEY_Y)) redo(v);
+    if (ctrl && hit(GLFW_KEY_S)) save(v, v.savePath[0] ? fs::path(v.savePath) : v.doc.path());
+    if (ctrl) return;
+    if (hit(GLFW_KEY_F)) frameSelection(v);
+    if (hit(GLFW_KEY_R)) resetCamera(v), v.lastInteraction = now();
+    if (hit(GLFW_KEY_1)) v.mode = RenderMode::Shaded;
+    if (hit(GLFW_KEY_2)) v.mode = RenderMode::Normals;
+    if (hit(GLFW_KEY_3)) v.mode = RenderMode::Depth;
+    if (hit(GLFW_KEY_4)) v.mode = RenderMode::Steps;
+    if (hit(GLFW_KEY_H)) v.showUi = !v.showUi;
+    if (hit(GLFW_KEY_G)) v.grid = !v.grid;
+    if (hit(GLFW_KEY_M) && v.mesh) v.meshView = !v.meshView;
+    if (hit(GLFW_KEY_B)) v.boxes = BoxOverlay((uint32_t(v.boxes) + 1) % 3);
+    if (hit(GLFW_KEY_ESCAPE)) v.selected = -1;
+}
+
+// ---- Overlays --------------------------------------------------------------------------------
+
+// A ground grid under the finite part of the scene, drawn over the image (not depth-tested).
+void drawGrid(Viewer& v) {
+    if (!v.grid || !v.evaluator) return;
+    Aabb box;
+    for (const FlatNode& n : v.evaluator->nodes())
+        if (!kindInfo(n.kind).operation && n.bounds.finite() && !n.bounds.empty())
+            box.min = glm::min(box.min, n.bounds.min), box.max = glm::max(box.max, n.bounds.max);
+    if (box.empty()) return;
+    float extent = std::max(box.max.x - box.min.x, box.max.z - box.min.z);
+    float spacing = std::pow(10.0f, std::floor(std::log10(std::max(extent, 1e-3f) / 2.0f)));
+    int lines = 20;
+    glm::vec3 c = 0.5f * (box.min + box.max);
+    float y = box.min.y;
+    c.x = std::round(c.x / spacing) * spacing, c.z = std::round(c.z / spacing) * spacing;
+    Camera cam = toCamera(v.camera);
+    ImVec2 size = ImGui::GetIO().DisplaySize;
+    glm::vec3 f = glm::normalize(cam.target - cam.eye);
+    glm::vec3 r = glm::normalize(glm::cross(f, cam.up));
+    glm::vec3 u = glm::cross(r, f);
+    float t = std::tan(glm::radians(cam.fov) * 0.5f), aspect = size.x / size.y;
+    auto project = [&](glm::vec3 p, ImVec2& out) {
+        glm::vec3 d = p - cam.eye;
+        float z = glm::dot(d, f);
+        if (z < 1e-3f) return false;
+        out = ImVec2((glm::dot(d, r) / (z * t * aspect) + 1.0f) * 0.5f * size.x,
+                     (1.0f - glm::dot(d, u) / (z * t)) * 0.5f * size.y);
+        return true;
+    };
+    ImDrawList* draw = ImGui::GetBackgroundDrawList();
+    float half = spacing * float(lines) / 2;
+    for (int i = 0; i <= lines; ++i) {
+        float o = -half + spacing * float(i);
+        ImU32 colour = i == lines / 2 ? IM_COL32(40, 40, 40, 160) : IM_COL32(60, 60, 60, 90);
+        // Short pieces, so lines that pass behind the eye still show their visible part.
+        for (int axis = 0; axis < 2; ++axis)
+            for (int s = 0; s < 20; ++s) {
+                float a = -half + 2 * half * float(s) / 20,
+                      b = -half + 2 * half * float(s + 1) / 20;
+                glm::vec3 p0 =
+                    axis ? glm::vec3(c.x + o, y, c.z + a) : glm::vec3(c.x + a, y, c.z + o);
+                glm::vec3 p1 =
+                    axis ? glm::vec3(c.x + o, y, c.z + b) : glm::vec3(c.x + b, y, c.z + o);
+                ImVec2 q0, q1;
+                if (project(p0, q0) && project(p1, q1)) draw->AddLine(q0, q1, colour);
+            }
+    }
+}
+
+// ---- Panels ----------------------------------------------------------------------------------
+
+void nodeTree(Viewer& v, uint32_t node) {
+    const Scene& s = *v.scene;
+    const Node& n = s.nodes[node];
+    bool operation = kindInfo(n.kind).operation;
+    ImGuiTreeNodeFlags flags = ImGuiTreeNodeFlags_OpenOnArrow | ImGuiTreeNodeFlags_DefaultOpen |
+                               ImGuiTreeNodeFlags_SpanAvailWidth;
+    if (!operation) flags |= ImGuiTreeNodeFlags_Leaf | ImGuiTreeNodeFlags_NoTreePushOnOpen;
+    if (int(node) == v.selected) flags |= ImGuiTreeNodeFlags_Selected;
+    std::string label = nodeLabel(s, node);
+    if (operation && s.nodes[node].params[0] > 0.0f)
+        label += " smooth " + std::to_string(s.nodes[node].params[0]).substr(0, 5);
+    bool open = ImGui::TreeNodeEx((void*)(uintptr_t)node, flags, "%s", label.c_str());
+    if (ImGui::IsItemClicked() && !ImGui::IsItemToggledOpen()) v.selected = int(node);
+    if (operation && open) {
+        for (uint32_t c : n.children)
+            nodeTree(v, c);
+        ImGui::TreePop();
+    }
+}
+
+void valueEditor(Viewer& v) {
+    if (v.selected < 0 || v.selected >= int(v.scene->nodes.size())) {
+        ImGui::TextDisabled("Click a node in the tree or the image to select it.");
+        return;
+    }
+    uint32_t id = uint32_t(v.selected);
+    const Node n = v.scene->nodes[id]; // a copy: edits replace the scene
+    const KindInfo& info = kindInfo(n.kind);
+    ImGui::Text("%s", nodeLabel(*v.scene, id).c_str());
+    ImGui::TextDisabled("%s", n.path.c_str());
+    auto edited = [&](const char* key, std::vector<float> values) {
+        commit(v, setValue(*v.scene, id, key, values), std::to_string(id) + key);
+    };
+    for (const ParamInfo& p : info.params) {
+        std::string name(p.name);
+        float min = p.check == Check::Positive      ? 1e-3f
+                    : p.check == Check::NonNegative ? 0.0f
+                                                    : -1e6f;
+        if (p.type == ValueType::Number) {
+            float value = n.params[p.slot];
+            if (ImGui::DragFloat(name.c_str(), &value, 0.01f, min, 1e6f, "%.3f"))
+                edited(name.c_str(), {std::max(value, min)});
+        } else {
+            float value[3] = {n.params[p.slot], n.params[p.slot + 1], n.params[p.slot + 2]};
+            if (ImGui::DragFloat3(name.c_str(), value, 0.01f, min, 1e6f, "%.3f"))
+                edited(name.c_str(),
+                       {std::max(value[0], min), std::max(value[1], min), std::max(value[2], min)});
+        }
+        if (ImGui::IsItemDeactivatedAfterEdit()) v.doc.history().endMerge();
+    }
+    glm::vec3 t = n.transform.translate, r = n.transform.rotate;
+    float s = n.transform.scale;
+    if (ImGui::DragFloat3("translate", &t.x, 0.01f)) edited("translate", {t.x, t.y, t.z});
+    if (ImGui::IsItemDeactivatedAfterEdit()) v.doc.history().endMerge();
+    if (ImGui::DragFloat3("rotate", &r.x, 0.5f)) edited("rotate", {r.x, r.y, r.z});
+    if (ImGui::IsItemDeactivatedAfterEdit()) v.doc.history().endMerge();
+    if (ImGui::DragFloat("scale", &s, 0.005f, 1e-3f, 1e3f)) edited("scale", {std::max(s, 1e-3f)});
+    if (ImGui::IsItemDeactivatedAfterEdit()) v.doc.history().endMerge();
+    bool own = n.color.has_value();
+    if (ImGui::Checkbox("own colour", &own))
+        own ? edited("color", {0.8f, 0.8f, 0.8f}) : edited("color", {});
+    if (own) {
+        glm::vec3 c = *n.color;
+        if (ImGui::ColorEdit3("color", &c.x)) edited("color", {c.x, c.y, c.z});
+        if (ImGui::IsItemDeactivatedAfterEdit()) v.doc.history().endMerge();
+    }
+
+    ImGui::Separator();
+    // Structural edits: the renderer recompiles on the worker thread.
+    if (ImGui::BeginCombo("kind", std::string(info.name).c_str())) {
+        for (const KindInfo& k : nodeKinds())
+            if (k.operation == info.operation &&
+                ImGui::Selectable(std::string(k.name).c_str(), k.kind == n.kind) &&
+                k.kind != n.kind)
+                commit(v, changeKind(*v.scene, id, k.kind));
+        ImGui::EndCombo();
+    }
+    if (info.operation) {
+        if (ImGui::BeginCombo("add child", "choose a kind")) {
+            for (const KindInfo& k : nodeKinds())
+                if (ImGui::Selectable(std::string(k.name).c_str())) {
+                    uint32_t added = 0;
+                    if (commit(v, addChild(*v.scene, id, k.kind, &added))) v.selected = int(added);
+                }
+            ImGui::EndCombo();
+        }
+    }
+    if (ImGui::Button("move up")) {
+        uint32_t moved = id;
+        if (commit(v, moveNode(*v.scene, id, -1, &moved))) v.selected = int(moved);
+    }
+    ImGui::SameLine();
+    if (ImGui::Button("move down")) {
+        uint32_t moved = id;
+        if (commit(v, moveNode(*v.scene, id, 1, &moved))) v.selected = int(moved);
+    }
+    ImGui::SameLine();
+    if (ImGui::Button("remove") && commit(v, removeNode(*v.scene, id))) v.selected = -1;
+}
+
+void fileBrowser(Viewer& v) {
+    if (!v.browserOpen) return;
+    ImGui::SetNextWindowSize(ImVec2(420, 360), ImGuiCond_FirstUseEver);
+    if (ImGui::Begin("Open scene", &v.browserOpen)) {
+        ImGui::TextWrapped("%s", v.browseDir.string().c_str());
+        if (ImGui::Selectable("..")) v.browseDir = v.browseDir.parent_path();
+        std::vector<fs::directory_entry> entries;
+        std::error_code ec;
+        for (const auto& e : fs::directory_iterator(v.browseDir, ec))
+            if (e.is_directory(ec) || e.path().extension() == ".json") entries.push_back(e);
+        std::sort(entries.begin(), entries.end(), [](auto& a, auto& b) {
+            return std::pair(!a.is_directory(), a.path()) < std::pair(!b.is_directory(), b.path());
+        });
+        for (const auto& e : entries) {
+            std::string name = e.path().filename().string() + (e.is_directory(ec) ? "/" : "");
+            if (ImGui::Selectable(name.c_str())) {
+                if (e.is_directory(ec)) {
+                    v.browseDir = e.path();
+                } else {
+                    openFile(v, e.path());
+                    v.browserOpen = false;
+                }
+            }
+        }
+    }
+    ImGui::End();
+}
+
+void meshPanel(Viewer& v) {
+    ImGui::SliderInt("resolution", &v.meshResolution, 16, 512);
+    ImGui::Checkbox("custom bounds", &v.customBounds);
+    if (v.customBounds) {
+        ImGui::DragFloat3("min", v.boundsMin, 0.01f);
+        ImGui::DragFloat3("max", v.boundsMax, 0.01f);
+    }
+    if (v.mesher->running()) {
+        ImGui::ProgressBar(v.mesher->progress());
+        if (ImGui::Button("cancel")) v.mesher->cancel();
+    } else if (ImGui::Button("extract mesh") && v.scene) {
+        MeshOptions o;
+        o.resolution = uint32_t(v.meshResolution);
+        if (v.customBounds)
+            o.bounds = Aabb{glm::vec3(v.boundsMin[0], v.boundsMin[1], v.boundsMin[2]),
+                            glm::vec3(v.boundsMax[0], v.boundsMax[1], v.boundsMax[2])};
+        v.mesher->start(v.scene, o);
+        v.meshMessage = "extracting...";
+    }
+    if (auto done = v.mesher->take()) {
+        if (*done) {
+            v.mesh = std::move(**done);
+            v.meshStats = v.mesher->stats();
+            char text[160];
+            std::snprintf(text, sizeof text, "%zu vertices, %zu triangles, %.2f s%s",
+                          v.mesh->vertexCount(), v.mesh->triangleCount(), v.meshStats.totalSeconds,
+                          v.meshStats.surfaceCut ? " (cut by bounds)" : "");
+            v.meshMessage = text;
+            v.meshView = true;
+        } else {
+            v.meshMessage = done->error().str();
+        }
+    }
+    if (!v.meshMessage.empty()) ImGui::TextWrapped("%s", v.meshMessage.c_str());
+    if (!v.mesh) return;
+    ImGui::Checkbox("show mesh (M)", &v.meshView);
+    ImGui::SameLine();
+    ImGui::Checkbox("wireframe", &v.wireframe);
+    ImGui::InputText("file", v.exportPath, sizeof v.exportPath);
+    ImGui::SameLine();
+    if (ImGui::Button("export")) {
+        auto format = meshFormatFromPath(v.exportPath);
+        if (!format) {
+            v.meshMessage = std::string(v.exportPath) +
+                            ": the extension names no mesh format (.ply, .obj, .stl, .glb)";
+        } else {
+            auto written = writeMesh(*v.mesh, v.exportPath, *format);
+            v.meshMessage = written ? "wrote " + std::string(v.exportPath) : written.error().str();
+        }
+    }
+}
+
+void panels(Viewer& v) {
+    ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(340, 0), ImGuiCond_FirstUseEver);
+    ImGui::Begin("sdfcsg");
+    if (ImGui::CollapsingHeader("File", ImGuiTreeNodeFlags_DefaultOpen)) {
+        ImGui::InputText("##open", v.openPath, sizeof v.openPath);
+        ImGui::SameLine();
+        if (ImGui::Button("open") && v.openPath[0]) openFile(v, v.openPath);
+        ImGui::SameLine();
+        if (ImGui::Button("browse")) v.browserOpen = true;
+        if (!v.recent.empty() && ImGui::BeginCombo("recent", v.recent[0].c_str())) {
+            for (const std::string& r : std::vector<std::string>(v.recent))
+                if (ImGui::Selectable(r.c_str())) openFile(v, r);
+            ImGui::EndCombo();
+        }
+        ImGui::InputText("##save", v.savePath, sizeof v.savePath);
+        ImGui::SameLine();
+        if (ImGui::Button("save") && v.savePath[0]) save(v, v.savePath);
+        ImGui::BeginDisabled(!v.doc.history().canUndo());
+        if (ImGui::Button("undo")) undo(v);
+        ImGui::EndDisabled();
+        ImGui::SameLine();
+        ImGui::BeginDisabled(!v.doc.history().canRedo());
+        if (ImGui::Button("redo")) redo(v);
+        ImGui::EndDisabled();
+    }
+    // Load errors (the file) and compile errors (the edited scene) both keep the last good
+    // scene on screen.
+    const std::optional<Error>* errors[] = {&v.doc.error(), &v.renderError};
+    for (const std::optional<Error>* e : errors) {
+        if (!*e) continue;
+        ImGui::PushStyleColor(ImGuiCol_Text, IM_COL32(255, 110, 110, 255));
+        ImGui::TextWrapped("%s", (*e)->str().c_str());
+        ImGui::PopStyleColor();
+        if (v.scene) ImGui::TextDisabled("showing the last scene that worked");
+    }
+    if (!v.status.empty()) ImGui::TextWrapped("%s", v.status.c_str());
+    if (ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen)) {
+        int mode = int(v.mode);
+        ImGui::RadioButton("shaded", &mode, 0);
+        ImGui::SameLine();
+        ImGui::RadioButton("normals", &mode, 1);
+        ImGui::SameLine();
+        ImGui::RadioButton("depth", &mode, 2);
+        ImGui::SameLine();
+        ImGui::RadioButton("steps", &mode, 3);
+        v.mode = RenderMode(mode);
+        ImGui::Checkbox("shadows", &v.shadows);
+        ImGui::SameLine();
+        ImGui::Checkbox("AO", &v.ao);
+        ImGui::SameLine();
+        ImGui::Checkbox("grid", &v.grid);
+        int boxes = int(v.boxes);
+        ImGui::Combo("boxes", &boxes, "none\0all\0selected\0");
+        v.boxes = BoxOverlay(boxes);
+        if (ImGui::Button("frame (F)")) frameSelection(v);
+        ImGui::SameLine();
+        if (ImGui::Button("reset (R)")) resetCamera(v), v.lastInteraction = now();
+        ImGui::InputText("##shot", v.shotPath, sizeof v.shotPath);
+        ImGui::SameLine();
+        if (ImGui::Button("screenshot")) v.pendingShot = v.shotPath;
+        ImGui::Text("render %.0f ms at %u x %u%s", v.renderMs, v.last.image.width,
+                    v.last.image.height,
+                    v.haveShown && v.shown.width < wantedKey(v, true).width ? " (preview)" : "");
+        if (v.compileMs > 0) ImGui::Text("last compile %.0f ms", v.compileMs);
+        ImGui::Text("UI %.1f ms/frame", 1000.0f / std::max(ImGui::GetIO().Framerate, 1.0f));
+        ImGui::TextDisabled("%s", v.context->deviceName().c_str());
+    }
+    if (v.scene && ImGui::CollapsingHeader("Scene", ImGuiTreeNodeFlags_DefaultOpen)) {
+        ImGui::BeginChild("tree", ImVec2(0, 220), true);
+        nodeTree(v, 0);
+        ImGui::EndChild();
+    }
+    if (v.scene && ImGui::CollapsingHeader("Node", ImGuiTreeNodeFlags_DefaultOpen)) valueEditor(v);
+    if (v.scene && ImGui::CollapsingHeader("Mesh")) meshPanel(v);
+    ImGui::End();
+    fileBrowser(v);
+}
+
+// ---- Automation ------------------------------------------------------------------------------
+
+// Runs commands until one has to wait for an image. False when a command failed.
+bool runScript(Viewer& v) {
+    while (!v.script.empty() && v.pendingShot.empty()) {
+        Command c = v.script.front();
+        v.script.pop_front();
+        std::string where = v.scriptFile + ":" + std::to_string(c.line) + ": ";
+        auto fail = [&](const std::string& message) {
+            std::fprintf(stderr, "%s%s\n", where.c_str(), message.c_str());
+            v.exitCode = 1;
+            return false;
+        };
+        syncScene(v);
+        if (!v.scene) return fail("no scene loaded");
+        const std::string arg = c.args.empty() ? "" : c.args[0];
+        if (c.verb == "select") {
+            if (arg == "none") {
+                v.selected = -1;
+            } else if (auto n = findNode(*v.scene, arg)) {
+                v.selected = int(*n);
+            } else {
+                return fail("no node named \"" + arg + "\"");
+            }
+        } else if (c.verb == "set") {
+            if (v.selected < 0) return fail("set: no node selected");
+            auto edited = setValue(*v.scene, uint32_t(v.selected), arg, c.numbers);
+            if (!edited) return fail(edited.error().str());
+            commit(v, std::move(edited));
+        } else if (c.verb == "mode") {
+            v.mode = *parseRenderMode(arg);
+        } else if (c.verb == "shadows") {
+            v.shadows = arg == "on";
+        } else if (c.verb == "ao") {
+            v.ao = arg == "on";
+        } else if (c.verb == "grid") {
+            v.grid = arg == "on";
+        } else if (c.verb == "boxes") {
+            v.boxes = arg == "none"  ? BoxOverlay::None
+                      : arg == "all" ? BoxOverlay::All
+                                     : BoxOverlay::Selected;
+        } else if (c.verb == "orbit") {
+            orbit(v.camera, glm::radians(c.numbers[0]), glm::radians(c.numbers[1]));
+        } else if (c.verb == "zoom") {
+            zoom(v.camera, c.numbers[0]);
+        } else if (c.verb == "frame") {
+            frameSelection(v);
+            v.lastInteraction = -1.0;
+        } else if (c.verb == "reset") {
+            resetCamera(v);
+        } else if (c.verb == "undo") {
+            undo(v);
+        } else if (c.verb == "redo") {
+            redo(v);
+        } else if (c.verb == "save") {
+            auto saved = v.doc.save(arg);
+            if (!saved) return fail(saved.error().str());
+        } else if (c.verb == "screenshot") {
+            v.pendingShot = arg;
+            v.waitStart = now();
+        }
+        syncScene(v);
+    }
+    return true;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    Args args;
+    std::string error;
+    if (!parseArgs(argc, argv, args, error)) {
+        std::fprintf(stderr, "sdfcsg-viewer: %s\n%s", error.c_str(), kUsage);
+        return 2;
+    }
+    Viewer v;
+    if (!args.script.empty()) {
+        std::ifstream in(args.script, std::ios::binary);
+        if (!in) {
+            std::fprintf(stderr, "%s: cannot read the file\n", args.script.string().c_str());
+            return 3;
+        }
+        std::stringstream text;
+        text << in.rdbuf();
+        auto parsed = parseScript(text.str(), args.script.string());
+        if (!parsed) {
+            std::fprintf(stderr, "%s\n", parsed.error().str().c_str());
+            return 2;
+        }
+        v.script.assign(parsed->begin(), parsed->end());
+        v.scriptFile = args.script.string();
+    }
+    v.showUi = !args.noUi;
+
+    auto context = Context::create();
+    if (!context) {
+        std::fprintf(stderr, "%s\n", context.error().str().c_str());
+        return 4;
+    }
+    v.context = std::move(*context);
+    v.renderer = std::make_unique<RenderWorker>(*v.context);
+    v.mesher = std::make_unique<MeshWorker>(*v.context);
+
+    if (!args.scene.empty()) {
+        openFile(v, args.scene);
+        if (!v.doc.loaded() && (!args.screenshot.empty() || !args.script.empty())) {
+            std::fprintf(stderr, "%s\n", v.doc.error()->str().c_str());
+            return 1;
+        }
+    }
+
+    glfwSetErrorCallback([](int code, const char* text) {
+        std::fprintf(stderr, "GLFW error %d: %s\n", code, text);
+    });
+    if (!glfwInit()) {
+        std::fprintf(stderr, "sdfcsg-viewer: cannot open a window (no display?)\n");
+        return 4;
+    }
+    glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
+    std::string title = "sdfcsg-viewer" + (args.scene.empty() ? "" : " - " + args.scene.string());
+    v.window = glfwCreateWindow(args.width, args.height, title.c_str(), nullptr, nullptr);
+    if (!v.window || !glfwVulkanSupported()) {
+        std::fprintf(stderr, "sdfcsg-viewer: cannot create a Vulkan window\n");
+        return 4;
+    }
+    IMGUI_CHECKVERSION();
+    ImGui::CreateContext();
+    ImGui::GetIO().IniFilename = nullptr; // the same layout every run, no file beside the scene
+    ImGui::StyleColorsDark();
+    ImGui_ImplGlfw_InitForVulkan(v.window, true);
+    v.presenter = createPresenter(v.window, error);
+    if (!v.presenter) {
+        std::fprintf(stderr, "sdfcsg-viewer: %s\n", error.c_str());
+        return 4;
+    }
+
+    v.framesLeft = args.frames;
+    if (!args.screenshot.empty()) {
+        v.pendingShot = args.screenshot;
+        v.exitAfterShot = true;
+        v.waitStart = now();
+    }
+    bool automated = !args.screenshot.empty() || !args.script.empty();
+    double lastPoll = 0;
+    while (!glfwWindowShouldClose(v.window)) {
+        // Automated runs never sleep; interactive ones wait for input while nothing is pending.
+        if (automated || !v.renderer->idle() || v.mesher->running() || moving(v))
+            glfwPollEvents();
+        else
+            glfwWaitEventsTimeout(0.1);
+        if (now() - lastPoll > 0.25) { // live reload
+            lastPoll = now();
+            if (v.doc.pollReload())
+                v.status = v.doc.error() ? "reload failed" : "reloaded " + v.doc.path().string();
+        }
+        syncScene(v);
+        if (!runScript(v)) break;
+
+        ImGui_ImplVulkan_NewFrame();
+        ImGui_ImplGlfw_NewFrame();
+        ImGui::NewFrame();
+        handleInput(v);
+        syncScene(v);
+        if (v.showUi)
+            panels(v);
+        else if (v.mesher->running())
+            v.mesher->take(); // keep the panel's state simple
+        drawGrid(v);
+        ImGui::Render();
+        syncScene(v);
+        updateImage(v);
+
+        Image capture;
+        // One settled frame more, so the panels show the numbers of the image they sit on.
+        v.settledFrames = settled(v) ? v.settledFrames + 1 : 0;
+        bool shoot = !v.pendingShot.empty() && v.settledFrames >= 2 && v.framesLeft <= 1;
+        float bg[3] = {0.1f, 0.1f, 0.1f};
+        if (v.scene)
+            bg[0] = v.scene->background.r, bg[1] = v.scene->background.g,
+            bg[2] = v.scene->background.b;
+        bool drawn = drawFrame(*v.presenter, ImGui::GetDrawData(), bg, shoot ? &capture : nullptr);
+        if (drawn && v.framesLeft > 0) --v.framesLeft;
+        if (shoot && drawn) {
+            if (capture.rgba.empty()) {
+                // This surface cannot be read back: the scene image alone is the next best.
+                capture = v.last.image;
+            }
+            auto written = writePng(capture, v.pendingShot);
+            if (!written) {
+                std::fprintf(stderr, "%s\n", written.error().str().c_str());
+                v.exitCode = 3;
+                break;
+            }
+            std::printf("wrote %s (%u x %u)\n", v.pendingShot.string().c_str(), capture.width,
+                        capture.height);
+            v.pendingShot.clear();
+            if (v.exitAfterShot) break;
+        }
+        if (!v.pendingShot.empty() && automated && now() - v.waitStart > 300.0) {
+            std::fprintf(stderr, "sdfcsg-viewer: no image after 300 s\n");
+            v.exitCode = 1;
+            break;
+        }
+        if (!args.script.empty() && v.script.empty() && v.pendingShot.empty() && !v.exitAfterShot)
+            break;
+    }
+    if (automated && v.renderError && v.exitCode == 0) {
+        std::fprintf(stderr, "%s\n", v.renderError->str().c_str());
+        v.exitCode = 1;
+    }
+    v.renderer.reset();
+    v.mesher.reset();
+    v.presenter.reset();
+    ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+    glfwDestroyWindow(v.window);
+    glfwTerminate();
+    return v.exitCode;
+}

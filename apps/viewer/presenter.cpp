@@ -1,0 +1,583 @@
+#include "presenter.h"
+
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <imgui_impl_vulkan.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <vector>
+
+namespace sdfcsg::viewer {
+
+namespace {
+
+// As in the engine: a failing Vulkan call here is a bug or a lost device, not a user error.
+void check(VkResult result, const char* call, int line) {
+    if (result == VK_SUCCESS) return;
+    std::fprintf(stderr, "%s:%d: %s failed: VkResult %d\n", __FILE__, line, call, int(result));
+    std::abort();
+}
+#define VK_CHECK(call) check((call), #call, __LINE__)
+
+void imguiCheck(VkResult result) {
+    check(result, "ImGui Vulkan backend", __LINE__);
+}
+
+struct Buffer {
+    VkBuffer buffer = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    void* mapped = nullptr;
+    VkDeviceSize size = 0;
+};
+
+} // namespace
+
+struct Presenter {
+    GLFWwindow* window = nullptr;
+    VkInstance instance = VK_NULL_HANDLE;
+    VkPhysicalDevice physical = VK_NULL_HANDLE;
+    VkPhysicalDeviceMemoryProperties memoryProperties{};
+    std::string deviceName;
+    uint32_t family = 0;
+    VkDevice device = VK_NULL_HANDLE;
+    VkQueue queue = VK_NULL_HANDLE;
+    VkSurfaceKHR surface = VK_NULL_HANDLE;
+    VkSurfaceFormatKHR format{};
+    VkRenderPass renderPass = VK_NULL_HANDLE;
+    VkDescriptorPool descriptorPool = VK_NULL_HANDLE;
+    VkCommandPool commandPool = VK_NULL_HANDLE;
+    VkCommandBuffer cmd = VK_NULL_HANDLE;
+    VkFence fence = VK_NULL_HANDLE;
+    VkSemaphore acquired = VK_NULL_HANDLE, rendered = VK_NULL_HANDLE;
+
+    VkSwapchainKHR swapchain = VK_NULL_HANDLE;
+    VkExtent2D extent{};
+    bool canCapture = false; // swapchain images allow TRANSFER_SRC
+    std::vector<VkImage> images;
+    std::vector<VkImageView> views;
+    std::vector<VkFramebuffer> framebuffers;
+    bool rebuild = true;
+
+    // The engine's image: host staging buffer, device image it is copied into.
+    Buffer staging;
+    VkImage sceneImage = VK_NULL_HANDLE;
+    VkDeviceMemory sceneMemory = VK_NULL_HANDLE;
+    uint32_t sceneWidth = 0, sceneHeight = 0;
+    bool sceneDirty = false;
+    bool hasScene = false;
+    Buffer readback;
+};
+
+namespace {
+
+uint32_t memoryType(const Presenter& p, uint32_t bits, VkMemoryPropertyFlags flags) {
+    for (uint32_t i = 0; i < p.memoryProperties.memoryTypeCount; ++i)
+        if ((bits & (1u << i)) &&
+            (p.memoryProperties.memoryTypes[i].propertyFlags & flags) == flags)
+            return i;
+    std::fprintf(stderr, "presenter: no suitable memory type\n");
+    std::abort();
+}
+
+void destroyBuffer(Presenter& p, Buffer& b) {
+    if (b.buffer) vkDestroyBuffer(p.device, b.buffer, nullptr);
+    if (b.memory) vkFreeMemory(p.device, b.memory, nullptr);
+    b = {};
+}
+
+// Host-visible, coherent, persistently mapped.
+void ensureBuffer(Presenter& p, Buffer& b, VkDeviceSize size, VkBufferUsageFlags usage) {
+    if (b.size >= size) return;
+    destroyBuffer(p, b);
+    VkBufferCreateInfo info = {VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+    info.size = size;
+    info.usage = usage;
+    VK_CHECK(vkCreateBuffer(p.device, &info, nullptr, &b.buffer));
+    VkMemoryRequirements req;
+    vkGetBufferMemoryRequirements(p.device, b.buffer, &req);
+    VkMemoryAllocateInfo alloc = {VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    alloc.allocationSize = req.size;
+    alloc.memoryTypeIndex =
+        memoryType(p, req.memoryTypeBits,
+                   VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+    VK_CHECK(vkAllocateMemory(p.device, &alloc, nullptr, &b.memory));
+    VK_CHECK(vkBindBufferMemory(p.device, b.buffer, b.memory, 0));
+    VK_CHECK(vkMapMemory(p.device, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped));
+    b.size = size;
+}
+
+void destroySceneImage(Presenter& p) {
+    if (p.sceneImage) vkDestroyImage(p.device, p.sceneImage, nullptr);
+    if (p.sceneMemory) vkFreeMemory(p.device, p.sceneMemory, nullptr);
+    p.sceneImage = VK_NULL_HANDLE;
+    p.sceneMemory = VK_NULL_HANDLE;
+}
+
+void createSceneImage(Presenter& p, uint32_t width, uint32_t height) {
+    destroySceneImage(p);
+    VkImageCreateInfo info = {VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+    info.imageType = VK_IMAGE_TYPE_2D;
+    info.format = VK_FORMAT_R8G8B8A8_UNORM; // the bytes as the engine wrote them, no conversion
+    info.extent = {width, height, 1};
+    info.mipLevels = 1;
+    info.arrayLayers = 1;
+    info.samples = VK_SAMPLE_COUNT_1_BIT;
+    info.tiling = VK_IMAGE_TILING_OPTIMAL;
+    info.usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    VK_CHECK(vkCreateImage(p.device, &info, nullptr, &p.sceneImage));
+    VkMemoryRequirements req;
+    vkGetImageMemoryRequirements(p.device, p.sceneImage, &req);
+    VkMemoryAllocateInfo alloc = {VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    alloc.allocationSize = req.size;
+    alloc.memoryTypeIndex = memoryType(p, req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    VK_CHECK(vkAllocateMemory(p.device, &alloc, nullptr, &p.sceneMemory));
+    VK_CHECK(vkBindImageMemory(p.device, p.sceneImage, p.sceneMemory, 0));
+    p.sceneWidth = width;
+    p.sceneHeight = height;
+}
+
+void destroySwapchainViews(Presenter& p) {
+    for (VkFramebuffer f : p.framebuffers)
+        vkDestroyFramebuffer(p.device, f, nullptr);
+    for (VkImageView v : p.views)
+        vkDestroyImageView(p.device, v, nullptr);
+    p.framebuffers.clear();
+    p.views.clear();
+    p.images.clear();
+}
+
+bool createSwapchain(Presenter& p) {
+    int w = 0, h = 0;
+    glfwGetFramebufferSize(p.window, &w, &h);
+    if (w <= 0 || h <= 0) return false;
+    VK_CHECK(vkDeviceWaitIdle(p.device));
+    VkSurfaceCapabilitiesKHR caps;
+    VK_CHECK(vkGetPhysicalDeviceSurfaceCapabilitiesKHR(p.physical, p.surface, &caps));
+    VkExtent2D extent = caps.currentExtent;
+    if (extent.width == UINT32_MAX) {
+        extent.width =
+            std::clamp(uint32_t(w), caps.minImageExtent.width, caps.maxImageExtent.width);
+        extent.height =
+            std::clamp(uint32_t(h), caps.minImageExtent.height, caps.maxImageExtent.height);
+    }
+    if (extent.width == 0 || extent.height == 0) return false;
+    p.canCapture = caps.supportedUsageFlags & VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    VkSwapchainCreateInfoKHR info = {VK_STRUCTURE_TYPE_SWAPCHAIN_CREATE_INFO_KHR};
+    info.surface = p.surface;
+    info.minImageCount = std::max(2u, caps.minImageCount);
+    if (caps.maxImageCount) info.minImageCount = std::min(info.minImageCount, caps.maxImageCount);
+    info.imageFormat = p.format.format;
+    info.imageColorSpace = p.format.colorSpace;
+    info.imageExtent = extent;
+    info.imageArrayLayers = 1;
+    info.imageUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
+                      (p.canCapture ? VK_IMAGE_USAGE_TRANSFER_SRC_BIT : 0);
+    info.imageSharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    info.preTransform = caps.currentTransform;
+    info.compositeAlpha = (caps.supportedCompositeAlpha & VK_COMPOSITE_ALPHA_OPAQUE_BIT_KHR)
+                              ? VK_COMPOSITE_ALPHA_OPAQUE_BIT_KHR
+                              : VkCompositeAlphaFlagBitsKHR(caps.supportedCompositeAlpha &
+                                                            -caps.supportedCompositeAlpha);
+    info.presentMode = VK_PRESENT_MODE_FIFO_KHR; // always available
+    info.clipped = VK_TRUE;
+    info.oldSwapchain = p.swapchain;
+    VkSwapchainKHR swapchain;
+    VK_CHECK(vkCreateSwapchainKHR(p.device, &info, nullptr, &swapchain));
+    destroySwapchainViews(p);
+    if (p.swapchain) vkDestroySwapchainKHR(p.device, p.swapchain, nullptr);
+    p.swapchain = swapchain;
+    p.extent = extent;
+    uint32_t count = 0;
+    VK_CHECK(vkGetSwapchainImagesKHR(p.device, swapchain, &count, nullptr));
+    p.images.resize(count);
+    VK_CHECK(vkGetSwapchainImagesKHR(p.device, swapchain, &count, p.images.data()));
+    for (VkImage image : p.images) {
+        VkImageViewCreateInfo view = {VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+        view.image = image;
+        view.viewType = VK_IMAGE_VIEW_TYPE_2D;
+        view.format = p.format.format;
+        view.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+        VkImageView v;
+        VK_CHECK(vkCreateImageView(p.device, &view, nullptr, &v));
+        p.views.push_back(v);
+        VkFramebufferCreateInfo fb = {VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
+        fb.renderPass = p.renderPass;
+        fb.attachmentCount = 1;
+        fb.pAttachments = &v;
+        fb.width = extent.width;
+        fb.height = extent.height;
+        fb.layers = 1;
+        VkFramebuffer f;
+        VK_CHECK(vkCreateFramebuffer(p.device, &fb, nullptr, &f));
+        p.framebuffers.push_back(f);
+    }
+    ImGui_ImplVulkan_SetMinImageCount(info.minImageCount);
+    p.rebuild = false;
+    return true;
+}
+
+void barrier(VkCommandBuffer cmd, VkImage image, VkImageLayout from, VkImageLayout to,
+             VkAccessFlags srcAccess, VkAccessFlags dstAccess, VkPipelineStageFlags srcStage,
+             VkPipelineStageFlags dstStage) {
+    VkImageMemoryBarrier b = {VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+    b.srcAccessMask = srcAccess;
+    b.dstAccessMask = dstAccess;
+    b.oldLayout = from;
+    b.newLayout = to;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = image;
+    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 0, nullptr, 0, nullptr, 1, &b);
+}
+
+} // namespace
+
+PresenterPtr createPresenter(GLFWwindow* window, std::string& error) {
+    PresenterPtr p(new Presenter);
+    p->window = window;
+    uint32_t extensionCount = 0;
+    const char** extensions = glfwGetRequiredInstanceExtensions(&extensionCount);
+    if (!extensions) {
+        error = "GLFW found no Vulkan window-system support";
+        return nullptr;
+    }
+    VkApplicationInfo app = {VK_STRUCTURE_TYPE_APPLICATION_INFO};
+    app.pApplicationName = "sdfcsg-viewer";
+    app.apiVersion = VK_API_VERSION_1_1;
+    VkInstanceCreateInfo instanceInfo = {VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+    instanceInfo.pApplicationInfo = &app;
+    instanceInfo.enabledExtensionCount = extensionCount;
+    instanceInfo.ppEnabledExtensionNames = extensions;
+    if (vkCreateInstance(&instanceInfo, nullptr, &p->instance) != VK_SUCCESS) {
+        error = "could not create a Vulkan instance with window-system extensions";
+        return nullptr;
+    }
+    if (glfwCreateWindowSurface(p->instance, window, nullptr, &p->surface) != VK_SUCCESS) {
+        error = "could not create a Vulkan surface for the window";
+        return nullptr;
+    }
+    // Any device that can draw to this window; a discrete GPU first.
+    uint32_t count = 0;
+    vkEnumeratePhysicalDevices(p->instance, &count, nullptr);
+    std::vector<VkPhysicalDevice> devices(count);
+    vkEnumeratePhysicalDevices(p->instance, &count, devices.data());
+    int bestScore = -1;
+    for (VkPhysicalDevice d : devices) {
+        uint32_t families = 0;
+        vkGetPhysicalDeviceQueueFamilyProperties(d, &families, nullptr);
+        std::vector<VkQueueFamilyProperties> props(families);
+        vkGetPhysicalDeviceQueueFamilyProperties(d, &families, props.data());
+        for (uint32_t f = 0; f < families; ++f) {
+            VkBool32 present = VK_FALSE;
+            vkGetPhysicalDeviceSurfaceSupportKHR(d, f, p->surface, &present);
+            if (!(props[f].queueFlags & VK_QUEUE_GRAPHICS_BIT) || !present) continue;
+            VkPhysicalDeviceProperties dp;
+            vkGetPhysicalDeviceProperties(d, &dp);
+            int score = dp.deviceType == VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU     ? 3
+                        : dp.deviceType == VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU ? 2
+                                                                                  : 1;
+            if (score > bestScore) {
+                bestScore = score;
+                p->physical = d;
+                p->family = f;
+                p->deviceName = dp.deviceName;
+            }
+            break;
+        }
+    }
+    if (!p->physical) {
+        error = "no Vulkan device can present to this window";
+        return nullptr;
+    }
+    vkGetPhysicalDeviceMemoryProperties(p->physical, &p->memoryProperties);
+    float priority = 1.0f;
+    VkDeviceQueueCreateInfo queueInfo = {VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+    queueInfo.queueFamilyIndex = p->family;
+    queueInfo.queueCount = 1;
+    queueInfo.pQueuePriorities = &priority;
+    const char* deviceExtensions[] = {VK_KHR_SWAPCHAIN_EXTENSION_NAME};
+    VkDeviceCreateInfo deviceInfo = {VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+    deviceInfo.queueCreateInfoCount = 1;
+    deviceInfo.pQueueCreateInfos = &queueInfo;
+    deviceInfo.enabledExtensionCount = 1;
+    deviceInfo.ppEnabledExtensionNames = deviceExtensions;
+    VK_CHECK(vkCreateDevice(p->physical, &deviceInfo, nullptr, &p->device));
+    vkGetDeviceQueue(p->device, p->family, 0, &p->queue);
+
+    // A UNORM format, so the engine's bytes reach the screen (and screenshots) unchanged.
+    uint32_t formatCount = 0;
+    vkGetPhysicalDeviceSurfaceFormatsKHR(p->physical, p->surface, &formatCount, nullptr);
+    std::vector<VkSurfaceFormatKHR> formats(formatCount);
+    vkGetPhysicalDeviceSurfaceFormatsKHR(p->physical, p->surface, &formatCount, formats.data());
+    p->format = formats.empty() ? VkSurfaceFormatKHR{VK_FORMAT_B8G8R8A8_UNORM,
+                                                     VK_COLOR_SPACE_SRGB_NONLINEAR_KHR}
+                                : formats[0];
+    for (const VkSurfaceFormatKHR& f : formats)
+        if (f.format == VK_FORMAT_B8G8R8A8_UNORM || f.format == VK_FORMAT_R8G8B8A8_UNORM) {
+            p->format = f;
+            break;
+        }
+
+    // ImGui draws over the blitted image: load, not clear.
+    VkAttachmentDescription attachment = {};
+    attachment.format = p->format.format;
+    attachment.samples = VK_SAMPLE_COUNT_1_BIT;
+    attachment.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
+    attachment.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    attachment.stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE;
+    attachment.stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+    attachment.initialLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+    attachment.finalLayout = VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
+    VkAttachmentReference ref = {0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL};
+    VkSubpassDescription subpass = {};
+    subpass.pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
+    subpass.colorAttachmentCount = 1;
+    subpass.pColorAttachments = &ref;
+    VkSubpassDependency dependency = {};
+    dependency.srcSubpass = VK_SUBPASS_EXTERNAL;
+    dependency.dstSubpass = 0;
+    dependency.srcStageMask =
+        VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
+    dependency.dstStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
+    dependency.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    dependency.dstAccessMask =
+        VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT;
+    VkRenderPassCreateInfo passInfo = {VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO};
+    passInfo.attachmentCount = 1;
+    passInfo.pAttachments = &attachment;
+    passInfo.subpassCount = 1;
+    passInfo.pSubpasses = &subpass;
+    passInfo.dependencyCount = 1;
+    passInfo.pDependencies = &dependency;
+    VK_CHECK(vkCreateRenderPass(p->device, &passInfo, nullptr, &p->renderPass));
+
+    VkDescriptorPoolSize poolSize = {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 16};
+    VkDescriptorPoolCreateInfo poolInfo = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+    poolInfo.flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT;
+    poolInfo.maxSets = 16;
+    poolInfo.poolSizeCount = 1;
+    poolInfo.pPoolSizes = &poolSize;
+    VK_CHECK(vkCreateDescriptorPool(p->device, &poolInfo, nullptr, &p->descriptorPool));
+
+    VkCommandPoolCreateInfo cmdPool = {VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    cmdPool.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    cmdPool.queueFamilyIndex = p->family;
+    VK_CHECK(vkCreateCommandPool(p->device, &cmdPool, nullptr, &p->commandPool));
+    VkCommandBufferAllocateInfo cmdInfo = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    cmdInfo.commandPool = p->commandPool;
+    cmdInfo.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    cmdInfo.commandBufferCount = 1;
+    VK_CHECK(vkAllocateCommandBuffers(p->device, &cmdInfo, &p->cmd));
+    VkFenceCreateInfo fenceInfo = {VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    VK_CHECK(vkCreateFence(p->device, &fenceInfo, nullptr, &p->fence));
+    VkSemaphoreCreateInfo semInfo = {VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
+    VK_CHECK(vkCreateSemaphore(p->device, &semInfo, nullptr, &p->acquired));
+    VK_CHECK(vkCreateSemaphore(p->device, &semInfo, nullptr, &p->rendered));
+
+    VkSurfaceCapabilitiesKHR caps;
+    VK_CHECK(vkGetPhysicalDeviceSurfaceCapabilitiesKHR(p->physical, p->surface, &caps));
+    ImGui_ImplVulkan_InitInfo init = {};
+    init.Instance = p->instance;
+    init.PhysicalDevice = p->physical;
+    init.Device = p->device;
+    init.QueueFamily = p->family;
+    init.Queue = p->queue;
+    init.DescriptorPool = p->descriptorPool;
+    init.MinImageCount = std::max(2u, caps.minImageCount);
+    init.ImageCount = std::max(init.MinImageCount, 3u);
+    init.MSAASamples = VK_SAMPLE_COUNT_1_BIT;
+    init.CheckVkResultFn = imguiCheck;
+    ImGui_ImplVulkan_Init(&init, p->renderPass);
+
+    // Fonts, once.
+    VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    VK_CHECK(vkBeginCommandBuffer(p->cmd, &begin));
+    ImGui_ImplVulkan_CreateFontsTexture(p->cmd);
+    VK_CHECK(vkEndCommandBuffer(p->cmd));
+    VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    submit.commandBufferCount = 1;
+    submit.pCommandBuffers = &p->cmd;
+    VK_CHECK(vkQueueSubmit(p->queue, 1, &submit, VK_NULL_HANDLE));
+    VK_CHECK(vkDeviceWaitIdle(p->device));
+    ImGui_ImplVulkan_DestroyFontUploadObjects();
+    return p;
+}
+
+void destroyPresenter(Presenter* p) {
+    if (!p) return;
+    if (p->device) {
+        vkDeviceWaitIdle(p->device);
+        if (p->renderPass) ImGui_ImplVulkan_Shutdown();
+        destroyBuffer(*p, p->staging);
+        destroyBuffer(*p, p->readback);
+        destroySceneImage(*p);
+        destroySwapchainViews(*p);
+        if (p->swapchain) vkDestroySwapchainKHR(p->device, p->swapchain, nullptr);
+        vkDestroySemaphore(p->device, p->acquired, nullptr);
+        vkDestroySemaphore(p->device, p->rendered, nullptr);
+        vkDestroyFence(p->device, p->fence, nullptr);
+        vkDestroyCommandPool(p->device, p->commandPool, nullptr);
+        vkDestroyDescriptorPool(p->device, p->descriptorPool, nullptr);
+        vkDestroyRenderPass(p->device, p->renderPass, nullptr);
+        vkDestroyDevice(p->device, nullptr);
+    }
+    if (p->surface) vkDestroySurfaceKHR(p->instance, p->surface, nullptr);
+    if (p->instance) vkDestroyInstance(p->instance, nullptr);
+    delete p;
+}
+
+void setImage(Presenter& p, const Image& image) {
+    if (image.width == 0 || image.height == 0) return;
+    ensureBuffer(p, p.staging, image.rgba.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    // The previous frame has finished (drawFrame waits), so the buffer is free to overwrite.
+    std::memcpy(p.staging.mapped, image.rgba.data(), image.rgba.size());
+    if (image.width != p.sceneWidth || image.height != p.sceneHeight)
+        createSceneImage(p, image.width, image.height);
+    p.sceneDirty = true;
+    p.hasScene = true;
+}
+
+bool drawFrame(Presenter& p, ImDrawData* ui, const float background[3], Image* capture) {
+    if (p.rebuild && !createSwapchain(p)) return false;
+    uint32_t index = 0;
+    VkResult acquired = vkAcquireNextImageKHR(p.device, p.swapchain, UINT64_MAX, p.acquired,
+                                              VK_NULL_HANDLE, &index);
+    if (acquired == VK_ERROR_OUT_OF_DATE_KHR) {
+        p.rebuild = true;
+        return false;
+    }
+    if (acquired != VK_SUBOPTIMAL_KHR) VK_CHECK(acquired);
+    VkImage target = p.images[index];
+
+    VK_CHECK(vkResetCommandBuffer(p.cmd, 0));
+    VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    VK_CHECK(vkBeginCommandBuffer(p.cmd, &begin));
+    if (p.sceneDirty) {
+        barrier(p.cmd, p.sceneImage, VK_IMAGE_LAYOUT_UNDEFINED,
+                VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0, VK_ACCESS_TRANSFER_WRITE_BIT,
+                VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
+        VkBufferImageCopy region = {};
+        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+        region.imageExtent = {p.sceneWidth, p.sceneHeight, 1};
+        vkCmdCopyBufferToImage(p.cmd, p.staging.buffer, p.sceneImage,
+                               VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+        barrier(p.cmd, p.sceneImage, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
+                VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                VK_PIPELINE_STAGE_TRANSFER_BIT);
+        p.sceneDirty = false;
+    }
+    barrier(p.cmd, target, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
+            VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+            VK_PIPELINE_STAGE_TRANSFER_BIT);
+    VkClearColorValue clear = {{background[0], background[1], background[2], 1.0f}};
+    VkImageSubresourceRange range = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    vkCmdClearColorImage(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &clear, 1, &range);
+    if (p.hasScene) {
+        // The engine renders at the window's aspect ratio, at full or reduced size; stretching
+        // fills the window either way. Same size: a plain copy of every pixel.
+        barrier(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
+                VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                VK_PIPELINE_STAGE_TRANSFER_BIT);
+        VkImageBlit blit = {};
+        blit.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+        blit.srcOffsets[1] = {int32_t(p.sceneWidth), int32_t(p.sceneHeight), 1};
+        blit.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+        blit.dstOffsets[1] = {int32_t(p.extent.width), int32_t(p.extent.height), 1};
+        bool same = p.sceneWidth == p.extent.width && p.sceneHeight == p.extent.height;
+        vkCmdBlitImage(p.cmd, p.sceneImage, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, target,
+                       VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &blit,
+                       same ? VK_FILTER_NEAREST : VK_FILTER_LINEAR);
+    }
+    barrier(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+            VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
+            VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
+            VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT);
+    VkRenderPassBeginInfo pass = {VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
+    pass.renderPass = p.renderPass;
+    pass.framebuffer = p.framebuffers[index];
+    pass.renderArea.extent = p.extent;
+    vkCmdBeginRenderPass(p.cmd, &pass, VK_SUBPASS_CONTENTS_INLINE);
+    if (ui) ImGui_ImplVulkan_RenderDrawData(ui, p.cmd);
+    vkCmdEndRenderPass(p.cmd);
+    bool capturing = capture && p.canCapture;
+    if (capturing) {
+        ensureBuffer(p, p.readback, VkDeviceSize(p.extent.width) * p.extent.height * 4,
+                     VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+        barrier(p.cmd, target, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
+                VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
+                VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+                VK_PIPELINE_STAGE_TRANSFER_BIT);
+        VkBufferImageCopy region = {};
+        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+        region.imageExtent = {p.extent.width, p.extent.height, 1};
+        vkCmdCopyImageToBuffer(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                               p.readback.buffer, 1, &region);
+        barrier(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_ACCESS_TRANSFER_READ_BIT, 0,
+                VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT);
+        VkBufferMemoryBarrier host = {VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
+        host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+        host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+        host.srcQueueFamilyIndex = host.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        host.buffer = p.readback.buffer;
+        host.size = VK_WHOLE_SIZE;
+        vkCmdPipelineBarrier(p.cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0,
+                             0, nullptr, 1, &host, 0, nullptr);
+    }
+    VK_CHECK(vkEndCommandBuffer(p.cmd));
+
+    VkPipelineStageFlags waitStage = VK_PIPELINE_STAGE_TRANSFER_BIT;
+    VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    submit.waitSemaphoreCount = 1;
+    submit.pWaitSemaphores = &p.acquired;
+    submit.pWaitDstStageMask = &waitStage;
+    submit.commandBufferCount = 1;
+    submit.pCommandBuffers = &p.cmd;
+    submit.signalSemaphoreCount = 1;
+    submit.pSignalSemaphores = &p.rendered;
+    VK_CHECK(vkQueueSubmit(p.queue, 1, &submit, p.fence));
+    VkPresentInfoKHR present = {VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
+    present.waitSemaphoreCount = 1;
+    present.pWaitSemaphores = &p.rendered;
+    present.swapchainCount = 1;
+    present.pSwapchains = &p.swapchain;
+    present.pImageIndices = &index;
+    VkResult presented = vkQueuePresentKHR(p.queue, &present);
+    if (presented == VK_ERROR_OUT_OF_DATE_KHR || presented == VK_SUBOPTIMAL_KHR)
+        p.rebuild = true;
+    else
+        VK_CHECK(presented);
+    // One frame in flight: the image takes ~ms to draw, the engine's render is the slow part.
+    VK_CHECK(vkWaitForFences(p.device, 1, &p.fence, VK_TRUE, UINT64_MAX));
+    VK_CHECK(vkResetFences(p.device, 1, &p.fence));
+
+    if (capturing) {
+        capture->width = p.extent.width;
+        capture->height = p.extent.height;
+        capture->rgba.resize(size_t(p.extent.width) * p.extent.height * 4);
+        std::memcpy(capture->rgba.data(), p.readback.mapped, capture->rgba.size());
+        bool bgra = p.format.format == VK_FORMAT_B8G8R8A8_UNORM ||
+                    p.format.format == VK_FORMAT_B8G8R8A8_SRGB;
+        for (size_t i = 0; i < capture->rgba.size(); i += 4) {
+            if (bgra) std::swap(capture->rgba[i], capture->rgba[i + 2]);
+            capture->rgba[i + 3] = 255;
+        }
+    } else if (capture) {
+        capture->width = capture->height = 0; // this surface cannot be read back
+    }
+    return true;
+}
+
+std::string presenterDeviceName(const Presenter& p) {
+    return p.deviceName;
+}
+
+} // namespace sdfcsg::viewer

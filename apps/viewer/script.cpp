@@ -1,0 +1,116 @@
+#include "script.h"
+
+#include <charconv>
+#include <sstream>
+
+namespace sdfcsg::viewer {
+
+namespace {
+
+struct Verb {
+    std::string_view name;
+    int minArgs, maxArgs;                  // -1: any number
+    bool numeric;                          // arguments (after the first for "set") must be numbers
+    std::vector<std::string_view> choices; // allowed single argument, when not empty
+};
+
+const std::vector<Verb>& verbs() {
+    static const std::vector<Verb> table = {
+        {"select", 1, 1, false, {}},
+        {"set", 1, 4, true, {}},
+        {"mode", 1, 1, false, {"shaded", "normals", "depth", "steps"}},
+        {"shadows", 1, 1, false, {"on", "off"}},
+        {"ao", 1, 1, false, {"on", "off"}},
+        {"grid", 1, 1, false, {"on", "off"}},
+        {"boxes", 1, 1, false, {"none", "all", "selected"}},
+        {"orbit", 2, 2, true, {}},
+        {"zoom", 1, 1, true, {}},
+        {"frame", 0, 0, false, {}},
+        {"reset", 0, 0, false, {}},
+        {"undo", 0, 0, false, {}},
+        {"redo", 0, 0, false, {}},
+        {"save", 1, 1, false, {}},
+        {"screenshot", 1, 1, false, {}},
+    };
+    return table;
+}
+
+bool parseFloat(const std::string& s, float& out) {
+    auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
+    return ec == std::errc() && end == s.data() + s.size();
+}
+
+} // namespace
+
+Result<std::vector<Command>> parseScript(std::string_view text, std::string_view file) {
+    std::vector<Command> commands;
+    std::vector<Diagnostic> problems;
+    std::istringstream in{std::string(text)};
+    std::string line;
+    int number = 0;
+    while (std::getline(in, line)) {
+        ++number;
+        if (auto hash = line.find('#'); hash != std::string::npos) line.resize(hash);
+        std::istringstream words(line);
+        Command c;
+        c.line = number;
+        if (!(words >> c.verb)) continue;
+        for (std::string w; words >> w;)
+            c.args.push_back(w);
+        auto problem = [&](std::string message) {
+            Diagnostic d{std::string(file), {}, std::move(message)};
+            d.line = number;
+            d.column = 1;
+            problems.push_back(std::move(d));
+        };
+        const Verb* verb = nullptr;
+        for (const Verb& v : verbs())
+            if (v.name == c.verb) verb = &v;
+        if (!verb) {
+            std::string known;
+            for (const Verb& v : verbs())
+                known += (known.empty() ? "" : ", ") + std::string(v.name);
+            problem("unknown command \"" + c.verb + "\" (known: " + known + ")");
+            continue;
+        }
+        int n = int(c.args.size());
+        if (n < verb->minArgs || n > verb->maxArgs) {
+            problem(c.verb + ": expected " +
+                    (verb->minArgs == verb->maxArgs
+                         ? std::to_string(verb->minArgs)
+                         : std::to_string(verb->minArgs) + " to " + std::to_string(verb->maxArgs)) +
+                    " arguments, got " + std::to_string(n));
+            continue;
+        }
+        if (!verb->choices.empty()) {
+            bool ok = false;
+            std::string options;
+            for (std::string_view choice : verb->choices) {
+                ok = ok || choice == c.args[0];
+                options += (options.empty() ? "" : ", ") + std::string(choice);
+            }
+            if (!ok) {
+                problem(c.verb + ": expected one of " + options + ", got \"" + c.args[0] + "\"");
+                continue;
+            }
+        }
+        if (verb->numeric) {
+            bool ok = true;
+            for (size_t i = c.verb == "set" ? 1 : 0; i < c.args.size(); ++i) {
+                float v;
+                if (!parseFloat(c.args[i], v)) {
+                    problem(c.verb + ": expected a number, got \"" + c.args[i] + "\"");
+                    ok = false;
+                    break;
+                }
+                c.numbers.push_back(v);
+            }
+            if (!ok) continue;
+        }
+        commands.push_back(std::move(c));
+    }
+    if (!problems.empty()) return Error(ErrorKind::Usage, std::move(problems));
+    return commands;
+}
+
+} // namespace sdfcsg::viewer

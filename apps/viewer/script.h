@@ -1,0 +1,35 @@
+// Command files that drive the viewer without a person: one command per line, '#' starts a
+// comment. Each command acts on the viewer as the matching control would:
+//
+//   select NODE              a node by name or index ("none" clears the selection)
+//   set KEY V...             a value of the selected node (radius 0.5, translate 0 1 0, ...)
+//   mode shaded|normals|depth|steps
+//   shadows on|off    ao on|off    grid on|off    boxes none|all|selected
+//   orbit DYAW DPITCH        turn the camera, in degrees
+//   zoom FACTOR              multiply the distance to the target
+//   frame    reset           frame the selection (or scene), or go back to the scene's camera
+//   undo    redo
+//   save PATH                write the scene as JSON
+//   screenshot PATH          wait for the full-resolution image, then write the window as PNG
+#pragma once
+
+#include <sdfcsg/error.h>
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace sdfcsg::viewer {
+
+struct Command {
+    int line = 0;
+    std::string verb;
+    std::vector<std::string> args;
+    std::vector<float> numbers; // args read as numbers, for commands that take numbers
+};
+
+// Parses and checks every line (known verb, argument count and values); all problems are
+// reported, each as "file:line: message".
+Result<std::vector<Command>> parseScript(std::string_view text, std::string_view file);
+
+} // namespace sdfcsg::viewer

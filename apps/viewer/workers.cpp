@@ -1,0 +1,166 @@
+#include "workers.h"
+
+#include "edit.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace sdfcsg::viewer {
+
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+} // namespace
+
+RenderWorker::RenderWorker(Context& context) : context_(context) {
+    thread_ = std::thread([this] { run(); });
+}
+
+RenderWorker::~RenderWorker() {
+    {
+        std::lock_guard lock(mutex_);
+        stop_ = true;
+    }
+    wake_.notify_all();
+    thread_.join();
+}
+
+void RenderWorker::submit(RenderJob job) {
+    {
+        std::lock_guard lock(mutex_);
+        pending_ = std::move(job);
+    }
+    wake_.notify_all();
+}
+
+std::optional<RenderOutput> RenderWorker::take() {
+    std::lock_guard lock(mutex_);
+    auto out = std::move(done_);
+    done_.reset();
+    return out;
+}
+
+bool RenderWorker::idle() const {
+    std::lock_guard lock(mutex_);
+    return !pending_ && !busy_;
+}
+
+void RenderWorker::run() {
+    for (;;) {
+        RenderJob job;
+        {
+            std::unique_lock lock(mutex_);
+            wake_.wait(lock, [&] { return stop_ || pending_; });
+            if (stop_) return;
+            job = std::move(*pending_);
+            pending_.reset();
+            busy_ = true;
+        }
+        RenderOutput out = process(job);
+        std::lock_guard lock(mutex_);
+        done_ = std::move(out);
+        busy_ = false;
+    }
+}
+
+RenderOutput RenderWorker::process(const RenderJob& job) {
+    RenderOutput out;
+    out.id = job.id;
+    if (!renderer_ || !sameStructure(*compiled_, *job.scene)) {
+        // A scene that failed once is not compiled again until it changes.
+        if (failedVersion_ != job.sceneVersion) {
+            auto start = std::chrono::steady_clock::now();
+            RendererOptions options;
+            options.inlineValues = false; // value edits are uploads, not recompiles
+            auto created = Renderer::create(context_, *job.scene, options);
+            out.compileSeconds = secondsSince(start);
+            if (created) {
+                renderer_ = std::move(*created);
+                compiled_ = job.scene;
+                compiledVersion_ = job.sceneVersion;
+                failedVersion_.reset();
+                failure_.reset();
+            } else {
+                failedVersion_ = job.sceneVersion;
+                failure_ = created.error();
+            }
+        }
+    } else if (compiledVersion_ != job.sceneVersion) {
+        if (auto updated = renderer_->updateValues(*job.scene); updated) {
+            compiled_ = job.scene;
+            compiledVersion_ = job.sceneVersion;
+            failure_.reset();
+        } else {
+            failure_ = updated.error();
+        }
+    }
+    out.error = failure_;
+    if (!renderer_) return out;
+    out.scene = compiled_;
+    out.options = job.options;
+    if (out.options.selectedNode >= int(compiled_->nodes.size())) out.options.selectedNode = -1;
+    auto start = std::chrono::steady_clock::now();
+    auto image = renderer_->render(out.options);
+    out.renderSeconds = secondsSince(start);
+    if (!image) {
+        out.error = image.error();
+        return out;
+    }
+    out.image = std::move(*image);
+    out.pixels = renderer_->lastPixelInfo();
+    return out;
+}
+
+MeshWorker::~MeshWorker() {
+    cancel_ = true;
+    if (thread_.joinable()) thread_.join();
+}
+
+bool MeshWorker::start(std::shared_ptr<const Scene> scene, MeshOptions options) {
+    if (running_) return false;
+    if (thread_.joinable()) thread_.join();
+    running_ = true;
+    cancel_ = false;
+    progress_ = 0.0f;
+    thread_ = std::thread([this, scene = std::move(scene), options = std::move(options)]() mutable {
+        options.progress = [this](float done) {
+            progress_ = done;
+            return !cancel_.load();
+        };
+        MeshStats stats;
+        Result<Mesh> mesh = extractMesh(context_, *scene, options, &stats);
+        {
+            std::lock_guard lock(mutex_);
+            done_ = std::move(mesh);
+            stats_ = stats;
+        }
+        running_ = false;
+    });
+    return true;
+}
+
+std::optional<Result<Mesh>> MeshWorker::take() {
+    std::lock_guard lock(mutex_);
+    auto out = std::move(done_);
+    done_.reset();
+    return out;
+}
+
+MeshStats MeshWorker::stats() const {
+    std::lock_guard lock(mutex_);
+    return stats_;
+}
+
+float previewScale(double lastSeconds, uint64_t lastPixels, uint64_t fullPixels, double target) {
+    if (lastSeconds <= 0.0 || lastPixels == 0 || fullPixels == 0) return 0.5f;
+    double perPixel = lastSeconds / double(lastPixels);
+    double pixels = target / perPixel;
+    double scale = std::sqrt(pixels / double(fullPixels));
+    return float(std::clamp(scale, 0.125, 1.0));
+}
+
+} // namespace sdfcsg::viewer

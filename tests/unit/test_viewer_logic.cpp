@@ -1,0 +1,398 @@
+// The viewer's logic without a window: camera, picking, edits, undo, file watching and reload,
+// command scripts, preview resolution and mesh drawing.
+#include "document.h"
+#include "edit.h"
+#include "history.h"
+#include "orbit_camera.h"
+#include "picking.h"
+#include "raster.h"
+#include "script.h"
+#include "workers.h"
+
+#include <sdfcsg/io.h>
+
+#include <gtest/gtest.h>
+
+#include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+using namespace sdfcsg;
+using namespace sdfcsg::viewer;
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kTwoSpheres = R"({
+  "version": 1,
+  "root": {"type": "union", "name": "all", "children": [
+    {"type": "sphere", "name": "left", "radius": 0.5, "translate": [-1, 0, 0]},
+    {"type": "difference", "name": "cut", "children": [
+      {"type": "box", "name": "block", "size": [1, 1, 1], "translate": [1, 0, 0]},
+      {"type": "sphere", "name": "hole", "radius": 0.3, "translate": [1, 0, 0.5]}
+    ]}
+  ]}
+})";
+
+Scene twoSpheres() {
+    auto scene = parseScene(kTwoSpheres, "two.json");
+    EXPECT_TRUE(scene) << scene.error().str();
+    return *scene;
+}
+
+void expectNear(glm::vec3 a, glm::vec3 b, float tolerance = 1e-4f) {
+    EXPECT_NEAR(a.x, b.x, tolerance);
+    EXPECT_NEAR(a.y, b.y, tolerance);
+    EXPECT_NEAR(a.z, b.z, tolerance);
+}
+
+fs::path tempDir(const std::string& name) {
+    fs::path dir = fs::path(SDFCSG_TEST_OUTPUT_DIR) / name;
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+void writeText(const fs::path& path, const std::string& text) {
+    std::ofstream(path, std::ios::binary) << text;
+}
+
+} // namespace
+
+TEST(ViewerCamera, RoundTripsAScenesCamera) {
+    Camera c;
+    c.eye = {3, 2, 4};
+    c.target = {0.5f, 0.25f, -1};
+    c.fov = 40;
+    Camera back = toCamera(orbitFromCamera(c));
+    expectNear(back.eye, c.eye);
+    expectNear(back.target, c.target);
+    EXPECT_EQ(back.fov, 40);
+}
+
+TEST(ViewerCamera, OrbitKeepsDistanceAndClampsPitch) {
+    OrbitCamera c;
+    c.distance = 4;
+    orbit(c, 1.0f, 0.3f);
+    EXPECT_NEAR(glm::length(eyeOf(c) - c.target), 4.0f, 1e-5f);
+    orbit(c, 0.0f, 10.0f);
+    EXPECT_FLOAT_EQ(c.pitch, kMaxPitch);
+    orbit(c, 0.0f, -20.0f);
+    EXPECT_FLOAT_EQ(c.pitch, -kMaxPitch);
+}
+
+TEST(ViewerCamera, PanMovesTheTargetWithTheCursor) {
+    OrbitCamera c; // looking from +z towards -z: right is +x, up is +y
+    c.distance = 2;
+    c.fov = 90;          // visible height at the target: 2 * 2 * tan(45 deg) = 4
+    pan(c, 0.25f, 0.0f); // cursor a quarter of the height to the right: the scene follows it
+    expectNear(c.target, {-1, 0, 0});
+    pan(c, 0.0f, 0.25f); // and downwards
+    expectNear(c.target, {-1, 1, 0});
+    expectNear(eyeOf(c), {-1, 1, 2});
+}
+
+TEST(ViewerCamera, ZoomAndFrame) {
+    OrbitCamera c;
+    zoom(c, 0.5f);
+    EXPECT_FLOAT_EQ(c.distance, 2.5f);
+    zoom(c, 0.0f);
+    EXPECT_FLOAT_EQ(c.distance, kMinDistance);
+    Aabb box{{1, 1, 1}, {3, 3, 3}};
+    frameBox(c, box, 2.0f);
+    expectNear(c.target, {2, 2, 2});
+    // The bounding sphere fits in the narrower (vertical) field of view.
+    float radius = std::sqrt(3.0f);
+    EXPECT_NEAR(std::asin(radius / c.distance), glm::radians(c.fov) / 2 / 1.0f, 0.05f);
+    EXPECT_GT(std::sin(glm::radians(c.fov) / 2) * c.distance, radius);
+    OrbitCamera unchanged = c;
+    frameBox(c, Aabb{}, 1.0f); // empty: nothing to frame
+    EXPECT_EQ(c.distance, unchanged.distance);
+}
+
+TEST(ViewerPicking, PointFromDepth) {
+    Camera camera;
+    camera.eye = {0, 0, 5};
+    camera.target = {0, 0, 0};
+    camera.fov = 45;
+    std::vector<PixelInfo> pixels(4 * 4, PixelInfo{-1.0f, 0});
+    pixels[1 * 4 + 2] = {4.0f, 10};
+    auto p = pickPoint(camera, 4, 4, pixels, 2.3f, 1.9f);
+    ASSERT_TRUE(p);
+    // The centre of pixel (2, 1): right of and above the image centre, at distance 4.
+    EXPECT_NEAR(glm::length(*p - camera.eye), 4.0f, 1e-5f);
+    EXPECT_GT(p->x, 0.0f);
+    EXPECT_GT(p->y, 0.0f);
+    EXPECT_FALSE(pickPoint(camera, 4, 4, pixels, 0.5f, 0.5f)); // a miss
+    EXPECT_FALSE(pickPoint(camera, 4, 4, pixels, 4.0f, 0.5f)); // outside
+}
+
+TEST(ViewerPicking, NearestPrimitiveIncludingCarvedFaces) {
+    Scene scene = twoSpheres();
+    Evaluator evaluator(scene);
+    EXPECT_EQ(scene.nodes[*findNode(scene, "left")].name, "left");
+    EXPECT_EQ(nearestPrimitive(evaluator, {-1.5f, 0, 0}), int(*findNode(scene, "left")));
+    EXPECT_EQ(nearestPrimitive(evaluator, {1.5f, 0.2f, 0}), int(*findNode(scene, "block")));
+    // Inside the carved hole, on its surface: the sphere that cut it.
+    EXPECT_EQ(nearestPrimitive(evaluator, {1.0f, 0.0f, 0.2f}), int(*findNode(scene, "hole")));
+}
+
+TEST(ViewerEdit, SetValuesValidatesLikeTheLoader) {
+    Scene scene = twoSpheres();
+    uint32_t left = *findNode(scene, "left");
+    float r[] = {0.75f};
+    auto edited = setValue(scene, left, "radius", r);
+    ASSERT_TRUE(edited) << edited.error().str();
+    EXPECT_FLOAT_EQ(edited->nodes[left].params[0], 0.75f);
+    EXPECT_TRUE(sameStructure(scene, *edited));
+    float t[] = {0, 2, 0};
+    edited = setValue(scene, left, "translate", t);
+    ASSERT_TRUE(edited);
+    EXPECT_EQ(edited->nodes[left].transform.translate, glm::vec3(0, 2, 0));
+    float c[] = {1, 0, 0};
+    edited = setValue(scene, left, "color", c);
+    ASSERT_TRUE(edited);
+    EXPECT_EQ(edited->nodes[left].color, glm::vec3(1, 0, 0));
+    edited = setValue(*edited, left, "color", {});
+    ASSERT_TRUE(edited);
+    EXPECT_FALSE(edited->nodes[left].color);
+
+    float bad[] = {-1.0f};
+    auto refused = setValue(scene, left, "radius", bad);
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error().str(),
+              "two.json: root.children[0].radius: expected a positive number, got -1");
+    refused = setValue(scene, left, "size", bad);
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error().str(),
+              "two.json: root.children[0]: a sphere has no value \"size\" (it has translate, "
+              "rotate, scale, color, radius)");
+    refused = setValue(scene, left, "translate", bad);
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error().str(),
+              "two.json: root.children[0]: translate: expected 3 numbers, got 1");
+}
+
+TEST(ViewerEdit, StructuralEditsKeepTheSceneValid) {
+    Scene scene = twoSpheres();
+    uint32_t cut = *findNode(scene, "cut");
+    uint32_t added = 0;
+    auto grown = addChild(scene, 0, NodeKind::Torus, &added);
+    ASSERT_TRUE(grown) << grown.error().str();
+    EXPECT_FALSE(sameStructure(scene, *grown));
+    EXPECT_EQ(grown->nodes.size(), scene.nodes.size() + 1);
+    EXPECT_EQ(grown->nodes[added].kind, NodeKind::Torus);
+    EXPECT_EQ(parentOf(*grown, added), 0);
+
+    auto removed = removeNode(scene, *findNode(scene, "hole"));
+    ASSERT_TRUE(removed);
+    EXPECT_EQ(removed->nodes.size(), scene.nodes.size() - 1);
+    EXPECT_FALSE(findNode(*removed, "hole"));
+    auto rootRemoved = removeNode(scene, 0);
+    ASSERT_FALSE(rootRemoved);
+    EXPECT_EQ(rootRemoved.error().str(), "two.json: root: the root cannot be removed");
+
+    auto kind = changeKind(scene, *findNode(scene, "left"), NodeKind::Box);
+    ASSERT_TRUE(kind) << kind.error().str();
+    EXPECT_EQ(kind->nodes[*findNode(*kind, "left")].kind, NodeKind::Box);
+    auto op = changeKind(scene, cut, NodeKind::Intersection);
+    ASSERT_TRUE(op);
+    EXPECT_EQ(op->nodes[cut].kind, NodeKind::Intersection);
+    auto mixed = changeKind(scene, cut, NodeKind::Sphere);
+    ASSERT_FALSE(mixed);
+    EXPECT_EQ(mixed.error().str(),
+              "two.json: root.children[1]: an operation can only become another operation");
+
+    uint32_t moved = 0;
+    auto reordered = moveNode(scene, *findNode(scene, "hole"), -1, &moved);
+    ASSERT_TRUE(reordered);
+    EXPECT_EQ(reordered->nodes[moved].name, "hole");
+    EXPECT_EQ(reordered->nodes[reordered->nodes[cut].children[0]].name, "hole");
+}
+
+TEST(ViewerHistory, UndoRedoAndMergedSteps) {
+    Scene a = twoSpheres();
+    History history(a);
+    EXPECT_FALSE(history.canUndo());
+    float r = 0.6f;
+    for (int i = 0; i < 5; ++i, r += 0.1f) // one slider drag
+        history.push(*setValue(history.current(), 1, "radius", std::span(&r, 1)), "1radius");
+    history.endMerge();
+    EXPECT_EQ(history.size(), 2u);
+    EXPECT_FLOAT_EQ(history.current().nodes[1].params[0], 1.0f);
+    history.push(*removeNode(history.current(), *findNode(history.current(), "hole")));
+    EXPECT_EQ(history.size(), 3u);
+    ASSERT_TRUE(history.undo());
+    EXPECT_TRUE(findNode(history.current(), "hole"));
+    ASSERT_TRUE(history.undo());
+    EXPECT_FLOAT_EQ(history.current().nodes[1].params[0], 0.5f);
+    EXPECT_FALSE(history.undo());
+    ASSERT_TRUE(history.redo());
+    EXPECT_FLOAT_EQ(history.current().nodes[1].params[0], 1.0f);
+    // A new step drops what could be redone.
+    history.push(a);
+    EXPECT_FALSE(history.canRedo());
+    EXPECT_EQ(history.size(), 3u);
+}
+
+TEST(ViewerHistory, KeepsAtMostTheLimit) {
+    History history(twoSpheres(), 4);
+    for (int i = 0; i < 10; ++i)
+        history.push(twoSpheres());
+    EXPECT_EQ(history.size(), 4u);
+    int undos = 0;
+    while (history.undo())
+        ++undos;
+    EXPECT_EQ(undos, 3);
+}
+
+TEST(ViewerFiles, WatcherReportsEachChangeOnce) {
+    fs::path dir = tempDir("viewer_watch");
+    fs::path file = dir / "scene.json";
+    writeText(file, "one");
+    FileWatcher watcher(file);
+    EXPECT_FALSE(watcher.poll());
+    writeText(file, "three"); // a different size, whatever the clock's resolution
+    EXPECT_TRUE(watcher.poll());
+    EXPECT_FALSE(watcher.poll());
+    fs::last_write_time(file, fs::last_write_time(file) + std::chrono::seconds(5));
+    EXPECT_TRUE(watcher.poll());
+    fs::remove(file);
+    EXPECT_FALSE(watcher.poll()); // gone: nothing to load
+    writeText(file, "back");
+    EXPECT_TRUE(watcher.poll());
+}
+
+TEST(ViewerFiles, ReloadKeepsTheLastGoodScene) {
+    fs::path dir = tempDir("viewer_reload");
+    fs::path file = dir / "scene.json";
+    writeText(file, kTwoSpheres);
+    Document doc;
+    ASSERT_TRUE(doc.open(file));
+    EXPECT_EQ(doc.scene().nodes.size(), 5u);
+    EXPECT_FALSE(doc.pollReload());
+
+    // Broken on disk: the scene stays, the error is kept.
+    writeText(file, R"({"version": 1, "root": {"type": "sphere", "radius": -2}})");
+    uint64_t before = doc.version();
+    EXPECT_TRUE(doc.pollReload());
+    EXPECT_GT(doc.version(), before);
+    ASSERT_TRUE(doc.error());
+    EXPECT_EQ(doc.error()->str(),
+              file.string() + ": root.radius: expected a positive number, got -2");
+    EXPECT_EQ(doc.scene().nodes.size(), 5u);
+
+    // Fixed on disk: loaded, and the change can be undone.
+    writeText(file, R"({"version": 1, "root": {"type": "sphere", "radius": 2}})");
+    EXPECT_TRUE(doc.pollReload());
+    EXPECT_FALSE(doc.error());
+    EXPECT_EQ(doc.scene().nodes.size(), 1u);
+    ASSERT_TRUE(doc.history().undo());
+    EXPECT_EQ(doc.scene().nodes.size(), 5u);
+}
+
+TEST(ViewerFiles, SaveIsAtomicAndNotReloaded) {
+    fs::path dir = tempDir("viewer_save");
+    fs::path file = dir / "scene.json";
+    writeText(file, kTwoSpheres);
+    Document doc;
+    ASSERT_TRUE(doc.open(file));
+    float r = 0.25f;
+    doc.history().push(*setValue(doc.scene(), 1, "radius", std::span(&r, 1)));
+    ASSERT_TRUE(doc.save());
+    EXPECT_FALSE(doc.pollReload()); // our own write is not a change from outside
+    auto back = loadScene(file);
+    ASSERT_TRUE(back);
+    EXPECT_FLOAT_EQ(back->nodes[1].params[0], 0.25f);
+    for (const auto& e : fs::directory_iterator(dir))
+        EXPECT_EQ(e.path().filename(), "scene.json");
+
+    auto failed = doc.save(dir / "missing" / "x.json");
+    ASSERT_FALSE(failed);
+    EXPECT_EQ(failed.error().kind, ErrorKind::Io);
+}
+
+TEST(ViewerFiles, OpenFailureKeepsTheCurrentScene) {
+    fs::path dir = tempDir("viewer_open");
+    writeText(dir / "good.json", kTwoSpheres);
+    writeText(dir / "bad.json", "{");
+    Document doc;
+    ASSERT_TRUE(doc.open(dir / "good.json"));
+    EXPECT_FALSE(doc.open(dir / "bad.json"));
+    EXPECT_TRUE(doc.error());
+    EXPECT_EQ(doc.scene().nodes.size(), 5u);
+    // The broken file is watched: fixing it loads it.
+    writeText(dir / "bad.json", R"({"version": 1, "root": {"type": "sphere", "radius": 1}})");
+    EXPECT_TRUE(doc.pollReload());
+    EXPECT_FALSE(doc.error());
+    EXPECT_EQ(doc.scene().nodes.size(), 1u);
+}
+
+TEST(ViewerScript, ParsesCommands) {
+    auto script = parseScript("# a comment\nselect nose\n\nset translate 0 1 -2.5  # move\n"
+                              "mode depth\norbit 30 -10\nscreenshot out.png\n",
+                              "s.txt");
+    ASSERT_TRUE(script) << script.error().str();
+    ASSERT_EQ(script->size(), 5u);
+    EXPECT_EQ((*script)[0].verb, "select");
+    EXPECT_EQ((*script)[0].args, std::vector<std::string>{"nose"});
+    EXPECT_EQ((*script)[1].line, 4);
+    EXPECT_EQ((*script)[1].args[0], "translate");
+    EXPECT_EQ((*script)[1].numbers, (std::vector<float>{0, 1, -2.5f}));
+    EXPECT_EQ((*script)[3].numbers, (std::vector<float>{30, -10}));
+}
+
+TEST(ViewerScript, ReportsEveryProblem) {
+    auto script = parseScript("mode shiny\nfly away\nset radius big\nzoom\nundo now\n", "s.txt");
+    ASSERT_FALSE(script);
+    EXPECT_EQ(script.error().str(),
+              "s.txt:1:1: mode: expected one of shaded, normals, depth, steps, got \"shiny\"\n"
+              "s.txt:2:1: unknown command \"fly\" (known: select, set, mode, shadows, ao, grid, "
+              "boxes, orbit, zoom, frame, reset, undo, redo, save, screenshot)\n"
+              "s.txt:3:1: set: expected a number, got \"big\"\n"
+              "s.txt:4:1: zoom: expected 1 arguments, got 0\n"
+              "s.txt:5:1: undo: expected 0 arguments, got 1");
+}
+
+TEST(ViewerResolution, PreviewScaleAimsAtTheTargetTime) {
+    // 0.4 s for a full 1000 x 1000 frame: 0.1 s wants a quarter of the pixels, half of each axis.
+    EXPECT_NEAR(previewScale(0.4, 1000000, 1000000, 0.1), 0.5f, 1e-6f);
+    EXPECT_FLOAT_EQ(previewScale(0.001, 1000000, 1000000, 0.1), 1.0f);
+    EXPECT_FLOAT_EQ(previewScale(100.0, 1000000, 1000000, 0.1), 0.125f);
+    EXPECT_FLOAT_EQ(previewScale(0.0, 0, 1000000, 0.1), 0.5f);
+}
+
+TEST(ViewerRaster, DrawsTheMeshWhereTheCameraSeesIt) {
+    Mesh mesh; // one triangle facing +z around the origin
+    mesh.positions = {{-1, -1, 0}, {1, -1, 0}, {0, 1, 0}};
+    mesh.normals = {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}};
+    mesh.colors = {{1, 0, 0}, {1, 0, 0}, {1, 0, 0}};
+    mesh.indices = {0, 1, 2};
+    RasterOptions o;
+    o.width = 64;
+    o.height = 64;
+    o.camera.eye = {0, 0, 5};
+    o.background = {0, 0, 1};
+    Image image = rasterize(mesh, o);
+    ASSERT_EQ(image.rgba.size(), 64u * 64u * 4u);
+    auto at = [&](int x, int y) { return &image.rgba[(size_t(y) * 64 + size_t(x)) * 4]; };
+    EXPECT_EQ(at(32, 34)[0], 255); // lit straight on: the full colour
+    EXPECT_EQ(at(32, 34)[2], 0);
+    EXPECT_EQ(at(2, 2)[2], 255); // background
+    o.wireframe = true;
+    o.shaded = false;
+    Image wire = rasterize(mesh, o);
+    // The bottom edge (y = -1) lies about 13 pixels below the centre.
+    int dark = 0;
+    for (int y = 40; y < 50; ++y)
+        dark += wire.rgba[(size_t(y) * 64 + 32) * 4] < 40;
+    EXPECT_GE(dark, 1);
+    // Behind the eye: nothing is drawn.
+    o.camera.eye = {0, 0, -5};
+    o.camera.target = {0, 0, -10};
+    Image behind = rasterize(mesh, o);
+    EXPECT_EQ(behind.rgba[(size_t(32) * 64 + 32) * 4 + 2], 255);
+}

@@ -1,0 +1,61 @@
+// Compares two PNG images for the viewer tests.
+//   image_diff A.png B.png same MAXDIFF MAXFRACTION  exit 0 when at most MAXFRACTION of the
+//                                                    pixels differ by more than MAXDIFF (0..255)
+//   image_diff A.png B.png differ MINFRACTION        exit 0 when at least MINFRACTION differ
+// Prints the sizes and the fraction of differing pixels either way; 1 when the check fails,
+// 2 on bad arguments or unreadable files.
+#define STB_IMAGE_IMPLEMENTATION
+#define STB_IMAGE_STATIC
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#pragma GCC diagnostic ignored "-Wunused-function"
+#pragma GCC diagnostic ignored "-Wshadow"
+#pragma GCC diagnostic ignored "-Wsign-compare"
+#endif
+#include <stb/stb_image.h>
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+int main(int argc, char** argv) {
+    if (argc < 5) {
+        std::fputs("usage: image_diff A.png B.png same MAXDIFF MAXFRACTION | differ MINFRACTION\n",
+                   stderr);
+        return 2;
+    }
+    std::string check = argv[3];
+    int wa, ha, wb, hb, n;
+    unsigned char* a = stbi_load(argv[1], &wa, &ha, &n, 4);
+    unsigned char* b = stbi_load(argv[2], &wb, &hb, &n, 4);
+    if (!a || !b) {
+        std::fprintf(stderr, "image_diff: cannot read %s\n", a ? argv[2] : argv[1]);
+        return 2;
+    }
+    if (wa != wb || ha != hb) {
+        std::printf("sizes differ: %dx%d and %dx%d\n", wa, ha, wb, hb);
+        return 1;
+    }
+    int threshold = check == "same" ? std::atoi(argv[4]) : 8;
+    long differing = 0, maxDiff = 0;
+    for (long i = 0; i < long(wa) * ha; ++i) {
+        int d = 0;
+        for (int c = 0; c < 3; ++c)
+            d = std::max(d, std::abs(int(a[4 * i + c]) - int(b[4 * i + c])));
+        maxDiff = std::max<long>(maxDiff, d);
+        if (d > threshold) ++differing;
+    }
+    double fraction = double(differing) / (double(wa) * ha);
+    std::printf("%dx%d: %.4f of the pixels differ by more than %d (largest difference %ld)\n", wa,
+                ha, fraction, threshold, maxDiff);
+    if (check == "same" && argc == 6) return fraction <= std::atof(argv[5]) ? 0 : 1;
+    if (check == "differ") return fraction >= std::atof(argv[4]) ? 0 : 1;
+    std::fputs("image_diff: expected \"same MAXDIFF MAXFRACTION\" or \"differ MINFRACTION\"\n",
+               stderr);
+    return 2;
+}
