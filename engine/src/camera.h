@@ -126,6 +126,21 @@ inline Aabb finitePrimitiveBounds(const Evaluator& evaluator) {
     return box;
 }
 
+// The box the solid lies in, as tight as the bounds know it: the root's bounds on every side
+// where they are finite (a difference lies within its first operand, whatever it subtracts), the
+// finite primitives' elsewhere (a ground plane makes the root's bounds infinite).
+inline Aabb finiteSceneBounds(const Evaluator& evaluator) {
+    const Aabb root = evaluator.bounds();
+    const Aabb parts = finitePrimitiveBounds(evaluator);
+    Aabb box;
+    for (int a = 0; a < 3; ++a) {
+        box.min[a] = std::isfinite(root.min[a]) ? root.min[a] : parts.min[a];
+        box.max[a] = std::isfinite(root.max[a]) ? root.max[a] : parts.max[a];
+        if (!(box.min[a] < box.max[a])) return parts; // an empty solid: frame its parts
+    }
+    return box;
+}
+
 inline ClipVolume makeClipVolume(const Evaluator& evaluator, glm::vec3 eye) {
     Aabb finite = finitePrimitiveBounds(evaluator);
     glm::vec3 centre = 0.5f * (finite.min + finite.max);

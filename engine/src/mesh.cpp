@@ -151,7 +151,7 @@ Result<Grid> planGrid(const Evaluator& evaluator, const MeshOptions& options) {
     } else {
         // The finite part of the scene, with a margin of a few cells so that the surface lies
         // strictly inside the grid.
-        box = detail::finitePrimitiveBounds(evaluator);
+        box = detail::finiteSceneBounds(evaluator);
         glm::vec3 e = box.max - box.min;
         float longest = std::max(std::max(e.x, e.y), std::max(e.z, 1e-6f));
         uint32_t margin = 3;
