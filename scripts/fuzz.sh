@@ -32,6 +32,8 @@ for target in $targets; do
     case $target in
         # Scenes that load only: this target checks what valid scenes compile to.
         glsl) seeds="assets/scenes tests/data/valid tests/data/legacy" ;;
+        # HTTP answers of language models (first byte: API and status, see fuzz_llm.cpp).
+        llm) seeds="tests/fuzz/llm_corpus" ;;
         *) seeds="tests/fuzz/corpus assets/scenes tests/data/valid tests/data/legacy" ;;
     esac
     mkdir -p "$build/corpus/$target" "$build/artifacts/$target"

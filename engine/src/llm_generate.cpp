@@ -463,8 +463,10 @@ Result<LlmRequest> firstLlmRequest(std::string_view request, const GenerateOptio
                       requestBody(*endpoint, options.llm, firstMessages(request, options), state)};
 }
 
-Result<Generated> generateScene(std::string_view request, const GenerateOptions& options,
-                                GenerateStats* statsOut) {
+namespace {
+
+Result<Generated> generate(std::string_view request, const GenerateOptions& options,
+                           GenerateStats* statsOut) {
     GenerateStats local;
     GenerateStats& stats = statsOut ? *statsOut : local;
     stats = GenerateStats{};
@@ -531,6 +533,29 @@ Result<Generated> generateScene(std::string_view request, const GenerateOptions&
         messages.push_back({"assistant", answer->content});
         messages.push_back({"user", sceneRepairPrompt(problems)});
     }
+}
+
+} // namespace
+
+// A server or a model may quote the key back, a hostile one on purpose (the fuzz target
+// fuzz_llm found a body quoted in an error): nothing that leaves here carries it.
+Result<Generated> generateScene(std::string_view request, const GenerateOptions& options,
+                                GenerateStats* stats) {
+    auto result = generate(request, options, stats);
+    const std::string& key = options.llm.apiKey;
+    auto clean = [&](std::vector<Diagnostic>& diagnostics) {
+        for (Diagnostic& d : diagnostics) {
+            d.path = redact(std::move(d.path), key);
+            d.message = redact(std::move(d.message), key);
+        }
+    };
+    if (result) {
+        clean(result->warnings);
+        return result;
+    }
+    Error error = result.error();
+    clean(error.diagnostics);
+    return error;
 }
 
 std::string recordingToJson(std::span<const HttpExchange> exchanges) {

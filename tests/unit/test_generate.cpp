@@ -361,6 +361,25 @@ TEST_F(Fixture, Unauthorized) {
     EXPECT_EQ(server.received().size(), 1u); // not retried
 }
 
+// A server that quotes the key back, in a body that is no answer and in a scene key: neither
+// message carries it (fuzz_llm found the first).
+TEST_F(Fixture, KeyEchoedByTheServerIsRedacted) {
+    server.script({{200, std::string("<html>bad key ") + kKey + "</html>"}});
+    auto g = generateScene("a sphere", options());
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().str(), server.url() + "/chat/completions: unexpected answer (not a JSON "
+                                              "object): <html>bad key [redacted]</html>");
+
+    auto o = options();
+    o.maxRepairs = 0;
+    server.script({openAi(std::string(R"({"version": 1, "root": {"type": "sphere", ")") + kKey +
+                          R"(": 1}})")});
+    g = generateScene("a sphere", o);
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().str().find(kKey), std::string::npos) << g.error().str();
+    EXPECT_NE(g.error().str().find("[redacted]"), std::string::npos) << g.error().str();
+}
+
 TEST_F(Fixture, RateLimitedHonoursRetryAfter) {
     server.script(
         {{429, R"({"error": {"message": "Rate limit reached", "code": "rate_limit_exceeded"}})",

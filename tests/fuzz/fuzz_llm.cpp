@@ -1,0 +1,61 @@
+// Fuzz target: a language model's HTTP answer -> the scene in it -> validation, through the
+// public generateScene() with a one-exchange replay, so no network is involved and every step a
+// real answer takes is taken: the response shape (OpenAI's or Ollama's), error bodies and status
+// codes, refusals and finish reasons, code fences and <think> blocks, null members, the limits on
+// untrusted scenes and the validator. The first byte picks the API and the status; the rest is
+// the response body.
+//
+// Whatever the answer, the result is a scene that loads again from its own JSON, or an Error
+// with a message, and the API key appears in no message (a hostile server may echo it back). The
+// scene itself is the model's answer and is kept as it came.
+#include <sdfcsg/generate.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+namespace {
+
+constexpr const char* kKey = "sk-fuzz-0123456789abcdef";
+
+[[noreturn]] void fail(const char* what, const std::string& detail) {
+    std::fprintf(stderr, "fuzz_llm: %s\n%s\n", what, detail.c_str());
+    std::abort();
+}
+
+} // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+    if (size == 0) return 0;
+    static const long kStatus[] = {200, 200, 200, 200, 400, 401, 429, 500};
+    const uint8_t pick = data[0];
+    std::vector<sdfcsg::HttpExchange> replay(1);
+    replay[0].status = kStatus[pick & 7];
+    replay[0].response.assign(reinterpret_cast<const char*>(data + 1), size - 1);
+    if (pick & 8) replay[0].retryAfter = "0";
+
+    sdfcsg::GenerateOptions options;
+    options.llm.baseUrl = pick & 16 ? "http://127.0.0.1:11434" : "http://127.0.0.1:8080/v1";
+    options.llm.apiKey = kKey;
+    options.llm.model = "fuzz";
+    options.maxRepairs = 0; // one answer: a repair round would find the replay exhausted
+    options.sleep = [](double) {};
+    if (pick & 32) options.currentScene = R"({"version": 1, "root": {"type": "sphere"}})";
+    options.replay = &replay;
+
+    auto generated = sdfcsg::generateScene("a fuzzed request", options);
+    if (!generated) {
+        if (generated.error().diagnostics.empty()) fail("an error without a message", "");
+        const std::string text = generated.error().str();
+        if (text.find(kKey) != std::string::npos) fail("the API key is in an error", text);
+        return 0;
+    }
+    for (const sdfcsg::Diagnostic& warning : generated->warnings)
+        if (warning.str().find(kKey) != std::string::npos)
+            fail("the API key is in a warning", warning.str());
+    auto again = sdfcsg::parseScene(generated->json, "fuzz.json", options.limits);
+    if (!again) fail("a generated scene does not load again", again.error().str());
+    return 0;
+}
