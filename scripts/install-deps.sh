@@ -6,7 +6,8 @@ PACKAGES="build-essential cmake ninja-build pkg-config git
   glslang-dev glslang-tools spirv-tools
   libglm-dev libsimdjson-dev libstb-dev libgtest-dev
   libcurl4-openssl-dev libcpp-httplib-dev
-  libglfw3-dev libimgui-dev xvfb xauth"
+  libglfw3-dev libimgui-dev xvfb xauth
+  clang-14 libclang-rt-14-dev"
 missing=""
 for p in $PACKAGES; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"

@@ -21,6 +21,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <memory>
 #include <string>
 
 int main(int argc, char** argv) {
@@ -31,8 +32,10 @@ int main(int argc, char** argv) {
     }
     std::string check = argv[3];
     int wa, ha, wb, hb, n;
-    unsigned char* a = stbi_load(argv[1], &wa, &ha, &n, 4);
-    unsigned char* b = stbi_load(argv[2], &wb, &hb, &n, 4);
+    using Pixels = std::unique_ptr<unsigned char, decltype(&stbi_image_free)>;
+    Pixels pa(stbi_load(argv[1], &wa, &ha, &n, 4), stbi_image_free);
+    Pixels pb(stbi_load(argv[2], &wb, &hb, &n, 4), stbi_image_free);
+    const unsigned char *a = pa.get(), *b = pb.get();
     if (!a || !b) {
         std::fprintf(stderr, "image_diff: cannot read %s\n", a ? argv[2] : argv[1]);
         return 2;
