@@ -220,16 +220,7 @@ struct Recording {
 };
 
 void printSummary(const std::string& out, const Generated& g, const GenerateStats& s) {
-    const int repairs = s.answers - 1;
-    std::string validity = s.firstTryValid
-                               ? "valid on the first try"
-                               : "valid after " + std::to_string(repairs) +
-                                     (repairs == 1 ? " repair round" : " repair rounds");
-    std::fprintf(stderr, "%s: %zu nodes, %s (%.*s, %d requests, %llu + %llu tokens, %.1f s)\n",
-                 out.c_str(), g.scene.nodes.size(), validity.c_str(),
-                 int(outputModeName(s.mode).size()), outputModeName(s.mode).data(), s.requests,
-                 static_cast<unsigned long long>(s.promptTokens),
-                 static_cast<unsigned long long>(s.completionTokens), s.seconds);
+    std::fprintf(stderr, "%s: %s\n", out.c_str(), generationSummary(g, s).c_str());
     for (const Diagnostic& w : g.warnings)
         std::fprintf(stderr, "warning: %s: %s\n", w.path.c_str(), w.message.c_str());
 }

@@ -59,6 +59,17 @@ bool Document::pollReload() {
     return true;
 }
 
+void Document::replace(Scene scene) {
+    if (loaded_) {
+        history_.endMerge();
+        history_.push(std::move(scene));
+    } else {
+        history_.reset(std::move(scene));
+    }
+    loaded_ = true;
+    ++version_;
+}
+
 Status Document::save(const std::filesystem::path& path) {
     auto written = writeFileAtomic(path, toJson(scene()));
     if (!written) return written;

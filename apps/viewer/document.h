@@ -49,6 +49,10 @@ class Document {
     // Writes the current scene as JSON, atomically, and takes that version as seen.
     Status save(const std::filesystem::path& path);
     Status save() { return save(path_); }
+    // Makes a scene from elsewhere (a language model's) the current one, as one undo step; the
+    // first scene of a document without a file starts its history instead. The file, if any,
+    // stays where save() writes.
+    void replace(Scene scene);
 
     const Scene& scene() const { return history_.current(); }
     History& history() { return history_; }

@@ -12,6 +12,7 @@
 #include "workers.h"
 
 #include <sdfcsg/export.h>
+#include <sdfcsg/generate.h>
 #include <sdfcsg/io.h>
 
 #include <GLFW/glfw3.h>
@@ -31,6 +32,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -47,7 +49,9 @@ constexpr const char* kUsage =
     "                     OUT (PNG) and exit\n"
     "  --frames N         frames to draw before the screenshot (default 1)\n"
     "  --script FILE      run viewer commands from FILE (see apps/viewer/script.h), then exit\n"
-    "  --no-ui            hide the panels (H toggles them)\n";
+    "  --no-ui            hide the panels (H toggles them)\n"
+    "The Generate panel and the script's generate command reach a language model set up as for\n"
+    "'sdfcsg generate': SDFCSG_LLM_BASE_URL, SDFCSG_LLM_MODEL, SDFCSG_LLM_API_KEY, ...\n";
 
 struct Args {
     fs::path scene;
@@ -174,6 +178,20 @@ struct Viewer {
     std::string meshMessage;
     char exportPath[512] = "mesh.glb";
 
+    // Generation.
+    std::unique_ptr<GenerateWorker> generator;
+    LlmConfig llm;        // from the environment
+    std::string endpoint; // "model at URL", or why there is none; never the key
+    bool endpointOk = false;
+    bool startedEmpty = false; // no scene given on the command line
+    char prompt[4096] = "";
+    bool generating = false; // started, and the result not yet applied
+    bool generatingEdit = false;
+    std::string generationScript; // "file:line: " when a script started it
+    std::string generateSummary;
+    std::vector<Diagnostic> generateWarnings;
+    std::optional<Error> generateError;
+
     // Files.
     char openPath[512] = "";
     char savePath[512] = "";
@@ -272,6 +290,64 @@ void undo(Viewer& v) {
 }
 void redo(Viewer& v) {
     if (v.doc.history().redo()) v.doc.touch();
+}
+
+// ---- Generation ------------------------------------------------------------------------------
+
+void describeEndpoint(Viewer& v) {
+    v.llm = llmConfigFromEnvironment();
+    auto endpoint = llmEndpoint(v.llm);
+    v.endpointOk = bool(endpoint);
+    v.endpoint = endpoint ? endpoint->model + " at " + endpoint->url +
+                                (v.llm.apiKey.empty() ? " (no API key)" : "")
+                          : endpoint.error().str();
+}
+
+// `edit`: the current scene goes with the request, to be changed (as `sdfcsg edit` does).
+void startGeneration(Viewer& v, std::string request, bool edit) {
+    GenerateOptions options;
+    options.llm = v.llm;
+    std::string current = edit && v.doc.loaded() ? toJson(v.doc.scene()) : std::string();
+    if (!v.generator->start(std::move(request), std::move(current), std::move(options))) return;
+    v.generating = true;
+    v.generatingEdit = edit;
+    v.generateSummary.clear();
+    v.generateWarnings.clear();
+    v.generateError.reset();
+}
+
+// Applies a finished generation: its scene as one undo step, or its problems in the panel while
+// the current scene stays. False when a script's generation failed.
+bool finishGeneration(Viewer& v) {
+    if (!v.generating) return true;
+    auto done = v.generator->take();
+    if (!done) return true;
+    v.generating = false;
+    const std::string where = std::exchange(v.generationScript, {});
+    if (!*done) {
+        v.generateError = done->error();
+        if (where.empty()) return true;
+        std::fprintf(stderr, "%s%s\n", where.c_str(), done->error().str().c_str());
+        v.exitCode = 1;
+        return false;
+    }
+    Generated& g = **done;
+    v.generateSummary = generationSummary(g, v.generator->stats());
+    v.generateWarnings = std::move(g.warnings);
+    if (!where.empty()) {
+        std::fprintf(stderr, "%s%s\n", where.c_str(), v.generateSummary.c_str());
+        for (const Diagnostic& w : v.generateWarnings)
+            std::fprintf(stderr, "%swarning: %s: %s\n", where.c_str(), w.path.c_str(),
+                         w.message.c_str());
+    }
+    v.doc.replace(std::move(g.scene));
+    v.selected = -1; // the node numbers changed
+    v.mesh.reset();
+    v.meshView = false;
+    if (!v.generatingEdit) v.scene.reset(); // a new scene gets its own camera (syncScene)
+    v.status = v.generatingEdit ? "edited by the model (undo: Ctrl+Z)"
+                                : "generated a new scene (undo: Ctrl+Z)";
+    return true;
 }
 
 void save(Viewer& v, const fs::path& path) {
@@ -706,6 +782,40 @@ void meshPanel(Viewer& v) {
     }
 }
 
+void generatePanel(Viewer& v) {
+    ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
+    ImGui::TextWrapped("%s", v.endpoint.c_str());
+    ImGui::PopStyleColor();
+    ImGui::InputTextMultiline("##prompt", v.prompt, sizeof v.prompt,
+                              ImVec2(-1, ImGui::GetTextLineHeight() * 4));
+    if (v.generating) {
+        const GenerateStatus s = v.generator->status();
+        ImGui::Text("%c %.0f s", "|/-\\"[int(s.seconds * 8) % 4], s.seconds);
+        ImGui::SameLine();
+        if (ImGui::Button("Cancel")) v.generator->cancel();
+        ImGui::TextWrapped("%s", s.message.c_str());
+    } else {
+        ImGui::BeginDisabled(!v.prompt[0] || !v.endpointOk);
+        if (ImGui::Button("Generate new scene")) startGeneration(v, v.prompt, false);
+        ImGui::SameLine();
+        ImGui::BeginDisabled(!v.doc.loaded());
+        if (ImGui::Button("Edit this scene")) startGeneration(v, v.prompt, true);
+        ImGui::EndDisabled();
+        ImGui::EndDisabled();
+    }
+    if (!v.generateSummary.empty()) ImGui::TextWrapped("%s", v.generateSummary.c_str());
+    ImGui::PushStyleColor(ImGuiCol_Text, IM_COL32(255, 200, 90, 255));
+    for (const Diagnostic& w : v.generateWarnings)
+        ImGui::TextWrapped("warning: %s: %s", w.path.c_str(), w.message.c_str());
+    ImGui::PopStyleColor();
+    if (v.generateError) {
+        ImGui::PushStyleColor(ImGuiCol_Text, IM_COL32(255, 110, 110, 255));
+        ImGui::TextWrapped("%s", v.generateError->str().c_str());
+        ImGui::PopStyleColor();
+        ImGui::TextDisabled("the scene was not changed");
+    }
+}
+
 void panels(Viewer& v) {
     ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowSize(ImVec2(340, 0), ImGuiCond_FirstUseEver);
@@ -781,6 +891,9 @@ void panels(Viewer& v) {
     }
     if (v.scene && ImGui::CollapsingHeader("Node", ImGuiTreeNodeFlags_DefaultOpen)) valueEditor(v);
     if (v.scene && ImGui::CollapsingHeader("Mesh")) meshPanel(v);
+    // Open at first when started without a scene: describing one is a way to start.
+    if (ImGui::CollapsingHeader("Generate", v.startedEmpty ? ImGuiTreeNodeFlags_DefaultOpen : 0))
+        generatePanel(v);
     ImGui::End();
     fileBrowser(v);
 }
@@ -789,7 +902,7 @@ void panels(Viewer& v) {
 
 // Runs commands until one has to wait for an image. False when a command failed.
 bool runScript(Viewer& v) {
-    while (!v.script.empty() && v.pendingShot.empty()) {
+    while (!v.script.empty() && v.pendingShot.empty() && !v.generating) {
         Command c = v.script.front();
         v.script.pop_front();
         std::string where = v.scriptFile + ":" + std::to_string(c.line) + ": ";
@@ -799,7 +912,7 @@ bool runScript(Viewer& v) {
             return false;
         };
         syncScene(v);
-        if (!v.scene) return fail("no scene loaded");
+        if (!v.scene && c.verb != "generate") return fail("no scene loaded");
         const std::string arg = c.args.empty() ? "" : c.args[0];
         if (c.verb == "select") {
             if (arg == "none") {
@@ -845,6 +958,10 @@ bool runScript(Viewer& v) {
         } else if (c.verb == "screenshot") {
             v.pendingShot = arg;
             v.waitStart = now();
+        } else if (c.verb == "generate" || c.verb == "edit-scene") {
+            std::snprintf(v.prompt, sizeof v.prompt, "%s", c.text.c_str()); // as if typed
+            startGeneration(v, c.text, c.verb == "edit-scene");
+            v.generationScript = where;
         }
         syncScene(v);
     }
@@ -887,6 +1004,9 @@ int main(int argc, char** argv) {
     v.context = std::move(*context);
     v.renderer = std::make_unique<RenderWorker>(*v.context);
     v.mesher = std::make_unique<MeshWorker>(*v.context);
+    v.generator = std::make_unique<GenerateWorker>();
+    describeEndpoint(v);
+    v.startedEmpty = args.scene.empty();
 
     if (!args.scene.empty()) {
         openFile(v, args.scene);
@@ -941,7 +1061,7 @@ int main(int argc, char** argv) {
                 v.status = v.doc.error() ? "reload failed" : "reloaded " + v.doc.path().string();
         }
         syncScene(v);
-        if (!runScript(v)) break;
+        if (!finishGeneration(v) || !runScript(v)) break;
 
         ImGui_ImplVulkan_NewFrame();
         ImGui_ImplGlfw_NewFrame();
@@ -988,7 +1108,8 @@ int main(int argc, char** argv) {
             v.exitCode = 1;
             break;
         }
-        if (!args.script.empty() && v.script.empty() && v.pendingShot.empty() && !v.exitAfterShot)
+        if (!args.script.empty() && v.script.empty() && v.pendingShot.empty() && !v.generating &&
+            !v.exitAfterShot)
             break;
     }
     if (automated && v.renderError && v.exitCode == 0) {
@@ -997,6 +1118,7 @@ int main(int argc, char** argv) {
     }
     v.renderer.reset();
     v.mesher.reset();
+    v.generator.reset(); // cancels a generation in flight
     v.presenter.reset();
     ImGui_ImplGlfw_Shutdown();
     ImGui::DestroyContext();

@@ -12,6 +12,7 @@ struct Verb {
     int minArgs, maxArgs;                  // -1: any number
     bool numeric;                          // arguments (after the first for "set") must be numbers
     std::vector<std::string_view> choices; // allowed single argument, when not empty
+    std::string_view text = {};            // free text: what the text describes, for the message
 };
 
 const std::vector<Verb>& verbs() {
@@ -31,6 +32,8 @@ const std::vector<Verb>& verbs() {
         {"redo", 0, 0, false, {}},
         {"save", 1, 1, false, {}},
         {"screenshot", 1, 1, false, {}},
+        {"generate", 1, -1, false, {}, "the scene"},
+        {"edit-scene", 1, -1, false, {}, "the change"},
     };
     return table;
 }
@@ -55,6 +58,11 @@ Result<std::vector<Command>> parseScript(std::string_view text, std::string_view
         Command c;
         c.line = number;
         if (!(words >> c.verb)) continue;
+        if (const auto at = words.tellg(); at >= 0) {
+            c.text = line.substr(size_t(at));
+            c.text.erase(0, c.text.find_first_not_of(" \t\r"));
+            c.text.erase(c.text.find_last_not_of(" \t\r") + 1);
+        }
         for (std::string w; words >> w;)
             c.args.push_back(w);
         auto problem = [&](std::string message) {
@@ -74,7 +82,11 @@ Result<std::vector<Command>> parseScript(std::string_view text, std::string_view
             continue;
         }
         int n = int(c.args.size());
-        if (n < verb->minArgs || n > verb->maxArgs) {
+        if (!verb->text.empty() && n == 0) {
+            problem(c.verb + ": expected a description of " + std::string(verb->text));
+            continue;
+        }
+        if (n < verb->minArgs || (verb->maxArgs >= 0 && n > verb->maxArgs)) {
             problem(c.verb + ": expected " +
                     (verb->minArgs == verb->maxArgs
                          ? std::to_string(verb->minArgs)

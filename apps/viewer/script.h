@@ -11,6 +11,13 @@
 //   undo    redo
 //   save PATH                write the scene as JSON
 //   screenshot PATH          wait for the full-resolution image, then write the window as PNG
+//   generate TEXT...         ask the language model for a new scene described by TEXT, wait
+//                            for it, and make it the current scene (one undo step)
+//   edit-scene TEXT...       the same, sending the current scene to be changed as TEXT says
+//
+// The text of generate and edit-scene is the rest of the line, so it cannot hold a '#'. A
+// generation that fails (no valid scene after the repair rounds, a network error) fails the
+// script.
 #pragma once
 
 #include <sdfcsg/error.h>
@@ -26,10 +33,11 @@ struct Command {
     std::string verb;
     std::vector<std::string> args;
     std::vector<float> numbers; // args read as numbers, for commands that take numbers
+    std::string text;           // the rest of the line after the verb, trimmed, for free text
 };
 
 // Parses and checks every line (known verb, argument count and values); all problems are
-// reported, each as "file:line: message".
+// reported, each as "file:line:column: message".
 Result<std::vector<Command>> parseScript(std::string_view text, std::string_view file);
 
 } // namespace sdfcsg::viewer

@@ -155,6 +155,58 @@ MeshStats MeshWorker::stats() const {
     return stats_;
 }
 
+GenerateWorker::~GenerateWorker() {
+    cancel_ = true;
+    if (thread_.joinable()) thread_.join();
+}
+
+bool GenerateWorker::start(std::string request, std::string currentScene, GenerateOptions options) {
+    if (running_) return false;
+    if (thread_.joinable()) thread_.join();
+    running_ = true;
+    cancel_ = false;
+    {
+        std::lock_guard lock(mutex_);
+        message_.clear();
+        start_ = std::chrono::steady_clock::now();
+    }
+    options.currentScene = std::move(currentScene);
+    options.progress = [this](const GenerateProgress& p) {
+        if (p.waiting) return; // the seconds are counted in status()
+        std::lock_guard lock(mutex_);
+        message_ = p.message;
+    };
+    options.cancelled = [this] { return cancel_.load(); };
+    thread_ = std::thread([this, request = std::move(request), options = std::move(options)] {
+        GenerateStats stats;
+        Result<Generated> generated = generateScene(request, options, &stats);
+        {
+            std::lock_guard lock(mutex_);
+            done_ = std::move(generated);
+            stats_ = stats;
+        }
+        running_ = false;
+    });
+    return true;
+}
+
+GenerateStatus GenerateWorker::status() const {
+    std::lock_guard lock(mutex_);
+    return {message_, secondsSince(start_)};
+}
+
+std::optional<Result<Generated>> GenerateWorker::take() {
+    std::lock_guard lock(mutex_);
+    auto out = std::move(done_);
+    done_.reset();
+    return out;
+}
+
+GenerateStats GenerateWorker::stats() const {
+    std::lock_guard lock(mutex_);
+    return stats_;
+}
+
 float previewScale(double lastSeconds, uint64_t lastPixels, uint64_t fullPixels, double target) {
     if (lastSeconds <= 0.0 || lastPixels == 0 || fullPixels == 0) return 0.5f;
     double perPixel = lastSeconds / double(lastPixels);

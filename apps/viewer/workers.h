@@ -1,18 +1,22 @@
 // Background threads for the slow engine calls, so the window keeps answering: one renders
-// (compiling when the structure changes), one extracts meshes. Both share the viewer's Context,
-// whose queue submissions take turns (context.h).
+// (compiling when the structure changes), one extracts meshes, one asks a language model for a
+// scene. The first two share the viewer's Context, whose queue submissions take turns
+// (context.h).
 #pragma once
 
 #include <sdfcsg/context.h>
+#include <sdfcsg/generate.h>
 #include <sdfcsg/mesh.h>
 #include <sdfcsg/render.h>
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <string>
 #include <thread>
 
 namespace sdfcsg::viewer {
@@ -90,6 +94,43 @@ class MeshWorker {
     mutable std::mutex mutex_;
     std::optional<Result<Mesh>> done_;
     MeshStats stats_;
+};
+
+// What a running generation is doing, for the panel.
+struct GenerateStatus {
+    std::string message; // the latest GenerateProgress message
+    double seconds = 0;  // since start()
+};
+
+// generateScene() on a thread, so the window never waits for the network. The result is only
+// handed over: applying it to the document is the caller's choice.
+class GenerateWorker {
+  public:
+    GenerateWorker() = default;
+    ~GenerateWorker(); // cancels a running generation and waits for it (about a second)
+    GenerateWorker(const GenerateWorker&) = delete;
+    GenerateWorker& operator=(const GenerateWorker&) = delete;
+
+    // Starts generating unless a generation is running (false then). A non-empty currentScene
+    // (a scene's JSON) asks for that scene changed as `request` says. The worker sets
+    // options.progress and options.cancelled itself.
+    bool start(std::string request, std::string currentScene, GenerateOptions options);
+    // The generation stops within about a second; take() then gives ErrorKind::Cancelled.
+    void cancel() { cancel_ = true; }
+    bool running() const { return running_; }
+    GenerateStatus status() const;
+    // The finished generation, once (an Error when it failed or was cancelled).
+    std::optional<Result<Generated>> take();
+    GenerateStats stats() const; // of the last finished generation
+
+  private:
+    std::thread thread_;
+    std::atomic<bool> running_{false}, cancel_{false};
+    mutable std::mutex mutex_;
+    std::string message_;
+    std::chrono::steady_clock::time_point start_;
+    std::optional<Result<Generated>> done_;
+    GenerateStats stats_;
 };
 
 // Internal resolution while the camera moves: the fraction of the full size along each axis

@@ -38,12 +38,6 @@ struct Message {
     std::string content;
 };
 
-struct Endpoint {
-    std::string url;
-    LlmApi api = LlmApi::OpenAI;
-    std::string model;
-};
-
 // What the server has shown it accepts; each rejection is answered once.
 struct RequestState {
     OutputMode mode = OutputMode::JsonSchema;
@@ -66,6 +60,11 @@ Error remote(const std::string& url, std::string message) {
     return Error::message(ErrorKind::Remote, url, std::move(message));
 }
 
+// The same error as an aborted transfer's (llm_http.cpp), whenever the request is stopped.
+Error cancelledAt(const std::string& url) {
+    return Error::message(ErrorKind::Cancelled, url, "cancelled");
+}
+
 // host:port of a URL, for Ollama's default port.
 int urlPort(std::string_view url) {
     size_t scheme = url.find("://");
@@ -77,7 +76,7 @@ int urlPort(std::string_view url) {
     return std::atoi(std::string(rest.substr(colon + 1)).c_str());
 }
 
-Result<Endpoint> resolve(const LlmConfig& config) {
+Result<LlmEndpoint> resolve(const LlmConfig& config) {
     std::string base = config.baseUrl.empty() ? "https://api.openai.com/v1" : config.baseUrl;
     while (base.ends_with('/'))
         base.pop_back();
@@ -85,7 +84,7 @@ Result<Endpoint> resolve(const LlmConfig& config) {
         return Error::message(ErrorKind::Usage, "<llm>",
                               "the base URL must start with http:// or https://, got " +
                                   detail::quote(base));
-    Endpoint e;
+    LlmEndpoint e;
     e.api = config.api != LlmApi::Auto ? config.api
             : urlPort(base) == 11434   ? LlmApi::Ollama
                                        : LlmApi::OpenAI;
@@ -116,7 +115,7 @@ std::string messagesJson(const std::vector<Message>& messages) {
     return out + "]";
 }
 
-std::string requestBody(const Endpoint& e, const LlmConfig& config,
+std::string requestBody(const LlmEndpoint& e, const LlmConfig& config,
                         const std::vector<Message>& messages, const RequestState& state) {
     std::string out =
         R"({"model":)" + jsonQuote(e.model) + R"(,"messages":)" + messagesJson(messages);
@@ -216,7 +215,7 @@ struct Answer {
     uint64_t promptTokens = 0, completionTokens = 0;
 };
 
-Result<Answer> readAnswer(const Endpoint& e, std::string_view body) {
+Result<Answer> readAnswer(const LlmEndpoint& e, std::string_view body) {
     dom::parser parser;
     dom::element top;
     auto unexpected = [&](const std::string& what) {
@@ -315,7 +314,7 @@ std::string withoutNulls(const std::string& text, const Limits& limits) {
 // One conversation: sends requests, retries, adapts to the server, counts.
 class Conversation {
   public:
-    Conversation(Endpoint endpoint, const GenerateOptions& options, GenerateStats& stats)
+    Conversation(LlmEndpoint endpoint, const GenerateOptions& options, GenerateStats& stats)
         : e_(std::move(endpoint)), options_(options), stats_(stats) {
         state_.mode = options.firstMode;
     }
@@ -324,6 +323,7 @@ class Conversation {
         const LlmConfig& config = options_.llm;
         int retries = 0;
         for (;;) {
+            if (cancelled()) return cancelledAt(e_.url);
             stats_.mode = state_.mode;
             const std::string body = requestBody(e_, config, messages, state_);
             const std::string status = what + " (" + std::string(outputModeName(state_.mode)) + ")";
@@ -349,12 +349,7 @@ class Conversation {
                              std::to_string(retries + 1) + " of " +
                              std::to_string(config.maxRetries + 1) + ")",
                          0.0, false);
-                if (options_.replay == nullptr) {
-                    if (options_.sleep)
-                        options_.sleep(delay);
-                    else
-                        std::this_thread::sleep_for(std::chrono::duration<double>(delay));
-                }
+                if (options_.replay == nullptr) wait(delay);
                 continue;
             }
             if ((code == 400 || code == 422) && adapt(error)) continue;
@@ -415,6 +410,7 @@ class Conversation {
         post.timeoutSeconds = options_.llm.timeoutSeconds;
         post.connectTimeoutSeconds = options_.llm.connectTimeoutSeconds;
         post.tick = [&](double elapsed) { progress(status, elapsed, true); };
+        post.cancelled = options_.cancelled;
         auto response = detail::httpPost(post);
         if (response && options_.record)
             options_.record->push_back(
@@ -422,11 +418,23 @@ class Conversation {
         return response;
     }
 
+    bool cancelled() const { return options_.cancelled && options_.cancelled(); }
+
+    // A back-off of up to a minute must not hold up a Cancel button.
+    void wait(double delay) {
+        if (options_.sleep) return options_.sleep(delay);
+        const Clock::time_point end = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                                         std::chrono::duration<double>(delay));
+        while (Clock::now() < end && !cancelled())
+            std::this_thread::sleep_for(
+                std::min<Clock::duration>(end - Clock::now(), std::chrono::milliseconds(50)));
+    }
+
     void progress(const std::string& message, double elapsed, bool waiting) {
         if (options_.progress) options_.progress(GenerateProgress{message, elapsed, waiting});
     }
 
-    Endpoint e_;
+    LlmEndpoint e_;
     const GenerateOptions& options_;
     GenerateStats& stats_;
     RequestState state_;
@@ -452,6 +460,10 @@ LlmConfig llmConfigFromEnvironment() {
     if (api == "openai") config.api = LlmApi::OpenAI;
     if (api == "ollama") config.api = LlmApi::Ollama;
     return config;
+}
+
+Result<LlmEndpoint> llmEndpoint(const LlmConfig& config) {
+    return resolve(config);
 }
 
 Result<LlmRequest> firstLlmRequest(std::string_view request, const GenerateOptions& options) {
@@ -556,6 +568,22 @@ Result<Generated> generateScene(std::string_view request, const GenerateOptions&
     Error error = result.error();
     clean(error.diagnostics);
     return error;
+}
+
+std::string generationSummary(const Generated& generated, const GenerateStats& stats) {
+    const int repairs = stats.answers - 1;
+    const std::string validity = stats.firstTryValid
+                                     ? "valid on the first try"
+                                     : "valid after " + std::to_string(repairs) +
+                                           (repairs == 1 ? " repair round" : " repair rounds");
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "%zu nodes, %s (%.*s, %d requests, %llu + %llu tokens, %.1f s)",
+                  generated.scene.nodes.size(), validity.c_str(),
+                  int(outputModeName(stats.mode).size()), outputModeName(stats.mode).data(),
+                  stats.requests, static_cast<unsigned long long>(stats.promptTokens),
+                  static_cast<unsigned long long>(stats.completionTokens), stats.seconds);
+    return text;
 }
 
 std::string recordingToJson(std::span<const HttpExchange> exchanges) {

@@ -16,6 +16,7 @@ struct Transfer {
     const HttpPost* post;
     HttpResponse response;
     bool tooLarge = false;
+    bool cancelled = false;
     std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
     std::chrono::steady_clock::time_point lastTick = start;
 };
@@ -58,7 +59,8 @@ int onProgress(void* user, curl_off_t, curl_off_t, curl_off_t, curl_off_t) {
         t->lastTick = now;
         t->post->tick(std::chrono::duration<double>(now - t->start).count());
     }
-    return 0;
+    t->cancelled = t->post->cancelled && t->post->cancelled();
+    return t->cancelled ? 1 : 0; // non-zero aborts the transfer
 }
 
 struct CurlDeleter {
@@ -116,6 +118,7 @@ Result<HttpResponse> httpPost(const HttpPost& post) {
     curl_easy_setopt(c, CURLOPT_NOPROGRESS, 0L);
 
     const CURLcode code = curl_easy_perform(c);
+    if (transfer.cancelled) return Error::message(ErrorKind::Cancelled, post.url, "cancelled");
     if (transfer.tooLarge)
         return fail("the answer exceeds " + std::to_string(post.maxResponseBytes >> 20) + " MiB");
     if (code == CURLE_OPERATION_TIMEDOUT) {

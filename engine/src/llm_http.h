@@ -19,6 +19,9 @@ struct HttpPost {
     size_t maxResponseBytes = 16u << 20; // a longer answer is cut off with an error
     // Called about four times a second while the answer is awaited, with the seconds elapsed.
     std::function<void(double)> tick;
+    // Asked as often as libcurl reports progress (about once a second while nothing arrives);
+    // true aborts the transfer with an error of kind Cancelled.
+    std::function<bool()> cancelled;
 };
 
 struct HttpResponse {
@@ -28,7 +31,7 @@ struct HttpResponse {
 };
 
 // Any HTTP status is a response; only transport failures (no connection, timeout, oversize
-// answer) are errors, of kind Remote, naming the URL.
+// answer) are errors, of kind Remote, naming the URL, and a cancel (kind Cancelled).
 Result<HttpResponse> httpPost(const HttpPost& post);
 
 } // namespace sdfcsg::detail

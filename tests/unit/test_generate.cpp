@@ -1,27 +1,26 @@
-// Scene generation against a loopback HTTP server inside the test process, which answers each
-// request with the next scripted response and keeps what it received: success, the answer
-// shapes, the repair loop, the server's rejections and the client's fallbacks, retries,
-// timeouts, Ollama's native API, the request body, where the key goes, and record/replay.
+// Scene generation against a loopback HTTP server inside the test process (fake_llm_server.h):
+// success, the answer shapes, the repair loop, the server's rejections and the client's
+// fallbacks, retries, timeouts, cancelling, Ollama's native API, the request body, where the
+// key goes, and record/replay.
 #include <sdfcsg/generate.h>
 
+#include "fake_llm_server.h"
 #include "json_writer.h"
 
 #include <gtest/gtest.h>
 
-#include <httplib.h>
 #include <simdjson.h>
 
+#include <atomic>
 #include <chrono>
-#include <condition_variable>
-#include <cstdlib>
 #include <deque>
-#include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
 using namespace sdfcsg;
+using namespace sdfcsg::test;
 using detail::jsonQuote;
 
 namespace {
@@ -33,86 +32,6 @@ const std::string kRepairText =
     "Your scene does not load. The validator reported:\n"
     "- root.radius: expected a positive number, got -1\n"
     "Answer with the whole corrected scene as one JSON object, and nothing else.";
-
-struct Scripted {
-    int status = 200;
-    std::string body;
-    std::string retryAfter;
-    bool hang = false; // answer only once the test releases the server
-};
-
-struct Received {
-    std::string path;
-    std::string body;
-    httplib::Headers headers;
-};
-
-class FakeServer {
-  public:
-    FakeServer() {
-        // A proxy from the environment must not stand between the client and the loopback.
-        ::setenv("no_proxy", "127.0.0.1,localhost", 1);
-        server_.Post(".*", [this](const httplib::Request& req, httplib::Response& res) {
-            Scripted next{500, R"({"error": {"message": "no scripted response left"}})"};
-            {
-                std::unique_lock lock(mutex_);
-                received_.push_back({req.path, req.body, req.headers});
-                if (!script_.empty()) {
-                    next = script_.front();
-                    script_.pop_front();
-                }
-                if (next.hang)
-                    released_.wait_for(lock, std::chrono::seconds(20), [this] { return release_; });
-            }
-            res.status = next.status;
-            if (!next.retryAfter.empty()) res.set_header("Retry-After", next.retryAfter);
-            res.set_content(next.body, "application/json");
-        });
-        port_ = server_.bind_to_any_port("127.0.0.1");
-        thread_ = std::thread([this] { server_.listen_after_bind(); });
-        while (!server_.is_running())
-            std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    }
-    ~FakeServer() {
-        release();
-        server_.stop();
-        thread_.join();
-    }
-    void script(std::vector<Scripted> responses) {
-        std::lock_guard lock(mutex_);
-        script_.assign(responses.begin(), responses.end());
-    }
-    void release() {
-        std::lock_guard lock(mutex_);
-        release_ = true;
-        released_.notify_all();
-    }
-    std::vector<Received> received() {
-        std::lock_guard lock(mutex_);
-        return received_;
-    }
-    std::string url(const std::string& path = "/v1") const {
-        return "http://127.0.0.1:" + std::to_string(port_) + path;
-    }
-
-  private:
-    httplib::Server server_;
-    std::thread thread_;
-    int port_ = 0;
-    std::mutex mutex_;
-    std::condition_variable released_;
-    bool release_ = false;
-    std::deque<Scripted> script_;
-    std::vector<Received> received_;
-};
-
-// An OpenAI Chat Completions answer.
-Scripted openAi(const std::string& content, const std::string& finish = "stop") {
-    return {200, R"({"id": "x", "object": "chat.completion", "choices": [{"index": 0, "message":
-        {"role": "assistant", "content": )" +
-                     jsonQuote(content) + R"(, "refusal": null}, "finish_reason": ")" + finish +
-                     R"("}], "usage": {"prompt_tokens": 100, "completion_tokens": 20}})"};
-}
 
 Scripted openAiError(int status, const std::string& message, const std::string& param = "",
                      const std::string& code = "") {
@@ -435,6 +354,55 @@ TEST_F(Fixture, Timeout) {
                                               "0.3 s (the request timeout)");
 }
 
+TEST_F(Fixture, CancelDuringASlowAnswer) {
+    server.script({{200, "{}", "", true}}); // would answer after 20 s
+    std::atomic<bool> cancel{false};
+    GenerateOptions o = options();
+    o.cancelled = [&] { return cancel.load(); };
+    std::thread canceller([&] {
+        if (server.awaitRequests(1)) cancel = true;
+    });
+    const auto start = std::chrono::steady_clock::now();
+    auto g = generateScene("a sphere", o);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    canceller.join();
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().kind, ErrorKind::Cancelled);
+    EXPECT_EQ(g.error().str(), server.url() + "/chat/completions: cancelled");
+    // libcurl asks about once a second while nothing arrives; the answer would take 20 s.
+    EXPECT_LT(seconds, 10.0);
+}
+
+TEST_F(Fixture, CancelDuringTheRetryWait) {
+    server.script({openAiError(503, "Service Unavailable"), openAi(kSphere)});
+    bool cancel = false;
+    GenerateOptions o = options();
+    o.cancelled = [&] { return cancel; };
+    o.sleep = [&](double) { cancel = true; };
+    auto g = generateScene("a sphere", o);
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().kind, ErrorKind::Cancelled);
+    EXPECT_EQ(server.received().size(), 1u); // the retry was never sent
+
+    // The engine's own wait ends early too: a 60 s back-off, cancelled after the first request.
+    server.script({openAiError(503, "Service Unavailable"), openAi(kSphere)});
+    std::atomic<bool> later{false};
+    o.sleep = nullptr;
+    o.llm.retryBaseSeconds = 60;
+    o.cancelled = [&] { return later.load(); };
+    std::thread canceller([&] {
+        if (server.awaitRequests(2)) later = true;
+    });
+    const auto start = std::chrono::steady_clock::now();
+    g = generateScene("a sphere", o);
+    canceller.join();
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().kind, ErrorKind::Cancelled);
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+              30.0);
+}
+
 TEST_F(Fixture, ConnectionRefused) {
     GenerateOptions o = options();
     o.llm.baseUrl = "http://127.0.0.1:1/v1";
@@ -614,6 +582,27 @@ TEST(GenerateConfig, Usage) {
     auto openai = firstLlmRequest("x", o);
     ASSERT_TRUE(openai);
     EXPECT_NE(openai->body.find(R"("model":"gpt-4o-mini")"), std::string::npos);
+}
+
+TEST(GenerateConfig, EndpointWithTheDefaultsApplied) {
+    LlmConfig c;
+    c.baseUrl = "https://api.openai.com/v1/";
+    auto openai = llmEndpoint(c);
+    ASSERT_TRUE(openai) << openai.error().str();
+    EXPECT_EQ(openai->url, "https://api.openai.com/v1/chat/completions");
+    EXPECT_EQ(openai->api, LlmApi::OpenAI);
+    EXPECT_EQ(openai->model, "gpt-4o-mini");
+    c.baseUrl = "http://127.0.0.1:11434/v1";
+    c.model = "llama3.1";
+    auto ollama = llmEndpoint(c);
+    ASSERT_TRUE(ollama) << ollama.error().str();
+    EXPECT_EQ(ollama->url, "http://127.0.0.1:11434/api/chat");
+    EXPECT_EQ(ollama->api, LlmApi::Ollama);
+    EXPECT_EQ(ollama->model, "llama3.1");
+    c.model.clear();
+    auto none = llmEndpoint(c);
+    ASSERT_FALSE(none);
+    EXPECT_EQ(none.error().kind, ErrorKind::Usage);
 }
 
 TEST(GenerateConfig, Environment) {

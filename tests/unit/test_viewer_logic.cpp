@@ -1,7 +1,9 @@
 // The viewer's logic without a window: camera, picking, edits, undo, file watching and reload,
-// command scripts, preview resolution and mesh drawing.
+// command scripts, preview resolution, mesh drawing, and scene generation against a loopback
+// language model (fake_llm_server.h).
 #include "document.h"
 #include "edit.h"
+#include "fake_llm_server.h"
 #include "history.h"
 #include "orbit_camera.h"
 #include "picking.h"
@@ -9,19 +11,26 @@
 #include "script.h"
 #include "workers.h"
 
+#include <sdfcsg/generate.h>
 #include <sdfcsg/io.h>
 
 #include <gtest/gtest.h>
 
+#include <simdjson.h>
+
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <thread>
 
 using namespace sdfcsg;
 using namespace sdfcsg::viewer;
+using sdfcsg::test::FakeServer;
+using sdfcsg::test::openAi;
 namespace fs = std::filesystem;
 
 namespace {
@@ -58,6 +67,48 @@ fs::path tempDir(const std::string& name) {
 
 void writeText(const fs::path& path, const std::string& text) {
     std::ofstream(path, std::ios::binary) << text;
+}
+
+constexpr const char* kRedBall =
+    R"({"version": 1, "root": {"type": "sphere", "name": "ball", "radius": 0.75, "color": [1, 0, 0]}})";
+constexpr const char* kBadBall = R"({"version": 1, "root": {"type": "sphere", "radius": -1}})";
+
+GenerateOptions fakeModel(const FakeServer& server) {
+    GenerateOptions o;
+    o.llm.baseUrl = server.url();
+    o.llm.model = "test-model";
+    o.llm.timeoutSeconds = 20;
+    o.sleep = [](double) {}; // no back-off between retries
+    return o;
+}
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// The worker's result once it has finished; the loopback answers at once, so 30 s is only a
+// bound for a stuck test.
+std::optional<Result<Generated>> finish(GenerateWorker& worker) {
+    const auto start = std::chrono::steady_clock::now();
+    while (worker.running() && secondsSince(start) < 30.0)
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    return worker.take();
+}
+
+// The last message of the n-th request: the request, with the current scene when editing.
+std::string userMessage(FakeServer& server, size_t n) {
+    simdjson::dom::parser parser;
+    simdjson::dom::array messages = parser.parse(server.received().at(n).body)["messages"];
+    std::string_view content = messages.at(messages.size() - 1)["content"];
+    return std::string(content);
+}
+
+Document twoSpheresDocument(const std::string& name) {
+    fs::path file = tempDir(name) / "scene.json";
+    writeText(file, kTwoSpheres);
+    Document doc;
+    EXPECT_TRUE(doc.open(file));
+    return doc;
 }
 
 } // namespace
@@ -351,10 +402,124 @@ TEST(ViewerScript, ReportsEveryProblem) {
     EXPECT_EQ(script.error().str(),
               "s.txt:1:1: mode: expected one of shaded, normals, depth, steps, got \"shiny\"\n"
               "s.txt:2:1: unknown command \"fly\" (known: select, set, mode, shadows, ao, grid, "
-              "boxes, orbit, zoom, frame, reset, undo, redo, save, screenshot)\n"
+              "boxes, orbit, zoom, frame, reset, undo, redo, save, screenshot, generate, "
+              "edit-scene)\n"
               "s.txt:3:1: set: expected a number, got \"big\"\n"
               "s.txt:4:1: zoom: expected 1 arguments, got 0\n"
               "s.txt:5:1: undo: expected 0 arguments, got 1");
+}
+
+TEST(ViewerScript, GenerateTakesTheRestOfTheLine) {
+    auto script = parseScript("generate a red  ball on a box   # not sent\n"
+                              "edit-scene\tmake the ball blue\r\n",
+                              "s.txt");
+    ASSERT_TRUE(script) << script.error().str();
+    ASSERT_EQ(script->size(), 2u);
+    EXPECT_EQ((*script)[0].verb, "generate");
+    EXPECT_EQ((*script)[0].text, "a red  ball on a box");
+    EXPECT_EQ((*script)[1].verb, "edit-scene");
+    EXPECT_EQ((*script)[1].text, "make the ball blue");
+}
+
+TEST(ViewerScript, GenerateNeedsADescription) {
+    auto script = parseScript("generate\nedit-scene    # nothing to say\n", "s.txt");
+    ASSERT_FALSE(script);
+    EXPECT_EQ(script.error().str(), "s.txt:1:1: generate: expected a description of the scene\n"
+                                    "s.txt:2:1: edit-scene: expected a description of the change");
+}
+
+TEST(ViewerGenerate, WorkerYieldsTheSceneAndChangesNothingItself) {
+    FakeServer server;
+    server.script({openAi(kRedBall)});
+    Document doc = twoSpheresDocument("viewer_generate");
+    const std::string before = toJson(doc.scene());
+    const uint64_t version = doc.version();
+    GenerateWorker worker;
+    ASSERT_TRUE(worker.start("a red ball", "", fakeModel(server)));
+    auto done = finish(worker);
+    ASSERT_TRUE(done);
+    ASSERT_TRUE(*done) << done->error().str();
+    EXPECT_EQ((*done)->json, toJson(*parseScene(kRedBall)));
+    EXPECT_EQ((*done)->scene.nodes.size(), 1u);
+    EXPECT_FALSE(worker.take()); // handed over once
+    EXPECT_FALSE(worker.running());
+    EXPECT_EQ(worker.status().message, "asking test-model (json_schema)");
+    EXPECT_TRUE(worker.stats().firstTryValid);
+    EXPECT_EQ(userMessage(server, 0), sceneUserPrompt("a red ball"));
+    EXPECT_EQ(toJson(doc.scene()), before);
+    EXPECT_EQ(doc.version(), version);
+}
+
+TEST(ViewerGenerate, AnEditIsOneUndoStep) {
+    FakeServer server;
+    server.script({openAi(kRedBall)});
+    Document doc = twoSpheresDocument("viewer_generate_edit");
+    const fs::path file = doc.path();
+    const std::string before = toJson(doc.scene());
+    GenerateWorker worker;
+    ASSERT_TRUE(worker.start("make it one red ball", before, fakeModel(server)));
+    auto done = finish(worker);
+    ASSERT_TRUE(done && *done);
+    EXPECT_EQ(userMessage(server, 0), sceneUserPrompt("make it one red ball", before));
+
+    const uint64_t version = doc.version();
+    const std::string generated = (*done)->json;
+    doc.replace(std::move((*done)->scene));
+    EXPECT_EQ(toJson(doc.scene()), generated);
+    EXPECT_GT(doc.version(), version);
+    EXPECT_EQ(doc.path(), file); // saving still writes the file that was opened
+    ASSERT_TRUE(doc.history().undo());
+    EXPECT_EQ(toJson(doc.scene()), before);
+    ASSERT_TRUE(doc.history().redo());
+    EXPECT_EQ(toJson(doc.scene()), generated);
+
+    // A viewer started without a file: the generated scene is where its history begins.
+    Document empty;
+    empty.replace(*parseScene(kRedBall));
+    EXPECT_TRUE(empty.loaded());
+    EXPECT_EQ(toJson(empty.scene()), generated);
+    EXPECT_FALSE(empty.history().canUndo());
+}
+
+TEST(ViewerGenerate, AnAnswerThatNeverLoadsIsAnError) {
+    FakeServer server;
+    server.script({openAi(kBadBall), openAi(kBadBall)});
+    Document doc = twoSpheresDocument("viewer_generate_bad");
+    const std::string before = toJson(doc.scene());
+    const uint64_t version = doc.version();
+    GenerateOptions o = fakeModel(server);
+    o.maxRepairs = 1;
+    GenerateWorker worker;
+    ASSERT_TRUE(worker.start("a ball", before, o));
+    auto done = finish(worker);
+    ASSERT_TRUE(done);
+    ASSERT_FALSE(*done);
+    EXPECT_EQ(done->error().kind, ErrorKind::Validation);
+    EXPECT_EQ(done->error().str(),
+              "answer: no answer loaded after 1 repair rounds; the last one's problems:\n"
+              "answer: root.radius: expected a positive number, got -1");
+    EXPECT_EQ(server.received().size(), 2u);
+    EXPECT_EQ(toJson(doc.scene()), before);
+    EXPECT_EQ(doc.version(), version);
+    EXPECT_FALSE(doc.history().canUndo());
+}
+
+TEST(ViewerGenerate, CancelStopsAWaitingRequest) {
+    FakeServer server;
+    server.script({{200, "{}", "", true}}); // answers only after 20 s
+    GenerateWorker worker;
+    ASSERT_TRUE(worker.start("a ball", "", fakeModel(server)));
+    ASSERT_TRUE(server.awaitRequests(1));
+    EXPECT_TRUE(worker.running());
+    EXPECT_FALSE(worker.start("another ball", "", fakeModel(server))); // one at a time
+    const auto start = std::chrono::steady_clock::now();
+    worker.cancel();
+    auto done = finish(worker);
+    EXPECT_LT(secondsSince(start), 10.0); // libcurl asks about once a second
+    ASSERT_TRUE(done);
+    ASSERT_FALSE(*done);
+    EXPECT_EQ(done->error().kind, ErrorKind::Cancelled);
+    EXPECT_EQ(done->error().str(), server.url() + "/chat/completions: cancelled");
 }
 
 TEST(ViewerResolution, PreviewScaleAimsAtTheTargetTime) {

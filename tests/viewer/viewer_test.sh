@@ -1,6 +1,7 @@
 #!/bin/sh
-# The viewer under a virtual X server: its screenshot matches the headless renderer, and a
-# scripted session (select, edit, modes, undo, save) changes the image at every step.
+# The viewer under a virtual X server: its screenshot matches the headless renderer, a scripted
+# session (select, edit, modes, undo, save) changes the image at every step, and a scripted
+# generation against a stand-in language model is one undo step.
 # Usage: viewer_test.sh VIEWER CLI IMAGE_DIFF SOURCE_DIR WORK_DIR. Exits 77 (skipped) without
 # xvfb-run.
 set -eu
@@ -59,4 +60,45 @@ mode shiny" > bad.txt
 if run edit.json --script bad.txt 2> bad.err; then fail "a bad script was accepted"; fi
 grep -q "bad.txt:2:1: mode: expected one of shaded, normals, depth, steps, got \"shiny\"" bad.err ||
     fail "unexpected message: $(cat bad.err)"
+# 4. Scripted generation against a stand-in language model (skipped without python3): the new
+# scene replaces the old one as one undo step, and an answer that never loads fails the script
+# while the scene stays.
+if command -v python3 >/dev/null 2>&1; then
+    echo '{"version": 1, "root": {"type": "sphere", "name": "ball", "radius": 1, "color": [1, 0, 0]}}' > answer.json
+    python3 "$src/tests/viewer/fake_llm.py" answer.json port.txt &
+    llm=$!
+    trap 'kill $llm 2>/dev/null' EXIT
+    tries=0
+    while [ ! -s port.txt ] && [ $tries -lt 100 ]; do sleep 0.1; tries=$((tries + 1)); done
+    [ -s port.txt ] || fail "the stand-in language model did not start"
+    export SDFCSG_LLM_BASE_URL="http://127.0.0.1:$(cat port.txt)/v1" SDFCSG_LLM_MODEL=fake \
+        SDFCSG_LLM_API_KEY= OPENAI_API_KEY= SDFCSG_LLM_API= no_proxy=127.0.0.1
+    cat > generate.txt <<'SCRIPT'
+screenshot g0-start.png
+generate a red ball
+screenshot g1-generated.png
+save generated.json
+undo
+reset
+screenshot g2-undone.png
+SCRIPT
+    run edit.json --script generate.txt --size 320x240 --no-ui 2> generate.err ||
+        fail "scripted generation: $(cat generate.err)"
+    grep -q "generate.txt:2: 1 nodes, valid on the first try" generate.err ||
+        fail "no summary of the generation: $(cat generate.err)"
+    grep -q '"name": "ball"' generated.json || fail "the generated scene was not the current one"
+    "$diff" g0-start.png g1-generated.png differ 0.05 || fail "the generated scene is not shown"
+    "$diff" g2-undone.png g0-start.png same 0 0 || fail "undo did not bring the scene back"
+
+    echo '{"version": 1, "root": {"type": "sphere", "radius": -1}}' > answer.json
+    printf 'edit-scene make it smaller\nsave unchanged.json\n' > bad-generate.txt
+    if run edit.json --script bad-generate.txt --size 320x240 --no-ui 2> bad-generate.err; then
+        fail "a failed generation did not fail the script"
+    fi
+    grep -q "bad-generate.txt:1: answer: no answer loaded after 3 repair rounds" bad-generate.err ||
+        fail "unexpected message: $(cat bad-generate.err)"
+    [ ! -e unchanged.json ] || fail "the script went on after a failed generation"
+else
+    echo "skipped the generation session: python3 not found"
+fi
 echo "viewer tests passed"

@@ -23,7 +23,7 @@ struct Diagnostic {
 };
 
 // Remote: an HTTP service (a language model endpoint) failed, refused or answered unusably.
-// Cancelled: a progress callback asked long work (a render, a mesh extraction) to stop.
+// Cancelled: a callback asked long work (a render, a mesh extraction, a generation) to stop.
 enum class ErrorKind { Io, Syntax, Validation, Limit, Shader, Vulkan, Usage, Remote, Cancelled };
 
 struct Error {

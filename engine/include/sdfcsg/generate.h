@@ -56,6 +56,15 @@ struct LlmConfig {
 // "ollama") forces the API. The base URL defaults to https://api.openai.com/v1.
 LlmConfig llmConfigFromEnvironment();
 
+// Where generateScene() sends its requests: the URL, the API and the model, defaults applied.
+// Holds no key, so it can be shown. Errors: Usage (no model, a base URL that is not http(s)).
+struct LlmEndpoint {
+    std::string url;
+    LlmApi api = LlmApi::OpenAI;
+    std::string model;
+};
+Result<LlmEndpoint> llmEndpoint(const LlmConfig& config);
+
 // One HTTP exchange, as recorded and replayed. It holds no headers, so never the API key.
 struct HttpExchange {
     std::string url;
@@ -84,7 +93,13 @@ struct GenerateOptions {
     // Non-empty: the JSON of a scene to change (`sdfcsg edit`); the request says how.
     std::string currentScene;
     std::function<void(const GenerateProgress&)> progress;
-    // Waits between retries; unset: the calling thread sleeps. Tests and replays pass their own.
+    // Asked on the generating thread before each request, during each wait between retries,
+    // and about once a second while an answer is awaited (the transfer is then aborted); true
+    // stops generation with ErrorKind::Cancelled ("cancelled"). It must be quick and must not
+    // block: typically it reads a flag that a Cancel button sets on another thread.
+    std::function<bool()> cancelled;
+    // Waits between retries; unset: the calling thread sleeps, asking `cancelled` as it goes.
+    // Tests pass their own (then `cancelled` is asked after the wait).
     std::function<void(double seconds)> sleep;
     std::vector<HttpExchange>* record = nullptr;       // every exchange is appended here
     const std::vector<HttpExchange>* replay = nullptr; // answers from here, in order; no network
@@ -107,12 +122,17 @@ struct Generated {
 };
 
 // Asks the model for a scene matching `request` (or, with options.currentScene, for that scene
-// changed as `request` says). Errors: Usage (no model, bad URL), Remote (HTTP and network
+// changed as `request` says). Blocks until done: callers with a window run it on a thread (the
+// viewer's GenerateWorker). Errors: Usage (no model, bad URL), Remote (HTTP and network
 // failures, refusals, answers cut off at the token limit), Validation (no answer loaded within
-// options.maxRepairs rounds; the diagnostics are the last answer's problems). `stats`, when
-// given, is filled in either case.
+// options.maxRepairs rounds; the diagnostics are the last answer's problems), Cancelled
+// (options.cancelled said so). `stats`, when given, is filled in either case.
 Result<Generated> generateScene(std::string_view request, const GenerateOptions& options,
                                 GenerateStats* stats = nullptr);
+
+// One line for people: "8 nodes, valid after 1 repair round (json_schema, 2 requests,
+// 8000 + 600 tokens, 4.2 s)".
+std::string generationSummary(const Generated& generated, const GenerateStats& stats);
 
 // The system prompt: the format reference, the composition rules and the examples.
 std::string sceneSystemPrompt();
