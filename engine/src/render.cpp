@@ -200,8 +200,8 @@ struct Renderer::Impl {
         return Ok{};
     }
 
-    FrameUniform frameUniform(const RenderOptions& options, const Camera& camera) const {
-        detail::RayCamera rc = detail::makeRayCamera(camera, options.width, options.height);
+    FrameUniform frameUniform(const RenderOptions& render, const Camera& camera) const {
+        detail::RayCamera rc = detail::makeRayCamera(camera, render.width, render.height);
         detail::ClipVolume clip = detail::makeClipVolume(*evaluator, rc.eye);
         Aabb finite = detail::finitePrimitiveBounds(*evaluator);
 
@@ -233,11 +233,11 @@ struct Renderer::Impl {
         f.distances = glm::vec4(nearest, farthest, 0.2f * size, size);
 
         uint32_t flags = 0;
-        if (options.shadows) flags |= SDFCSG_FLAG_SHADOWS;
-        if (options.ambientOcclusion) flags |= SDFCSG_FLAG_AO;
-        if (options.boxes == BoxOverlay::All) flags |= SDFCSG_FLAG_BOXES_ALL;
-        if (options.boxes == BoxOverlay::Selected) flags |= SDFCSG_FLAG_BOXES_SELECTED;
-        f.size = glm::uvec4(options.width, options.height, uint32_t(options.mode), flags);
+        if (render.shadows) flags |= SDFCSG_FLAG_SHADOWS;
+        if (render.ambientOcclusion) flags |= SDFCSG_FLAG_AO;
+        if (render.boxes == BoxOverlay::All) flags |= SDFCSG_FLAG_BOXES_ALL;
+        if (render.boxes == BoxOverlay::Selected) flags |= SDFCSG_FLAG_BOXES_SELECTED;
+        f.size = glm::uvec4(render.width, render.height, uint32_t(render.mode), flags);
 
         std::vector<Light> lights = scene.lights.empty() ? defaultLights() : scene.lights;
         uint32_t lightCount = uint32_t(std::min<size_t>(lights.size(), SDFCSG_MAX_LIGHTS));
@@ -249,8 +249,8 @@ struct Renderer::Impl {
                     1.0f / (std::abs(l[c]) < 1e-20f ? (l[c] >= 0.0f ? 1e-20f : -1e-20f) : l[c]);
             f.lights[i].color = glm::vec4(lights[i].color * lights[i].intensity, 0.0f);
         }
-        uint32_t selected = options.selectedNode >= 0 ? uint32_t(options.selectedNode) : nodeCount;
-        f.counts = glm::uvec4(options.aa, lightCount, nodeCount, selected);
+        uint32_t selected = render.selectedNode >= 0 ? uint32_t(render.selectedNode) : nodeCount;
+        f.counts = glm::uvec4(render.aa, lightCount, nodeCount, selected);
         return f;
     }
 };
