@@ -38,7 +38,7 @@ std::vector<fs::path> findScenes(const fs::path& dir) {
     return scenes;
 }
 
-const char* kHelp = R"(Usage: sdfcsg bench [--scenes DIR] [--width W] [--height H] [--frames N]
+const char* kHelp = R"(Usage: sdfcsg bench [--scenes DIR] [--width W] [--height H] [--frames N] [--buffer]
        sdfcsg bench --mesh [--scenes DIR] [--resolutions 128,256,512] [--runs N]
 
 For every scene (*.json) in DIR (default assets/scenes), prints the median milliseconds per
@@ -53,6 +53,9 @@ Options:
   --width W      image width (default 1280)
   --height H     image height (default 720)
   --frames N     timed frames per measurement (default 5)
+  --buffer       also time a renderer that reads the values from the node buffer, as the
+                 viewer's value edits do (so no recompile): its frame and its build from a
+                 parsed scene, with nothing cached (slow to compile on lavapipe)
 
 With --mesh, prints for every scene and resolution the median seconds of each stage of mesh
 extraction and of the whole (from a compiled scene to an indexed mesh in host memory), over
@@ -127,6 +130,7 @@ struct Row {
     std::string name;
     size_t nodes = 0;
     double skip = 0, noSkip = 0, cold = 0, warm = 0;
+    double buffer = 0, bufferBuild = 0; // with --buffer
 };
 
 // The reference scenes of the mesh benchmark come with bounds of their own; every other scene
@@ -294,11 +298,16 @@ int runBench(int argc, char** argv) {
         }
     fs::path dir = "assets/scenes";
     uint32_t width = 1280, height = 720, frames = 5;
+    bool buffer = false;
     for (int i = 0; i < argc; ++i) {
         std::string_view a = argv[i];
         if (a == "--help" || a == "-h") {
             std::fputs(kHelp, stdout);
             return 0;
+        }
+        if (a == "--buffer") {
+            buffer = true;
+            continue;
         }
         bool ok = i + 1 < argc;
         if (ok && a == "--scenes")
@@ -407,16 +416,43 @@ int runBench(int argc, char** argv) {
         }
         row.skip = *skip;
         row.noSkip = *noSkip;
+        if (buffer) {
+            ScopedEnv off("SDFCSG_CACHE_DIR", "off");
+            detail::clearShaderMemoryCache();
+            auto scene = parseScene(json, file);
+            RendererOptions values;
+            values.inlineValues = false;
+            auto start = Clock::now();
+            auto built = scene ? Renderer::create(**coldContext, *scene, values)
+                               : Result<std::unique_ptr<Renderer>>(scene.error());
+            if (!built) {
+                fail(built.error());
+                break;
+            }
+            row.bufferBuild = msSince(start);
+            options.boundsSkipping.reset();
+            auto frame = medianFrameMs(**built, options, frames);
+            if (!frame) {
+                fail(frame.error());
+                break;
+            }
+            row.buffer = *frame;
+        }
         std::fprintf(stderr, "  %s done\n", row.name.c_str());
         rows.push_back(row);
     }
     fs::remove_all(cacheDir, ec);
 
-    std::printf("\n%-16s %6s %14s %14s %8s %16s %16s\n", "scene", "nodes", "skip ms", "no-skip ms",
+    std::printf("\n%-16s %6s %14s %14s %8s %16s %16s", "scene", "nodes", "skip ms", "no-skip ms",
                 "speedup", "json->pipe cold", "json->pipe warm");
-    for (const Row& r : rows)
-        std::printf("%-16s %6zu %14.1f %14.1f %7.2fx %16.1f %16.1f\n", r.name.c_str(), r.nodes,
+    if (buffer) std::printf(" %10s %16s", "buffer ms", "buffer build ms");
+    std::printf("\n");
+    for (const Row& r : rows) {
+        std::printf("%-16s %6zu %14.1f %14.1f %7.2fx %16.1f %16.1f", r.name.c_str(), r.nodes,
                     r.skip, r.noSkip, r.noSkip / std::max(r.skip, 1e-9), r.cold, r.warm);
+        if (buffer) std::printf(" %10.1f %16.1f", r.buffer, r.bufferBuild);
+        std::printf("\n");
+    }
     std::printf(
         "\njson->pipe: parse + codegen + GLSL compile + pipeline ready to run. cold: nothing "
         "cached; warm: SPIR-V and driver disk caches filled, in-process cache cleared.\n"

@@ -429,6 +429,7 @@ void updateImage(Viewer& v) {
     job.scene = v.scene;
     job.sceneVersion = v.sceneVersion;
     job.id = v.nextJob++;
+    job.preview = moving(v);
     job.options.width = want.width;
     job.options.height = want.height;
     job.options.camera = want.camera;
@@ -634,6 +635,7 @@ void valueEditor(Viewer& v) {
     ImGui::TextDisabled("%s", n.path.c_str());
     auto edited = [&](const char* key, std::vector<float> values) {
         commit(v, setValue(*v.scene, id, key, values), std::to_string(id) + key);
+        v.lastInteraction = now(); // previews while a value is dragged, as while the camera moves
     };
     for (const ParamInfo& p : info.params) {
         std::string name(p.name);
@@ -1116,6 +1118,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "%s\n", v.renderError->str().c_str());
         v.exitCode = 1;
     }
+    glfwHideWindow(v.window); // the workers may need a moment to finish a compile
     v.renderer.reset();
     v.mesher.reset();
     v.generator.reset(); // cancels a generation in flight

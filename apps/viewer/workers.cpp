@@ -27,6 +27,7 @@ RenderWorker::~RenderWorker() {
     }
     wake_.notify_all();
     thread_.join();
+    if (liveThread_.joinable()) liveThread_.join(); // a compile cannot be interrupted
 }
 
 void RenderWorker::submit(RenderJob job) {
@@ -67,51 +68,94 @@ void RenderWorker::run() {
     }
 }
 
+bool RenderWorker::liveBuildDone() const {
+    return liveDone_;
+}
+
+void RenderWorker::startLiveBuild(std::shared_ptr<const Scene> scene) {
+    if (!liveDone_ || live_) return;
+    if (liveThread_.joinable()) liveThread_.join();
+    liveBuildScene_ = scene;
+    liveDone_ = false;
+    liveThread_ = std::thread([this, scene = std::move(scene)] {
+        RendererOptions options;
+        options.inlineValues = false;
+        auto built = Renderer::create(context_, *scene, options);
+        std::lock_guard lock(mutex_);
+        liveBuilt_ = std::move(built);
+        liveDone_ = true;
+    });
+}
+
+// Adopts a finished live build when it fits the wanted structure (one built for a structure
+// that was edited away meanwhile is dropped).
+void RenderWorker::takeLiveBuild(const Scene& wanted) {
+    std::optional<Result<std::unique_ptr<Renderer>>> built;
+    {
+        std::lock_guard lock(mutex_);
+        built.swap(liveBuilt_);
+    }
+    if (!built || !*built || !sameStructure(*liveBuildScene_, wanted)) return;
+    live_ = std::move(**built);
+    liveScene_ = liveBuildScene_;
+    liveVersion_ = ~0ull; // it holds the build's values; its first use uploads the wanted ones
+}
+
 RenderOutput RenderWorker::process(const RenderJob& job) {
     RenderOutput out;
     out.id = job.id;
-    if (!renderer_ || !sameStructure(*compiled_, *job.scene)) {
-        // A scene that failed once is not compiled again until it changes.
-        if (failedVersion_ != job.sceneVersion) {
-            auto start = std::chrono::steady_clock::now();
-            RendererOptions options;
-            options.inlineValues = false; // value edits are uploads, not recompiles
-            auto created = Renderer::create(context_, *job.scene, options);
-            out.compileSeconds = secondsSince(start);
-            if (created) {
-                renderer_ = std::move(*created);
-                compiled_ = job.scene;
-                compiledVersion_ = job.sceneVersion;
-                failedVersion_.reset();
-                failure_.reset();
-            } else {
-                failedVersion_ = job.sceneVersion;
-                failure_ = created.error();
-            }
+    takeLiveBuild(*job.scene);
+    if (live_ && !sameStructure(*liveScene_, *job.scene)) live_.reset();
+
+    Renderer* renderer = nullptr;
+    if (baked_ && bakedVersion_ == job.sceneVersion) {
+        renderer = baked_.get();
+    } else if (job.preview && live_) {
+        if (liveVersion_ != job.sceneVersion) {
+            if (auto updated = live_->updateValues(*job.scene); updated)
+                liveVersion_ = job.sceneVersion;
+            else
+                failure_ = updated.error();
         }
-    } else if (compiledVersion_ != job.sceneVersion) {
-        if (auto updated = renderer_->updateValues(*job.scene); updated) {
-            compiled_ = job.scene;
-            compiledVersion_ = job.sceneVersion;
+        if (liveVersion_ == job.sceneVersion) {
+            renderer = live_.get();
+            out.live = true;
             failure_.reset();
+        }
+    } else if (failedVersion_ != job.sceneVersion) { // a scene that failed waits for a change
+        const bool valueEdit = baked_ && sameStructure(*bakedScene_, *job.scene);
+        auto start = std::chrono::steady_clock::now();
+        auto created = Renderer::create(context_, *job.scene);
+        out.compileSeconds = secondsSince(start);
+        if (created) {
+            baked_ = std::move(*created);
+            bakedScene_ = job.scene;
+            bakedVersion_ = job.sceneVersion;
+            failedVersion_.reset();
+            failure_.reset();
+            renderer = baked_.get();
+            if (valueEdit && job.preview) startLiveBuild(job.scene); // a value is being dragged
         } else {
-            failure_ = updated.error();
+            failedVersion_ = job.sceneVersion;
+            failure_ = created.error();
         }
     }
     out.error = failure_;
-    if (!renderer_) return out;
-    out.scene = compiled_;
+    // A scene that does not compile leaves the last one that did on screen.
+    if (!renderer) renderer = baked_.get();
+    if (!renderer) return out;
+    out.scene = out.live ? job.scene : bakedScene_;
     out.options = job.options;
-    if (out.options.selectedNode >= int(compiled_->nodes.size())) out.options.selectedNode = -1;
+    if (out.options.selectedNode >= int(out.scene->nodes.size())) out.options.selectedNode = -1;
     auto start = std::chrono::steady_clock::now();
-    auto image = renderer_->render(out.options);
+    auto image = renderer->render(out.options);
     out.renderSeconds = secondsSince(start);
     if (!image) {
         out.error = image.error();
         return out;
     }
     out.image = std::move(*image);
-    out.pixels = renderer_->lastPixelInfo();
+    out.pixels = renderer->lastPixelInfo();
     return out;
 }
 

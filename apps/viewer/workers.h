@@ -1,5 +1,5 @@
 // Background threads for the slow engine calls, so the window keeps answering: one renders
-// (compiling when the structure changes), one extracts meshes, one asks a language model for a
+// (compiling when the scene changes), one extracts meshes, one asks a language model for a
 // scene. The first two share the viewer's Context, whose queue submissions take turns
 // (context.h).
 #pragma once
@@ -23,9 +23,10 @@ namespace sdfcsg::viewer {
 
 struct RenderJob {
     std::shared_ptr<const Scene> scene;
-    uint64_t sceneVersion = 0; // a new version with the same structure is only an upload
+    uint64_t sceneVersion = 0; // a new version with the same structure is only new values
     RenderOptions options;     // camera set by the caller
     uint64_t id = 0;
+    bool preview = false; // a frame while the camera or a value moves: speed over exactness
 };
 
 struct RenderOutput {
@@ -36,9 +37,16 @@ struct RenderOutput {
     std::shared_ptr<const Scene> scene; // the scene the image shows (the last that compiled)
     double renderSeconds = 0.0;
     double compileSeconds = 0.0; // 0 when no compile was needed
+    bool live = false; // drawn by the live renderer: new values uploaded, not compiled
     std::optional<Error> error;  // the job's scene failed to compile (or the render failed)
 };
 
+// Frames come from a renderer with the values inlined ("baked"): on CPU drivers its kernel
+// compiles many times faster and runs several times faster than one that reads them from the
+// node buffer. A new version of the values is baked again, except for previews once the "live"
+// renderer is there: it reads the values from the node buffer, so a value edit is an upload, not
+// a recompile. It is built on a thread of its own after the first value edit of a structure,
+// since its compile takes seconds on lavapipe; until then previews of edits bake too.
 class RenderWorker {
   public:
     explicit RenderWorker(Context& context);
@@ -52,10 +60,14 @@ class RenderWorker {
     std::optional<RenderOutput> take();
     // No job waiting or running.
     bool idle() const;
+    // The live renderer's build, started by a value edit, has finished (or none is running).
+    bool liveBuildDone() const;
 
   private:
     void run();
     RenderOutput process(const RenderJob& job);
+    void startLiveBuild(std::shared_ptr<const Scene> scene);
+    void takeLiveBuild(const Scene& wanted);
 
     Context& context_;
     mutable std::mutex mutex_;
@@ -64,11 +76,19 @@ class RenderWorker {
     std::optional<RenderOutput> done_;
     bool busy_ = false, stop_ = false;
     // Used by the worker thread only.
-    std::unique_ptr<Renderer> renderer_;
-    std::shared_ptr<const Scene> compiled_;
-    uint64_t compiledVersion_ = 0;
+    std::unique_ptr<Renderer> baked_;
+    std::shared_ptr<const Scene> bakedScene_;
+    uint64_t bakedVersion_ = 0;
+    std::unique_ptr<Renderer> live_;
+    std::shared_ptr<const Scene> liveScene_; // the structure it was built for
+    uint64_t liveVersion_ = 0;               // the values it holds
     std::optional<uint64_t> failedVersion_;
     std::optional<Error> failure_;
+    // The live renderer's build: the worker starts and takes it; liveDone_ tells the others.
+    std::thread liveThread_;
+    std::shared_ptr<const Scene> liveBuildScene_;
+    std::optional<Result<std::unique_ptr<Renderer>>> liveBuilt_; // under mutex_
+    std::atomic<bool> liveDone_{true};
     std::thread thread_;
 };
 

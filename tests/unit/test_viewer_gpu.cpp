@@ -33,41 +33,79 @@ class ViewerGpu : public test::GpuTest {};
 
 } // namespace
 
+// Fraction of pixels whose colour differs by more than `tolerance` in a channel.
+double differingFraction(const Image& a, const Image& b, int tolerance) {
+    EXPECT_EQ(a.rgba.size(), b.rgba.size());
+    size_t differing = 0;
+    for (size_t i = 0; i + 3 < std::min(a.rgba.size(), b.rgba.size()); i += 4)
+        for (size_t c = 0; c < 3; ++c)
+            if (std::abs(int(a.rgba[i + c]) - int(b.rgba[i + c])) > tolerance) {
+                ++differing;
+                break;
+            }
+    return double(differing) / double(std::max<size_t>(a.rgba.size() / 4, 1));
+}
+
+// Frames are baked (values inlined); a dragged value (previews) starts the live renderer's
+// build, after which previews of new values are uploads that match the baked image, while the
+// still frame bakes again; a structural edit bakes and drops the live renderer.
 TEST_F(ViewerGpu, ValueEditsUploadAndStructuralEditsRecompile) {
     auto scene = std::make_shared<const Scene>(*parseScene(kScene, "scene.json"));
     RenderWorker worker(context());
     RenderJob job;
-    job.scene = scene;
-    job.sceneVersion = 1;
     job.options.width = 64;
     job.options.height = 48;
     job.options.camera = scene->camera;
-    job.id = 1;
-    worker.submit(job);
-    RenderOutput first = wait(worker);
-    ASSERT_FALSE(first.error) << first.error->str();
-    EXPECT_EQ(first.id, 1u);
+    auto render = [&](std::shared_ptr<const Scene> s, uint64_t version, bool preview) {
+        job.scene = std::move(s);
+        job.sceneVersion = version;
+        job.preview = preview;
+        ++job.id;
+        worker.submit(job);
+        RenderOutput out = wait(worker);
+        EXPECT_FALSE(out.error) << out.error->str();
+        EXPECT_EQ(out.id, job.id);
+        return out;
+    };
+    auto withRadius = [&](float r) {
+        return std::make_shared<const Scene>(*setValue(*scene, 1, "radius", std::span(&r, 1)));
+    };
+
+    RenderOutput first = render(scene, 1, false);
     EXPECT_GT(first.compileSeconds, 0.0);
+    EXPECT_FALSE(first.live);
     EXPECT_EQ(first.image.width, 64u);
     EXPECT_EQ(first.pixels.size(), 64u * 48u);
     EXPECT_TRUE(worker.idle());
 
-    float r = 0.9f;
-    job.scene = std::make_shared<const Scene>(*setValue(*scene, 1, "radius", std::span(&r, 1)));
-    job.sceneVersion = 2;
-    job.id = 2;
-    worker.submit(job);
-    RenderOutput second = wait(worker);
-    EXPECT_EQ(second.compileSeconds, 0.0); // an upload
-    EXPECT_NE(second.image.rgba, first.image.rgba);
+    RenderOutput dragged = render(withRadius(0.7f), 2, true); // baked: no live renderer yet
+    EXPECT_GT(dragged.compileSeconds, 0.0);
+    EXPECT_FALSE(dragged.live);
+    EXPECT_NE(dragged.image.rgba, first.image.rgba);
+    for (int i = 0; i < 24000 && !worker.liveBuildDone(); ++i) // at most two minutes
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    ASSERT_TRUE(worker.liveBuildDone());
 
-    job.scene = std::make_shared<const Scene>(*removeNode(*job.scene, 2));
-    job.sceneVersion = 3;
-    job.id = 3;
-    worker.submit(job);
-    RenderOutput third = wait(worker);
-    EXPECT_GT(third.compileSeconds, 0.0);
-    EXPECT_EQ(third.scene->nodes.size(), 2u);
+    auto bigger = withRadius(0.9f);
+    RenderOutput live = render(bigger, 3, true);
+    EXPECT_EQ(live.compileSeconds, 0.0); // an upload
+    EXPECT_TRUE(live.live);
+    EXPECT_NE(live.image.rgba, dragged.image.rgba);
+    RenderOutput still = render(bigger, 3, false); // the same values, baked
+    EXPECT_GT(still.compileSeconds, 0.0);
+    EXPECT_FALSE(still.live);
+    // Kernels with values inlined or read from a buffer may round differently by a step or two.
+    EXPECT_LE(differingFraction(live.image, still.image, 6), 0.002);
+
+    RenderOutput removed = render(std::make_shared<const Scene>(*removeNode(*bigger, 2)), 4, false);
+    EXPECT_GT(removed.compileSeconds, 0.0);
+    EXPECT_EQ(removed.scene->nodes.size(), 2u);
+    float r = 0.5f;
+    RenderOutput afterRemoval =
+        render(std::make_shared<const Scene>(*setValue(*removed.scene, 1, "radius", std::span(&r, 1))),
+               5, true);
+    EXPECT_FALSE(afterRemoval.live); // the live renderer was for the old structure
+    EXPECT_GT(afterRemoval.compileSeconds, 0.0);
 }
 
 TEST_F(ViewerGpu, ClickingAPixelSelectsThePrimitiveThere) {
