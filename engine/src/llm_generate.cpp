@@ -409,6 +409,7 @@ class Conversation {
         post.apiKey = options_.llm.apiKey;
         post.timeoutSeconds = options_.llm.timeoutSeconds;
         post.connectTimeoutSeconds = options_.llm.connectTimeoutSeconds;
+        post.maxResponseBytes = options_.llm.maxResponseBytes;
         post.tick = [&](double elapsed) { progress(status, elapsed, true); };
         post.cancelled = options_.cancelled;
         auto response = detail::httpPost(post);

@@ -120,7 +120,8 @@ Result<HttpResponse> httpPost(const HttpPost& post) {
     const CURLcode code = curl_easy_perform(c);
     if (transfer.cancelled) return Error::message(ErrorKind::Cancelled, post.url, "cancelled");
     if (transfer.tooLarge)
-        return fail("the answer exceeds " + std::to_string(post.maxResponseBytes >> 20) + " MiB");
+        return fail("the answer exceeds the limit of " + std::to_string(post.maxResponseBytes) +
+                    " bytes");
     if (code == CURLE_OPERATION_TIMEDOUT) {
         char seconds[32];
         std::snprintf(seconds, sizeof seconds, "%g", post.timeoutSeconds);

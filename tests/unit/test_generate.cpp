@@ -188,6 +188,19 @@ TEST_F(Fixture, UntrustedAnswerLimits) {
         << g.error().str();
 }
 
+// The answer's size is limited before it is read whole: the transfer stops at the limit.
+TEST_F(Fixture, AnswerLargerThanTheLimitIsRefused) {
+    server.script({openAi(std::string(R"({"version": 1, "name": ")") + std::string(3000, 'x') +
+                          R"(", "root": {"type": "sphere", "radius": 1}})")});
+    GenerateOptions o = options();
+    o.llm.maxResponseBytes = 2048;
+    auto g = generateScene("a sphere", o);
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().kind, ErrorKind::Remote);
+    EXPECT_EQ(g.error().str(),
+              server.url() + "/chat/completions: the answer exceeds the limit of 2048 bytes");
+}
+
 TEST_F(Fixture, FinishReasonLength) {
     server.script({openAi(R"({"version": 1, "root": {"type": "uni)", "length")});
     auto g = generateScene("a sphere", options());

@@ -416,17 +416,25 @@ TEST_F(Render, RejectsBadOptions) {
     Scene scene = loadOrDie(scenePath("csg_part.json"));
     auto renderer = Renderer::create(context(), scene);
     ASSERT_TRUE(renderer) << renderer.error().str();
+    auto refused = [&](const RenderOptions& options) {
+        auto image = (*renderer)->render(options);
+        return image ? std::string("rendered") : image.error().str();
+    };
     RenderOptions options;
     options.width = 0;
-    EXPECT_FALSE((*renderer)->render(options));
+    EXPECT_EQ(refused(options), "<render>: the image must be at least 1 x 1 pixels");
     options.width = 8;
     options.aa = 0;
-    EXPECT_FALSE((*renderer)->render(options));
+    EXPECT_EQ(refused(options), "<render>: aa must be in 1..16");
+    options.aa = 17;
+    EXPECT_EQ(refused(options), "<render>: aa must be in 1..16");
     options.aa = 1;
     options.width = options.height = 1u << 16; // 4 G pixels
     auto huge = (*renderer)->render(options);
     ASSERT_FALSE(huge);
     EXPECT_EQ(huge.error().kind, ErrorKind::Limit);
+    EXPECT_EQ(huge.error().str(), "<render>: an image of 65536 x 65536 pixels is too large for " +
+                                      context().deviceName());
 }
 
 // A render is computed in bands of rows; the caller follows them and may stop between two.

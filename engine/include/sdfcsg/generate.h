@@ -15,6 +15,7 @@
 #include "sdfcsg/error.h"
 #include "sdfcsg/scene.h"
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -49,6 +50,7 @@ struct LlmConfig {
     uint32_t maxTokens = 8192;        // answer length limit
     std::optional<float> temperature = 0.2f; // unset: the server's default
     uint32_t contextTokens = 16384; // Ollama's options.num_ctx (its default is far too small)
+    size_t maxResponseBytes = 16u << 20; // a longer HTTP answer is cut off with a Remote error
 };
 
 // Settings from the environment: OPENAI_BASE_URL and OPENAI_API_KEY, overridden by
