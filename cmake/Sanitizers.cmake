@@ -28,11 +28,6 @@ if(SDFCSG_SANITIZERS)
     if(SDFCSG_SANITIZERS MATCHES "undefined")
         add_compile_options(-fno-sanitize=vptr)
     endif()
-    # GCC 12 warns of overlapping copies inside std::string that cannot happen once the
-    # sanitizers' checks are inlined (GCC bug 105329).
-    if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
-        add_compile_options(-Wno-restrict)
-    endif()
 endif()
 if(SDFCSG_FUZZ)
     # Coverage feedback from every target; only the fuzz targets link libFuzzer's main.

@@ -73,14 +73,6 @@ uint32_t loadedIndex(const Scene& scene, uint32_t node) {
 
 } // namespace
 
-bool sameStructure(const Scene& a, const Scene& b) {
-    if (a.nodes.size() != b.nodes.size()) return false;
-    for (size_t i = 0; i < a.nodes.size(); ++i)
-        if (a.nodes[i].kind != b.nodes[i].kind || a.nodes[i].children != b.nodes[i].children)
-            return false;
-    return true;
-}
-
 std::string nodeLabel(const Scene& scene, uint32_t node) {
     const Node& n = scene.nodes[node];
     std::string kind(kindInfo(n.kind).name);

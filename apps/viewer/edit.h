@@ -15,10 +15,6 @@
 
 namespace sdfcsg::viewer {
 
-// Same node count, kinds and children: values may differ, so a renderer compiled for one can
-// take the other's values with updateValues() instead of a recompile.
-bool sameStructure(const Scene& a, const Scene& b);
-
 // "name (kind)", or the kind alone for an unnamed node.
 std::string nodeLabel(const Scene& scene, uint32_t node);
 

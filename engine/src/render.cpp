@@ -51,15 +51,6 @@ constexpr detail::Binding kBindings[] = {
     {SDFCSG_BINDING_INFO, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
 };
 
-// What must not change for updateValues() to reuse the compiled kernel.
-bool sameStructure(const Scene& a, const Scene& b) {
-    if (a.nodes.size() != b.nodes.size()) return false;
-    for (size_t i = 0; i < a.nodes.size(); ++i)
-        if (a.nodes[i].kind != b.nodes[i].kind || a.nodes[i].children != b.nodes[i].children)
-            return false;
-    return true;
-}
-
 Error usage(std::string text) {
     return Error::message(ErrorKind::Usage, "<render>", std::move(text));
 }
@@ -68,6 +59,14 @@ Error usage(std::string text) {
 constexpr uint32_t kBandPixels = 1u << 16;
 
 } // namespace
+
+bool sameStructure(const Scene& a, const Scene& b) {
+    if (a.nodes.size() != b.nodes.size()) return false;
+    for (size_t i = 0; i < a.nodes.size(); ++i)
+        if (a.nodes[i].kind != b.nodes[i].kind || a.nodes[i].children != b.nodes[i].children)
+            return false;
+    return true;
+}
 
 struct Renderer::Impl {
     Context::Impl& ctx;

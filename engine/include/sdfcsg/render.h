@@ -52,6 +52,9 @@ struct PixelInfo {
     uint32_t steps;
 };
 
+// Same node kinds and children, node for node: what updateValues() needs to keep the kernel.
+bool sameStructure(const Scene& a, const Scene& b);
+
 struct RendererOptions {
     // true: numeric values are baked into the kernel as literals. CPU drivers (lavapipe) run
     // that several times faster, but updateValues() must then regenerate and recompile.
