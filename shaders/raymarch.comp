@@ -1,5 +1,13 @@
 #version 450
-// Sphere tracing of the generated scene, one invocation per pixel.
+// Sphere tracing of the generated scene in three passes over a band of rows (kPass):
+//   march:   one invocation per sample (aa x aa per pixel) traces its ray to the first hit and
+//            writes the colour of misses and of the depth and steps modes; hits that need
+//            shading are appended to a list, which also counts the shade pass's workgroups;
+//   shade:   one invocation per listed hit (an indirect dispatch): normal, occlusion, shadows
+//            and lighting;
+//   resolve: with several samples per pixel, one invocation per pixel averages them.
+// CPU drivers such as lavapipe run invocations in SIMD lanes and execute every branch that any
+// lane takes; split this way, misses never pay for shading and every shading lane has a hit.
 //
 // Rays are generated and clipped exactly as engine/src/camera.h does on the CPU (the tests trace
 // the same rays with the reference evaluator). Normals use the four-tap tetrahedral difference
@@ -13,6 +21,7 @@
 #include "scene.glsl"
 
 layout(local_size_x = SDFCSG_RAYMARCH_GROUP_X, local_size_y = SDFCSG_RAYMARCH_GROUP_Y) in;
+layout(constant_id = SDFCSG_SPEC_RAYMARCH_PASS) const uint kPass = SDFCSG_RAYMARCH_PASS_MARCH;
 
 struct FrameLight {
     vec4 direction; // xyz: unit vector towards the light
@@ -27,7 +36,7 @@ layout(std140, set = 0, binding = SDFCSG_BINDING_FRAME) uniform Frame {
     vec4 up;         // xyz; w: pixel footprint at unit distance
     vec4 forward;    // xyz; w: minimum hit epsilon
     vec4 clipMin;    // xyz: ray clip box; w: far distance
-    vec4 clipMax;    // xyz
+    vec4 clipMax;    // xyz; w: sample footprint at unit distance (the pixel's / aa)
     vec4 background; // rgb as given (output space)
     vec4 sky;        // rgb: background in linear space, for the ambient term
     vec4 distances;  // x: depth-mode near, y: depth-mode far, z: occlusion scale, w: shadow reach
@@ -39,9 +48,11 @@ layout(std140, set = 0, binding = SDFCSG_BINDING_FRAME) uniform Frame {
     vec4 surfaceBoxes[2 * SDFCSG_MAX_CLIP_BOXES];
 } frame;
 
-// The first row of the band this dispatch computes (engine/src/render.cpp).
+// The band this dispatch computes (engine/src/render.cpp): its first pixel row, and where its
+// first sample's colour goes in Colors.
 layout(push_constant) uniform Band {
     uint firstRow;
+    uint colorOffset;
 } band;
 
 layout(std430, set = 0, binding = SDFCSG_BINDING_PIXELS) writeonly buffer Pixels {
@@ -52,8 +63,25 @@ layout(std430, set = 0, binding = SDFCSG_BINDING_INFO) writeonly buffer Info {
     vec2 info[];
 };
 
+// Packed RGBA8 per sample of the band, row-major over the band's sample grid; with one sample
+// per pixel this is the Pixels buffer itself (colorOffset: the band's first pixel).
+layout(std430, set = 0, binding = SDFCSG_BINDING_SAMPLES) buffer Colors {
+    uint colors[];
+};
+
+// Hits of the band that need shading: x: sample index in the band, y: ray parameter (bits).
+// count and groups are cleared before the march pass; groups, 1, 1 are the shade pass's
+// indirect dispatch.
+layout(std430, set = 0, binding = SDFCSG_BINDING_HITS) buffer Hits {
+    uint count;
+    uint groups;
+    uint groupsY;
+    uint groupsZ;
+    uvec2 hits[];
+};
+
 float hitEpsilon(float t) {
-    return max(frame.forward.w, 0.5 * t * frame.up.w);
+    return max(frame.forward.w, 0.5 * t * frame.clipMax.w);
 }
 
 vec3 rayDirection(vec2 xy) {
@@ -87,14 +115,6 @@ vec2 partInterval(uint i, vec3 ro, vec3 rd) {
     return dn < 0.0 ? vec2(tPlane, 1.0e30) : vec2(1.0, 0.0);
 }
 
-// All scene evaluations of a sample go through one call of sceneDistance in one loop, driven by
-// a small state machine: march, then four normal taps, five occlusion taps and one shadow ray
-// per light. Every phase evaluates the scene at origin + dir * t. Two reasons, both about
-// lavapipe: its compiler inlines every call site, so one site keeps the JIT compile short; and
-// it runs invocations in SIMD lanes without skipping masked-off code, so a lane that has
-// finished marching evaluates its normal or shadow taps in the same instructions as its
-// neighbours' march steps instead of idling through them.
-const uint kMarch = 0u, kNormal = 1u, kOcclusion = 2u, kShadow = 3u, kDone = 4u;
 const int kShadowSteps = 16; // enough for soft shadows; each step is a full scene evaluation
 const float kShadowSharpness = 10.0;
 
@@ -106,21 +126,8 @@ struct Trace {
     vec4 shadow; // per light: 1 lit, 0 shadowed
 };
 
-// The tetrahedron k = (1, -1): k.xyy, k.yyx, k.yxy, k.xxx.
-vec3 tetraTap(int i) {
-    return i == 0 ? vec3(1.0, -1.0, -1.0)
-         : i == 1 ? vec3(-1.0, -1.0, 1.0)
-         : i == 2 ? vec3(-1.0, 1.0, -1.0)
-                  : vec3(1.0);
-}
-
-Trace trace(vec3 ro, vec3 rd) {
-    uint mode = frame.size.z;
-    uint flags = frame.size.w;
-    uint lightCount = (flags & SDFCSG_FLAG_SHADOWS) != 0u ? frame.counts.y : 0u;
-    float aoScale = frame.distances.z;
-    float shadowReach = frame.distances.w;
-
+// The march pass: the first hit along the ray, clipped to the boxes that hold surfaces.
+Trace march(vec3 ro, vec3 rd) {
     Trace r = Trace(-1.0, 0u, vec3(0.0), 1.0, vec4(1.0));
     vec2 range = clipRay(frame.clipMin.xyz, frame.clipMax.xyz, ro, rd);
     if (frame.surfaceBoxCount.x > 0u) {
@@ -133,17 +140,56 @@ Trace trace(vec3 ro, vec3 rd) {
         range = vec2(max(range.x, parts.x), min(range.y, parts.y));
     }
     float tFar = min(range.y, frame.clipMin.w);
-    uint phase = range.x > tFar ? kDone : kMarch;
-    vec3 origin = ro, dir = rd;
     float t = range.x;
+    bool marching = t <= tFar;
+    while (marching) {
+        float d = sceneDistance(ro + rd * t);
+        r.steps += 1u;
+        if (d < hitEpsilon(t)) {
+            r.t = t;
+            marching = false;
+        } else {
+            t += d;
+            marching = t <= tFar && r.steps < SDFCSG_MAX_STEPS;
+        }
+    }
+    return r;
+}
+
+// The shade pass: normal, occlusion and shadows at the hit r.t. All scene evaluations go
+// through one call of sceneDistance in one loop, driven by a small state machine: four normal
+// taps, five occlusion taps and one shadow ray per light, each evaluating the scene at
+// origin + dir * t. Two reasons, both about lavapipe: its compiler inlines every call site, so
+// one site keeps the JIT compile short; and a lane that has finished its occlusion taps
+// evaluates its shadow steps in the same instructions as its neighbours' taps instead of
+// idling through them.
+const uint kNormal = 1u, kOcclusion = 2u, kShadow = 3u, kDone = 4u;
+
+// The tetrahedron k = (1, -1): k.xyy, k.yyx, k.yxy, k.xxx.
+vec3 tetraTap(int i) {
+    return i == 0 ? vec3(1.0, -1.0, -1.0)
+         : i == 1 ? vec3(-1.0, -1.0, 1.0)
+         : i == 2 ? vec3(-1.0, 1.0, -1.0)
+                  : vec3(1.0);
+}
+
+void surface(vec3 ro, vec3 rd, inout Trace r) {
+    uint mode = frame.size.z;
+    uint flags = frame.size.w;
+    uint lightCount = (flags & SDFCSG_FLAG_SHADOWS) != 0u ? frame.counts.y : 0u;
+    float aoScale = frame.distances.z;
+    float shadowReach = frame.distances.w;
 
     vec3 light0 = frame.lights[0].direction.xyz, inverse0 = frame.lights[0].inverse.xyz;
     vec3 light1 = frame.lights[1].direction.xyz, inverse1 = frame.lights[1].inverse.xyz;
     vec3 light2 = frame.lights[2].direction.xyz, inverse2 = frame.lights[2].inverse.xyz;
     vec3 light3 = frame.lights[3].direction.xyz, inverse3 = frame.lights[3].inverse.xyz;
 
-    vec3 p = vec3(0.0); // the hit, then the hit lifted off the surface
-    float eps = 0.0;
+    float eps = hitEpsilon(r.t);
+    vec3 p = ro + rd * r.t; // the hit, then the hit lifted off the surface
+    uint phase = kNormal;
+    vec3 origin = p, dir = tetraTap(0);
+    float t = eps;
     int tap = 0;
     float weight = 1.0;
     uint light = 0u;
@@ -153,23 +199,7 @@ Trace trace(vec3 ro, vec3 rd) {
         float d = sceneDistance(origin + dir * t);
         bool nextLight = false;
 
-        if (phase == kMarch) {
-            r.steps += 1u;
-            float e = hitEpsilon(t);
-            if (d < e) {
-                r.t = t;
-                eps = e;
-                p = origin + dir * t;
-                phase = mode == SDFCSG_MODE_NORMALS || mode == SDFCSG_MODE_SHADED ? kNormal : kDone;
-                tap = 0;
-                origin = p;
-                dir = tetraTap(0);
-                t = eps;
-            } else {
-                t += d;
-                if (t > tFar || r.steps >= SDFCSG_MAX_STEPS) phase = kDone;
-            }
-        } else if (phase == kNormal) {
+        if (phase == kNormal) {
             r.n += dir * d;
             tap += 1;
             dir = tetraTap(tap);
@@ -244,7 +274,6 @@ Trace trace(vec3 ro, vec3 rd) {
             ph = 1.0e20;
         }
     }
-    return r;
 }
 
 vec3 heat(float x) {
@@ -259,18 +288,27 @@ float pow48(float x) {
     return x16 * x16 * x16;
 }
 
-// Scene colours are treated as gamma 2 (sRGB, close enough): squared to shade, square-rooted
-// back; pow() is slow on CPU drivers. Lambert and Blinn-Phong per light, an ambient term from the
-// background, occlusion and shadows from trace().
-vec3 shade(vec3 ro, vec3 rd, Trace r) {
+// Whether a sample's colour needs the shade pass: hits in the shaded and normals modes.
+bool needsShading(Trace r) {
+    uint mode = frame.size.z;
+    return r.t >= 0.0 && (mode == SDFCSG_MODE_SHADED || mode == SDFCSG_MODE_NORMALS);
+}
+
+// The colour of a sample that needs no shading (see needsShading).
+vec3 plainColor(Trace r) {
     uint mode = frame.size.z;
     // Steps on a log scale: a handful already shows, and 256 is red.
     if (mode == SDFCSG_MODE_STEPS) return heat(log2(1.0 + float(r.steps)) / log2(1.0 + float(SDFCSG_MAX_STEPS)));
     if (r.t < 0.0) return mode == SDFCSG_MODE_SHADED ? frame.background.rgb : vec3(0.0);
-    if (mode == SDFCSG_MODE_DEPTH) {
-        float x = (r.t - frame.distances.x) / max(frame.distances.y - frame.distances.x, 1e-6);
-        return vec3(1.0 - 0.85 * clamp(x, 0.0, 1.0));
-    }
+    float x = (r.t - frame.distances.x) / max(frame.distances.y - frame.distances.x, 1e-6);
+    return vec3(1.0 - 0.85 * clamp(x, 0.0, 1.0)); // depth
+}
+
+// Scene colours are treated as gamma 2 (sRGB, close enough): squared to shade, square-rooted
+// back; pow() is slow on CPU drivers. Lambert and Blinn-Phong per light, an ambient term from the
+// background, occlusion and shadows from surface().
+vec3 shade(vec3 ro, vec3 rd, Trace r) {
+    uint mode = frame.size.z;
     vec3 n = r.n;
     if (mode == SDFCSG_MODE_NORMALS) return n * 0.5 + 0.5;
 
@@ -329,28 +367,77 @@ uint packColor(vec3 c) {
     return u.r | (u.g << 8) | (u.b << 16) | (255u << 24);
 }
 
-void main() {
+vec3 unpackColor(uint c) {
+    return vec3(uvec3(c, c >> 8, c >> 16) & 255u) / 255.0;
+}
+
+// Sample `sampleIndex` of the band (row-major over its width * aa columns): its pixel and its ray.
+void sampleRay(uint sampleIndex, out uvec2 pixel, out vec3 rd) {
+    uint aa = max(frame.counts.x, 1u);
+    uvec2 s = uvec2(sampleIndex % (frame.size.x * aa), sampleIndex / (frame.size.x * aa));
+    pixel = s / aa + uvec2(0u, band.firstRow);
+    vec2 offset = (vec2(s % aa) + 0.5) / float(aa);
+    rd = rayDirection(vec2(pixel) + offset);
+}
+
+// The sample's final colour: the box overlay drawn over it.
+uint finish(vec3 c, vec3 ro, vec3 rd, float t) {
+    if ((frame.size.w & (SDFCSG_FLAG_BOXES_ALL | SDFCSG_FLAG_BOXES_SELECTED)) != 0u) {
+        vec4 o = boxOverlay(ro, rd, t);
+        c = mix(c, o.rgb, o.a);
+    }
+    return packColor(c);
+}
+
+void marchPass() {
+    uint aa = max(frame.counts.x, 1u);
+    uvec2 s = gl_GlobalInvocationID.xy;
+    if (s.x >= frame.size.x * aa || s.y / aa + band.firstRow >= frame.size.y) return;
+    uint sampleIndex = s.y * frame.size.x * aa + s.x;
+    uvec2 pixel;
+    vec3 rd;
+    sampleRay(sampleIndex, pixel, rd);
+    vec3 ro = frame.eye.xyz;
+    Trace r = march(ro, rd);
+    if (all(equal(s % aa, uvec2(0u)))) info[pixel.y * frame.size.x + pixel.x] = vec2(r.t, float(r.steps));
+    if (needsShading(r)) {
+        uint slot = atomicAdd(count, 1u);
+        if (slot % (SDFCSG_RAYMARCH_GROUP_X * SDFCSG_RAYMARCH_GROUP_Y) == 0u) atomicAdd(groups, 1u);
+        hits[slot] = uvec2(sampleIndex, floatBitsToUint(r.t));
+    } else {
+        colors[band.colorOffset + sampleIndex] = finish(plainColor(r), ro, rd, r.t);
+    }
+}
+
+void shadePass() {
+    uint slot = gl_WorkGroupID.x * (SDFCSG_RAYMARCH_GROUP_X * SDFCSG_RAYMARCH_GROUP_Y) +
+                gl_LocalInvocationIndex;
+    if (slot >= count) return;
+    uvec2 hit = hits[slot];
+    uvec2 pixel;
+    vec3 rd;
+    sampleRay(hit.x, pixel, rd);
+    vec3 ro = frame.eye.xyz;
+    Trace r = Trace(uintBitsToFloat(hit.y), 0u, vec3(0.0), 1.0, vec4(1.0));
+    surface(ro, rd, r);
+    colors[band.colorOffset + hit.x] = finish(shade(ro, rd, r), ro, rd, r.t);
+}
+
+void resolvePass() {
     uvec2 pixel = gl_GlobalInvocationID.xy + uvec2(0u, band.firstRow);
     if (any(greaterThanEqual(pixel, frame.size.xy))) return;
-    uint index = pixel.y * frame.size.x + pixel.x;
     uint aa = max(frame.counts.x, 1u);
-    bool boxes = (frame.size.w & (SDFCSG_FLAG_BOXES_ALL | SDFCSG_FLAG_BOXES_SELECTED)) != 0u;
-
-    vec3 ro = frame.eye.xyz;
+    uint row = frame.size.x * aa;
+    uint first = gl_GlobalInvocationID.y * aa * row + gl_GlobalInvocationID.x * aa;
     vec3 sum = vec3(0.0);
-    for (uint sy = 0u; sy < aa; ++sy) {
-        for (uint sx = 0u; sx < aa; ++sx) {
-            vec2 offset = (vec2(sx, sy) + 0.5) / float(aa);
-            vec3 rd = rayDirection(vec2(pixel) + offset);
-            Trace r = trace(ro, rd);
-            if (sx == 0u && sy == 0u) info[index] = vec2(r.t, float(r.steps));
-            vec3 c = shade(ro, rd, r);
-            if (boxes) {
-                vec4 o = boxOverlay(ro, rd, r.t);
-                c = mix(c, o.rgb, o.a);
-            }
-            sum += c;
-        }
-    }
-    pixels[index] = packColor(sum / float(aa * aa));
+    for (uint sy = 0u; sy < aa; ++sy)
+        for (uint sx = 0u; sx < aa; ++sx)
+            sum += unpackColor(colors[first + sy * row + sx]);
+    pixels[pixel.y * frame.size.x + pixel.x] = packColor(sum / float(aa * aa));
+}
+
+void main() {
+    if (kPass == SDFCSG_RAYMARCH_PASS_MARCH) marchPass();
+    else if (kPass == SDFCSG_RAYMARCH_PASS_SHADE) shadePass();
+    else resolvePass();
 }

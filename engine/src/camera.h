@@ -54,7 +54,8 @@ inline glm::vec3 rayDirection(const RayCamera& rc, float x, float y, uint32_t wi
     return glm::normalize(rc.forward + u * rc.right + v * rc.up);
 }
 
-// About half a pixel's footprint at distance t: finer is invisible and costs steps.
+// About half a pixel's footprint at distance t: finer is invisible and costs steps. (With aa
+// samples per pixel the renderer uses the sample's footprint, a pixel's / aa.)
 inline float hitEpsilon(const RayCamera& rc, float t) {
     return std::max(kMinHitEpsilon, 0.5f * t * rc.footprint);
 }

@@ -1,4 +1,5 @@
-// The ray-march pass: one compute dispatch per image, read back to RGBA8 and per-pixel info.
+// The ray march: per band of rows, a march, a shade and (with several samples per pixel) a
+// resolve pass (shaders/raymarch.comp), read back to RGBA8 and per-pixel info.
 #include "sdfcsg/render.h"
 
 #include "camera.h"
@@ -16,6 +17,7 @@
 #include <array>
 #include <cstring>
 #include <string>
+#include <thread>
 
 namespace sdfcsg {
 namespace {
@@ -49,14 +51,25 @@ constexpr detail::Binding kBindings[] = {
     {SDFCSG_BINDING_NODES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
     {SDFCSG_BINDING_PIXELS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
     {SDFCSG_BINDING_INFO, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+    {SDFCSG_BINDING_SAMPLES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+    {SDFCSG_BINDING_HITS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
 };
+
+// Mirrors the Band push constants of shaders/raymarch.comp.
+struct BandConstants {
+    uint32_t firstRow;
+    uint32_t colorOffset;
+};
+
+constexpr uint32_t kGroupSize = SDFCSG_RAYMARCH_GROUP_X * SDFCSG_RAYMARCH_GROUP_Y;
+constexpr VkDeviceSize kHitsHeader = 16; // count, then the shade pass's dispatch
 
 Error usage(std::string text) {
     return Error::message(ErrorKind::Usage, "<render>", std::move(text));
 }
 
-// Pixels per submission (see Renderer::render).
-constexpr uint32_t kBandPixels = 1u << 16;
+// Samples per submission (see Renderer::render).
+constexpr uint32_t kBandSamples = 1u << 16;
 
 } // namespace
 
@@ -78,12 +91,17 @@ struct Renderer::Impl {
     VkShaderModule module = VK_NULL_HANDLE;
     VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
     VkPipelineLayout pipelineLayout = VK_NULL_HANDLE;
-    VkPipeline pipelines[2] = {}; // [0]: bounds skipping off (made on first use), [1]: on
+    // [pass][bounds skipping], made on first use; the resolve pass does not evaluate the scene.
+    VkPipeline pipelines[3][2] = {};
     VkDescriptorPool pool = VK_NULL_HANDLE;
     VkDescriptorSet set = VK_NULL_HANDLE;
 
-    Buffer frame, nodes, pixels, info, pixelsStaging, infoStaging;
-    uint32_t capacity = 0; // pixels the image buffers hold
+    // The image (pixels, info), and per band: the samples' colours (with several per pixel)
+    // and the hits to shade.
+    Buffer frame, nodes, pixels, info, pixelsStaging, infoStaging, samples, hits;
+    uint32_t capacity = 0;       // pixels the image buffers hold
+    uint32_t sampleCapacity = 0; // samples the band buffers hold
+    bool samplesArePixels = false; // what the SAMPLES binding points at
     std::vector<PixelInfo> lastInfo;
 
     explicit Impl(Context::Impl& c) : ctx(c) {}
@@ -91,7 +109,8 @@ struct Renderer::Impl {
     // device may be busy with other threads' work: nothing to wait for.
     ~Impl() {
         VkDevice device = ctx.device;
-        for (Buffer* b : {&frame, &nodes, &pixels, &info, &pixelsStaging, &infoStaging})
+        for (Buffer* b :
+             {&frame, &nodes, &pixels, &info, &pixelsStaging, &infoStaging, &samples, &hits})
             detail::destroyBuffer(ctx, *b);
         destroyKernel();
         if (pool) vkDestroyDescriptorPool(device, pool, nullptr);
@@ -112,10 +131,11 @@ struct Renderer::Impl {
     }
 
     void destroyKernel() {
-        for (VkPipeline& p : pipelines) {
-            if (p) vkDestroyPipeline(ctx.device, p, nullptr);
-            p = VK_NULL_HANDLE;
-        }
+        for (auto& pass : pipelines)
+            for (VkPipeline& p : pass) {
+                if (p) vkDestroyPipeline(ctx.device, p, nullptr);
+                p = VK_NULL_HANDLE;
+            }
         if (module) vkDestroyShaderModule(ctx.device, module, nullptr);
         module = VK_NULL_HANDLE;
     }
@@ -124,30 +144,52 @@ struct Renderer::Impl {
         return ctx.properties.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU;
     }
 
-    // The pipeline for a skipping choice, created and warmed up on first use.
-    VkPipeline pipeline(bool skipping) {
-        VkPipeline& p = pipelines[skipping ? 1 : 0];
+    // The pipeline of a pass and skipping choice, created and warmed up on first use.
+    VkPipeline pipeline(uint32_t pass, bool skipping) {
+        if (pass == SDFCSG_RAYMARCH_PASS_RESOLVE) skipping = false;
+        VkPipeline& p = pipelines[pass][skipping ? 1 : 0];
         if (!p) {
-            detail::SpecConstant spec[] = {{SDFCSG_SPEC_BOUNDS_SKIPPING, skipping ? 1u : 0u}};
+            detail::SpecConstant spec[] = {{SDFCSG_SPEC_BOUNDS_SKIPPING, skipping ? 1u : 0u},
+                                           {SDFCSG_SPEC_RAYMARCH_PASS, pass}};
             p = detail::createComputePipeline(ctx, module, pipelineLayout, spec);
             warmUp(p);
         }
         return p;
     }
 
+    // The march and shade pipelines that render() uses by default, built side by side.
+    void createDefaultPipelines() {
+        const bool skipping = defaultSkipping();
+        VkPipeline made[2] = {};
+        auto create = [&](uint32_t pass) {
+            detail::SpecConstant spec[] = {{SDFCSG_SPEC_BOUNDS_SKIPPING, skipping ? 1u : 0u},
+                                           {SDFCSG_SPEC_RAYMARCH_PASS, pass}};
+            made[pass] = detail::createComputePipeline(ctx, module, pipelineLayout, spec);
+        };
+        std::thread shade(create, uint32_t(SDFCSG_RAYMARCH_PASS_SHADE));
+        create(SDFCSG_RAYMARCH_PASS_MARCH);
+        shade.join();
+        for (uint32_t pass = 0; pass < 2; ++pass) {
+            pipelines[pass][skipping ? 1 : 0] = made[pass];
+            warmUp(made[pass]);
+        }
+    }
+
     // Some drivers (llvmpipe among them) compile a compute pipeline to machine code only at its
-    // first dispatch. An empty dispatch (image size 0: every invocation returns at once) moves
-    // that cost here, so a created pipeline is ready and the first frame costs what later ones do.
+    // first dispatch. An empty dispatch (image size 0 and no hits: every invocation returns at
+    // once) moves that cost here, so a created pipeline is ready and the first frame costs what
+    // later ones do.
     void warmUp(VkPipeline p) {
         FrameUniform empty = {};
         detail::uploadBuffer(ctx, frame, &empty, sizeof(empty));
         VkCommandBuffer cmd = detail::beginCommands(ctx);
+        vkCmdFillBuffer(cmd, hits.buffer, 0, kHitsHeader, 0);
+        detail::recordComputeBarrier(cmd);
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p);
         vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipelineLayout, 0, 1, &set, 0,
                                 nullptr);
-        const uint32_t firstRow = 0;
-        vkCmdPushConstants(cmd, pipelineLayout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof firstRow,
-                           &firstRow);
+        const BandConstants band = {};
+        vkCmdPushConstants(cmd, pipelineLayout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof band, &band);
         vkCmdDispatch(cmd, 1, 1, 1);
         detail::submitAndWait(ctx);
     }
@@ -157,9 +199,38 @@ struct Renderer::Impl {
         detail::uploadBuffer(ctx, nodes, packed.data(), packed.size() * sizeof(detail::GpuNode));
     }
 
+    // Once the image and band buffers exist (create() reserves both).
     void writeDescriptors() {
-        const Buffer* buffers[] = {&frame, &nodes, &pixels, &info};
+        if (!pixels.buffer || !samples.buffer) return;
+        const Buffer* buffers[] = {&frame, &nodes, &pixels, &info,
+                                   samplesArePixels ? &pixels : &samples, &hits};
         detail::writeDescriptorSet(ctx, set, kBindings, buffers);
+    }
+
+    // Grows the band buffers to hold `count` samples; never shrinks them. On failure the old
+    // buffers stay.
+    Status reserveSamples(uint32_t count) {
+        if (count <= sampleCapacity) return Ok{};
+        auto madeSamples = detail::createBuffer(ctx, VkDeviceSize(count) * 4,
+                                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                                detail::MemoryUse::Device);
+        if (!madeSamples) return madeSamples.error();
+        auto madeHits = detail::createBuffer(
+            ctx, kHitsHeader + VkDeviceSize(count) * 8,
+            VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
+                VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+            detail::MemoryUse::Device);
+        if (!madeHits) {
+            detail::destroyBuffer(ctx, *madeSamples);
+            return madeHits.error();
+        }
+        detail::destroyBuffer(ctx, samples);
+        detail::destroyBuffer(ctx, hits);
+        samples = *madeSamples;
+        hits = *madeHits;
+        sampleCapacity = count;
+        writeDescriptors();
+        return Ok{};
     }
 
     // Grows the image buffers to hold `count` pixels; never shrinks them. On failure the old
@@ -210,7 +281,8 @@ struct Renderer::Impl {
         f.up = glm::vec4(rc.up, rc.footprint);
         f.forward = glm::vec4(rc.forward, detail::kMinHitEpsilon);
         f.clipMin = glm::vec4(clip.box.min, clip.far);
-        f.clipMax = glm::vec4(clip.box.max, 0.0f);
+        // Supersampling resolves detail finer than a pixel: the hit epsilon follows the sample.
+        f.clipMax = glm::vec4(clip.box.max, rc.footprint / float(std::max(render.aa, 1u)));
         f.surfaceBoxCount.x = uint32_t(clip.parts.size());
         for (size_t i = 0; i < clip.parts.size(); ++i) {
             const detail::SurfacePart& part = clip.parts[i];
@@ -277,7 +349,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene
 
     if (auto built = r.buildKernel(); !built) return built.error();
     r.setLayout = detail::createDescriptorSetLayout(r.ctx, kBindings);
-    r.pipelineLayout = detail::createPipelineLayout(r.ctx, r.setLayout, sizeof(uint32_t));
+    r.pipelineLayout = detail::createPipelineLayout(r.ctx, r.setLayout, sizeof(BandConstants));
     r.pool = detail::createDescriptorPool(r.ctx, kBindings);
     r.set = detail::allocateDescriptorSet(r.ctx, r.pool, r.setLayout);
 
@@ -292,7 +364,8 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene
     r.nodes = *nodes;
     r.uploadNodes();
     if (auto reserved = r.reserve(64 * 64); !reserved) return reserved.error();
-    r.pipeline(r.defaultSkipping());
+    if (auto reserved = r.reserveSamples(64 * 64); !reserved) return reserved.error();
+    r.createDefaultPipelines();
     return std::unique_ptr<Renderer>(new Renderer(std::move(impl)));
 }
 
@@ -308,7 +381,7 @@ Status Renderer::updateValues(const Scene& scene) {
             r.scene = std::move(previous);
             return built.error();
         }
-        r.pipeline(r.defaultSkipping());
+        r.createDefaultPipelines();
     }
     r.evaluator = std::make_unique<Evaluator>(scene);
     r.uploadNodes(); // no render is in flight: render() waits for its fence
@@ -325,39 +398,74 @@ Result<Image> Renderer::render(const RenderOptions& options) {
         (options.selectedNode < 0 || uint32_t(options.selectedNode) >= r.nodeCount))
         return usage("selectedNode " + std::to_string(options.selectedNode) +
                      " is not a node of the scene (it has " + std::to_string(r.nodeCount) + ")");
-    uint64_t count = uint64_t(options.width) * options.height;
-    uint32_t groupsX = detail::groupCount(options.width, SDFCSG_RAYMARCH_GROUP_X);
-    uint32_t groupsY = detail::groupCount(options.height, SDFCSG_RAYMARCH_GROUP_Y);
-    if (count * 8 > limits.maxStorageBufferRange || groupsX > limits.maxComputeWorkGroupCount[0] ||
-        groupsY > limits.maxComputeWorkGroupCount[1])
+    // Bands of whole workgroup rows, about kBandSamples samples each: a heavy scene or a huge
+    // image never becomes one long dispatch (GPU drivers reset a device whose work runs for
+    // seconds), and the caller can follow progress and stop between bands.
+    const uint64_t count = uint64_t(options.width) * options.height;
+    const uint32_t aa = options.aa;
+    const uint64_t rowGroupSamples =
+        uint64_t(options.width) * aa * aa * SDFCSG_RAYMARCH_GROUP_Y;
+    const uint32_t bandGroups = uint32_t(std::max<uint64_t>(1, kBandSamples / rowGroupSamples));
+    const uint64_t bandSamples = rowGroupSamples * bandGroups;
+    const uint64_t sampleColumns = uint64_t(options.width) * aa;
+    const uint32_t groupsY = detail::groupCount(options.height, SDFCSG_RAYMARCH_GROUP_Y);
+    const uint64_t groupsX = (sampleColumns + SDFCSG_RAYMARCH_GROUP_X - 1) / SDFCSG_RAYMARCH_GROUP_X;
+    if (count * 8 > limits.maxStorageBufferRange ||
+        kHitsHeader + bandSamples * 8 > limits.maxStorageBufferRange ||
+        groupsX > limits.maxComputeWorkGroupCount[0] ||
+        uint64_t(bandGroups) * aa > limits.maxComputeWorkGroupCount[1] ||
+        bandSamples / kGroupSize > limits.maxComputeWorkGroupCount[0])
         return Error::message(ErrorKind::Limit, "<render>",
                               "an image of " + std::to_string(options.width) + " x " +
-                                  std::to_string(options.height) + " pixels is too large for " +
-                                  r.ctx.properties.deviceName);
+                                  std::to_string(options.height) + " pixels" +
+                                  (aa > 1 ? " at aa " + std::to_string(aa) : std::string()) +
+                                  " is too large for " + r.ctx.properties.deviceName);
     if (auto reserved = r.reserve(uint32_t(count)); !reserved) return reserved.error();
+    if (auto reserved = r.reserveSamples(uint32_t(bandSamples)); !reserved)
+        return reserved.error();
+    // One sample per pixel: the passes write the image directly and no resolve runs.
+    if (r.samplesArePixels != (aa == 1)) {
+        r.samplesArePixels = aa == 1;
+        r.writeDescriptors();
+    }
 
     float aspect = float(options.width) / float(options.height);
     Camera camera = options.camera   ? *options.camera
                     : r.scene.camera ? *r.scene.camera
                                      : frameCamera(*r.evaluator, aspect);
-    VkPipeline pipeline = r.pipeline(options.boundsSkipping.value_or(r.defaultSkipping()));
+    const bool skipping = options.boundsSkipping.value_or(r.defaultSkipping());
+    const bool shading = options.mode == RenderMode::Shaded || options.mode == RenderMode::Normals;
+    VkPipeline march = r.pipeline(SDFCSG_RAYMARCH_PASS_MARCH, skipping);
+    VkPipeline shade = shading ? r.pipeline(SDFCSG_RAYMARCH_PASS_SHADE, skipping) : VK_NULL_HANDLE;
+    VkPipeline resolve = aa > 1 ? r.pipeline(SDFCSG_RAYMARCH_PASS_RESOLVE, false) : VK_NULL_HANDLE;
     FrameUniform f = r.frameUniform(options, camera);
     detail::uploadBuffer(r.ctx, r.frame, &f, sizeof(f));
 
-    // Bands of whole workgroup rows, about kBandPixels each: a heavy scene or a huge image never
-    // becomes one long dispatch (GPU drivers reset a device whose work runs for seconds), and
-    // the caller can follow progress and stop between bands.
-    const uint32_t bandGroups = std::max(1u, kBandPixels / (options.width * SDFCSG_RAYMARCH_GROUP_Y));
     for (uint32_t firstGroup = 0; firstGroup < groupsY; firstGroup += bandGroups) {
         const uint32_t groups = std::min(bandGroups, groupsY - firstGroup);
         const uint32_t firstRow = firstGroup * SDFCSG_RAYMARCH_GROUP_Y;
+        const BandConstants band = {firstRow, aa == 1 ? firstRow * options.width : 0u};
         VkCommandBuffer cmd = detail::beginCommands(r.ctx);
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+        vkCmdFillBuffer(cmd, r.hits.buffer, 0, 8, 0); // count, and the shade dispatch's x
+        vkCmdFillBuffer(cmd, r.hits.buffer, 8, 8, 1); // its y and z
+        detail::recordComputeBarrier(cmd);
         vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r.pipelineLayout, 0, 1,
                                 &r.set, 0, nullptr);
-        vkCmdPushConstants(cmd, r.pipelineLayout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof firstRow,
-                           &firstRow);
-        vkCmdDispatch(cmd, groupsX, groups, 1);
+        vkCmdPushConstants(cmd, r.pipelineLayout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof band,
+                           &band);
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, march);
+        vkCmdDispatch(cmd, uint32_t(groupsX), groups * aa, 1);
+        if (shade) {
+            detail::recordComputeBarrier(cmd);
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, shade);
+            vkCmdDispatchIndirect(cmd, r.hits.buffer, 4);
+        }
+        if (resolve) {
+            detail::recordComputeBarrier(cmd);
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, resolve);
+            vkCmdDispatch(cmd, detail::groupCount(options.width, SDFCSG_RAYMARCH_GROUP_X), groups,
+                          1);
+        }
         const bool last = firstGroup + groups == groupsY;
         if (last) {
             detail::recordReadback(cmd, r.pixels, &r.pixelsStaging);

@@ -115,6 +115,9 @@ VkCommandBuffer beginCommands(Context::Impl& ctx);
 // Ends, submits, waits on the fence and releases the submit lock.
 void submitAndWait(Context::Impl& ctx);
 
+// Compute shader writes -> reads by later compute dispatches and their indirect arguments.
+void recordComputeBarrier(VkCommandBuffer cmd);
+
 // Shader writes -> host reads: records the barrier and, when `buffer` is not mappable, a copy
 // into `staging` (which must then exist). Call before submitAndWait(), then readback().
 void recordReadback(VkCommandBuffer cmd, const Buffer& buffer, const Buffer* staging);

@@ -297,6 +297,44 @@ TEST_F(Render, ShadowsOcclusionAndSupersamplingChangeTheImage) {
     EXPECT_EQ(aa->rgba.size(), both->rgba.size());
 }
 
+TEST_F(Render, SupersamplingAveragesTheSamplesOfALargerImage) {
+    // aa 2 traces the rays of the image twice as large, with its hit epsilon, and averages each
+    // 2 x 2 block; the two sets of rays round differently in the last bit, and the average of
+    // 8-bit samples rounds once more.
+    auto parsed = parseScene(R"({"version": 1, "root": {"type": "union", "smooth": 0.3,
+        "children": [{"type": "sphere", "radius": 1, "color": [0.9, 0.3, 0.2]},
+                     {"type": "box", "size": [1.2, 1.2, 1.2], "translate": [1.2, 0, 0],
+                      "rotate": [20, 30, 0], "color": [0.2, 0.5, 0.9]}]}})",
+                             "aa.json");
+    ASSERT_TRUE(parsed) << parsed.error().str();
+    Scene scene = *parsed;
+    auto renderer = Renderer::create(context(), scene);
+    ASSERT_TRUE(renderer) << renderer.error().str();
+    RenderOptions options;
+    options.width = 128, options.height = 96;
+    auto large = (*renderer)->render(options);
+    options.width = 64, options.height = 48, options.aa = 2;
+    auto aa = (*renderer)->render(options);
+    ASSERT_TRUE(large && aa);
+    size_t close = 0;
+    double total = 0.0;
+    for (uint32_t y = 0; y < 48; ++y)
+        for (uint32_t x = 0; x < 64; ++x) {
+            bool near = true;
+            for (int c = 0; c < 3; ++c) {
+                int sum = 0;
+                for (uint32_t k = 0; k < 4; ++k)
+                    sum += large->rgba[4 * ((2 * y + k / 2) * 128 + 2 * x + k % 2) + c];
+                const double diff = std::abs(sum / 4.0 - aa->rgba[4 * (y * 64 + x) + c]);
+                total += diff;
+                near = near && diff <= 1.0;
+            }
+            close += near;
+        }
+    EXPECT_GE(close, size_t(0.995 * 64 * 48));
+    EXPECT_LT(total / (64 * 48 * 3), 0.3) << "mean difference per channel";
+}
+
 TEST_F(Render, BoxOverlayDrawsEdges) {
     Scene scene = loadOrDie(scenePath("csg_part.json"));
     auto renderer = Renderer::create(context(), scene);
