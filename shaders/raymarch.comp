@@ -187,6 +187,28 @@ void surface(vec3 ro, vec3 rd, inout Trace r) {
 
     float eps = hitEpsilon(r.t);
     vec3 p = ro + rd * r.t; // the hit, then the hit lifted off the surface
+
+    // Where each shadow ray can end, worked out here rather than in the loop (whose every
+    // iteration would run it): occluders lie inside the clip box and the boxes that hold
+    // surfaces, so a ray ends where it leaves them. From the hit; the ray starts from the
+    // hit lifted by 2 eps, hence the margin.
+    vec4 ends = vec4(0.0);
+    for (uint i = 0u; i < lightCount; ++i) {
+        vec3 l = i == 0u ? light0 : i == 1u ? light1 : i == 2u ? light2 : light3;
+        vec3 inv = i == 0u ? inverse0 : i == 1u ? inverse1 : i == 2u ? inverse2 : inverse3;
+        vec3 t0 = (frame.clipMin.xyz - p) * inv, t1 = (frame.clipMax.xyz - p) * inv;
+        vec3 far = max(t0, t1);
+        float end = min(min(far.x, far.y), min(far.z, shadowReach));
+        if (frame.surfaceBoxCount.x > 0u) {
+            float lastExit = 0.0;
+            for (uint b = 0u; b < frame.surfaceBoxCount.x; ++b) {
+                vec2 range = partInterval(b, p, l);
+                if (range.x <= range.y) lastExit = max(lastExit, range.y);
+            }
+            end = min(end, lastExit);
+        }
+        ends = mix(ends, vec4(end), equal(uvec4(0u, 1u, 2u, 3u), uvec4(i)));
+    }
     uint phase = kNormal;
     vec3 origin = p, dir = tetraTap(0);
     float t = eps;
@@ -252,21 +274,8 @@ void surface(vec3 ro, vec3 rd, inout Trace r) {
             // Light directions come from locals with selects: indexing the uniform array by a
             // per-lane index would gather in every iteration of this loop on CPU drivers.
             dir = light == 0u ? light0 : light == 1u ? light1 : light == 2u ? light2 : light3;
-            vec3 inv = light == 0u ? inverse0 : light == 1u ? inverse1 : light == 2u ? inverse2 : inverse3;
+            shadowEnd = light == 0u ? ends.x : light == 1u ? ends.y : light == 2u ? ends.z : ends.w;
             phase = light < lightCount ? kShadow : kDone;
-            // Occluders lie inside the clip box: the ray ends where it leaves it.
-            vec3 t0 = (frame.clipMin.xyz - p) * inv, t1 = (frame.clipMax.xyz - p) * inv;
-            vec3 far = max(t0, t1);
-            shadowEnd = min(min(far.x, far.y), min(far.z, shadowReach));
-            if (frame.surfaceBoxCount.x > 0u) {
-                // Nothing can shadow beyond the last exit from the boxes that hold surfaces.
-                float lastExit = 0.0;
-                for (uint i = 0u; i < frame.surfaceBoxCount.x; ++i) {
-                    vec2 b = partInterval(i, p, dir);
-                    if (b.x <= b.y) lastExit = max(lastExit, b.y);
-                }
-                shadowEnd = min(shadowEnd, lastExit);
-            }
             t = 2.0 * eps;
             // A light behind the surface needs no shadow (Lambert is zero): end it at once.
             tap = dot(r.n, dir) > 0.0 ? 0 : kShadowSteps;
