@@ -2,7 +2,9 @@
 // Sphere tracing of the generated scene in three passes over a band of rows (kPass):
 //   march:   one invocation per sample (aa x aa per pixel) traces its ray to the first hit and
 //            writes the colour of misses and of the depth and steps modes; hits that need
-//            shading are appended to a list, which also counts the shade pass's workgroups;
+//            shading are appended to a list, which also counts the shade pass's workgroups.
+//            It runs only the workgroups whose rays can meet a surface (the host lists them);
+//            the host fills the rest of the band with the colour of a miss;
 //   shade:   one invocation per listed hit (an indirect dispatch): normal, occlusion, shadows
 //            and lighting;
 //   resolve: with several samples per pixel, one invocation per pixel averages them.
@@ -67,6 +69,12 @@ layout(std430, set = 0, binding = SDFCSG_BINDING_INFO) writeonly buffer Info {
 // per pixel this is the Pixels buffer itself (colorOffset: the band's first pixel).
 layout(std430, set = 0, binding = SDFCSG_BINDING_SAMPLES) buffer Colors {
     uint colors[];
+};
+
+// The workgroups of the band's sample grid that the march pass runs, one per workgroup of the
+// dispatch: x | y << 16.
+layout(std430, set = 0, binding = SDFCSG_BINDING_TILES) readonly buffer Tiles {
+    uint tiles[];
 };
 
 // Hits of the band that need shading: x: sample index in the band, y: ray parameter (bits).
@@ -400,7 +408,8 @@ uint finish(vec3 c, vec3 ro, vec3 rd, float t) {
 
 void marchPass() {
     uint aa = max(frame.counts.x, 1u);
-    uvec2 s = gl_GlobalInvocationID.xy;
+    uint tile = tiles[gl_WorkGroupID.x];
+    uvec2 s = uvec2(tile & 0xffffu, tile >> 16) * gl_WorkGroupSize.xy + gl_LocalInvocationID.xy;
     if (s.x >= frame.size.x * aa || s.y / aa + band.firstRow >= frame.size.y) return;
     uint sampleIndex = s.y * frame.size.x * aa + s.x;
     uvec2 pixel;

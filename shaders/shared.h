@@ -15,6 +15,7 @@
 #define SDFCSG_BINDING_INFO 3   // buffer of vec2 per pixel: (hit depth or -1, step count)
 #define SDFCSG_BINDING_SAMPLES 6 // raymarch.comp: packed RGBA8 per sample of a band
 #define SDFCSG_BINDING_HITS 7    // raymarch.comp: hits to shade, after an indirect dispatch
+#define SDFCSG_BINDING_TILES 8   // raymarch.comp: workgroups of a band that the march pass runs
 #define SDFCSG_BINDING_PROBE_IN 4  // probe.comp: readonly buffer of vec4 points (xyz used)
 #define SDFCSG_BINDING_PROBE_OUT 5 // probe.comp: buffer of vec4 sceneSample() results
 

@@ -201,4 +201,44 @@ inline bool rayInterval(const ClipVolume& clip, glm::vec3 origin, glm::vec3 dir,
     return tNear <= tFar;
 }
 
+// A rectangle of the image, in pixels from the top-left corner (x0 <= x < x1, y0 <= y < y1).
+struct ScreenRect {
+    float x0, y0, x1, y1;
+};
+
+// Rectangles of the image outside which no ray can meet a surface: the projections of the
+// surface boxes (or of the clip box when there are none), cut to the clip box, a pixel wider on
+// every side. Empty when nothing is in view. False when that cannot be bounded (a half-space,
+// or a box reaching behind the eye): then every ray must be traced.
+inline bool surfaceRects(const RayCamera& rc, const ClipVolume& clip, uint32_t width,
+                         uint32_t height, std::vector<ScreenRect>& rects) {
+    rects.clear();
+    std::vector<Aabb> boxes;
+    if (clip.parts.empty()) boxes.push_back(clip.box);
+    for (const SurfacePart& part : clip.parts) {
+        if (part.halfSpace) return false;
+        Aabb b{glm::max(part.box.min, clip.box.min), glm::min(part.box.max, clip.box.max)};
+        if (!b.empty()) boxes.push_back(b);
+    }
+    const float sx = 0.5f * float(width) / (rc.tanHalfFov * rc.aspect);
+    const float sy = 0.5f * float(height) / rc.tanHalfFov;
+    for (const Aabb& b : boxes) {
+        ScreenRect r{1e30f, 1e30f, -1e30f, -1e30f};
+        for (int c = 0; c < 8; ++c) {
+            glm::vec3 corner((c & 1) ? b.max.x : b.min.x, (c & 2) ? b.max.y : b.min.y,
+                             (c & 4) ? b.max.z : b.min.z);
+            glm::vec3 v = corner - rc.eye;
+            float z = glm::dot(v, rc.forward);
+            if (z < 1e-4f * (1.0f + glm::length(v))) return false; // at or behind the eye
+            float x = 0.5f * float(width) + sx * glm::dot(v, rc.right) / z;
+            float y = 0.5f * float(height) - sy * glm::dot(v, rc.up) / z;
+            r = {std::min(r.x0, x), std::min(r.y0, y), std::max(r.x1, x), std::max(r.y1, y)};
+        }
+        r = {r.x0 - 1.0f, r.y0 - 1.0f, r.x1 + 1.0f, r.y1 + 1.0f};
+        if (r.x1 > 0.0f && r.y1 > 0.0f && r.x0 < float(width) && r.y0 < float(height))
+            rects.push_back(r);
+    }
+    return true;
+}
+
 } // namespace sdfcsg::detail

@@ -53,6 +53,7 @@ constexpr detail::Binding kBindings[] = {
     {SDFCSG_BINDING_INFO, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
     {SDFCSG_BINDING_SAMPLES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
     {SDFCSG_BINDING_HITS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+    {SDFCSG_BINDING_TILES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
 };
 
 // Mirrors the Band push constants of shaders/raymarch.comp.
@@ -96,11 +97,12 @@ struct Renderer::Impl {
     VkDescriptorPool pool = VK_NULL_HANDLE;
     VkDescriptorSet set = VK_NULL_HANDLE;
 
-    // The image (pixels, info), and per band: the samples' colours (with several per pixel)
-    // and the hits to shade.
-    Buffer frame, nodes, pixels, info, pixelsStaging, infoStaging, samples, hits;
+    // The image (pixels, info), and per band: the samples' colours (with several per pixel),
+    // the workgroups to march and the hits to shade.
+    Buffer frame, nodes, pixels, info, pixelsStaging, infoStaging, samples, hits, tiles;
     uint32_t capacity = 0;       // pixels the image buffers hold
     uint32_t sampleCapacity = 0; // samples the band buffers hold
+    uint32_t tileCapacity = 0;   // workgroups the tile list holds
     bool samplesArePixels = false; // what the SAMPLES binding points at
     std::vector<PixelInfo> lastInfo;
 
@@ -110,7 +112,7 @@ struct Renderer::Impl {
     ~Impl() {
         VkDevice device = ctx.device;
         for (Buffer* b :
-             {&frame, &nodes, &pixels, &info, &pixelsStaging, &infoStaging, &samples, &hits})
+             {&frame, &nodes, &pixels, &info, &pixelsStaging, &infoStaging, &samples, &hits, &tiles})
             detail::destroyBuffer(ctx, *b);
         destroyKernel();
         if (pool) vkDestroyDescriptorPool(device, pool, nullptr);
@@ -203,32 +205,42 @@ struct Renderer::Impl {
     void writeDescriptors() {
         if (!pixels.buffer || !samples.buffer) return;
         const Buffer* buffers[] = {&frame, &nodes, &pixels, &info,
-                                   samplesArePixels ? &pixels : &samples, &hits};
+                                   samplesArePixels ? &pixels : &samples, &hits, &tiles};
         detail::writeDescriptorSet(ctx, set, kBindings, buffers);
     }
 
-    // Grows the band buffers to hold `count` samples; never shrinks them. On failure the old
-    // buffers stay.
-    Status reserveSamples(uint32_t count) {
-        if (count <= sampleCapacity) return Ok{};
-        auto madeSamples = detail::createBuffer(ctx, VkDeviceSize(count) * 4,
-                                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                                detail::MemoryUse::Device);
-        if (!madeSamples) return madeSamples.error();
-        auto madeHits = detail::createBuffer(
-            ctx, kHitsHeader + VkDeviceSize(count) * 8,
-            VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
-                VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-            detail::MemoryUse::Device);
-        if (!madeHits) {
-            detail::destroyBuffer(ctx, *madeSamples);
-            return madeHits.error();
+    // Grows the band buffers to hold `count` samples in `tileCount` workgroups; never shrinks
+    // them. On failure the old buffers stay.
+    Status reserveSamples(uint32_t count, uint32_t tileCount) {
+        if (count <= sampleCapacity && tileCount <= tileCapacity) return Ok{};
+        count = std::max(count, sampleCapacity);
+        tileCount = std::max(tileCount, tileCapacity);
+        constexpr VkBufferUsageFlags kStorage =
+            VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+        const VkDeviceSize sizes[] = {VkDeviceSize(count) * 4, kHitsHeader + VkDeviceSize(count) * 8,
+                                      VkDeviceSize(tileCount) * 4};
+        const VkBufferUsageFlags usages[] = {kStorage,
+                                             kStorage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT,
+                                             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT};
+        const detail::MemoryUse uses[] = {detail::MemoryUse::Device, detail::MemoryUse::Device,
+                                          detail::MemoryUse::Upload};
+        Buffer made[3];
+        for (int i = 0; i < 3; ++i) {
+            auto buffer = detail::createBuffer(ctx, sizes[i], usages[i], uses[i]);
+            if (!buffer) {
+                for (Buffer& b : made)
+                    detail::destroyBuffer(ctx, b);
+                return buffer.error();
+            }
+            made[i] = *buffer;
         }
-        detail::destroyBuffer(ctx, samples);
-        detail::destroyBuffer(ctx, hits);
-        samples = *madeSamples;
-        hits = *madeHits;
+        Buffer* current[] = {&samples, &hits, &tiles};
+        for (int i = 0; i < 3; ++i) {
+            detail::destroyBuffer(ctx, *current[i]);
+            *current[i] = made[i];
+        }
         sampleCapacity = count;
+        tileCapacity = tileCount;
         writeDescriptors();
         return Ok{};
     }
@@ -237,8 +249,9 @@ struct Renderer::Impl {
     // buffers stay.
     Status reserve(uint32_t count) {
         if (count <= capacity) return Ok{};
-        constexpr VkBufferUsageFlags kOutput =
-            VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+        constexpr VkBufferUsageFlags kOutput = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                               VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                                               VK_BUFFER_USAGE_TRANSFER_DST_BIT;
         const VkDeviceSize sizes[] = {VkDeviceSize(count) * 4, VkDeviceSize(count) * 8};
         Buffer made[4]; // pixels, info, and their staging copies when those are not mappable
         auto create = [&](int i, VkDeviceSize size, VkBufferUsageFlags usage,
@@ -270,9 +283,8 @@ struct Renderer::Impl {
         return Ok{};
     }
 
-    FrameUniform frameUniform(const RenderOptions& render, const Camera& camera) const {
-        detail::RayCamera rc = detail::makeRayCamera(camera, render.width, render.height);
-        detail::ClipVolume clip = detail::makeClipVolume(*evaluator, rc.eye);
+    FrameUniform frameUniform(const RenderOptions& render, const detail::RayCamera& rc,
+                              const detail::ClipVolume& clip) const {
         Aabb finite = detail::finitePrimitiveBounds(*evaluator);
 
         FrameUniform f = {};
@@ -364,7 +376,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene
     r.nodes = *nodes;
     r.uploadNodes();
     if (auto reserved = r.reserve(64 * 64); !reserved) return reserved.error();
-    if (auto reserved = r.reserveSamples(64 * 64); !reserved) return reserved.error();
+    if (auto reserved = r.reserveSamples(64 * 64, 64); !reserved) return reserved.error();
     r.createDefaultPipelines();
     return std::unique_ptr<Renderer>(new Renderer(std::move(impl)));
 }
@@ -412,7 +424,8 @@ Result<Image> Renderer::render(const RenderOptions& options) {
     const uint64_t groupsX = (sampleColumns + SDFCSG_RAYMARCH_GROUP_X - 1) / SDFCSG_RAYMARCH_GROUP_X;
     if (count * 8 > limits.maxStorageBufferRange ||
         kHitsHeader + bandSamples * 8 > limits.maxStorageBufferRange ||
-        groupsX > limits.maxComputeWorkGroupCount[0] ||
+        groupsX > limits.maxComputeWorkGroupCount[0] || groupsX > 0xffff ||
+        uint64_t(bandGroups) * aa > 0xffff || // the march pass's tile list packs x | y << 16
         uint64_t(bandGroups) * aa > limits.maxComputeWorkGroupCount[1] ||
         bandSamples / kGroupSize > limits.maxComputeWorkGroupCount[0])
         return Error::message(ErrorKind::Limit, "<render>",
@@ -421,7 +434,8 @@ Result<Image> Renderer::render(const RenderOptions& options) {
                                   (aa > 1 ? " at aa " + std::to_string(aa) : std::string()) +
                                   " is too large for " + r.ctx.properties.deviceName);
     if (auto reserved = r.reserve(uint32_t(count)); !reserved) return reserved.error();
-    if (auto reserved = r.reserveSamples(uint32_t(bandSamples)); !reserved)
+    if (auto reserved = r.reserveSamples(uint32_t(bandSamples), uint32_t(groupsX) * bandGroups * aa);
+        !reserved)
         return reserved.error();
     // One sample per pixel: the passes write the image directly and no resolve runs.
     if (r.samplesArePixels != (aa == 1)) {
@@ -438,14 +452,60 @@ Result<Image> Renderer::render(const RenderOptions& options) {
     VkPipeline march = r.pipeline(SDFCSG_RAYMARCH_PASS_MARCH, skipping);
     VkPipeline shade = shading ? r.pipeline(SDFCSG_RAYMARCH_PASS_SHADE, skipping) : VK_NULL_HANDLE;
     VkPipeline resolve = aa > 1 ? r.pipeline(SDFCSG_RAYMARCH_PASS_RESOLVE, false) : VK_NULL_HANDLE;
-    FrameUniform f = r.frameUniform(options, camera);
+    const detail::RayCamera rc = detail::makeRayCamera(camera, options.width, options.height);
+    const detail::ClipVolume clip = detail::makeClipVolume(*r.evaluator, rc.eye);
+    FrameUniform f = r.frameUniform(options, rc, clip);
     detail::uploadBuffer(r.ctx, r.frame, &f, sizeof(f));
+
+    // Workgroups whose rays cannot meet a surface are not marched; the band is filled with the
+    // colour and info of a miss first (t = -1; the steps word too, read back as 0). The box
+    // overlay draws outside the surfaces and the steps mode colours misses by their steps,
+    // so those trace every ray.
+    std::vector<detail::ScreenRect> rects;
+    const bool culling = options.boxes == BoxOverlay::None && options.mode != RenderMode::Steps &&
+                         detail::surfaceRects(rc, clip, options.width, options.height, rects);
+    auto packed = [](glm::vec3 c) {
+        glm::uvec3 u(glm::clamp(c, 0.0f, 1.0f) * 255.0f + 0.5f);
+        return u.r | (u.g << 8) | (u.b << 16) | (255u << 24);
+    };
+    const uint32_t missColor = packed(options.mode == RenderMode::Shaded ? r.scene.background
+                                                                          : glm::vec3(0.0f));
+    const float missInfo = -1.0f;
+    uint32_t missInfoBits;
+    std::memcpy(&missInfoBits, &missInfo, sizeof missInfoBits);
+    std::vector<uint32_t> tiles;
 
     for (uint32_t firstGroup = 0; firstGroup < groupsY; firstGroup += bandGroups) {
         const uint32_t groups = std::min(bandGroups, groupsY - firstGroup);
         const uint32_t firstRow = firstGroup * SDFCSG_RAYMARCH_GROUP_Y;
         const BandConstants band = {firstRow, aa == 1 ? firstRow * options.width : 0u};
+        const uint32_t rows = std::min(groups * SDFCSG_RAYMARCH_GROUP_Y, options.height - firstRow);
+        tiles.clear();
+        for (uint32_t ty = 0; ty < groups * aa; ++ty) {
+            const float y0 = float(firstRow) + float(ty * SDFCSG_RAYMARCH_GROUP_Y) / float(aa);
+            const float y1 = y0 + float(SDFCSG_RAYMARCH_GROUP_Y) / float(aa);
+            for (uint32_t tx = 0; tx < groupsX; ++tx) {
+                const float x0 = float(tx * SDFCSG_RAYMARCH_GROUP_X) / float(aa);
+                const float x1 = x0 + float(SDFCSG_RAYMARCH_GROUP_X) / float(aa);
+                bool visible = !culling;
+                for (const detail::ScreenRect& q : rects)
+                    visible = visible || (x0 < q.x1 && x1 > q.x0 && y0 < q.y1 && y1 > q.y0);
+                if (visible) tiles.push_back(tx | ty << 16);
+            }
+        }
+        if (!tiles.empty())
+            detail::uploadBuffer(r.ctx, r.tiles, tiles.data(), tiles.size() * sizeof(uint32_t));
+
         VkCommandBuffer cmd = detail::beginCommands(r.ctx);
+        if (culling) {
+            const VkDeviceSize first = VkDeviceSize(firstRow) * options.width;
+            const VkDeviceSize pixelsInBand = VkDeviceSize(rows) * options.width;
+            if (aa == 1)
+                vkCmdFillBuffer(cmd, r.pixels.buffer, first * 4, pixelsInBand * 4, missColor);
+            else
+                vkCmdFillBuffer(cmd, r.samples.buffer, 0, pixelsInBand * aa * aa * 4, missColor);
+            vkCmdFillBuffer(cmd, r.info.buffer, first * 8, pixelsInBand * 8, missInfoBits);
+        }
         vkCmdFillBuffer(cmd, r.hits.buffer, 0, 8, 0); // count, and the shade dispatch's x
         vkCmdFillBuffer(cmd, r.hits.buffer, 8, 8, 1); // its y and z
         detail::recordComputeBarrier(cmd);
@@ -454,7 +514,7 @@ Result<Image> Renderer::render(const RenderOptions& options) {
         vkCmdPushConstants(cmd, r.pipelineLayout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof band,
                            &band);
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, march);
-        vkCmdDispatch(cmd, uint32_t(groupsX), groups * aa, 1);
+        if (!tiles.empty()) vkCmdDispatch(cmd, uint32_t(tiles.size()), 1, 1);
         if (shade) {
             detail::recordComputeBarrier(cmd);
             vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, shade);
@@ -485,7 +545,7 @@ Result<Image> Renderer::render(const RenderOptions& options) {
     const auto* info = static_cast<const float*>(detail::readback(r.ctx, r.info, &r.infoStaging));
     r.lastInfo.resize(count);
     for (uint64_t i = 0; i < count; ++i)
-        r.lastInfo[i] = PixelInfo{info[2 * i], uint32_t(info[2 * i + 1])};
+        r.lastInfo[i] = PixelInfo{info[2 * i], info[2 * i + 1] > 0.0f ? uint32_t(info[2 * i + 1]) : 0u};
     return image;
 }
 

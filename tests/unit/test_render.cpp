@@ -144,6 +144,44 @@ TEST_P(SceneRender, HitMaskDepthAndColoursAgreeWithCpuTracing) {
         << normalOk << " of " << colourChecked << " normals within 6/255";
 }
 
+// The march pass skips workgroups outside the projections of the surface boxes; a ray there
+// must miss everything, and the renderer must report it as a miss without steps.
+TEST_P(SceneRender, RaysOutsideTheSurfaceRectanglesMiss) {
+    Scene scene = loadOrDie(GetParam());
+    Evaluator ev(scene);
+    Camera camera = cameraFor(scene, ev);
+    detail::RayCamera rc = detail::makeRayCamera(camera, kSize, kSize);
+    detail::ClipVolume clip = detail::makeClipVolume(ev, rc.eye);
+    std::vector<detail::ScreenRect> rects;
+    if (!detail::surfaceRects(rc, clip, kSize, kSize, rects))
+        GTEST_SKIP() << "a half-space holds surfaces: every ray is traced";
+    auto renderer = Renderer::create(context(), scene);
+    ASSERT_TRUE(renderer) << renderer.error().str();
+    RenderOptions options;
+    options.width = options.height = kSize;
+    options.camera = camera;
+    ASSERT_TRUE((*renderer)->render(options));
+    const std::vector<PixelInfo>& info = (*renderer)->lastPixelInfo();
+    size_t outside = 0;
+    for (uint32_t y = 0; y < kSize; ++y)
+        for (uint32_t x = 0; x < kSize; ++x) {
+            const float px = x + 0.5f, py = y + 0.5f;
+            bool inside = false;
+            for (const detail::ScreenRect& r : rects)
+                inside = inside || (px >= r.x0 && px < r.x1 && py >= r.y0 && py < r.y1);
+            if (inside) continue;
+            ++outside;
+            glm::vec3 dir = detail::rayDirection(rc, px, py, kSize, kSize);
+            EXPECT_LT(traceCpu(ev, rc, clip, dir).t, 0.0f) << "pixel " << x << ", " << y;
+            const PixelInfo& p = info[size_t(y) * kSize + x];
+            EXPECT_LT(p.depth, 0.0f) << "pixel " << x << ", " << y;
+            EXPECT_EQ(p.steps, 0u) << "pixel " << x << ", " << y;
+        }
+    if (fs::path(GetParam()).stem() == "house") {
+        EXPECT_GT(outside, size_t(kSize) * kSize / 5) << "the sky above the house";
+    }
+}
+
 TEST_P(SceneRender, BoundsSkippingDoesNotChangeTheImage) {
     Scene scene = loadOrDie(GetParam());
     auto renderer = Renderer::create(context(), scene);
