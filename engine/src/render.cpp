@@ -146,14 +146,18 @@ struct Renderer::Impl {
         return ctx.properties.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU;
     }
 
+    VkPipeline createPass(uint32_t pass, bool skipping) const {
+        detail::SpecConstant spec[] = {{SDFCSG_SPEC_BOUNDS_SKIPPING, skipping ? 1u : 0u},
+                                       {SDFCSG_SPEC_RAYMARCH_PASS, pass}};
+        return detail::createComputePipeline(ctx, module, pipelineLayout, spec);
+    }
+
     // The pipeline of a pass and skipping choice, created and warmed up on first use.
     VkPipeline pipeline(uint32_t pass, bool skipping) {
         if (pass == SDFCSG_RAYMARCH_PASS_RESOLVE) skipping = false;
         VkPipeline& p = pipelines[pass][skipping ? 1 : 0];
         if (!p) {
-            detail::SpecConstant spec[] = {{SDFCSG_SPEC_BOUNDS_SKIPPING, skipping ? 1u : 0u},
-                                           {SDFCSG_SPEC_RAYMARCH_PASS, pass}};
-            p = detail::createComputePipeline(ctx, module, pipelineLayout, spec);
+            p = createPass(pass, skipping);
             warmUp(p);
         }
         return p;
@@ -163,13 +167,8 @@ struct Renderer::Impl {
     void createDefaultPipelines() {
         const bool skipping = defaultSkipping();
         VkPipeline made[2] = {};
-        auto create = [&](uint32_t pass) {
-            detail::SpecConstant spec[] = {{SDFCSG_SPEC_BOUNDS_SKIPPING, skipping ? 1u : 0u},
-                                           {SDFCSG_SPEC_RAYMARCH_PASS, pass}};
-            made[pass] = detail::createComputePipeline(ctx, module, pipelineLayout, spec);
-        };
-        std::thread shade(create, uint32_t(SDFCSG_RAYMARCH_PASS_SHADE));
-        create(SDFCSG_RAYMARCH_PASS_MARCH);
+        std::thread shade([&] { made[1] = createPass(SDFCSG_RAYMARCH_PASS_SHADE, skipping); });
+        made[0] = createPass(SDFCSG_RAYMARCH_PASS_MARCH, skipping);
         shade.join();
         for (uint32_t pass = 0; pass < 2; ++pass) {
             pipelines[pass][skipping ? 1 : 0] = made[pass];
