@@ -48,6 +48,7 @@ layout(std140, set = 0, binding = SDFCSG_BINDING_FRAME) uniform Frame {
     uvec4 surfaceBoxCount; // x: regions that hold every surface (0: use the clip box alone)
     // Pairs: a box (min, w = 0; max), or a half-space dot(p, n) < offset (n, w = 1; offset, ...).
     vec4 surfaceBoxes[2 * SDFCSG_MAX_CLIP_BOXES];
+    vec4 grid; // ground grid: xy: centre (x, z); z: height of its plane; w: line spacing
 } frame;
 
 // The band this dispatch computes (engine/src/render.cpp): its first pixel row, and where its
@@ -379,6 +380,25 @@ vec4 boxOverlay(vec3 ro, vec3 rd, float tHit) {
     return result;
 }
 
+// How much of the sample the ground grid covers where the ray meets the grid's plane in front
+// of the hit (tHit < 0: a miss): lines frame.grid.w apart, 2 SDFCSG_GRID_HALF_LINES + 1 each
+// way, about a pixel wide, fading out where a pixel spans so much of the spacing that they
+// would alias.
+float gridCoverage(vec3 ro, vec3 rd, float tHit) {
+    float spacing = frame.grid.w;
+    float tPlane = (frame.grid.z - ro.y) / (abs(rd.y) < 1.0e-20 ? 1.0e-20 : rd.y);
+    if (tPlane <= 0.0 || (tHit >= 0.0 && tPlane > tHit) || tPlane > frame.clipMin.w) return 0.0;
+    vec2 q = (ro.xz + rd.xz * tPlane - frame.grid.xy) / spacing; // in spacings from the centre
+    if (any(greaterThan(abs(q), vec2(float(SDFCSG_GRID_HALF_LINES) + 0.5)))) return 0.0;
+    vec2 toLine = abs(q - round(q));
+    float width = tPlane * frame.up.w / spacing; // a pixel, in spacings, across the ray
+    float along = width / max(abs(rd.y), 0.05);  // ... and along it, where the plane tilts away
+    float line = 1.0 - smoothstep(0.5 * width, 1.5 * width, min(toLine.x, toLine.y));
+    bool axis = (abs(round(q.x)) < 0.5 && toLine.x <= toLine.y) ||
+                (abs(round(q.y)) < 0.5 && toLine.y <= toLine.x);
+    return line * (axis ? 0.7 : 0.4) * (1.0 - smoothstep(0.1, 0.3, along));
+}
+
 uint packColor(vec3 c) {
     uvec3 u = uvec3(clamp(c, 0.0, 1.0) * 255.0 + 0.5);
     return u.r | (u.g << 8) | (u.b << 16) | (255u << 24);
@@ -397,8 +417,9 @@ void sampleRay(uint sampleIndex, out uvec2 pixel, out vec3 rd) {
     rd = rayDirection(vec2(pixel) + offset);
 }
 
-// The sample's final colour: the box overlay drawn over it.
+// The sample's final colour: the ground grid and the box overlay drawn over it.
 uint finish(vec3 c, vec3 ro, vec3 rd, float t) {
+    if ((frame.size.w & SDFCSG_FLAG_GRID) != 0u) c = mix(c, vec3(0.12), gridCoverage(ro, rd, t));
     if ((frame.size.w & (SDFCSG_FLAG_BOXES_ALL | SDFCSG_FLAG_BOXES_SELECTED)) != 0u) {
         vec4 o = boxOverlay(ro, rd, t);
         c = mix(c, o.rgb, o.a);

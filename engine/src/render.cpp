@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstring>
 #include <string>
 #include <thread>
@@ -41,9 +42,10 @@ struct FrameUniform {
     FrameLight lights[SDFCSG_MAX_LIGHTS];
     glm::uvec4 surfaceBoxCount; // x
     glm::vec4 surfaceBoxes[2 * SDFCSG_MAX_CLIP_BOXES]; // surface parts, as in raymarch.comp
+    glm::vec4 grid; // centre x, z; plane height; spacing
 };
 static_assert(sizeof(FrameUniform) ==
-              12 * 16 + SDFCSG_MAX_LIGHTS * 48 + SDFCSG_MAX_CLIP_BOXES * 32);
+              13 * 16 + SDFCSG_MAX_LIGHTS * 48 + SDFCSG_MAX_CLIP_BOXES * 32);
 static_assert(SDFCSG_MAX_LIGHTS == 4, "raymarch.comp reads the lights into four locals");
 
 constexpr detail::Binding kBindings[] = {
@@ -319,6 +321,11 @@ struct Renderer::Impl {
         if (render.ambientOcclusion) flags |= SDFCSG_FLAG_AO;
         if (render.boxes == BoxOverlay::All) flags |= SDFCSG_FLAG_BOXES_ALL;
         if (render.boxes == BoxOverlay::Selected) flags |= SDFCSG_FLAG_BOXES_SELECTED;
+        if (render.grid) {
+            flags |= SDFCSG_FLAG_GRID;
+            const GroundGrid g = groundGrid(*evaluator);
+            f.grid = glm::vec4(g.centreX, g.centreZ, g.height, g.spacing);
+        }
         f.size = glm::uvec4(render.width, render.height, uint32_t(render.mode), flags);
 
         std::vector<Light> lights = scene.lights.empty() ? defaultLights() : scene.lights;
@@ -336,6 +343,18 @@ struct Renderer::Impl {
         return f;
     }
 };
+
+GroundGrid groundGrid(const Evaluator& evaluator) {
+    const Aabb box = detail::finiteSceneBounds(evaluator);
+    const float width = std::max(box.max.x - box.min.x, box.max.z - box.min.z);
+    GroundGrid g;
+    g.spacing = std::pow(10.0f, std::floor(std::log10(std::max(width, 1e-3f) / 2.0f)));
+    g.centreX = std::round(0.5f * (box.min.x + box.max.x) / g.spacing) * g.spacing;
+    g.centreZ = std::round(0.5f * (box.min.z + box.max.z) / g.spacing) * g.spacing;
+    g.height = box.min.y;
+    g.halfLines = SDFCSG_GRID_HALF_LINES;
+    return g;
+}
 
 std::optional<RenderMode> parseRenderMode(std::string_view name) {
     if (name == "shaded") return RenderMode::Shaded;
@@ -458,10 +477,11 @@ Result<Image> Renderer::render(const RenderOptions& options) {
 
     // Workgroups whose rays cannot meet a surface are not marched; the band is filled with the
     // colour and info of a miss first (t = -1; the steps word too, read back as 0). The box
-    // overlay draws outside the surfaces and the steps mode colours misses by their steps,
-    // so those trace every ray.
+    // overlay and the grid draw outside the surfaces and the steps mode colours misses by
+    // their steps, so those trace every ray.
     std::vector<detail::ScreenRect> rects;
-    const bool culling = options.boxes == BoxOverlay::None && options.mode != RenderMode::Steps &&
+    const bool culling = options.boxes == BoxOverlay::None && !options.grid &&
+                         options.mode != RenderMode::Steps &&
                          detail::surfaceRects(rc, clip, options.width, options.height, rects);
     auto packed = [](glm::vec3 c) {
         glm::uvec3 u(glm::clamp(c, 0.0f, 1.0f) * 255.0f + 0.5f);
