@@ -95,7 +95,7 @@ struct Renderer::Impl {
     VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
     VkPipelineLayout pipelineLayout = VK_NULL_HANDLE;
     // [pass][bounds skipping], made on first use; the resolve pass does not evaluate the scene.
-    VkPipeline pipelines[3][2] = {};
+    VkPipeline pipelines[4][2] = {};
     VkDescriptorPool pool = VK_NULL_HANDLE;
     VkDescriptorSet set = VK_NULL_HANDLE;
 
@@ -156,7 +156,8 @@ struct Renderer::Impl {
 
     // The pipeline of a pass and skipping choice, created and warmed up on first use.
     VkPipeline pipeline(uint32_t pass, bool skipping) {
-        if (pass == SDFCSG_RAYMARCH_PASS_RESOLVE) skipping = false;
+        if (pass == SDFCSG_RAYMARCH_PASS_RESOLVE || pass == SDFCSG_RAYMARCH_PASS_OVERLAY)
+            skipping = false; // no scene evaluation
         VkPipeline& p = pipelines[pass][skipping ? 1 : 0];
         if (!p) {
             p = createPass(pass, skipping);
@@ -470,18 +471,19 @@ Result<Image> Renderer::render(const RenderOptions& options) {
     VkPipeline march = r.pipeline(SDFCSG_RAYMARCH_PASS_MARCH, skipping);
     VkPipeline shade = shading ? r.pipeline(SDFCSG_RAYMARCH_PASS_SHADE, skipping) : VK_NULL_HANDLE;
     VkPipeline resolve = aa > 1 ? r.pipeline(SDFCSG_RAYMARCH_PASS_RESOLVE, false) : VK_NULL_HANDLE;
+    VkPipeline overlay = options.grid || options.boxes != BoxOverlay::None
+                             ? r.pipeline(SDFCSG_RAYMARCH_PASS_OVERLAY, false)
+                             : VK_NULL_HANDLE;
     const detail::RayCamera rc = detail::makeRayCamera(camera, options.width, options.height);
     const detail::ClipVolume clip = detail::makeClipVolume(*r.evaluator, rc.eye);
     FrameUniform f = r.frameUniform(options, rc, clip);
     detail::uploadBuffer(r.ctx, r.frame, &f, sizeof(f));
 
     // Workgroups whose rays cannot meet a surface are not marched; the band is filled with the
-    // colour and info of a miss first (t = -1; the steps word too, read back as 0). The box
-    // overlay and the grid draw outside the surfaces and the steps mode colours misses by
-    // their steps, so those trace every ray.
+    // colour and info of a miss first (t = -1; the steps word too, read back as 0). The steps
+    // mode colours misses by their steps, so it traces every ray.
     std::vector<detail::ScreenRect> rects;
-    const bool culling = options.boxes == BoxOverlay::None && !options.grid &&
-                         options.mode != RenderMode::Steps &&
+    const bool culling = options.mode != RenderMode::Steps &&
                          detail::surfaceRects(rc, clip, options.width, options.height, rects);
     auto packed = [](glm::vec3 c) {
         glm::uvec3 u(glm::clamp(c, 0.0f, 1.0f) * 255.0f + 0.5f);
@@ -539,9 +541,11 @@ Result<Image> Renderer::render(const RenderOptions& options) {
             vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, shade);
             vkCmdDispatchIndirect(cmd, r.hits.buffer, 4);
         }
-        if (resolve) {
+        // One invocation per pixel of the band each.
+        for (VkPipeline perPixel : {resolve, overlay}) {
+            if (!perPixel) continue;
             detail::recordComputeBarrier(cmd);
-            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, resolve);
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, perPixel);
             vkCmdDispatch(cmd, detail::groupCount(options.width, SDFCSG_RAYMARCH_GROUP_X), groups,
                           1);
         }
