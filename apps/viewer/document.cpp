@@ -28,14 +28,20 @@ bool FileWatcher::poll() {
 
 Status Document::open(const std::filesystem::path& path) {
     auto scene = loadScene(path);
-    // Watch the file whatever happened, so fixing it on disk loads it.
-    path_ = path;
-    watcher_ = FileWatcher(path);
+    // A broken file replaces nothing: with a scene on screen, saving and live reload stay on
+    // that scene's file (else Save would write it over the broken one). Without one, the
+    // broken file is watched, so fixing it on disk loads it.
     if (!scene) {
         error_ = scene.error();
         ++version_;
+        if (!loaded_) {
+            path_ = path;
+            watcher_ = FileWatcher(path);
+        }
         return scene.error();
     }
+    path_ = path;
+    watcher_ = FileWatcher(path);
     error_.reset();
     history_.reset(std::move(*scene));
     loaded_ = true;
@@ -73,6 +79,7 @@ void Document::replace(Scene scene) {
 Status Document::save(const std::filesystem::path& path) {
     auto written = writeFileAtomic(path, toJson(scene()));
     if (!written) return written;
+    error_.reset(); // the file now holds the scene on screen, whatever failed to load before
     if (path != path_) {
         path_ = path;
         watcher_ = FileWatcher(path);

@@ -42,7 +42,8 @@ class FileWatcher {
 
 class Document {
   public:
-    // Loads a file; on failure the current scene stays and error() holds the problems.
+    // Loads a file; on failure the current scene stays, with its path and watcher (a document
+    // without a scene watches the broken file instead), and error() holds the problems.
     Status open(const std::filesystem::path& path);
     // Reloads if the file changed on disk; true when something changed (scene or error).
     bool pollReload();
@@ -57,7 +58,7 @@ class Document {
     const Scene& scene() const { return history_.current(); }
     History& history() { return history_; }
     const std::filesystem::path& path() const { return path_; }
-    // Problems of the last load or reload; cleared by the next load that succeeds.
+    // Problems of the last load or reload; cleared by the next load or save that succeeds.
     const std::optional<Error>& error() const { return error_; }
     // True once a scene has loaded; before that scene() is empty.
     bool loaded() const { return loaded_; }

@@ -259,10 +259,10 @@ void syncScene(Viewer& v) {
 }
 
 void openFile(Viewer& v, const fs::path& path) {
-    bool hadScene = v.doc.loaded();
     auto opened = v.doc.open(path);
-    std::snprintf(v.savePath, sizeof v.savePath, "%s", path.string().c_str());
     if (opened) {
+        // Only a file that loaded becomes where Save writes: the scene on screen is its scene.
+        std::snprintf(v.savePath, sizeof v.savePath, "%s", path.string().c_str());
         addRecent(v, path);
         v.selected = -1;
         v.scene.reset(); // the camera is reset for a new file
@@ -270,7 +270,6 @@ void openFile(Viewer& v, const fs::path& path) {
         v.status = "opened " + path.string();
     } else {
         v.status = "could not open " + path.string();
-        (void)hadScene;
     }
 }
 

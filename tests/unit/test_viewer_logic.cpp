@@ -25,6 +25,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <thread>
 
 using namespace sdfcsg;
@@ -366,7 +367,7 @@ TEST(ViewerFiles, SaveIsAtomicAndNotReloaded) {
     EXPECT_EQ(failed.error().kind, ErrorKind::Io);
 }
 
-TEST(ViewerFiles, OpenFailureKeepsTheCurrentScene) {
+TEST(ViewerFiles, OpenFailureKeepsTheCurrentSceneAndItsFile) {
     fs::path dir = tempDir("viewer_open");
     writeText(dir / "good.json", kTwoSpheres);
     writeText(dir / "bad.json", "{");
@@ -375,7 +376,32 @@ TEST(ViewerFiles, OpenFailureKeepsTheCurrentScene) {
     EXPECT_FALSE(doc.open(dir / "bad.json"));
     EXPECT_TRUE(doc.error());
     EXPECT_EQ(doc.scene().nodes.size(), 5u);
-    // The broken file is watched: fixing it loads it.
+    EXPECT_EQ(doc.path(), dir / "good.json");
+
+    // Saving writes the scene on screen to its own file, never over the broken one, and
+    // the stale load error goes.
+    ASSERT_TRUE(doc.save());
+    EXPECT_FALSE(doc.error());
+    std::ifstream bad(dir / "bad.json");
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(bad), {}), "{");
+    EXPECT_TRUE(loadScene(dir / "good.json"));
+
+    // The scene's file is still the one watched.
+    writeText(dir / "bad.json", R"({"version": 1, "root": {"type": "box", "size": 1}})");
+    EXPECT_FALSE(doc.pollReload());
+    writeText(dir / "good.json", R"({"version": 1, "root": {"type": "sphere", "radius": 1}})");
+    EXPECT_TRUE(doc.pollReload());
+    EXPECT_FALSE(doc.error());
+    EXPECT_EQ(doc.scene().nodes.size(), 1u);
+}
+
+TEST(ViewerFiles, ABrokenFirstFileIsWatched) {
+    fs::path dir = tempDir("viewer_open_first");
+    writeText(dir / "bad.json", "{");
+    Document doc;
+    EXPECT_FALSE(doc.open(dir / "bad.json"));
+    EXPECT_FALSE(doc.loaded());
+    // Nothing else to show: fixing the file on disk loads it.
     writeText(dir / "bad.json", R"({"version": 1, "root": {"type": "sphere", "radius": 1}})");
     EXPECT_TRUE(doc.pollReload());
     EXPECT_FALSE(doc.error());
