@@ -27,6 +27,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <deque>
 #include <fstream>
@@ -139,6 +140,7 @@ struct Viewer {
     GLFWwindow* window = nullptr;
     PresenterPtr presenter;
     std::unique_ptr<Context> context;
+    std::unique_ptr<Context> liveContext; // the live renderer's own device (RenderWorker)
     std::unique_ptr<RenderWorker> renderer;
     std::unique_ptr<MeshWorker> mesher;
     Document doc;
@@ -160,6 +162,7 @@ struct Viewer {
     RenderOutput last;                              // the image on screen, with its depths
     double lastInteraction = -1.0;
     float scale = 0.5f; // preview resolution while the camera moves
+    bool refining = false; // a job redraws the live image with its baked kernel
     double renderMs = 0.0, compileMs = 0.0;
     std::optional<Error> renderError;
 
@@ -365,7 +368,7 @@ ViewKey wantedKey(Viewer& v, bool full) {
     k.shadows = v.shadows;
     k.ao = v.ao;
     k.boxes = v.boxes;
-    k.selected = v.boxes == BoxOverlay::None ? -1 : v.selected;
+    k.selected = v.selected; // its box, and its highlight in full-resolution frames
     int w = 1, h = 1;
     glfwGetFramebufferSize(v.window, &w, &h);
     float s = full ? 1.0f : v.scale;
@@ -387,6 +390,7 @@ void updateImage(Viewer& v) {
         ViewKey key = job != v.jobs.end() ? job->second : ViewKey{};
         v.jobs.erase(v.jobs.begin(), job == v.jobs.end() ? job : job + 1);
         v.renderError = out->error;
+        v.refining = false;
         if (out->compileSeconds > 0) v.compileMs = out->compileSeconds * 1000.0;
         if (!out->image.rgba.empty()) {
             v.renderMs = out->renderSeconds * 1000.0;
@@ -420,10 +424,17 @@ void updateImage(Viewer& v) {
         }
         return;
     }
-    if (v.haveSubmitted && v.submitted == want) return;
-    if (v.haveShown && v.shown == want) return;
+    // A value edit drawn by the live renderer is drawn again once its baked kernel is built:
+    // the same image as `sdfcsg render` gives, and faster to redraw.
+    const bool refine = v.haveShown && v.shown == want && v.last.live && !v.refining &&
+                        v.renderer->refinementReady(v.sceneVersion);
+    if (!refine) {
+        if (v.haveSubmitted && v.submitted == want) return;
+        if (v.haveShown && v.shown == want) return;
+    }
     // While a render runs, wait: a newer job replaces the queued one anyway.
     if (!v.renderer->idle() && v.haveSubmitted) return;
+    v.refining = refine;
     RenderJob job;
     job.scene = v.scene;
     job.sceneVersion = v.sceneVersion;
@@ -438,15 +449,18 @@ void updateImage(Viewer& v) {
     job.options.boxes =
         want.selected < 0 && want.boxes == BoxOverlay::Selected ? BoxOverlay::None : want.boxes;
     job.options.selectedNode = want.selected;
+    job.highlight = want.selected;
     v.jobs.emplace_back(job.id, want);
     v.renderer->submit(std::move(job));
     v.submitted = want;
     v.haveSubmitted = true;
 }
 
-// The full-resolution image of the current state is on screen.
+// The full-resolution image of the current state is on screen, from its baked kernel (so a
+// screenshot is the same whether or not the live renderer drew the edit first).
 bool settled(Viewer& v) {
-    return v.scene && v.haveShown && v.shown == wantedKey(v, true) && v.renderer->idle();
+    return v.scene && v.haveShown && v.shown == wantedKey(v, true) && v.renderer->idle() &&
+           !(v.last.live && v.renderer->refinementPending(v.sceneVersion));
 }
 
 // ---- Input -----------------------------------------------------------------------------------
@@ -1003,7 +1017,10 @@ int main(int argc, char** argv) {
         return 4;
     }
     v.context = std::move(*context);
-    v.renderer = std::make_unique<RenderWorker>(*v.context);
+    // Without a second device the live renderer shares the first, and its compile then
+    // delays frames once.
+    if (auto live = Context::create()) v.liveContext = std::move(*live);
+    v.renderer = std::make_unique<RenderWorker>(*v.context, v.liveContext.get());
     v.mesher = std::make_unique<MeshWorker>(*v.context);
     v.generator = std::make_unique<GenerateWorker>();
     describeEndpoint(v);
@@ -1117,10 +1134,18 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "%s\n", v.renderError->str().c_str());
         v.exitCode = 1;
     }
-    glfwHideWindow(v.window); // the workers may need a moment to finish a compile
-    v.renderer.reset();
-    v.mesher.reset();
+    glfwHideWindow(v.window);
     v.generator.reset(); // cancels a generation in flight
+    v.mesher.reset();    // cancels an extraction
+    if (v.renderer->compiling()) {
+        // A compile cannot be interrupted and may take seconds more. Everything the user asked
+        // for is written already (saves and screenshots are synchronous and atomic), so leave
+        // without the destructors, which would wait for it.
+        std::fflush(stdout);
+        std::fflush(stderr);
+        std::_Exit(v.exitCode);
+    }
+    v.renderer.reset();
     v.presenter.reset();
     ImGui_ImplGlfw_Shutdown();
     ImGui::DestroyContext();

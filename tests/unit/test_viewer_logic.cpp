@@ -11,6 +11,8 @@
 #include "script.h"
 #include "workers.h"
 
+#include "camera.h" // the renderer's rays, to trace depths as it does
+
 #include <sdfcsg/generate.h>
 #include <sdfcsg/io.h>
 
@@ -21,6 +23,7 @@
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -190,6 +193,107 @@ TEST(ViewerPicking, NearestPrimitiveIncludingCarvedFaces) {
     EXPECT_EQ(nearestPrimitive(evaluator, {1.5f, 0.2f, 0}), int(*findNode(scene, "block")));
     // Inside the carved hole, on its surface: the sphere that cut it.
     EXPECT_EQ(nearestPrimitive(evaluator, {1.0f, 0.0f, 0.2f}), int(*findNode(scene, "hole")));
+}
+
+// Depths as the renderer's march finds them, traced on the CPU along the renderer's rays.
+std::vector<PixelInfo> traceDepths(const Evaluator& evaluator, const Camera& camera, uint32_t w,
+                                   uint32_t h) {
+    detail::RayCamera rc = detail::makeRayCamera(camera, w, h);
+    std::vector<PixelInfo> pixels(size_t(w) * h, PixelInfo{-1.0f, 0});
+    for (uint32_t j = 0; j < h; ++j)
+        for (uint32_t i = 0; i < w; ++i) {
+            glm::vec3 dir = detail::rayDirection(rc, float(i) + 0.5f, float(j) + 0.5f, w, h);
+            float t = 0.0f;
+            for (int step = 0; step < 256 && t < 50.0f; ++step) {
+                float d = evaluator.distance(rc.eye + t * dir);
+                if (d < detail::hitEpsilon(rc, t)) {
+                    pixels[size_t(j) * w + i].depth = t;
+                    break;
+                }
+                t += d;
+            }
+        }
+    return pixels;
+}
+
+TEST(ViewerPicking, HighlightCoversTheSelectedSurfaceOnly) {
+    Scene scene = twoSpheres();
+    Evaluator evaluator(scene);
+    Camera camera;
+    camera.eye = {0, 0, 6};
+    camera.target = {0, 0, 0};
+    camera.fov = 40;
+    const uint32_t w = 96, h = 64;
+    auto pixels = traceDepths(evaluator, camera, w, h);
+    auto count = [](const std::vector<uint8_t>& mask) {
+        return std::count(mask.begin(), mask.end(), uint8_t(1));
+    };
+    for (const char* name : {"left", "cut", "hole"}) {
+        SCOPED_TRACE(name);
+        uint32_t node = *findNode(scene, name);
+        PixelRect r = projectedRect(camera, w, h, evaluator.nodes()[node].bounds);
+        ASSERT_FALSE(r.empty());
+        auto mask = selectionMask(evaluator, node, camera, w, h, pixels);
+        long inside = 0;
+        for (uint32_t j = 0; j < h; ++j)
+            for (uint32_t i = 0; i < w; ++i)
+                if (mask[j * w + i]) {
+                    // The march takes points within half a pixel of a surface as hits.
+                    EXPECT_TRUE(int(i) >= r.x0 - 2 && int(i) < r.x1 + 2 && int(j) >= r.y0 - 2 &&
+                                int(j) < r.y1 + 2);
+                    ++inside;
+                }
+        EXPECT_GT(inside, 20) << "the node's visible surface is selected";
+    }
+    // The left sphere's pixels and the carved block's are apart; the carved face belongs to
+    // both the hole and the block's difference.
+    auto left = selectionMask(evaluator, *findNode(scene, "left"), camera, w, h, pixels);
+    auto cut = selectionMask(evaluator, *findNode(scene, "cut"), camera, w, h, pixels);
+    auto hole = selectionMask(evaluator, *findNode(scene, "hole"), camera, w, h, pixels);
+    for (size_t k = 0; k < left.size(); ++k) {
+        EXPECT_FALSE(left[k] && cut[k]);
+        if (hole[k]) {
+            EXPECT_TRUE(cut[k]);
+        }
+    }
+    EXPECT_LT(count(hole), count(cut));
+    // Every hit pixel belongs to the root.
+    auto all = selectionMask(evaluator, 0, camera, w, h, pixels);
+    EXPECT_EQ(count(all), std::count_if(pixels.begin(), pixels.end(),
+                                        [](const PixelInfo& p) { return p.depth >= 0.0f; }));
+
+    // Tinted inside, outlined around: only pixels in or next to the mask change.
+    Image image{w, h, std::vector<uint8_t>(size_t(w) * h * 4, 128)};
+    drawHighlight(image, left);
+    for (uint32_t j = 0; j < h; ++j)
+        for (uint32_t i = 0; i < w; ++i) {
+            bool changed = image.rgba[(j * w + i) * 4 + 2] != 128;
+            bool near = false;
+            for (int dj = -1; dj <= 1; ++dj)
+                for (int di = -1; di <= 1; ++di) {
+                    int x = int(i) + di, y = int(j) + dj;
+                    if ((di == 0 || dj == 0) && x >= 0 && y >= 0 && x < int(w) && y < int(h))
+                        near = near || left[size_t(y) * w + x];
+                }
+            EXPECT_EQ(changed, near) << i << "," << j;
+        }
+}
+
+TEST(ViewerPicking, ProjectedRectOfBoxes) {
+    Camera camera;
+    camera.eye = {0, 0, 5};
+    camera.target = {0, 0, 0};
+    camera.fov = 90;
+    // A box at the centre, half as wide as the view at its depth.
+    PixelRect r = projectedRect(camera, 100, 100, Aabb{{-1, -1, 0}, {1, 1, 0}});
+    EXPECT_NEAR(r.x0, 40, 1); // rounded outwards
+    EXPECT_NEAR(r.x1, 60, 1);
+    EXPECT_NEAR(r.y0, 40, 1);
+    EXPECT_NEAR(r.y1, 60, 1);
+    EXPECT_TRUE(projectedRect(camera, 100, 100, Aabb{}).empty());
+    EXPECT_TRUE(projectedRect(camera, 100, 100, Aabb{{20, 0, 0}, {21, 1, 1}}).empty());
+    PixelRect behind = projectedRect(camera, 100, 100, Aabb{{-1, -1, 4}, {1, 1, 6}});
+    EXPECT_EQ(behind.x1 - behind.x0, 100);
 }
 
 TEST(ViewerEdit, SetValuesValidatesLikeTheLoader) {

@@ -40,6 +40,7 @@ screenshot 4-depth.png
 mode shaded
 shadows on
 boxes none
+select none
 undo
 screenshot 5-undone.png
 save saved.json
