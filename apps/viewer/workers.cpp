@@ -208,10 +208,16 @@ RenderOutput RenderWorker::process(const RenderJob& job) {
     adoptBuilds(job);
     if (live_ && !sameStructure(*liveScene_, *job.scene)) live_.reset(), drawn_.reset();
 
+    // A still frame is drawn live unless recompiling and drawing baked has been measured to be
+    // sooner: on lavapipe a small scene's inlined kernel compiles in a fraction of a second
+    // and draws several times faster, so at full resolution the live frame can come later.
+    const double pixels = double(job.options.width) * double(job.options.height);
+    const bool bakeSooner = !job.preview && liveRate_ > 0 && bakedRate_ > 0 &&
+                            bakeSeconds_ + bakedRate_ * pixels < liveRate_ * pixels;
     Renderer* renderer = nullptr;
     if (baked_ && bakedVersion_ == job.sceneVersion) {
         renderer = baked_.get();
-    } else if (live_) {
+    } else if (live_ && !bakeSooner) {
         if (liveVersion_ != job.sceneVersion) {
             drawn_.reset();
             if (auto updated = live_->updateValues(*job.scene); updated)
@@ -233,6 +239,7 @@ RenderOutput RenderWorker::process(const RenderJob& job) {
         compilingHere_ = false;
         out.compileSeconds = secondsSince(start);
         if (created) {
+            bakeSeconds_ = out.compileSeconds;
             baked_ = std::move(*created);
             bakedScene_ = job.scene;
             bakedVersion_ = job.sceneVersion;
@@ -242,7 +249,7 @@ RenderOutput RenderWorker::process(const RenderJob& job) {
             renderer = baked_.get();
             // A structure on screen: its live renderer is built now, so that the first value
             // edit is already an upload.
-            if (!liveBuilder_->pendingStructure(*job.scene))
+            if (!live_ && !liveBuilder_->pendingStructure(*job.scene))
                 liveBuilder_->request(job.scene, job.sceneVersion);
         } else {
             failedVersion_ = job.sceneVersion;
@@ -265,6 +272,7 @@ RenderOutput RenderWorker::process(const RenderJob& job) {
         auto start = std::chrono::steady_clock::now();
         auto image = renderer->render(out.options);
         out.renderSeconds = secondsSince(start);
+        (out.live ? liveRate_ : bakedRate_) = out.renderSeconds / pixels;
         if (!image) {
             out.error = image.error();
             drawn_.reset();

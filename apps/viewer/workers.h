@@ -91,10 +91,11 @@ class RendererBuilder {
 // recompile. Its compile takes seconds on lavapipe, so it runs on a Context of its own (another
 // device and queue), where it stalls no baked frame; the live renderer draws there too.
 //
-// Once it exists, a value edit is drawn by it at once (previews and still frames alike), and a
-// still frame's values are baked again by a second builder in the background: a refinement
-// (faster to draw, and the same pixels as `sdfcsg render`) that the caller asks for once
-// refinementReady(), never a wait before the edit shows.
+// Once it exists, a value edit is drawn by it at once (previews, and still frames unless a
+// recompile has been measured to show them sooner), and a still frame drawn live has its values
+// baked again by a second builder in the background: a refinement (faster to draw, and the
+// same pixels as `sdfcsg render`) that the caller asks for once refinementReady(), never a wait
+// before the edit shows.
 class RenderWorker {
   public:
     // The live renderer is built and draws on `liveContext` (null: on `context`). Both must
@@ -142,7 +143,8 @@ class RenderWorker {
     uint64_t liveVersion_ = 0;               // the values it holds
     std::optional<uint64_t> failedVersion_;
     std::optional<Error> failure_;
-    std::shared_ptr<const Scene> latest_; // the newest job's scene (liveBuildDone())
+    // Measured: seconds per pixel of the last live and baked frames, and of the last compile.
+    double liveRate_ = 0, bakedRate_ = 0, bakeSeconds_ = 0;
     // The last frame before its highlight, so a new selection only redraws the highlight.
     struct Drawn {
         const Renderer* renderer = nullptr;
