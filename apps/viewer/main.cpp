@@ -213,6 +213,8 @@ struct Viewer {
     int settledFrames = 0; // frames in a row that showed the current full image
     int exitCode = 0;
     double waitStart = 0;
+    double commandWaitStart = 0; // of a command waiting for an image or a reload
+    int reloads = 0; // not yet answered by the script's wait-reload
 };
 
 float aspectOf(const Viewer& v) {
@@ -350,6 +352,11 @@ bool finishGeneration(Viewer& v) {
     v.status = v.generatingEdit ? "edited by the model (undo: Ctrl+Z)"
                                 : "generated a new scene (undo: Ctrl+Z)";
     return true;
+}
+
+// Where Ctrl+S writes.
+fs::path savePathOf(const Viewer& v) {
+    return v.savePath[0] ? fs::path(v.savePath) : v.doc.path();
 }
 
 void save(Viewer& v, const fs::path& path) {
@@ -549,7 +556,7 @@ void handleInput(Viewer& v) {
     auto hit = [&](int key) { return ImGui::IsKeyPressed(key, false); };
     if (ctrl && hit(GLFW_KEY_Z)) shift ? redo(v) : undo(v);
     if (ctrl && hit(GLFW_KEY_Y)) redo(v);
-    if (ctrl && hit(GLFW_KEY_S)) save(v, v.savePath[0] ? fs::path(v.savePath) : v.doc.path());
+    if (ctrl && hit(GLFW_KEY_S)) save(v, savePathOf(v));
     if (ctrl) return;
     if (hit(GLFW_KEY_F)) frameSelection(v);
     if (hit(GLFW_KEY_R)) resetCamera(v), v.lastInteraction = now();
@@ -927,8 +934,28 @@ bool runScript(Viewer& v) {
             return false;
         };
         syncScene(v);
-        if (!v.scene && c.verb != "generate") return fail("no scene loaded");
+        if (!v.scene && c.verb != "generate" && c.verb != "open") return fail("no scene loaded");
         const std::string arg = c.args.empty() ? "" : c.args[0];
+        // Commands that look at the image wait for the full-resolution one of the current state.
+        const bool needsImage =
+            c.verb == "pick" || c.verb == "print-bounds" || c.verb == "expect-error";
+        if ((needsImage && !settled(v)) || (c.verb == "wait-reload" && v.reloads == 0)) {
+            if (v.commandWaitStart == 0) v.commandWaitStart = now();
+            if (now() - v.commandWaitStart > 300.0)
+                return fail(c.verb + ": still waiting after 300 s");
+            v.script.push_front(c);
+            return true;
+        }
+        v.commandWaitStart = 0;
+        auto selectedNode = [&]() -> std::optional<uint32_t> {
+            if (v.selected < 0 || v.selected >= int(v.scene->nodes.size())) return std::nullopt;
+            return uint32_t(v.selected);
+        };
+        auto kindNamed = [](const std::string& name) {
+            for (const KindInfo& k : nodeKinds())
+                if (k.name == name) return k.kind;
+            return NodeKind::Sphere; // parseScript admits known names only
+        };
         if (c.verb == "select") {
             if (arg == "none") {
                 v.selected = -1;
@@ -968,8 +995,58 @@ bool runScript(Viewer& v) {
         } else if (c.verb == "redo") {
             redo(v);
         } else if (c.verb == "save") {
-            auto saved = v.doc.save(arg);
+            fs::path path = !arg.empty() ? fs::path(arg) : savePathOf(v);
+            auto saved = v.doc.save(path);
             if (!saved) return fail(saved.error().str());
+        } else if (c.verb == "add" || c.verb == "remove" || c.verb == "kind" || c.verb == "op" ||
+                   c.verb == "move") {
+            auto node = selectedNode();
+            if (!node) return fail(c.verb + ": no node selected");
+            uint32_t moved = *node;
+            Result<Scene> edited = c.verb == "add"      ? addChild(*v.scene, *node, kindNamed(arg), &moved)
+                                   : c.verb == "remove" ? removeNode(*v.scene, *node)
+                                   : c.verb == "move"
+                                       ? moveNode(*v.scene, *node, arg == "up" ? -1 : 1, &moved)
+                                       : changeKind(*v.scene, *node, kindNamed(arg));
+            if (!edited) return fail(edited.error().str());
+            commit(v, std::move(edited));
+            // As the Node panel's buttons leave the selection.
+            if (c.verb == "remove")
+                v.selected = -1;
+            else
+                v.selected = int(moved);
+        } else if (c.verb == "open") {
+            openFile(v, arg); // a failure shows in the panel, as in the file browser
+        } else if (c.verb == "wait-reload") {
+            --v.reloads;
+        } else if (c.verb == "pick") {
+            pick(v, c.numbers[0], c.numbers[1]);
+        } else if (c.verb == "ui") {
+            v.showUi = arg == "on";
+        } else if (c.verb == "print-bounds") {
+            auto n = findNode(*v.scene, arg);
+            if (!n) return fail("no node named \"" + arg + "\"");
+            Evaluator shown(*v.last.scene);
+            if (*n >= shown.nodes().size()) return fail("print-bounds: the image shows no " + arg);
+            PixelRect r = projectedRect(*v.last.options.camera, v.last.image.width,
+                                        v.last.image.height, shown.nodes()[*n].bounds);
+            std::printf("bounds %s %d %d %d %d\n", arg.c_str(), r.x0, r.y0, r.x1, r.y1);
+            std::fflush(stdout);
+        } else if (c.verb == "expect-error") {
+            std::string shown = v.doc.error() ? v.doc.error()->str() : "";
+            if (v.renderError) shown += (shown.empty() ? "" : "\n") + v.renderError->str();
+            if (c.text == "none" ? !shown.empty() : shown.find(c.text) == std::string::npos)
+                return fail("expected the error \"" + c.text + "\", shown: \"" + shown + "\"");
+        } else if (c.verb == "expect-selected") {
+            std::optional<uint32_t> want;
+            if (arg != "none") {
+                want = findNode(*v.scene, arg);
+                if (!want) return fail("no node named \"" + arg + "\"");
+            }
+            if (selectedNode() != want)
+                return fail("expected " + (want ? nodeLabel(*v.scene, *want) : "no node") +
+                            " selected, got " +
+                            (selectedNode() ? nodeLabel(*v.scene, *selectedNode()) : "none"));
         } else if (c.verb == "screenshot") {
             v.pendingShot = arg;
             v.waitStart = now();
@@ -1075,8 +1152,10 @@ int main(int argc, char** argv) {
             glfwWaitEventsTimeout(0.1);
         if (now() - lastPoll > 0.25) { // live reload
             lastPoll = now();
-            if (v.doc.pollReload())
+            if (v.doc.pollReload()) {
                 v.status = v.doc.error() ? "reload failed" : "reloaded " + v.doc.path().string();
+                ++v.reloads;
+            }
         }
         syncScene(v);
         if (!finishGeneration(v) || !runScript(v)) break;

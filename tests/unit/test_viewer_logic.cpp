@@ -533,10 +533,25 @@ TEST(ViewerScript, ReportsEveryProblem) {
               "s.txt:1:1: mode: expected one of shaded, normals, depth, steps, got \"shiny\"\n"
               "s.txt:2:1: unknown command \"fly\" (known: select, set, mode, shadows, ao, grid, "
               "boxes, orbit, zoom, frame, reset, undo, redo, save, screenshot, generate, "
-              "edit-scene)\n"
-              "s.txt:3:1: set: expected a number, got \"big\"\n"
+              "edit-scene, add, remove, kind, op, move, open, pick, wait-reload, ui, "
+              "expect-error, expect-selected, print-bounds)\n"
+              "s.txt:3:1: set: expected a finite number, got \"big\"\n"
               "s.txt:4:1: zoom: expected 1 arguments, got 0\n"
               "s.txt:5:1: undo: expected 0 arguments, got 1");
+}
+
+TEST(ViewerScript, RefusesNumbersThatAreNotFinite) {
+    auto script = parseScript("orbit nan nan\nzoom inf\nset radius -inf\npick 1e99 2\nzoom 0\n"
+                              "op sphere\nkind union\nadd torus\nmove up\n",
+                              "s.txt");
+    ASSERT_FALSE(script);
+    EXPECT_EQ(script.error().str(), "s.txt:1:1: orbit: expected a finite number, got \"nan\"\n"
+                                    "s.txt:2:1: zoom: expected a finite number, got \"inf\"\n"
+                                    "s.txt:3:1: set: expected a finite number, got \"-inf\"\n"
+                                    "s.txt:4:1: pick: expected a finite number, got \"1e99\"\n"
+                                    "s.txt:5:1: zoom: expected a positive factor, got \"0\"\n"
+                                    "s.txt:6:1: op: expected one of union, intersection, "
+                                    "difference, got \"sphere\"");
 }
 
 TEST(ViewerScript, GenerateTakesTheRestOfTheLine) {
