@@ -231,17 +231,7 @@ void resetCamera(Viewer& v) {
 
 void frameSelection(Viewer& v) {
     if (!v.evaluator) return;
-    Aabb box;
-    if (v.selected >= 0 && v.selected < int(v.evaluator->nodes().size()))
-        box = v.evaluator->nodes()[v.selected].bounds;
-    if (box.empty() || !box.finite()) {
-        // The finite primitives: planes would make the whole scene unbounded.
-        for (const FlatNode& n : v.evaluator->nodes())
-            if (!kindInfo(n.kind).operation && n.bounds.finite() && !n.bounds.empty())
-                box.min = glm::min(box.min, n.bounds.min),
-                box.max = glm::max(box.max, n.bounds.max);
-    }
-    frameBox(v.camera, box, aspectOf(v));
+    frameBox(v.camera, framedBounds(*v.evaluator, v.selected), aspectOf(v));
     v.lastInteraction = now();
 }
 

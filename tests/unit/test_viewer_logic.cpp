@@ -168,6 +168,25 @@ TEST(ViewerCamera, ZoomAndFrame) {
     EXPECT_EQ(c.distance, unchanged.distance);
 }
 
+TEST(ViewerCamera, FramesTheSolidNotWhatItSubtracts) {
+    auto scene = parseScene(R"({"version": 1, "root": {"type": "union", "children": [
+        {"type": "plane", "name": "ground"},
+        {"type": "difference", "name": "cut", "children": [
+          {"type": "box", "size": [1, 1, 1]},
+          {"type": "sphere", "name": "far", "radius": 0.5, "translate": [5, 0, 0]}]}]}})",
+                            "s.json");
+    ASSERT_TRUE(scene) << scene.error().str();
+    Evaluator evaluator(*scene);
+    Aabb box = framedBounds(evaluator, -1);
+    EXPECT_NEAR(box.max.x, 0.5f, 0.01f); // the subtracted sphere at x = 5 is not framed
+    EXPECT_NEAR(box.min.x, -0.5f, 0.01f);
+    Aabb far = framedBounds(evaluator, int(*findNode(*scene, "far")));
+    EXPECT_NEAR(far.min.x, 4.5f, 0.01f); // a selection is framed as it is
+    // An unbounded selection (the plane) frames the solid.
+    Aabb ground = framedBounds(evaluator, int(*findNode(*scene, "ground")));
+    EXPECT_NEAR(ground.max.x, 0.5f, 0.01f);
+}
+
 TEST(ViewerPicking, PointFromDepth) {
     Camera camera;
     camera.eye = {0, 0, 5};
