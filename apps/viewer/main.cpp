@@ -1142,8 +1142,14 @@ int main(int argc, char** argv) {
             glfwWaitEventsTimeout(0.1);
         if (now() - lastPoll > 0.25) { // live reload
             lastPoll = now();
+            const std::shared_ptr<const Scene> before = v.scene;
             if (v.doc.pollReload()) {
                 v.status = v.doc.error() ? "reload failed" : "reloaded " + v.doc.path().string();
+                // Node numbers change with the file: the selection follows its node.
+                if (!v.doc.error() && before && v.selected >= 0) {
+                    auto same = sameNode(*before, uint32_t(v.selected), v.doc.scene());
+                    v.selected = same ? int(*same) : -1;
+                }
                 ++v.reloads;
             }
         }

@@ -373,6 +373,23 @@ TEST(ViewerEdit, StructuralEditsKeepTheSceneValid) {
     auto kind = changeKind(scene, *findNode(scene, "left"), NodeKind::Box);
     ASSERT_TRUE(kind) << kind.error().str();
     EXPECT_EQ(kind->nodes[*findNode(*kind, "left")].kind, NodeKind::Box);
+    // Comparable sizes, not the defaults: the sphere of radius 0.5 becomes a box 1 across, and
+    // back to a sphere of radius 0.5; a box 1 across becomes a torus about as wide.
+    Evaluator sized(*kind);
+    Aabb box = sized.nodes()[*findNode(*kind, "left")].bounds;
+    EXPECT_NEAR(box.max.x - box.min.x, 1.0f, 0.01f);
+    auto back = changeKind(*kind, *findNode(*kind, "left"), NodeKind::Sphere);
+    ASSERT_TRUE(back);
+    EXPECT_FLOAT_EQ(back->nodes[*findNode(*back, "left")].params[0], 0.5f);
+    float small = 0.1f;
+    auto tiny = setValue(scene, *findNode(scene, "left"), "radius", std::span(&small, 1));
+    auto tinyBox = changeKind(*tiny, *findNode(*tiny, "left"), NodeKind::Box);
+    ASSERT_TRUE(tinyBox);
+    EXPECT_FLOAT_EQ(tinyBox->nodes[*findNode(*tinyBox, "left")].params[0], 0.2f);
+    auto torus = changeKind(scene, *findNode(scene, "block"), NodeKind::Torus);
+    ASSERT_TRUE(torus);
+    Aabb ring = Evaluator(*torus).nodes()[*findNode(*torus, "block")].bounds;
+    EXPECT_NEAR(ring.max.x - ring.min.x, 1.0f, 0.05f);
     auto op = changeKind(scene, cut, NodeKind::Intersection);
     ASSERT_TRUE(op);
     EXPECT_EQ(op->nodes[cut].kind, NodeKind::Intersection);
@@ -386,6 +403,29 @@ TEST(ViewerEdit, StructuralEditsKeepTheSceneValid) {
     ASSERT_TRUE(reordered);
     EXPECT_EQ(reordered->nodes[moved].name, "hole");
     EXPECT_EQ(reordered->nodes[reordered->nodes[cut].children[0]].name, "hole");
+}
+
+TEST(ViewerEdit, SameNodeAfterAReload) {
+    Scene before = twoSpheres();
+    // Named nodes are found by name wherever they moved; unnamed ones by their JSON path.
+    auto after = parseScene(R"({"version": 1, "root": {"type": "union", "children": [
+        {"type": "box", "name": "block", "size": [1, 1, 1]},
+        {"type": "sphere", "radius": 1},
+        {"type": "sphere", "name": "left", "radius": 0.5}]}})",
+                            "two.json");
+    ASSERT_TRUE(after);
+    EXPECT_EQ(sameNode(before, *findNode(before, "left"), *after), findNode(*after, "left"));
+    EXPECT_EQ(sameNode(before, *findNode(before, "block"), *after), findNode(*after, "block"));
+    EXPECT_FALSE(sameNode(before, *findNode(before, "hole"), *after));
+    auto unnamed = parseScene(R"({"version": 1, "root": {"type": "union", "children": [
+        {"type": "sphere", "radius": 1}, {"type": "box", "size": [1, 1, 1]}]}})",
+                              "u.json");
+    ASSERT_TRUE(unnamed);
+    float r = 2.0f;
+    auto resized = setValue(*unnamed, 1, "radius", std::span(&r, 1));
+    EXPECT_EQ(sameNode(*unnamed, 1, *resized), 1u);
+    EXPECT_EQ(sameNode(*unnamed, 2, *resized), 2u);
+    EXPECT_FALSE(sameNode(*unnamed, 2, *after)); // root.children[1] is a sphere there
 }
 
 TEST(ViewerHistory, UndoRedoAndMergedSteps) {
