@@ -2,6 +2,8 @@
 
 #include <sdfcsg/io.h>
 
+#include <cstdlib>
+#include <fstream>
 #include <system_error>
 
 namespace sdfcsg::viewer {
@@ -24,6 +26,33 @@ bool FileWatcher::poll() {
     seen_ = now;
     // A file being replaced is briefly absent; its reappearance is the change to report.
     return now.exists;
+}
+
+std::filesystem::path recentFilesPath() {
+    if (const char* xdg = std::getenv("XDG_CONFIG_HOME"); xdg && *xdg)
+        return std::filesystem::path(xdg) / "sdfcsg" / "recent";
+    if (const char* home = std::getenv("HOME"); home && *home)
+        return std::filesystem::path(home) / ".config" / "sdfcsg" / "recent";
+    return {};
+}
+
+std::vector<std::string> loadRecent(const std::filesystem::path& file, size_t limit) {
+    std::vector<std::string> recent;
+    if (file.empty()) return recent;
+    std::ifstream in(file);
+    for (std::string line; recent.size() < limit && std::getline(in, line);)
+        if (!line.empty()) recent.push_back(line);
+    return recent;
+}
+
+void saveRecent(const std::filesystem::path& file, const std::vector<std::string>& recent) {
+    if (file.empty()) return;
+    std::error_code ec;
+    std::filesystem::create_directories(file.parent_path(), ec);
+    std::string text;
+    for (const std::string& r : recent)
+        text += r + "\n";
+    (void)writeFileAtomic(file, text);
 }
 
 Status Document::open(const std::filesystem::path& path) {

@@ -11,6 +11,8 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <string>
+#include <vector>
 
 namespace sdfcsg::viewer {
 
@@ -39,6 +41,14 @@ class FileWatcher {
     std::filesystem::path path_;
     FileStamp seen_;
 };
+
+// The recent-files list, one path a line: $XDG_CONFIG_HOME/sdfcsg/recent, else
+// ~/.config/sdfcsg/recent; empty when neither variable is set.
+std::filesystem::path recentFilesPath();
+// Missing or unreadable: an empty list. At most `limit` entries.
+std::vector<std::string> loadRecent(const std::filesystem::path& file, size_t limit = 10);
+// Written atomically, its folder made as needed; failures are ignored (a convenience only).
+void saveRecent(const std::filesystem::path& file, const std::vector<std::string>& recent);
 
 class Document {
   public:

@@ -202,6 +202,9 @@ struct Viewer {
     std::vector<std::string> recent;
     fs::path browseDir = fs::current_path();
     bool browserOpen = false;
+    std::vector<fs::directory_entry> browseEntries; // the listing of browseListed
+    fs::path browseListed;
+    double browseTime = 0;
     std::string status;
 
     // Automation.
@@ -240,6 +243,7 @@ void addRecent(Viewer& v, const fs::path& path) {
     v.recent.erase(std::remove(v.recent.begin(), v.recent.end(), p), v.recent.end());
     v.recent.insert(v.recent.begin(), p);
     if (v.recent.size() > 10) v.recent.resize(10);
+    saveRecent(recentFilesPath(), v.recent);
 }
 
 // Hands the document's scene to the workers when it changed.
@@ -720,13 +724,22 @@ void fileBrowser(Viewer& v) {
     if (ImGui::Begin("Open scene", &v.browserOpen)) {
         ImGui::TextWrapped("%s", v.browseDir.string().c_str());
         if (ImGui::Selectable("..")) v.browseDir = v.browseDir.parent_path();
-        std::vector<fs::directory_entry> entries;
+        // Listed again on navigation and every second, not every frame: a large or network
+        // folder would slow the window down.
         std::error_code ec;
-        for (const auto& e : fs::directory_iterator(v.browseDir, ec))
-            if (e.is_directory(ec) || e.path().extension() == ".json") entries.push_back(e);
-        std::sort(entries.begin(), entries.end(), [](auto& a, auto& b) {
-            return std::pair(!a.is_directory(), a.path()) < std::pair(!b.is_directory(), b.path());
-        });
+        if (v.browseListed != v.browseDir || now() - v.browseTime > 1.0) {
+            v.browseEntries.clear();
+            for (const auto& e : fs::directory_iterator(v.browseDir, ec))
+                if (e.is_directory(ec) || e.path().extension() == ".json")
+                    v.browseEntries.push_back(e);
+            std::sort(v.browseEntries.begin(), v.browseEntries.end(), [](auto& a, auto& b) {
+                return std::pair(!a.is_directory(), a.path()) <
+                       std::pair(!b.is_directory(), b.path());
+            });
+            v.browseListed = v.browseDir;
+            v.browseTime = now();
+        }
+        const std::vector<fs::directory_entry> entries = v.browseEntries; // may change below
         for (const auto& e : entries) {
             std::string name = e.path().filename().string() + (e.is_directory(ec) ? "/" : "");
             if (ImGui::Selectable(name.c_str())) {
@@ -1077,6 +1090,7 @@ int main(int argc, char** argv) {
         v.scriptFile = args.script.string();
     }
     v.showUi = !args.noUi;
+    v.recent = loadRecent(recentFilesPath());
 
     auto context = Context::create();
     if (!context) {

@@ -558,6 +558,22 @@ TEST(ViewerFiles, OpenFailureKeepsTheCurrentSceneAndItsFile) {
     EXPECT_EQ(doc.scene().nodes.size(), 1u);
 }
 
+TEST(ViewerFiles, RecentFilesPersist) {
+    fs::path dir = tempDir("viewer_recent");
+    fs::path file = dir / "config" / "sdfcsg" / "recent";
+    EXPECT_TRUE(loadRecent(file).empty());
+    saveRecent(file, {"/a/one.json", "two.json"});
+    EXPECT_EQ(loadRecent(file), (std::vector<std::string>{"/a/one.json", "two.json"}));
+    EXPECT_EQ(loadRecent(file, 1), std::vector<std::string>{"/a/one.json"});
+    writeText(dir / "blocker", "a file, not a folder");
+    saveRecent(dir / "blocker" / "recent", {"a"}); // cannot be written: ignored
+    const char* old = std::getenv("XDG_CONFIG_HOME");
+    const std::string saved = old ? old : "";
+    setenv("XDG_CONFIG_HOME", (dir / "config").c_str(), 1);
+    EXPECT_EQ(recentFilesPath(), file);
+    old ? setenv("XDG_CONFIG_HOME", saved.c_str(), 1) : unsetenv("XDG_CONFIG_HOME");
+}
+
 TEST(ViewerFiles, ABrokenFirstFileIsWatched) {
     fs::path dir = tempDir("viewer_open_first");
     writeText(dir / "bad.json", "{");
