@@ -2,6 +2,8 @@
 
 #include <sdfcsg/io.h>
 
+#include <cstdlib>
+#include <fstream>
 #include <system_error>
 
 namespace sdfcsg::viewer {
@@ -26,16 +28,49 @@ bool FileWatcher::poll() {
     return now.exists;
 }
 
+std::filesystem::path recentFilesPath() {
+    if (const char* xdg = std::getenv("XDG_CONFIG_HOME"); xdg && *xdg)
+        return std::filesystem::path(xdg) / "sdfcsg" / "recent";
+    if (const char* home = std::getenv("HOME"); home && *home)
+        return std::filesystem::path(home) / ".config" / "sdfcsg" / "recent";
+    return {};
+}
+
+std::vector<std::string> loadRecent(const std::filesystem::path& file, size_t limit) {
+    std::vector<std::string> recent;
+    if (file.empty()) return recent;
+    std::ifstream in(file);
+    for (std::string line; recent.size() < limit && std::getline(in, line);)
+        if (!line.empty()) recent.push_back(line);
+    return recent;
+}
+
+void saveRecent(const std::filesystem::path& file, const std::vector<std::string>& recent) {
+    if (file.empty()) return;
+    std::error_code ec;
+    std::filesystem::create_directories(file.parent_path(), ec);
+    std::string text;
+    for (const std::string& r : recent)
+        text += r + "\n";
+    (void)writeFileAtomic(file, text);
+}
+
 Status Document::open(const std::filesystem::path& path) {
     auto scene = loadScene(path);
-    // Watch the file whatever happened, so fixing it on disk loads it.
-    path_ = path;
-    watcher_ = FileWatcher(path);
+    // A broken file replaces nothing: with a scene on screen, saving and live reload stay on
+    // that scene's file (else Save would write it over the broken one). Without one, the
+    // broken file is watched, so fixing it on disk loads it.
     if (!scene) {
         error_ = scene.error();
         ++version_;
+        if (!loaded_) {
+            path_ = path;
+            watcher_ = FileWatcher(path);
+        }
         return scene.error();
     }
+    path_ = path;
+    watcher_ = FileWatcher(path);
     error_.reset();
     history_.reset(std::move(*scene));
     loaded_ = true;
@@ -73,6 +108,7 @@ void Document::replace(Scene scene) {
 Status Document::save(const std::filesystem::path& path) {
     auto written = writeFileAtomic(path, toJson(scene()));
     if (!written) return written;
+    error_.reset(); // the file now holds the scene on screen, whatever failed to load before
     if (path != path_) {
         path_ = path;
         watcher_ = FileWatcher(path);

@@ -11,6 +11,8 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <string>
+#include <vector>
 
 namespace sdfcsg::viewer {
 
@@ -40,9 +42,18 @@ class FileWatcher {
     FileStamp seen_;
 };
 
+// The recent-files list, one path a line: $XDG_CONFIG_HOME/sdfcsg/recent, else
+// ~/.config/sdfcsg/recent; empty when neither variable is set.
+std::filesystem::path recentFilesPath();
+// Missing or unreadable: an empty list. At most `limit` entries.
+std::vector<std::string> loadRecent(const std::filesystem::path& file, size_t limit = 10);
+// Written atomically, its folder made as needed; failures are ignored (a convenience only).
+void saveRecent(const std::filesystem::path& file, const std::vector<std::string>& recent);
+
 class Document {
   public:
-    // Loads a file; on failure the current scene stays and error() holds the problems.
+    // Loads a file; on failure the current scene stays, with its path and watcher (a document
+    // without a scene watches the broken file instead), and error() holds the problems.
     Status open(const std::filesystem::path& path);
     // Reloads if the file changed on disk; true when something changed (scene or error).
     bool pollReload();
@@ -57,7 +68,7 @@ class Document {
     const Scene& scene() const { return history_.current(); }
     History& history() { return history_; }
     const std::filesystem::path& path() const { return path_; }
-    // Problems of the last load or reload; cleared by the next load that succeeds.
+    // Problems of the last load or reload; cleared by the next load or save that succeeds.
     const std::optional<Error>& error() const { return error_; }
     // True once a scene has loaded; before that scene() is empty.
     bool loaded() const { return loaded_; }

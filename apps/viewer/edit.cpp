@@ -1,7 +1,10 @@
 #include "edit.h"
 
+#include <glm/geometric.hpp>
+
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <string>
 
 namespace sdfcsg::viewer {
@@ -40,6 +43,45 @@ void defaultParams(Node& node) {
         int n = p.type == ValueType::Vec3 ? 3 : 1;
         for (int k = 0; k < n; ++k)
             node.params[p.slot + k] = v[k];
+    }
+}
+
+// About half the width of a primitive, from its sizes.
+float halfExtent(const Node& node) {
+    const auto& p = node.params;
+    switch (node.kind) {
+    case NodeKind::Sphere: return p[0];
+    case NodeKind::Box:
+    case NodeKind::RoundBox: return 0.5f * std::max({p[0], p[1], p[2]});
+    case NodeKind::TriangularPrism: return 0.5f * std::max({p[0], p[1], p[2]});
+    case NodeKind::Torus: return p[0] + p[1];
+    case NodeKind::Cylinder:
+    case NodeKind::Cone: return std::max(p[0], 0.5f * p[1]);
+    case NodeKind::Capsule: {
+        glm::vec3 a(p[0], p[1], p[2]), b(p[3], p[4], p[5]);
+        return p[6] + 0.5f * glm::length(b - a);
+    }
+    default: return 0.5f; // unbounded (a plane): the defaults' scale
+    }
+}
+
+// Sizes a primitive's required lengths to about `h` across each half, in the proportions of
+// defaultParams().
+void sizeLike(Node& node, float h) {
+    if (!(h > 0.0f) || !std::isfinite(h)) return;
+    auto& p = node.params;
+    switch (node.kind) {
+    case NodeKind::Sphere: p[0] = h; break;
+    case NodeKind::Box: p[0] = p[1] = p[2] = 2 * h; break;
+    case NodeKind::RoundBox: p[0] = p[1] = p[2] = 2 * h, p[3] = 0.2f * h; break;
+    case NodeKind::TriangularPrism: p[0] = p[1] = p[2] = 2 * h; break;
+    case NodeKind::Torus: p[0] = 0.7f * h, p[1] = 0.3f * h; break;
+    case NodeKind::Cylinder:
+    case NodeKind::Cone: p[0] = h, p[1] = 2 * h; break;
+    case NodeKind::Capsule:
+        p[0] = p[2] = p[3] = p[5] = 0.0f, p[1] = -0.5f * h, p[4] = 0.5f * h, p[6] = 0.5f * h;
+        break;
+    default: break;
     }
 }
 
@@ -95,6 +137,16 @@ std::optional<uint32_t> findNode(const Scene& scene, std::string_view nameOrInde
     if (ec == std::errc() && end == nameOrIndex.data() + nameOrIndex.size() &&
         index < scene.nodes.size())
         return index;
+    return std::nullopt;
+}
+
+std::optional<uint32_t> sameNode(const Scene& before, uint32_t node, const Scene& after) {
+    if (node >= before.nodes.size()) return std::nullopt;
+    const Node& n = before.nodes[node];
+    for (uint32_t i = 0; i < after.nodes.size(); ++i)
+        if (n.name.empty() ? after.nodes[i].path == n.path && after.nodes[i].kind == n.kind
+                           : after.nodes[i].name == n.name)
+            return i;
     return std::nullopt;
 }
 
@@ -191,6 +243,7 @@ Result<Scene> changeKind(const Scene& scene, uint32_t node, NodeKind kind) {
     Node old = n;
     n.kind = kind;
     defaultParams(n);
+    if (!wasOperation) sizeLike(n, halfExtent(old));
     for (const ParamInfo& p : kindInfo(kind).params)
         if (const ParamInfo* q = findParam(old.kind, p.name); q && q->type == p.type)
             std::copy_n(old.params.begin() + q->slot, p.type == ValueType::Vec3 ? 3 : 1,

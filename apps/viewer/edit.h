@@ -24,6 +24,11 @@ int parentOf(const Scene& scene, uint32_t node);
 // A node by name (first in file order) or by index; nullopt if there is none.
 std::optional<uint32_t> findNode(const Scene& scene, std::string_view nameOrIndex);
 
+// The node of `after` that is `node` of `before`, across a reload or an outside edit: the first
+// node of the same name when it has one, else the node of the same kind at the same JSON path;
+// nullopt if gone.
+std::optional<uint32_t> sameNode(const Scene& before, uint32_t node, const Scene& after);
+
 // Validates through the loader: parseScene(toJson(scene)).
 Result<Scene> revalidate(const Scene& scene);
 
@@ -41,7 +46,8 @@ Result<Scene> addChild(const Scene& scene, uint32_t parent, NodeKind kind,
 // Removes a node and its subtree; the root and an operation's only child cannot be removed.
 Result<Scene> removeNode(const Scene& scene, uint32_t node);
 // Turns a primitive into another primitive (parameters of the same name are kept, the others
-// get defaults) or an operation into another operation.
+// sized to the old primitive's extent: a sphere of radius 0.1 becomes a box 0.2 across) or an
+// operation into another operation.
 Result<Scene> changeKind(const Scene& scene, uint32_t node, NodeKind kind);
 // Moves a node among its siblings by `delta` places (the first child of a difference is what
 // the others are cut from, so order matters). *newIndex receives the node's index afterwards.

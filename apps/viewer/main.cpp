@@ -27,6 +27,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <deque>
 #include <fstream>
@@ -139,6 +140,7 @@ struct Viewer {
     GLFWwindow* window = nullptr;
     PresenterPtr presenter;
     std::unique_ptr<Context> context;
+    std::unique_ptr<Context> liveContext; // the live renderer's own device (RenderWorker)
     std::unique_ptr<RenderWorker> renderer;
     std::unique_ptr<MeshWorker> mesher;
     Document doc;
@@ -160,6 +162,7 @@ struct Viewer {
     RenderOutput last;                              // the image on screen, with its depths
     double lastInteraction = -1.0;
     float scale = 0.5f; // preview resolution while the camera moves
+    bool refining = false; // a job redraws the live image with its baked kernel
     double renderMs = 0.0, compileMs = 0.0;
     std::optional<Error> renderError;
 
@@ -199,6 +202,9 @@ struct Viewer {
     std::vector<std::string> recent;
     fs::path browseDir = fs::current_path();
     bool browserOpen = false;
+    std::vector<fs::directory_entry> browseEntries; // the listing of browseListed
+    fs::path browseListed;
+    double browseTime = 0;
     std::string status;
 
     // Automation.
@@ -210,6 +216,8 @@ struct Viewer {
     int settledFrames = 0; // frames in a row that showed the current full image
     int exitCode = 0;
     double waitStart = 0;
+    double commandWaitStart = 0; // of a command waiting for an image or a reload
+    int reloads = 0; // not yet answered by the script's wait-reload
 };
 
 float aspectOf(const Viewer& v) {
@@ -226,17 +234,7 @@ void resetCamera(Viewer& v) {
 
 void frameSelection(Viewer& v) {
     if (!v.evaluator) return;
-    Aabb box;
-    if (v.selected >= 0 && v.selected < int(v.evaluator->nodes().size()))
-        box = v.evaluator->nodes()[v.selected].bounds;
-    if (box.empty() || !box.finite()) {
-        // The finite primitives: planes would make the whole scene unbounded.
-        for (const FlatNode& n : v.evaluator->nodes())
-            if (!kindInfo(n.kind).operation && n.bounds.finite() && !n.bounds.empty())
-                box.min = glm::min(box.min, n.bounds.min),
-                box.max = glm::max(box.max, n.bounds.max);
-    }
-    frameBox(v.camera, box, aspectOf(v));
+    frameBox(v.camera, framedBounds(*v.evaluator, v.selected), aspectOf(v));
     v.lastInteraction = now();
 }
 
@@ -245,6 +243,7 @@ void addRecent(Viewer& v, const fs::path& path) {
     v.recent.erase(std::remove(v.recent.begin(), v.recent.end(), p), v.recent.end());
     v.recent.insert(v.recent.begin(), p);
     if (v.recent.size() > 10) v.recent.resize(10);
+    saveRecent(recentFilesPath(), v.recent);
 }
 
 // Hands the document's scene to the workers when it changed.
@@ -259,10 +258,10 @@ void syncScene(Viewer& v) {
 }
 
 void openFile(Viewer& v, const fs::path& path) {
-    bool hadScene = v.doc.loaded();
     auto opened = v.doc.open(path);
-    std::snprintf(v.savePath, sizeof v.savePath, "%s", path.string().c_str());
     if (opened) {
+        // Only a file that loaded becomes where Save writes: the scene on screen is its scene.
+        std::snprintf(v.savePath, sizeof v.savePath, "%s", path.string().c_str());
         addRecent(v, path);
         v.selected = -1;
         v.scene.reset(); // the camera is reset for a new file
@@ -270,7 +269,6 @@ void openFile(Viewer& v, const fs::path& path) {
         v.status = "opened " + path.string();
     } else {
         v.status = "could not open " + path.string();
-        (void)hadScene;
     }
 }
 
@@ -350,6 +348,11 @@ bool finishGeneration(Viewer& v) {
     return true;
 }
 
+// Where Ctrl+S writes.
+fs::path savePathOf(const Viewer& v) {
+    return v.savePath[0] ? fs::path(v.savePath) : v.doc.path();
+}
+
 void save(Viewer& v, const fs::path& path) {
     auto saved = v.doc.save(path);
     v.status = saved ? "saved " + path.string() : saved.error().str();
@@ -366,7 +369,7 @@ ViewKey wantedKey(Viewer& v, bool full) {
     k.shadows = v.shadows;
     k.ao = v.ao;
     k.boxes = v.boxes;
-    k.selected = v.boxes == BoxOverlay::None ? -1 : v.selected;
+    k.selected = v.selected; // its box, and its highlight in full-resolution frames
     int w = 1, h = 1;
     glfwGetFramebufferSize(v.window, &w, &h);
     float s = full ? 1.0f : v.scale;
@@ -388,6 +391,7 @@ void updateImage(Viewer& v) {
         ViewKey key = job != v.jobs.end() ? job->second : ViewKey{};
         v.jobs.erase(v.jobs.begin(), job == v.jobs.end() ? job : job + 1);
         v.renderError = out->error;
+        v.refining = false;
         if (out->compileSeconds > 0) v.compileMs = out->compileSeconds * 1000.0;
         if (!out->image.rgba.empty()) {
             v.renderMs = out->renderSeconds * 1000.0;
@@ -421,10 +425,17 @@ void updateImage(Viewer& v) {
         }
         return;
     }
-    if (v.haveSubmitted && v.submitted == want) return;
-    if (v.haveShown && v.shown == want) return;
+    // A value edit drawn by the live renderer is drawn again once its baked kernel is built:
+    // the same image as `sdfcsg render` gives, and faster to redraw.
+    const bool refine = v.haveShown && v.shown == want && v.last.live && !v.refining &&
+                        v.renderer->refinementReady(v.sceneVersion);
+    if (!refine) {
+        if (v.haveSubmitted && v.submitted == want) return;
+        if (v.haveShown && v.shown == want) return;
+    }
     // While a render runs, wait: a newer job replaces the queued one anyway.
     if (!v.renderer->idle() && v.haveSubmitted) return;
+    v.refining = refine;
     RenderJob job;
     job.scene = v.scene;
     job.sceneVersion = v.sceneVersion;
@@ -439,15 +450,18 @@ void updateImage(Viewer& v) {
     job.options.boxes =
         want.selected < 0 && want.boxes == BoxOverlay::Selected ? BoxOverlay::None : want.boxes;
     job.options.selectedNode = want.selected;
+    job.highlight = want.selected;
     v.jobs.emplace_back(job.id, want);
     v.renderer->submit(std::move(job));
     v.submitted = want;
     v.haveSubmitted = true;
 }
 
-// The full-resolution image of the current state is on screen.
+// The full-resolution image of the current state is on screen, from its baked kernel (so a
+// screenshot is the same whether or not the live renderer drew the edit first).
 bool settled(Viewer& v) {
-    return v.scene && v.haveShown && v.shown == wantedKey(v, true) && v.renderer->idle();
+    return v.scene && v.haveShown && v.shown == wantedKey(v, true) && v.renderer->idle() &&
+           !(v.last.live && v.renderer->refinementPending(v.sceneVersion));
 }
 
 // ---- Input -----------------------------------------------------------------------------------
@@ -536,7 +550,7 @@ void handleInput(Viewer& v) {
     auto hit = [&](int key) { return ImGui::IsKeyPressed(key, false); };
     if (ctrl && hit(GLFW_KEY_Z)) shift ? redo(v) : undo(v);
     if (ctrl && hit(GLFW_KEY_Y)) redo(v);
-    if (ctrl && hit(GLFW_KEY_S)) save(v, v.savePath[0] ? fs::path(v.savePath) : v.doc.path());
+    if (ctrl && hit(GLFW_KEY_S)) save(v, savePathOf(v));
     if (ctrl) return;
     if (hit(GLFW_KEY_F)) frameSelection(v);
     if (hit(GLFW_KEY_R)) resetCamera(v), v.lastInteraction = now();
@@ -710,13 +724,22 @@ void fileBrowser(Viewer& v) {
     if (ImGui::Begin("Open scene", &v.browserOpen)) {
         ImGui::TextWrapped("%s", v.browseDir.string().c_str());
         if (ImGui::Selectable("..")) v.browseDir = v.browseDir.parent_path();
-        std::vector<fs::directory_entry> entries;
+        // Listed again on navigation and every second, not every frame: a large or network
+        // folder would slow the window down.
         std::error_code ec;
-        for (const auto& e : fs::directory_iterator(v.browseDir, ec))
-            if (e.is_directory(ec) || e.path().extension() == ".json") entries.push_back(e);
-        std::sort(entries.begin(), entries.end(), [](auto& a, auto& b) {
-            return std::pair(!a.is_directory(), a.path()) < std::pair(!b.is_directory(), b.path());
-        });
+        if (v.browseListed != v.browseDir || now() - v.browseTime > 1.0) {
+            v.browseEntries.clear();
+            for (const auto& e : fs::directory_iterator(v.browseDir, ec))
+                if (e.is_directory(ec) || e.path().extension() == ".json")
+                    v.browseEntries.push_back(e);
+            std::sort(v.browseEntries.begin(), v.browseEntries.end(), [](auto& a, auto& b) {
+                return std::pair(!a.is_directory(), a.path()) <
+                       std::pair(!b.is_directory(), b.path());
+            });
+            v.browseListed = v.browseDir;
+            v.browseTime = now();
+        }
+        const std::vector<fs::directory_entry> entries = v.browseEntries; // may change below
         for (const auto& e : entries) {
             std::string name = e.path().filename().string() + (e.is_directory(ec) ? "/" : "");
             if (ImGui::Selectable(name.c_str())) {
@@ -914,8 +937,28 @@ bool runScript(Viewer& v) {
             return false;
         };
         syncScene(v);
-        if (!v.scene && c.verb != "generate") return fail("no scene loaded");
+        if (!v.scene && c.verb != "generate" && c.verb != "open") return fail("no scene loaded");
         const std::string arg = c.args.empty() ? "" : c.args[0];
+        // Commands that look at the image wait for the full-resolution one of the current state.
+        const bool needsImage =
+            c.verb == "pick" || c.verb == "print-bounds" || c.verb == "expect-error";
+        if ((needsImage && !settled(v)) || (c.verb == "wait-reload" && v.reloads == 0)) {
+            if (v.commandWaitStart == 0) v.commandWaitStart = now();
+            if (now() - v.commandWaitStart > 300.0)
+                return fail(c.verb + ": still waiting after 300 s");
+            v.script.push_front(c);
+            return true;
+        }
+        v.commandWaitStart = 0;
+        auto selectedNode = [&]() -> std::optional<uint32_t> {
+            if (v.selected < 0 || v.selected >= int(v.scene->nodes.size())) return std::nullopt;
+            return uint32_t(v.selected);
+        };
+        auto kindNamed = [](const std::string& name) {
+            for (const KindInfo& k : nodeKinds())
+                if (k.name == name) return k.kind;
+            return NodeKind::Sphere; // parseScript admits known names only
+        };
         if (c.verb == "select") {
             if (arg == "none") {
                 v.selected = -1;
@@ -955,8 +998,58 @@ bool runScript(Viewer& v) {
         } else if (c.verb == "redo") {
             redo(v);
         } else if (c.verb == "save") {
-            auto saved = v.doc.save(arg);
+            fs::path path = !arg.empty() ? fs::path(arg) : savePathOf(v);
+            auto saved = v.doc.save(path);
             if (!saved) return fail(saved.error().str());
+        } else if (c.verb == "add" || c.verb == "remove" || c.verb == "kind" || c.verb == "op" ||
+                   c.verb == "move") {
+            auto node = selectedNode();
+            if (!node) return fail(c.verb + ": no node selected");
+            uint32_t moved = *node;
+            Result<Scene> edited = c.verb == "add"      ? addChild(*v.scene, *node, kindNamed(arg), &moved)
+                                   : c.verb == "remove" ? removeNode(*v.scene, *node)
+                                   : c.verb == "move"
+                                       ? moveNode(*v.scene, *node, arg == "up" ? -1 : 1, &moved)
+                                       : changeKind(*v.scene, *node, kindNamed(arg));
+            if (!edited) return fail(edited.error().str());
+            commit(v, std::move(edited));
+            // As the Node panel's buttons leave the selection.
+            if (c.verb == "remove")
+                v.selected = -1;
+            else
+                v.selected = int(moved);
+        } else if (c.verb == "open") {
+            openFile(v, arg); // a failure shows in the panel, as in the file browser
+        } else if (c.verb == "wait-reload") {
+            --v.reloads;
+        } else if (c.verb == "pick") {
+            pick(v, c.numbers[0], c.numbers[1]);
+        } else if (c.verb == "ui") {
+            v.showUi = arg == "on";
+        } else if (c.verb == "print-bounds") {
+            auto n = findNode(*v.scene, arg);
+            if (!n) return fail("no node named \"" + arg + "\"");
+            Evaluator shown(*v.last.scene);
+            if (*n >= shown.nodes().size()) return fail("print-bounds: the image shows no " + arg);
+            PixelRect r = projectedRect(*v.last.options.camera, v.last.image.width,
+                                        v.last.image.height, shown.nodes()[*n].bounds);
+            std::printf("bounds %s %d %d %d %d\n", arg.c_str(), r.x0, r.y0, r.x1, r.y1);
+            std::fflush(stdout);
+        } else if (c.verb == "expect-error") {
+            std::string shown = v.doc.error() ? v.doc.error()->str() : "";
+            if (v.renderError) shown += (shown.empty() ? "" : "\n") + v.renderError->str();
+            if (c.text == "none" ? !shown.empty() : shown.find(c.text) == std::string::npos)
+                return fail("expected the error \"" + c.text + "\", shown: \"" + shown + "\"");
+        } else if (c.verb == "expect-selected") {
+            std::optional<uint32_t> want;
+            if (arg != "none") {
+                want = findNode(*v.scene, arg);
+                if (!want) return fail("no node named \"" + arg + "\"");
+            }
+            if (selectedNode() != want)
+                return fail("expected " + (want ? nodeLabel(*v.scene, *want) : "no node") +
+                            " selected, got " +
+                            (selectedNode() ? nodeLabel(*v.scene, *selectedNode()) : "none"));
         } else if (c.verb == "screenshot") {
             v.pendingShot = arg;
             v.waitStart = now();
@@ -997,6 +1090,7 @@ int main(int argc, char** argv) {
         v.scriptFile = args.script.string();
     }
     v.showUi = !args.noUi;
+    v.recent = loadRecent(recentFilesPath());
 
     auto context = Context::create();
     if (!context) {
@@ -1004,7 +1098,10 @@ int main(int argc, char** argv) {
         return 4;
     }
     v.context = std::move(*context);
-    v.renderer = std::make_unique<RenderWorker>(*v.context);
+    // Without a second device the live renderer shares the first, and its compile then
+    // delays frames once.
+    if (auto live = Context::create()) v.liveContext = std::move(*live);
+    v.renderer = std::make_unique<RenderWorker>(*v.context, v.liveContext.get());
     v.mesher = std::make_unique<MeshWorker>(*v.context);
     v.generator = std::make_unique<GenerateWorker>();
     describeEndpoint(v);
@@ -1059,8 +1156,16 @@ int main(int argc, char** argv) {
             glfwWaitEventsTimeout(0.1);
         if (now() - lastPoll > 0.25) { // live reload
             lastPoll = now();
-            if (v.doc.pollReload())
+            const std::shared_ptr<const Scene> before = v.scene;
+            if (v.doc.pollReload()) {
                 v.status = v.doc.error() ? "reload failed" : "reloaded " + v.doc.path().string();
+                // Node numbers change with the file: the selection follows its node.
+                if (!v.doc.error() && before && v.selected >= 0) {
+                    auto same = sameNode(*before, uint32_t(v.selected), v.doc.scene());
+                    v.selected = same ? int(*same) : -1;
+                }
+                ++v.reloads;
+            }
         }
         syncScene(v);
         if (!finishGeneration(v) || !runScript(v)) break;
@@ -1118,10 +1223,18 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "%s\n", v.renderError->str().c_str());
         v.exitCode = 1;
     }
-    glfwHideWindow(v.window); // the workers may need a moment to finish a compile
-    v.renderer.reset();
-    v.mesher.reset();
+    glfwHideWindow(v.window);
     v.generator.reset(); // cancels a generation in flight
+    v.mesher.reset();    // cancels an extraction
+    if (v.renderer->compiling()) {
+        // A compile cannot be interrupted and may take seconds more. Everything the user asked
+        // for is written already (saves and screenshots are synchronous and atomic), so leave
+        // without the destructors, which would wait for it.
+        std::fflush(stdout);
+        std::fflush(stderr);
+        std::_Exit(v.exitCode);
+    }
+    v.renderer.reset();
     v.presenter.reset();
     ImGui_ImplGlfw_Shutdown();
     ImGui::DestroyContext();

@@ -1,5 +1,7 @@
 #include "orbit_camera.h"
 
+#include "camera.h" // finiteSceneBounds(), as the mesher uses
+
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
@@ -67,6 +69,38 @@ void frameBox(OrbitCamera& camera, const Aabb& box, float aspect) {
     float halfY = glm::radians(camera.fov) * 0.5f;
     float halfX = std::atan(std::tan(halfY) * aspect);
     camera.distance = 1.05f * radius / std::sin(std::min(halfX, halfY));
+}
+
+namespace {
+
+// A node's bounds with unbounded primitives (planes) left out: finite bounds as they are, else
+// a union of its operands', of the first operand's alone for a difference. (Parsed scenes are
+// depth-capped, so the recursion is bounded.)
+Aabb finitePart(const Evaluator& evaluator, uint32_t node) {
+    const FlatNode& n = evaluator.nodes()[node];
+    if (n.bounds.empty() || n.bounds.finite() || n.children.empty()) {
+        return n.bounds.finite() ? n.bounds : Aabb{};
+    }
+    if (n.kind == NodeKind::Difference) return finitePart(evaluator, n.children[0]);
+    Aabb box;
+    for (uint32_t c : n.children) {
+        Aabb part = finitePart(evaluator, c);
+        if (part.empty()) continue;
+        box.min = glm::min(box.min, part.min), box.max = glm::max(box.max, part.max);
+    }
+    return box;
+}
+
+} // namespace
+
+Aabb framedBounds(const Evaluator& evaluator, int node) {
+    if (node >= 0 && node < int(evaluator.nodes().size())) {
+        const Aabb& box = evaluator.nodes()[node].bounds;
+        if (!box.empty() && box.finite()) return box;
+    }
+    if (evaluator.nodes().empty()) return detail::finiteSceneBounds(evaluator);
+    Aabb box = finitePart(evaluator, 0);
+    return box.empty() ? detail::finiteSceneBounds(evaluator) : box;
 }
 
 } // namespace sdfcsg::viewer

@@ -35,4 +35,9 @@ void zoom(OrbitCamera& camera, float factor);
 // its bounding sphere inside both fields of view. aspect = width / height.
 void frameBox(OrbitCamera& camera, const Aabb& box, float aspect);
 
+// What F frames: the bounds of nodes()[node] when finite, else the box the solid's finite part
+// lies in: a difference within its first operand, whatever it subtracts, and planes left out
+// (so a ground plane does not bring in what is cut away elsewhere). node < 0: the solid.
+Aabb framedBounds(const Evaluator& evaluator, int node);
+
 } // namespace sdfcsg::viewer

@@ -1,6 +1,9 @@
 #include "script.h"
 
+#include <sdfcsg/scene.h>
+
 #include <charconv>
+#include <cmath>
 #include <sstream>
 
 namespace sdfcsg::viewer {
@@ -14,6 +17,19 @@ struct Verb {
     std::vector<std::string_view> choices; // allowed single argument, when not empty
     std::string_view text = {};            // free text: what the text describes, for the message
 };
+
+std::vector<std::string_view> kindNames(bool operations) {
+    std::vector<std::string_view> names;
+    for (const KindInfo& k : nodeKinds())
+        if (k.operation == operations) names.push_back(k.name);
+    return names;
+}
+
+std::vector<std::string_view> allKindNames() {
+    std::vector<std::string_view> names = kindNames(false), ops = kindNames(true);
+    names.insert(names.end(), ops.begin(), ops.end());
+    return names;
+}
 
 const std::vector<Verb>& verbs() {
     static const std::vector<Verb> table = {
@@ -30,17 +46,30 @@ const std::vector<Verb>& verbs() {
         {"reset", 0, 0, false, {}},
         {"undo", 0, 0, false, {}},
         {"redo", 0, 0, false, {}},
-        {"save", 1, 1, false, {}},
+        {"save", 0, 1, false, {}},
         {"screenshot", 1, 1, false, {}},
         {"generate", 1, -1, false, {}, "the scene"},
         {"edit-scene", 1, -1, false, {}, "the change"},
+        {"add", 1, 1, false, allKindNames()},
+        {"remove", 0, 0, false, {}},
+        {"kind", 1, 1, false, allKindNames()},
+        {"op", 1, 1, false, kindNames(true)},
+        {"move", 1, 1, false, {"up", "down"}},
+        {"open", 1, 1, false, {}},
+        {"pick", 2, 2, true, {}},
+        {"wait-reload", 0, 0, false, {}},
+        {"ui", 1, 1, false, {"on", "off"}},
+        {"expect-error", 1, -1, false, {}, "the error"},
+        {"expect-selected", 1, 1, false, {}},
+        {"print-bounds", 1, 1, false, {}},
     };
     return table;
 }
 
+// Finite numbers only: a NaN or infinite angle or factor would poison the camera for good.
 bool parseFloat(const std::string& s, float& out) {
     auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
-    return ec == std::errc() && end == s.data() + s.size();
+    return ec == std::errc() && end == s.data() + s.size() && std::isfinite(out);
 }
 
 } // namespace
@@ -111,13 +140,17 @@ Result<std::vector<Command>> parseScript(std::string_view text, std::string_view
             for (size_t i = c.verb == "set" ? 1 : 0; i < c.args.size(); ++i) {
                 float v;
                 if (!parseFloat(c.args[i], v)) {
-                    problem(c.verb + ": expected a number, got \"" + c.args[i] + "\"");
+                    problem(c.verb + ": expected a finite number, got \"" + c.args[i] + "\"");
                     ok = false;
                     break;
                 }
                 c.numbers.push_back(v);
             }
             if (!ok) continue;
+            if (c.verb == "zoom" && !(c.numbers[0] > 0.0f)) {
+                problem("zoom: expected a positive factor, got \"" + c.args[0] + "\"");
+                continue;
+            }
         }
         commands.push_back(std::move(c));
     }

@@ -9,15 +9,30 @@
 //   zoom FACTOR              multiply the distance to the target
 //   frame    reset           frame the selection (or scene), or go back to the scene's camera
 //   undo    redo
-//   save PATH                write the scene as JSON
+//   add KIND                 a child of the selected operation, which selects it
+//   remove                   the selected node and its subtree
+//   kind KIND                turn the selected primitive (operation) into another one
+//   op union|intersection|difference|...   the same, for operations only
+//   move up|down             the selected node among its siblings
+//   open PATH                load a scene file as the file panel does (a failure is no
+//                            script error: the scene stays, see expect-error)
+//   save [PATH]              write the scene as JSON (no PATH: where Ctrl+S writes)
+//   wait-reload              wait until the scene's file changed on disk and was reloaded
+//                            (each reload answers one wait, also one that came first)
+//   pick X Y                 wait for the full-resolution image, then click window pixel X, Y
+//   ui on|off                show or hide the panels (H)
 //   screenshot PATH          wait for the full-resolution image, then write the window as PNG
+//   print-bounds NODE        wait for the full-resolution image, then print the window pixels
+//                            NODE's bounds cover: "bounds NODE X0 Y0 X1 Y1" (end exclusive)
+//   expect-error TEXT...     fail unless the shown error holds TEXT ("none": unless none shows)
+//   expect-selected NODE     fail unless NODE (a name, an index or "none") is selected
 //   generate TEXT...         ask the language model for a new scene described by TEXT, wait
 //                            for it, and make it the current scene (one undo step)
 //   edit-scene TEXT...       the same, sending the current scene to be changed as TEXT says
 //
-// The text of generate and edit-scene is the rest of the line, so it cannot hold a '#'. A
-// generation that fails (no valid scene after the repair rounds, a network error) fails the
-// script.
+// Numbers must be finite. The text of generate, edit-scene and expect-error is the rest of the
+// line, so it cannot hold a '#'. A generation that fails (no valid scene after the repair
+// rounds, a network error) fails the script.
 #pragma once
 
 #include <sdfcsg/error.h>

@@ -1,6 +1,7 @@
 #include "workers.h"
 
 #include "edit.h"
+#include "picking.h"
 
 #include <algorithm>
 #include <chrono>
@@ -16,7 +17,106 @@ double secondsSince(std::chrono::steady_clock::time_point start) {
 
 } // namespace
 
-RenderWorker::RenderWorker(Context& context) : context_(context) {
+RendererBuilder::RendererBuilder(Context& context, RendererOptions options)
+    : context_(context), options_(options) {
+    thread_ = std::thread([this] { run(); });
+}
+
+RendererBuilder::~RendererBuilder() {
+    {
+        std::lock_guard lock(mutex_);
+        stop_ = true;
+    }
+    wake_.notify_all();
+    thread_.join();
+}
+
+void RendererBuilder::request(std::shared_ptr<const Scene> scene, uint64_t version) {
+    {
+        std::lock_guard lock(mutex_);
+        if (wanted_ && wantedVersion_ == version) return; // asked for already
+        wanted_ = std::move(scene);
+        wantedVersion_ = version;
+        waiting_ = true;
+    }
+    wake_.notify_all();
+}
+
+std::optional<RendererBuilder::Built> RendererBuilder::take() {
+    std::lock_guard lock(mutex_);
+    std::optional<Built> out = std::move(done_);
+    done_.reset();
+    // The newest request is answered once its build is taken; an older build leaves it waiting.
+    if (out && !waiting_ && !running_ && out->version == wantedVersion_) wanted_.reset();
+    return out;
+}
+
+bool RendererBuilder::pending(uint64_t version) const {
+    std::lock_guard lock(mutex_);
+    if (!wanted_ || wantedVersion_ != version) return false;
+    // A build that failed is nothing to wait for.
+    return !(done_ && done_->version == version && !done_->renderer && !waiting_);
+}
+
+bool RendererBuilder::ready(uint64_t version) const {
+    std::lock_guard lock(mutex_);
+    return done_ && done_->version == version && bool(done_->renderer);
+}
+
+bool RendererBuilder::pendingStructure(const Scene& scene) const {
+    std::lock_guard lock(mutex_);
+    return wanted_ && sameStructure(*wanted_, scene);
+}
+
+bool RendererBuilder::busy() const {
+    std::lock_guard lock(mutex_);
+    return waiting_ || running_;
+}
+
+bool RendererBuilder::building() const {
+    std::lock_guard lock(mutex_);
+    return running_;
+}
+
+void RendererBuilder::run() {
+    for (;;) {
+        std::shared_ptr<const Scene> scene;
+        uint64_t version = 0;
+        {
+            std::unique_lock lock(mutex_);
+            wake_.wait(lock, [&] { return stop_ || waiting_; });
+            if (stop_) return;
+            scene = wanted_;
+            version = wantedVersion_;
+            waiting_ = false;
+            running_ = true;
+        }
+        auto built = Renderer::create(context_, *scene, options_);
+        std::lock_guard lock(mutex_);
+        done_.emplace(Built{std::move(scene), version, std::move(built)});
+        running_ = false;
+    }
+}
+
+namespace {
+
+bool sameView(const RenderOptions& a, const RenderOptions& b) {
+    const Camera ca = a.camera.value_or(Camera{}), cb = b.camera.value_or(Camera{});
+    return a.width == b.width && a.height == b.height && a.mode == b.mode &&
+           a.camera.has_value() == b.camera.has_value() && ca.eye == cb.eye &&
+           ca.target == cb.target && ca.up == cb.up && ca.fov == cb.fov && a.aa == b.aa &&
+           a.shadows == b.shadows && a.ambientOcclusion == b.ambientOcclusion &&
+           a.boundsSkipping == b.boundsSkipping && a.boxes == b.boxes &&
+           (a.boxes != BoxOverlay::Selected || a.selectedNode == b.selectedNode);
+}
+
+} // namespace
+
+RenderWorker::RenderWorker(Context& context, Context* liveContext) : context_(context) {
+    RendererOptions live;
+    live.inlineValues = false;
+    liveBuilder_ = std::make_unique<RendererBuilder>(liveContext ? *liveContext : context, live);
+    bakeBuilder_ = std::make_unique<RendererBuilder>(context, RendererOptions{});
     thread_ = std::thread([this] { run(); });
 }
 
@@ -27,7 +127,6 @@ RenderWorker::~RenderWorker() {
     }
     wake_.notify_all();
     thread_.join();
-    if (liveThread_.joinable()) liveThread_.join(); // a compile cannot be interrupted
 }
 
 void RenderWorker::submit(RenderJob job) {
@@ -69,49 +168,58 @@ void RenderWorker::run() {
 }
 
 bool RenderWorker::liveBuildDone() const {
-    return liveDone_;
+    return !liveBuilder_->busy();
 }
 
-void RenderWorker::startLiveBuild(std::shared_ptr<const Scene> scene) {
-    if (!liveDone_ || live_) return;
-    if (liveThread_.joinable()) liveThread_.join();
-    liveBuildScene_ = scene;
-    liveDone_ = false;
-    liveThread_ = std::thread([this, scene = std::move(scene)] {
-        RendererOptions options;
-        options.inlineValues = false;
-        auto built = Renderer::create(context_, *scene, options);
-        std::lock_guard lock(mutex_);
-        liveBuilt_ = std::move(built);
-        liveDone_ = true;
-    });
+bool RenderWorker::refinementPending(uint64_t version) const {
+    return bakeBuilder_->pending(version);
 }
 
-// Adopts a finished live build when it fits the wanted structure (one built for a structure
-// that was edited away meanwhile is dropped).
-void RenderWorker::takeLiveBuild(const Scene& wanted) {
-    std::optional<Result<std::unique_ptr<Renderer>>> built;
-    {
-        std::lock_guard lock(mutex_);
-        built.swap(liveBuilt_);
+bool RenderWorker::refinementReady(uint64_t version) const {
+    return bakeBuilder_->ready(version);
+}
+
+bool RenderWorker::compiling() const {
+    return compilingHere_ || liveBuilder_->building() || bakeBuilder_->building();
+}
+
+// Takes finished builds that fit the job: a live renderer for its structure (one built for a
+// structure edited away meanwhile is dropped), a baked one for its values.
+void RenderWorker::adoptBuilds(const RenderJob& job) {
+    if (auto built = liveBuilder_->take();
+        built && built->renderer && sameStructure(*built->scene, *job.scene)) {
+        live_ = std::move(*built->renderer);
+        liveScene_ = built->scene;
+        liveVersion_ = built->version; // it holds that version's values
+        drawn_.reset();
     }
-    if (!built || !*built || !sameStructure(*liveBuildScene_, wanted)) return;
-    live_ = std::move(**built);
-    liveScene_ = liveBuildScene_;
-    liveVersion_ = ~0ull; // it holds the build's values; its first use uploads the wanted ones
+    if (auto built = bakeBuilder_->take();
+        built && built->renderer && built->version == job.sceneVersion) {
+        baked_ = std::move(*built->renderer);
+        bakedScene_ = built->scene;
+        bakedVersion_ = built->version;
+        drawn_.reset();
+    }
 }
 
 RenderOutput RenderWorker::process(const RenderJob& job) {
     RenderOutput out;
     out.id = job.id;
-    takeLiveBuild(*job.scene);
-    if (live_ && !sameStructure(*liveScene_, *job.scene)) live_.reset();
+    adoptBuilds(job);
+    if (live_ && !sameStructure(*liveScene_, *job.scene)) live_.reset(), drawn_.reset();
 
+    // A still frame is drawn live unless recompiling and drawing baked has been measured to be
+    // sooner: on lavapipe a small scene's inlined kernel compiles in a fraction of a second
+    // and draws several times faster, so at full resolution the live frame can come later.
+    const double pixels = double(job.options.width) * double(job.options.height);
+    const bool bakeSooner = !job.preview && liveRate_ > 0 && bakedRate_ > 0 &&
+                            bakeSeconds_ + bakedRate_ * pixels < liveRate_ * pixels;
     Renderer* renderer = nullptr;
     if (baked_ && bakedVersion_ == job.sceneVersion) {
         renderer = baked_.get();
-    } else if (job.preview && live_) {
+    } else if (live_ && !bakeSooner) {
         if (liveVersion_ != job.sceneVersion) {
+            drawn_.reset();
             if (auto updated = live_->updateValues(*job.scene); updated)
                 liveVersion_ = job.sceneVersion;
             else
@@ -121,20 +229,28 @@ RenderOutput RenderWorker::process(const RenderJob& job) {
             renderer = live_.get();
             out.live = true;
             failure_.reset();
+            // The edit shows now; its baked kernel follows, for the caller to swap in.
+            if (!job.preview) bakeBuilder_->request(job.scene, job.sceneVersion);
         }
     } else if (failedVersion_ != job.sceneVersion) { // a scene that failed waits for a change
-        const bool valueEdit = baked_ && sameStructure(*bakedScene_, *job.scene);
         auto start = std::chrono::steady_clock::now();
+        compilingHere_ = true;
         auto created = Renderer::create(context_, *job.scene);
+        compilingHere_ = false;
         out.compileSeconds = secondsSince(start);
         if (created) {
+            bakeSeconds_ = out.compileSeconds;
             baked_ = std::move(*created);
             bakedScene_ = job.scene;
             bakedVersion_ = job.sceneVersion;
+            drawn_.reset();
             failedVersion_.reset();
             failure_.reset();
             renderer = baked_.get();
-            if (valueEdit && job.preview) startLiveBuild(job.scene); // a value is being dragged
+            // A structure on screen: its live renderer is built now, so that the first value
+            // edit is already an upload.
+            if (!live_ && !liveBuilder_->pendingStructure(*job.scene))
+                liveBuilder_->request(job.scene, job.sceneVersion);
         } else {
             failedVersion_ = job.sceneVersion;
             failure_ = created.error();
@@ -147,16 +263,38 @@ RenderOutput RenderWorker::process(const RenderJob& job) {
     out.scene = out.live ? job.scene : bakedScene_;
     out.options = job.options;
     if (out.options.selectedNode >= int(out.scene->nodes.size())) out.options.selectedNode = -1;
-    auto start = std::chrono::steady_clock::now();
-    auto image = renderer->render(out.options);
-    out.renderSeconds = secondsSince(start);
-    if (!image) {
-        out.error = image.error();
-        return out;
+    const uint64_t version = out.live ? liveVersion_ : bakedVersion_;
+    if (drawn_ && drawn_->renderer == renderer && drawn_->version == version &&
+        sameView(drawn_->options, out.options)) {
+        out.image = drawn_->image; // only the highlight changed
+        out.pixels = drawn_->pixels;
+    } else {
+        auto start = std::chrono::steady_clock::now();
+        auto image = renderer->render(out.options);
+        out.renderSeconds = secondsSince(start);
+        (out.live ? liveRate_ : bakedRate_) = out.renderSeconds / pixels;
+        if (!image) {
+            out.error = image.error();
+            drawn_.reset();
+            return out;
+        }
+        out.image = std::move(*image);
+        out.pixels = renderer->lastPixelInfo();
+        drawn_ = Drawn{renderer, version, out.options, out.image, out.pixels};
     }
-    out.image = std::move(*image);
-    out.pixels = renderer->lastPixelInfo();
+    if (!job.preview) highlight(out, job.highlight);
     return out;
+}
+
+void RenderWorker::highlight(RenderOutput& out, int node) {
+    if (node < 0 || node >= int(out.scene->nodes.size()) || !out.options.camera) return;
+    if (evaluatorScene_ != out.scene) {
+        evaluator_ = std::make_unique<Evaluator>(*out.scene);
+        evaluatorScene_ = out.scene;
+    }
+    auto mask = selectionMask(*evaluator_, uint32_t(node), *out.options.camera, out.image.width,
+                              out.image.height, out.pixels);
+    drawHighlight(out.image, mask);
 }
 
 MeshWorker::~MeshWorker() {

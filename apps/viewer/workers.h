@@ -1,10 +1,11 @@
 // Background threads for the slow engine calls, so the window keeps answering: one renders
-// (compiling when the scene changes), one extracts meshes, one asks a language model for a
-// scene. The first two share the viewer's Context, whose queue submissions take turns
-// (context.h).
+// (compiling when the scene changes), two build renderers beside it, one extracts meshes, one
+// asks a language model for a scene. All but the live renderer share the viewer's Context,
+// whose queue submissions take turns (context.h).
 #pragma once
 
 #include <sdfcsg/context.h>
+#include <sdfcsg/eval.h>
 #include <sdfcsg/generate.h>
 #include <sdfcsg/mesh.h>
 #include <sdfcsg/render.h>
@@ -27,6 +28,7 @@ struct RenderJob {
     RenderOptions options;     // camera set by the caller
     uint64_t id = 0;
     bool preview = false; // a frame while the camera or a value moves: speed over exactness
+    int highlight = -1;   // a node whose visible surface full-resolution frames tint and outline
 };
 
 struct RenderOutput {
@@ -41,16 +43,65 @@ struct RenderOutput {
     std::optional<Error> error;  // the job's scene failed to compile (or the render failed)
 };
 
+// Builds renderers on a thread of its own, one at a time, for the newest scene asked for: a
+// request made while a build runs waits for it, replacing any older waiting request.
+class RendererBuilder {
+  public:
+    struct Built {
+        std::shared_ptr<const Scene> scene;
+        uint64_t version = 0;
+        Result<std::unique_ptr<Renderer>> renderer;
+    };
+    // `context` must outlive the builder.
+    RendererBuilder(Context& context, RendererOptions options);
+    ~RendererBuilder(); // waits for a running build: a compile cannot be interrupted
+    RendererBuilder(const RendererBuilder&) = delete;
+    RendererBuilder& operator=(const RendererBuilder&) = delete;
+
+    void request(std::shared_ptr<const Scene> scene, uint64_t version);
+    // The latest finished build, once.
+    std::optional<Built> take();
+    // The newest request is for `version` and has not been taken: waiting, running, or built
+    // (successfully, for ready()).
+    bool pending(uint64_t version) const;
+    bool ready(uint64_t version) const;
+    // The newest request is for this structure (any version) and has not been taken.
+    bool pendingStructure(const Scene& scene) const;
+    bool busy() const;     // a request waits or is being built
+    bool building() const; // a compile is running
+
+  private:
+    void run();
+
+    Context& context_;
+    RendererOptions options_;
+    mutable std::mutex mutex_;
+    std::condition_variable wake_;
+    std::shared_ptr<const Scene> wanted_; // the newest request, until taken
+    uint64_t wantedVersion_ = 0;
+    bool waiting_ = false, running_ = false, stop_ = false;
+    std::optional<Built> done_;
+    std::thread thread_;
+};
+
 // Frames come from a renderer with the values inlined ("baked"): on CPU drivers its kernel
 // compiles many times faster and runs several times faster than one that reads them from the
-// node buffer. A new version of the values is baked again, except for previews once the "live"
-// renderer is there: it reads the values from the node buffer, so a value edit is an upload, not
-// a recompile. It is built on a thread of its own after the first value edit of a structure,
-// since its compile takes seconds on lavapipe; until then previews of edits bake too.
+// node buffer. Beside it, once a structure is on screen, the "live" renderer is built in the
+// background: it reads the values from the node buffer, so a value edit is an upload, not a
+// recompile. Its compile takes seconds on lavapipe, so it runs on a Context of its own (another
+// device and queue), where it stalls no baked frame; the live renderer draws there too.
+//
+// Once it exists, a value edit is drawn by it at once (previews, and still frames unless a
+// recompile has been measured to show them sooner), and a still frame drawn live has its values
+// baked again by a second builder in the background: a refinement (faster to draw, and the
+// same pixels as `sdfcsg render`) that the caller asks for once refinementReady(), never a wait
+// before the edit shows.
 class RenderWorker {
   public:
-    explicit RenderWorker(Context& context);
-    ~RenderWorker();
+    // The live renderer is built and draws on `liveContext` (null: on `context`). Both must
+    // outlive the worker.
+    explicit RenderWorker(Context& context, Context* liveContext = nullptr);
+    ~RenderWorker(); // waits for running compiles (see compiling())
     RenderWorker(const RenderWorker&) = delete;
     RenderWorker& operator=(const RenderWorker&) = delete;
 
@@ -60,14 +111,21 @@ class RenderWorker {
     std::optional<RenderOutput> take();
     // No job waiting or running.
     bool idle() const;
-    // The live renderer's build, started by a value edit, has finished (or none is running).
+    // The live renderer for the newest job's structure is built (or its build failed): no
+    // build of it is waiting or running.
     bool liveBuildDone() const;
+    // A baked renderer for values `version`, drawn live so far, is being built / is built and
+    // waits for a job of that version to use it.
+    bool refinementPending(uint64_t version) const;
+    bool refinementReady(uint64_t version) const;
+    // A compile is running on some thread, so destroying the worker would wait for it.
+    bool compiling() const;
 
   private:
     void run();
     RenderOutput process(const RenderJob& job);
-    void startLiveBuild(std::shared_ptr<const Scene> scene);
-    void takeLiveBuild(const Scene& wanted);
+    void adoptBuilds(const RenderJob& job);
+    void highlight(RenderOutput& out, int node);
 
     Context& context_;
     mutable std::mutex mutex_;
@@ -75,6 +133,7 @@ class RenderWorker {
     std::optional<RenderJob> pending_;
     std::optional<RenderOutput> done_;
     bool busy_ = false, stop_ = false;
+    std::atomic<bool> compilingHere_{false};
     // Used by the worker thread only.
     std::unique_ptr<Renderer> baked_;
     std::shared_ptr<const Scene> bakedScene_;
@@ -84,11 +143,21 @@ class RenderWorker {
     uint64_t liveVersion_ = 0;               // the values it holds
     std::optional<uint64_t> failedVersion_;
     std::optional<Error> failure_;
-    // The live renderer's build: the worker starts and takes it; liveDone_ tells the others.
-    std::thread liveThread_;
-    std::shared_ptr<const Scene> liveBuildScene_;
-    std::optional<Result<std::unique_ptr<Renderer>>> liveBuilt_; // under mutex_
-    std::atomic<bool> liveDone_{true};
+    // Measured: seconds per pixel of the last live and baked frames, and of the last compile.
+    double liveRate_ = 0, bakedRate_ = 0, bakeSeconds_ = 0;
+    // The last frame before its highlight, so a new selection only redraws the highlight.
+    struct Drawn {
+        const Renderer* renderer = nullptr;
+        uint64_t version = 0;
+        RenderOptions options;
+        Image image;
+        std::vector<PixelInfo> pixels;
+    };
+    std::optional<Drawn> drawn_;
+    std::shared_ptr<const Scene> evaluatorScene_;
+    std::unique_ptr<Evaluator> evaluator_; // of evaluatorScene_, for highlights
+    // Declared last, so they stop before the renderers above are destroyed.
+    std::unique_ptr<RendererBuilder> liveBuilder_, bakeBuilder_;
     std::thread thread_;
 };
 

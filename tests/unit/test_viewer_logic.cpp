@@ -11,6 +11,8 @@
 #include "script.h"
 #include "workers.h"
 
+#include "camera.h" // the renderer's rays, to trace depths as it does
+
 #include <sdfcsg/generate.h>
 #include <sdfcsg/io.h>
 
@@ -21,10 +23,12 @@
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <thread>
 
 using namespace sdfcsg;
@@ -164,6 +168,25 @@ TEST(ViewerCamera, ZoomAndFrame) {
     EXPECT_EQ(c.distance, unchanged.distance);
 }
 
+TEST(ViewerCamera, FramesTheSolidNotWhatItSubtracts) {
+    auto scene = parseScene(R"({"version": 1, "root": {"type": "union", "children": [
+        {"type": "plane", "name": "ground"},
+        {"type": "difference", "name": "cut", "children": [
+          {"type": "box", "size": [1, 1, 1]},
+          {"type": "sphere", "name": "far", "radius": 0.5, "translate": [5, 0, 0]}]}]}})",
+                            "s.json");
+    ASSERT_TRUE(scene) << scene.error().str();
+    Evaluator evaluator(*scene);
+    Aabb box = framedBounds(evaluator, -1);
+    EXPECT_NEAR(box.max.x, 0.5f, 0.01f); // the subtracted sphere at x = 5 is not framed
+    EXPECT_NEAR(box.min.x, -0.5f, 0.01f);
+    Aabb far = framedBounds(evaluator, int(*findNode(*scene, "far")));
+    EXPECT_NEAR(far.min.x, 4.5f, 0.01f); // a selection is framed as it is
+    // An unbounded selection (the plane) frames the solid.
+    Aabb ground = framedBounds(evaluator, int(*findNode(*scene, "ground")));
+    EXPECT_NEAR(ground.max.x, 0.5f, 0.01f);
+}
+
 TEST(ViewerPicking, PointFromDepth) {
     Camera camera;
     camera.eye = {0, 0, 5};
@@ -189,6 +212,107 @@ TEST(ViewerPicking, NearestPrimitiveIncludingCarvedFaces) {
     EXPECT_EQ(nearestPrimitive(evaluator, {1.5f, 0.2f, 0}), int(*findNode(scene, "block")));
     // Inside the carved hole, on its surface: the sphere that cut it.
     EXPECT_EQ(nearestPrimitive(evaluator, {1.0f, 0.0f, 0.2f}), int(*findNode(scene, "hole")));
+}
+
+// Depths as the renderer's march finds them, traced on the CPU along the renderer's rays.
+std::vector<PixelInfo> traceDepths(const Evaluator& evaluator, const Camera& camera, uint32_t w,
+                                   uint32_t h) {
+    detail::RayCamera rc = detail::makeRayCamera(camera, w, h);
+    std::vector<PixelInfo> pixels(size_t(w) * h, PixelInfo{-1.0f, 0});
+    for (uint32_t j = 0; j < h; ++j)
+        for (uint32_t i = 0; i < w; ++i) {
+            glm::vec3 dir = detail::rayDirection(rc, float(i) + 0.5f, float(j) + 0.5f, w, h);
+            float t = 0.0f;
+            for (int step = 0; step < 256 && t < 50.0f; ++step) {
+                float d = evaluator.distance(rc.eye + t * dir);
+                if (d < detail::hitEpsilon(rc, t)) {
+                    pixels[size_t(j) * w + i].depth = t;
+                    break;
+                }
+                t += d;
+            }
+        }
+    return pixels;
+}
+
+TEST(ViewerPicking, HighlightCoversTheSelectedSurfaceOnly) {
+    Scene scene = twoSpheres();
+    Evaluator evaluator(scene);
+    Camera camera;
+    camera.eye = {0, 0, 6};
+    camera.target = {0, 0, 0};
+    camera.fov = 40;
+    const uint32_t w = 96, h = 64;
+    auto pixels = traceDepths(evaluator, camera, w, h);
+    auto count = [](const std::vector<uint8_t>& mask) {
+        return std::count(mask.begin(), mask.end(), uint8_t(1));
+    };
+    for (const char* name : {"left", "cut", "hole"}) {
+        SCOPED_TRACE(name);
+        uint32_t node = *findNode(scene, name);
+        PixelRect r = projectedRect(camera, w, h, evaluator.nodes()[node].bounds);
+        ASSERT_FALSE(r.empty());
+        auto mask = selectionMask(evaluator, node, camera, w, h, pixels);
+        long inside = 0;
+        for (uint32_t j = 0; j < h; ++j)
+            for (uint32_t i = 0; i < w; ++i)
+                if (mask[j * w + i]) {
+                    // The march takes points within half a pixel of a surface as hits.
+                    EXPECT_TRUE(int(i) >= r.x0 - 2 && int(i) < r.x1 + 2 && int(j) >= r.y0 - 2 &&
+                                int(j) < r.y1 + 2);
+                    ++inside;
+                }
+        EXPECT_GT(inside, 20) << "the node's visible surface is selected";
+    }
+    // The left sphere's pixels and the carved block's are apart; the carved face belongs to
+    // both the hole and the block's difference.
+    auto left = selectionMask(evaluator, *findNode(scene, "left"), camera, w, h, pixels);
+    auto cut = selectionMask(evaluator, *findNode(scene, "cut"), camera, w, h, pixels);
+    auto hole = selectionMask(evaluator, *findNode(scene, "hole"), camera, w, h, pixels);
+    for (size_t k = 0; k < left.size(); ++k) {
+        EXPECT_FALSE(left[k] && cut[k]);
+        if (hole[k]) {
+            EXPECT_TRUE(cut[k]);
+        }
+    }
+    EXPECT_LT(count(hole), count(cut));
+    // Every hit pixel belongs to the root.
+    auto all = selectionMask(evaluator, 0, camera, w, h, pixels);
+    EXPECT_EQ(count(all), std::count_if(pixels.begin(), pixels.end(),
+                                        [](const PixelInfo& p) { return p.depth >= 0.0f; }));
+
+    // Tinted inside, outlined around: only pixels in or next to the mask change.
+    Image image{w, h, std::vector<uint8_t>(size_t(w) * h * 4, 128)};
+    drawHighlight(image, left);
+    for (uint32_t j = 0; j < h; ++j)
+        for (uint32_t i = 0; i < w; ++i) {
+            bool changed = image.rgba[(j * w + i) * 4 + 2] != 128;
+            bool near = false;
+            for (int dj = -1; dj <= 1; ++dj)
+                for (int di = -1; di <= 1; ++di) {
+                    int x = int(i) + di, y = int(j) + dj;
+                    if ((di == 0 || dj == 0) && x >= 0 && y >= 0 && x < int(w) && y < int(h))
+                        near = near || left[size_t(y) * w + x];
+                }
+            EXPECT_EQ(changed, near) << i << "," << j;
+        }
+}
+
+TEST(ViewerPicking, ProjectedRectOfBoxes) {
+    Camera camera;
+    camera.eye = {0, 0, 5};
+    camera.target = {0, 0, 0};
+    camera.fov = 90;
+    // A box at the centre, half as wide as the view at its depth.
+    PixelRect r = projectedRect(camera, 100, 100, Aabb{{-1, -1, 0}, {1, 1, 0}});
+    EXPECT_NEAR(r.x0, 40, 1); // rounded outwards
+    EXPECT_NEAR(r.x1, 60, 1);
+    EXPECT_NEAR(r.y0, 40, 1);
+    EXPECT_NEAR(r.y1, 60, 1);
+    EXPECT_TRUE(projectedRect(camera, 100, 100, Aabb{}).empty());
+    EXPECT_TRUE(projectedRect(camera, 100, 100, Aabb{{20, 0, 0}, {21, 1, 1}}).empty());
+    PixelRect behind = projectedRect(camera, 100, 100, Aabb{{-1, -1, 4}, {1, 1, 6}});
+    EXPECT_EQ(behind.x1 - behind.x0, 100);
 }
 
 TEST(ViewerEdit, SetValuesValidatesLikeTheLoader) {
@@ -249,6 +373,23 @@ TEST(ViewerEdit, StructuralEditsKeepTheSceneValid) {
     auto kind = changeKind(scene, *findNode(scene, "left"), NodeKind::Box);
     ASSERT_TRUE(kind) << kind.error().str();
     EXPECT_EQ(kind->nodes[*findNode(*kind, "left")].kind, NodeKind::Box);
+    // Comparable sizes, not the defaults: the sphere of radius 0.5 becomes a box 1 across, and
+    // back to a sphere of radius 0.5; a box 1 across becomes a torus about as wide.
+    Evaluator sized(*kind);
+    Aabb box = sized.nodes()[*findNode(*kind, "left")].bounds;
+    EXPECT_NEAR(box.max.x - box.min.x, 1.0f, 0.01f);
+    auto back = changeKind(*kind, *findNode(*kind, "left"), NodeKind::Sphere);
+    ASSERT_TRUE(back);
+    EXPECT_FLOAT_EQ(back->nodes[*findNode(*back, "left")].params[0], 0.5f);
+    float small = 0.1f;
+    auto tiny = setValue(scene, *findNode(scene, "left"), "radius", std::span(&small, 1));
+    auto tinyBox = changeKind(*tiny, *findNode(*tiny, "left"), NodeKind::Box);
+    ASSERT_TRUE(tinyBox);
+    EXPECT_FLOAT_EQ(tinyBox->nodes[*findNode(*tinyBox, "left")].params[0], 0.2f);
+    auto torus = changeKind(scene, *findNode(scene, "block"), NodeKind::Torus);
+    ASSERT_TRUE(torus);
+    Aabb ring = Evaluator(*torus).nodes()[*findNode(*torus, "block")].bounds;
+    EXPECT_NEAR(ring.max.x - ring.min.x, 1.0f, 0.05f);
     auto op = changeKind(scene, cut, NodeKind::Intersection);
     ASSERT_TRUE(op);
     EXPECT_EQ(op->nodes[cut].kind, NodeKind::Intersection);
@@ -262,6 +403,29 @@ TEST(ViewerEdit, StructuralEditsKeepTheSceneValid) {
     ASSERT_TRUE(reordered);
     EXPECT_EQ(reordered->nodes[moved].name, "hole");
     EXPECT_EQ(reordered->nodes[reordered->nodes[cut].children[0]].name, "hole");
+}
+
+TEST(ViewerEdit, SameNodeAfterAReload) {
+    Scene before = twoSpheres();
+    // Named nodes are found by name wherever they moved; unnamed ones by their JSON path.
+    auto after = parseScene(R"({"version": 1, "root": {"type": "union", "children": [
+        {"type": "box", "name": "block", "size": [1, 1, 1]},
+        {"type": "sphere", "radius": 1},
+        {"type": "sphere", "name": "left", "radius": 0.5}]}})",
+                            "two.json");
+    ASSERT_TRUE(after);
+    EXPECT_EQ(sameNode(before, *findNode(before, "left"), *after), findNode(*after, "left"));
+    EXPECT_EQ(sameNode(before, *findNode(before, "block"), *after), findNode(*after, "block"));
+    EXPECT_FALSE(sameNode(before, *findNode(before, "hole"), *after));
+    auto unnamed = parseScene(R"({"version": 1, "root": {"type": "union", "children": [
+        {"type": "sphere", "radius": 1}, {"type": "box", "size": [1, 1, 1]}]}})",
+                              "u.json");
+    ASSERT_TRUE(unnamed);
+    float r = 2.0f;
+    auto resized = setValue(*unnamed, 1, "radius", std::span(&r, 1));
+    EXPECT_EQ(sameNode(*unnamed, 1, *resized), 1u);
+    EXPECT_EQ(sameNode(*unnamed, 2, *resized), 2u);
+    EXPECT_FALSE(sameNode(*unnamed, 2, *after)); // root.children[1] is a sphere there
 }
 
 TEST(ViewerHistory, UndoRedoAndMergedSteps) {
@@ -366,7 +530,7 @@ TEST(ViewerFiles, SaveIsAtomicAndNotReloaded) {
     EXPECT_EQ(failed.error().kind, ErrorKind::Io);
 }
 
-TEST(ViewerFiles, OpenFailureKeepsTheCurrentScene) {
+TEST(ViewerFiles, OpenFailureKeepsTheCurrentSceneAndItsFile) {
     fs::path dir = tempDir("viewer_open");
     writeText(dir / "good.json", kTwoSpheres);
     writeText(dir / "bad.json", "{");
@@ -375,7 +539,48 @@ TEST(ViewerFiles, OpenFailureKeepsTheCurrentScene) {
     EXPECT_FALSE(doc.open(dir / "bad.json"));
     EXPECT_TRUE(doc.error());
     EXPECT_EQ(doc.scene().nodes.size(), 5u);
-    // The broken file is watched: fixing it loads it.
+    EXPECT_EQ(doc.path(), dir / "good.json");
+
+    // Saving writes the scene on screen to its own file, never over the broken one, and
+    // the stale load error goes.
+    ASSERT_TRUE(doc.save());
+    EXPECT_FALSE(doc.error());
+    std::ifstream bad(dir / "bad.json");
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(bad), {}), "{");
+    EXPECT_TRUE(loadScene(dir / "good.json"));
+
+    // The scene's file is still the one watched.
+    writeText(dir / "bad.json", R"({"version": 1, "root": {"type": "box", "size": 1}})");
+    EXPECT_FALSE(doc.pollReload());
+    writeText(dir / "good.json", R"({"version": 1, "root": {"type": "sphere", "radius": 1}})");
+    EXPECT_TRUE(doc.pollReload());
+    EXPECT_FALSE(doc.error());
+    EXPECT_EQ(doc.scene().nodes.size(), 1u);
+}
+
+TEST(ViewerFiles, RecentFilesPersist) {
+    fs::path dir = tempDir("viewer_recent");
+    fs::path file = dir / "config" / "sdfcsg" / "recent";
+    EXPECT_TRUE(loadRecent(file).empty());
+    saveRecent(file, {"/a/one.json", "two.json"});
+    EXPECT_EQ(loadRecent(file), (std::vector<std::string>{"/a/one.json", "two.json"}));
+    EXPECT_EQ(loadRecent(file, 1), std::vector<std::string>{"/a/one.json"});
+    writeText(dir / "blocker", "a file, not a folder");
+    saveRecent(dir / "blocker" / "recent", {"a"}); // cannot be written: ignored
+    const char* old = std::getenv("XDG_CONFIG_HOME");
+    const std::string saved = old ? old : "";
+    setenv("XDG_CONFIG_HOME", (dir / "config").c_str(), 1);
+    EXPECT_EQ(recentFilesPath(), file);
+    old ? setenv("XDG_CONFIG_HOME", saved.c_str(), 1) : unsetenv("XDG_CONFIG_HOME");
+}
+
+TEST(ViewerFiles, ABrokenFirstFileIsWatched) {
+    fs::path dir = tempDir("viewer_open_first");
+    writeText(dir / "bad.json", "{");
+    Document doc;
+    EXPECT_FALSE(doc.open(dir / "bad.json"));
+    EXPECT_FALSE(doc.loaded());
+    // Nothing else to show: fixing the file on disk loads it.
     writeText(dir / "bad.json", R"({"version": 1, "root": {"type": "sphere", "radius": 1}})");
     EXPECT_TRUE(doc.pollReload());
     EXPECT_FALSE(doc.error());
@@ -403,10 +608,25 @@ TEST(ViewerScript, ReportsEveryProblem) {
               "s.txt:1:1: mode: expected one of shaded, normals, depth, steps, got \"shiny\"\n"
               "s.txt:2:1: unknown command \"fly\" (known: select, set, mode, shadows, ao, grid, "
               "boxes, orbit, zoom, frame, reset, undo, redo, save, screenshot, generate, "
-              "edit-scene)\n"
-              "s.txt:3:1: set: expected a number, got \"big\"\n"
+              "edit-scene, add, remove, kind, op, move, open, pick, wait-reload, ui, "
+              "expect-error, expect-selected, print-bounds)\n"
+              "s.txt:3:1: set: expected a finite number, got \"big\"\n"
               "s.txt:4:1: zoom: expected 1 arguments, got 0\n"
               "s.txt:5:1: undo: expected 0 arguments, got 1");
+}
+
+TEST(ViewerScript, RefusesNumbersThatAreNotFinite) {
+    auto script = parseScript("orbit nan nan\nzoom inf\nset radius -inf\npick 1e99 2\nzoom 0\n"
+                              "op sphere\nkind union\nadd torus\nmove up\n",
+                              "s.txt");
+    ASSERT_FALSE(script);
+    EXPECT_EQ(script.error().str(), "s.txt:1:1: orbit: expected a finite number, got \"nan\"\n"
+                                    "s.txt:2:1: zoom: expected a finite number, got \"inf\"\n"
+                                    "s.txt:3:1: set: expected a finite number, got \"-inf\"\n"
+                                    "s.txt:4:1: pick: expected a finite number, got \"1e99\"\n"
+                                    "s.txt:5:1: zoom: expected a positive factor, got \"0\"\n"
+                                    "s.txt:6:1: op: expected one of union, intersection, "
+                                    "difference, got \"sphere\"");
 }
 
 TEST(ViewerScript, GenerateTakesTheRestOfTheLine) {

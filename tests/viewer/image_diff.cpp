@@ -2,6 +2,10 @@
 //   image_diff A.png B.png same MAXDIFF MAXFRACTION  exit 0 when at most MAXFRACTION of the
 //                                                    pixels differ by more than MAXDIFF (0..255)
 //   image_diff A.png B.png differ MINFRACTION        exit 0 when at least MINFRACTION differ
+//   image_diff A.png B.png within X0 Y0 X1 Y1 MARGIN MINFRACTION
+//                                                    exit 0 when every differing pixel lies in
+//                                                    [X0, X1) x [Y0, Y1) grown by MARGIN, and at
+//                                                    least MINFRACTION of that rectangle differs
 // Prints the sizes and the fraction of differing pixels either way; 1 when the check fails,
 // 2 on bad arguments or unreadable files.
 #define STB_IMAGE_IMPLEMENTATION
@@ -18,6 +22,7 @@
 #pragma GCC diagnostic pop
 #endif
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -46,16 +51,35 @@ int main(int argc, char** argv) {
     }
     int threshold = check == "same" ? std::atoi(argv[4]) : 8;
     long differing = 0, maxDiff = 0;
+    int x0 = wa, y0 = ha, x1 = 0, y1 = 0; // the differing pixels' bounding rectangle
     for (long i = 0; i < long(wa) * ha; ++i) {
         int d = 0;
         for (int c = 0; c < 3; ++c)
             d = std::max(d, std::abs(int(a[4 * i + c]) - int(b[4 * i + c])));
         maxDiff = std::max<long>(maxDiff, d);
-        if (d > threshold) ++differing;
+        if (d > threshold) {
+            ++differing;
+            int x = int(i % wa), y = int(i / wa);
+            x0 = std::min(x0, x), y0 = std::min(y0, y);
+            x1 = std::max(x1, x + 1), y1 = std::max(y1, y + 1);
+        }
     }
     double fraction = double(differing) / (double(wa) * ha);
     std::printf("%dx%d: %.4f of the pixels differ by more than %d (largest difference %ld)\n", wa,
                 ha, fraction, threshold, maxDiff);
+    if (check == "within" && argc == 10) {
+        int r[5];
+        for (int k = 0; k < 5; ++k)
+            r[k] = std::atoi(argv[4 + k]);
+        const int m = r[4];
+        std::printf("differing pixels in [%d, %d) x [%d, %d), expected within [%d, %d) x [%d, %d)\n",
+                    x0, x1, y0, y1, r[0] - m, r[2] + m, r[1] - m, r[3] + m);
+        double area = std::max(1.0, double(r[2] - r[0]) * double(r[3] - r[1]));
+        bool inside = differing == 0 || (x0 >= r[0] - m && y0 >= r[1] - m && x1 <= r[2] + m &&
+                                         y1 <= r[3] + m);
+        std::printf("%.3f of the rectangle differs\n", double(differing) / area);
+        return inside && double(differing) / area >= std::atof(argv[9]) ? 0 : 1;
+    }
     if (check == "same" && argc == 6) return fraction <= std::atof(argv[5]) ? 0 : 1;
     if (check == "differ") return fraction >= std::atof(argv[4]) ? 0 : 1;
     std::fputs("image_diff: expected \"same MAXDIFF MAXFRACTION\" or \"differ MINFRACTION\"\n",

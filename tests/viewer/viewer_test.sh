@@ -11,6 +11,7 @@ if ! command -v xvfb-run >/dev/null 2>&1; then
     exit 77
 fi
 rm -rf "$work" && mkdir -p "$work" && cd "$work"
+export XDG_CONFIG_HOME="$work/config" # the recent-files list stays in here
 # 24-bit colour: xvfb-run's default screen is 8-bit, which Vulkan cannot present to.
 run() { xvfb-run -a -s "-screen 0 1280x1024x24" "$viewer" "$@"; }
 fail() { echo "FAIL: $*"; exit 1; }
@@ -40,6 +41,7 @@ screenshot 4-depth.png
 mode shaded
 shadows on
 boxes none
+select none
 undo
 screenshot 5-undone.png
 save saved.json
@@ -53,6 +55,134 @@ run edit.json --script session.txt --size 320x240 --no-ui || fail "scripted sess
 "$diff" 5-undone.png 0-start.png same 0 0 || fail "undo did not restore the scene"
 grep -q '"radius": 0.3\b' saved.json && fail "the saved scene holds the undone edit"
 "$cli" validate saved.json || fail "the saved scene does not load"
+
+# Structural edits change the image and undo restores it; each view option changes the image.
+cat > structure.txt <<'SCRIPT'
+screenshot t0.png
+select coal
+remove
+expect-selected none
+screenshot t1-removed.png
+undo
+screenshot t2-undone.png
+select coal
+op intersection
+select none
+screenshot t3-op.png
+undo
+select nose
+kind box
+select none
+screenshot t4-kind.png
+undo
+select brim
+move down
+expect-selected brim
+select coal
+add sphere
+select none
+screenshot t5-added.png
+undo
+undo
+mode steps
+screenshot m-steps.png
+mode shaded
+grid on
+screenshot m-grid.png
+grid off
+ao off
+screenshot m-ao.png
+ao on
+boxes all
+screenshot m-boxes.png
+boxes none
+screenshot t6-end.png
+SCRIPT
+run edit.json --script structure.txt --size 320x240 --no-ui || fail "structural edits"
+"$diff" t0.png t1-removed.png differ 0.001 || fail "removing the coal changed nothing"
+"$diff" t0.png t2-undone.png same 0 0 || fail "undo did not restore the removed node"
+"$diff" t0.png t3-op.png differ 0.001 || fail "changing an operation changed nothing"
+"$diff" t0.png t4-kind.png differ 0.001 || fail "changing a kind changed nothing"
+"$diff" t0.png t5-added.png differ 0.001 || fail "adding a node changed nothing"
+"$diff" t0.png m-steps.png differ 0.3 || fail "steps mode looks like shaded"
+"$diff" t0.png m-grid.png differ 0.001 || fail "the grid shows nothing"
+"$diff" t0.png m-ao.png differ 0.01 || fail "turning AO off changed nothing"
+"$diff" t0.png m-boxes.png differ 0.005 || fail "boxes all shows nothing"
+"$diff" t0.png t6-end.png same 0 0 || fail "the view options did not go back"
+
+# The selection: its highlight and its box lie within the node's projected bounds; a click
+# selects the node under the cursor, and one on the sky clears the selection.
+cat > select.txt <<'SCRIPT'
+boxes none
+screenshot p0.png
+select head
+screenshot p1-highlight.png
+print-bounds head
+boxes selected
+select none
+screenshot p2-nobox.png
+select head
+screenshot p3-box.png
+select none
+pick 160 60
+expect-selected head
+pick 2 2
+expect-selected none
+SCRIPT
+run edit.json --script select.txt --size 320x240 --no-ui > select.out ||
+    fail "selection script: $(cat select.out)"
+set -- $(grep '^bounds head ' select.out | cut -d' ' -f3-)
+[ $# -eq 4 ] || fail "no bounds printed: $(cat select.out)"
+"$diff" p0.png p1-highlight.png within "$@" 3 0.2 || fail "the highlight is not on the head"
+"$diff" p0.png p2-nobox.png same 0 0 || fail "boxes selected without a selection drew something"
+"$diff" p1-highlight.png p3-box.png within "$@" 3 0.0 || fail "the box is not around the head"
+"$diff" p1-highlight.png p3-box.png differ 0.001 || fail "selecting showed no bounding box"
+
+# An invalid file on disk shows its error and keeps the last image; fixing it reloads. Opening
+# an invalid file keeps the scene, and Save still writes the scene's own file.
+cp "$src/assets/scenes/snowman.json" live.json
+echo '{' > bad.json
+cat > reload.txt <<'SCRIPT'
+screenshot r0.png
+ui on
+screenshot u0.png
+ui off
+wait-reload
+expect-error root.radius: expected a positive number, got -2
+screenshot r1.png
+ui on
+screenshot u1.png
+ui off
+wait-reload
+expect-error none
+screenshot r2.png
+open bad.json
+expect-error bad.json
+screenshot r3.png
+save
+SCRIPT
+run live.json --script reload.txt --size 320x240 --no-ui > reload.out 2>&1 &
+viewer_pid=$!
+replace() { # FILE CONTENT_FILE after WAIT_FOR appears
+    tries=0
+    while [ ! -e "$1" ] && [ $tries -lt 1200 ]; do sleep 0.1; tries=$((tries + 1)); done
+    cp "$2" live.tmp && mv live.tmp live.json
+}
+echo '{"version": 1, "root": {"type": "sphere", "radius": -2}}' > broken.json
+replace u0.png broken.json
+replace u1.png "$src/assets/scenes/house.json"
+wait $viewer_pid || fail "reload script: $(cat reload.out)"
+"$diff" r0.png r1.png same 0 0 || fail "a broken file replaced the image"
+"$diff" u0.png u1.png differ 0.001 || fail "the panel shows no error"
+"$diff" r0.png r2.png differ 0.05 || fail "the fixed file was not reloaded"
+"$diff" r2.png r3.png same 0 0 || fail "opening a broken file replaced the image"
+[ "$(cat bad.json)" = "{" ] || fail "Save wrote over the broken file"
+"$cli" validate live.json || fail "Save did not write the scene's own file"
+
+# Leaving right after a value edit does not wait for the background compiles (generous limit).
+printf 'select nose\nset radius 0.2\n' > quit.txt
+timeout 60 xvfb-run -a -s "-screen 0 1280x1024x24" "$viewer" edit.json --script quit.txt \
+    --size 320x240 --no-ui || fail "the viewer did not exit promptly after an edit"
 
 # 3. A script with a mistake is refused before any window opens.
 echo "select nose
