@@ -126,6 +126,9 @@ Context::~Context() = default;
 std::string Context::deviceName() const {
     return impl_->properties.deviceName;
 }
+bool Context::cpuDevice() const {
+    return impl_->properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+}
 bool Context::validationEnabled() const {
     return impl_->validation;
 }

@@ -34,6 +34,9 @@ class Context {
     Context& operator=(const Context&) = delete;
 
     std::string deviceName() const;
+    // The device is a CPU implementation (lavapipe): invocations run in SIMD lanes through both
+    // sides of every branch, so kernels with values baked in run several times faster there.
+    bool cpuDevice() const;
     bool validationEnabled() const;
     // Messages the validation layer has reported so far (warnings and errors). Each is also
     // printed to stderr.
