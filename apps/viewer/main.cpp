@@ -7,7 +7,6 @@
 #include "orbit_camera.h"
 #include "picking.h"
 #include "presenter.h"
-#include "raster.h"
 #include "script.h"
 #include "workers.h"
 
@@ -141,6 +140,7 @@ struct Viewer {
     std::unique_ptr<Context> context;
     std::unique_ptr<RenderWorker> renderer;
     std::unique_ptr<MeshWorker> mesher;
+    std::unique_ptr<ExportWorker> exporter;
     Document doc;
     std::shared_ptr<const Scene> scene; // doc.scene() as handed to the workers
     uint64_t sceneVersion = ~0ull;
@@ -168,15 +168,19 @@ struct Viewer {
     double pressX = 0, pressY = 0, lastX = 0, lastY = 0;
     bool dragged = false;
 
-    // Mesh mode.
-    std::optional<Mesh> mesh;
+    // Mesh mode. The mesh is shared with the export thread; the presenter holds its own copy on
+    // the device.
+    std::shared_ptr<const Mesh> mesh;
     MeshStats meshStats;
+    double meshFrameMs = 0.0, meshDrawMs = -1.0; // the last mesh frame: whole / the draw alone
+    std::string meshScript, exportScript; // "file:line: " while a script's extraction or write runs
     bool meshView = false, wireframe = false;
     int meshResolution = 128;
     bool customBounds = false;
     float boundsMin[3] = {-1, -1, -1}, boundsMax[3] = {1, 1, 1};
     std::string meshMessage;
     char exportPath[512] = "mesh.glb";
+    fs::path exporting; // the file the export worker writes
 
     // Generation.
     std::unique_ptr<GenerateWorker> generator;
@@ -406,19 +410,10 @@ void updateImage(Viewer& v) {
     }
     if (!v.scene) return;
     ViewKey want = wantedKey(v, !moving(v));
-    if (want.mesh) {
-        if (!v.haveShown || !(v.shown == want)) {
-            RasterOptions o;
-            o.width = want.width;
-            o.height = want.height;
-            o.camera = want.camera;
-            o.wireframe = want.wireframe;
-            o.background = v.scene->background;
-            setImage(*v.presenter, rasterize(*v.mesh, o));
-            v.shown = want;
-            v.haveShown = true;
-            v.haveSubmitted = false;
-        }
+    if (want.mesh) { // the presenter draws the mesh itself, every frame
+        v.shown = want;
+        v.haveShown = true;
+        v.haveSubmitted = false;
         return;
     }
     if (v.haveSubmitted && v.submitted == want) return;
@@ -732,6 +727,60 @@ void fileBrowser(Viewer& v) {
     ImGui::End();
 }
 
+// Starts writing the mesh in the background; the problem when it cannot start.
+std::optional<std::string> startExport(Viewer& v, const fs::path& path) {
+    auto format = meshFormatFromPath(path);
+    if (!format)
+        return path.string() + ": the extension names no mesh format (.ply, .obj, .stl, .glb)";
+    if (!v.exporter->start(v.mesh, path, *format)) return "a mesh is being written";
+    v.exporting = path;
+    v.meshMessage = "writing " + path.string() + "...";
+    return std::nullopt;
+}
+
+// Takes a finished extraction (the mesh goes to the device once, here) and a finished export.
+// False when one that a script started failed.
+bool finishMesh(Viewer& v) {
+    bool ok = true;
+    auto report = [&](std::string& where, const std::string& message, bool failed) {
+        if (!where.empty() && failed) {
+            std::fprintf(stderr, "%s%s\n", where.c_str(), message.c_str());
+            v.exitCode = 1;
+            ok = false;
+        }
+        where.clear();
+    };
+    if (auto done = v.mesher->take()) {
+        if (*done) {
+            auto mesh = std::make_shared<const Mesh>(std::move(**done));
+            v.meshStats = v.mesher->stats();
+            std::string error;
+            if (setMesh(*v.presenter, *mesh, error)) {
+                v.mesh = std::move(mesh);
+                char text[160];
+                std::snprintf(text, sizeof text, "%zu vertices, %zu triangles, %.2f s%s",
+                              v.mesh->vertexCount(), v.mesh->triangleCount(),
+                              v.meshStats.totalSeconds,
+                              v.meshStats.surfaceCut ? " (cut by bounds)" : "");
+                v.meshMessage = text;
+                v.meshView = true;
+            } else {
+                v.mesh.reset();
+                v.meshView = false;
+                v.meshMessage = error;
+            }
+        } else {
+            v.meshMessage = done->error().str();
+        }
+        report(v.meshScript, v.meshMessage, !v.mesh || !*done);
+    }
+    if (auto written = v.exporter->take()) {
+        v.meshMessage = *written ? "wrote " + v.exporting.string() : written->error().str();
+        report(v.exportScript, v.meshMessage, !*written);
+    }
+    return ok;
+}
+
 void meshPanel(Viewer& v) {
     ImGui::SliderInt("resolution", &v.meshResolution, 16, 512);
     ImGui::Checkbox("custom bounds", &v.customBounds);
@@ -751,36 +800,19 @@ void meshPanel(Viewer& v) {
         v.mesher->start(v.scene, o);
         v.meshMessage = "extracting...";
     }
-    if (auto done = v.mesher->take()) {
-        if (*done) {
-            v.mesh = std::move(**done);
-            v.meshStats = v.mesher->stats();
-            char text[160];
-            std::snprintf(text, sizeof text, "%zu vertices, %zu triangles, %.2f s%s",
-                          v.mesh->vertexCount(), v.mesh->triangleCount(), v.meshStats.totalSeconds,
-                          v.meshStats.surfaceCut ? " (cut by bounds)" : "");
-            v.meshMessage = text;
-            v.meshView = true;
-        } else {
-            v.meshMessage = done->error().str();
-        }
-    }
     if (!v.meshMessage.empty()) ImGui::TextWrapped("%s", v.meshMessage.c_str());
     if (!v.mesh) return;
     ImGui::Checkbox("show mesh (M)", &v.meshView);
     ImGui::SameLine();
     ImGui::Checkbox("wireframe", &v.wireframe);
+    if (v.meshView)
+        ImGui::Text("mesh frame %.1f ms (draw %.1f ms)", v.meshFrameMs, v.meshDrawMs);
     ImGui::InputText("file", v.exportPath, sizeof v.exportPath);
     ImGui::SameLine();
-    if (ImGui::Button("export")) {
-        auto format = meshFormatFromPath(v.exportPath);
-        if (!format) {
-            v.meshMessage = std::string(v.exportPath) +
-                            ": the extension names no mesh format (.ply, .obj, .stl, .glb)";
-        } else {
-            auto written = writeMesh(*v.mesh, v.exportPath, *format);
-            v.meshMessage = written ? "wrote " + std::string(v.exportPath) : written.error().str();
-        }
+    if (v.exporter->running()) {
+        ImGui::TextDisabled("writing...");
+    } else if (ImGui::Button("export")) {
+        if (auto problem = startExport(v, v.exportPath)) v.meshMessage = *problem;
     }
 }
 
@@ -904,7 +936,9 @@ void panels(Viewer& v) {
 
 // Runs commands until one has to wait for an image. False when a command failed.
 bool runScript(Viewer& v) {
-    while (!v.script.empty() && v.pendingShot.empty() && !v.generating) {
+    // A script's extraction or write is waited for until finishMesh() has taken its result.
+    while (!v.script.empty() && v.pendingShot.empty() && !v.generating && v.meshScript.empty() &&
+           v.exportScript.empty()) {
         Command c = v.script.front();
         v.script.pop_front();
         std::string where = v.scriptFile + ":" + std::to_string(c.line) + ": ";
@@ -960,6 +994,21 @@ bool runScript(Viewer& v) {
         } else if (c.verb == "screenshot") {
             v.pendingShot = arg;
             v.waitStart = now();
+        } else if (c.verb == "mesh" && arg == "extract") {
+            MeshOptions o;
+            o.resolution = uint32_t(c.numbers[0]);
+            v.meshResolution = int(o.resolution); // as if set in the panel
+            v.mesher->start(v.scene, o);
+            v.meshScript = where;
+        } else if (c.verb == "mesh") { // export
+            if (!v.mesh) return fail("mesh export: no mesh extracted");
+            if (auto problem = startExport(v, c.args[1])) return fail(*problem);
+            v.exportScript = where;
+        } else if (c.verb == "view") {
+            if (arg == "mesh" && !v.mesh) return fail("view mesh: no mesh extracted");
+            v.meshView = arg == "mesh";
+        } else if (c.verb == "wireframe") {
+            v.wireframe = arg == "on";
         } else if (c.verb == "generate" || c.verb == "edit-scene") {
             std::snprintf(v.prompt, sizeof v.prompt, "%s", c.text.c_str()); // as if typed
             startGeneration(v, c.text, c.verb == "edit-scene");
@@ -1006,6 +1055,7 @@ int main(int argc, char** argv) {
     v.context = std::move(*context);
     v.renderer = std::make_unique<RenderWorker>(*v.context);
     v.mesher = std::make_unique<MeshWorker>(*v.context);
+    v.exporter = std::make_unique<ExportWorker>();
     v.generator = std::make_unique<GenerateWorker>();
     describeEndpoint(v);
     v.startedEmpty = args.scene.empty();
@@ -1053,7 +1103,8 @@ int main(int argc, char** argv) {
     double lastPoll = 0;
     while (!glfwWindowShouldClose(v.window)) {
         // Automated runs never sleep; interactive ones wait for input while nothing is pending.
-        if (automated || !v.renderer->idle() || v.mesher->running() || moving(v))
+        if (automated || !v.renderer->idle() || v.mesher->running() || v.exporter->running() ||
+            moving(v))
             glfwPollEvents();
         else
             glfwWaitEventsTimeout(0.1);
@@ -1063,17 +1114,14 @@ int main(int argc, char** argv) {
                 v.status = v.doc.error() ? "reload failed" : "reloaded " + v.doc.path().string();
         }
         syncScene(v);
-        if (!finishGeneration(v) || !runScript(v)) break;
+        if (!finishGeneration(v) || !finishMesh(v) || !runScript(v)) break;
 
         ImGui_ImplVulkan_NewFrame();
         ImGui_ImplGlfw_NewFrame();
         ImGui::NewFrame();
         handleInput(v);
         syncScene(v);
-        if (v.showUi)
-            panels(v);
-        else if (v.mesher->running())
-            v.mesher->take(); // keep the panel's state simple
+        if (v.showUi) panels(v);
         drawGrid(v);
         ImGui::Render();
         syncScene(v);
@@ -1087,7 +1135,17 @@ int main(int argc, char** argv) {
         if (v.scene)
             bg[0] = v.scene->background.r, bg[1] = v.scene->background.g,
             bg[2] = v.scene->background.b;
-        bool drawn = drawFrame(*v.presenter, ImGui::GetDrawData(), bg, shoot ? &capture : nullptr);
+        MeshView meshView;
+        meshView.camera = toCamera(v.camera);
+        meshView.wireframe = v.wireframe;
+        const bool drawsMesh = v.meshView && v.mesh;
+        const double frameStart = now();
+        bool drawn = drawFrame(*v.presenter, ImGui::GetDrawData(), bg,
+                               drawsMesh ? &meshView : nullptr, shoot ? &capture : nullptr);
+        if (drawn && drawsMesh) {
+            v.meshFrameMs = (now() - frameStart) * 1000.0;
+            v.meshDrawMs = meshDrawMilliseconds(*v.presenter);
+        }
         if (drawn && v.framesLeft > 0) --v.framesLeft;
         if (shoot && drawn) {
             if (capture.rgba.empty()) {
@@ -1111,16 +1169,23 @@ int main(int argc, char** argv) {
             break;
         }
         if (!args.script.empty() && v.script.empty() && v.pendingShot.empty() && !v.generating &&
-            !v.exitAfterShot)
+            v.meshScript.empty() && v.exportScript.empty() && !v.exitAfterShot)
             break;
     }
     if (automated && v.renderError && v.exitCode == 0) {
         std::fprintf(stderr, "%s\n", v.renderError->str().c_str());
         v.exitCode = 1;
     }
+    // Under the tests' validation layer, any message fails an automated run.
+    if (automated && v.exitCode == 0 &&
+        (presenterValidationMessages(*v.presenter) || v.context->validationMessageCount())) {
+        std::fprintf(stderr, "sdfcsg-viewer: the validation layer reported problems\n");
+        v.exitCode = 1;
+    }
     glfwHideWindow(v.window); // the workers may need a moment to finish a compile
     v.renderer.reset();
     v.mesher.reset();
+    v.exporter.reset(); // waits for a file being written
     v.generator.reset(); // cancels a generation in flight
     v.presenter.reset();
     ImGui_ImplGlfw_Shutdown();

@@ -1,18 +1,26 @@
 #include "presenter.h"
 
+#include "camera.h"
+
 #include <GLFW/glfw3.h>
 #include <imgui.h>
 #include <imgui_impl_vulkan.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <string_view>
 #include <vector>
 
 namespace sdfcsg::viewer {
 
 namespace {
+
+// SPIR-V of shaders/mesh.vert and mesh.frag, compiled by glslangValidator during the build.
+#include "mesh_frag.h"
+#include "mesh_vert.h"
 
 // As in the engine: a failing Vulkan call here is a bug or a lost device, not a user error.
 void check(VkResult result, const char* call, int line) {
@@ -38,6 +46,8 @@ struct Buffer {
 struct Presenter {
     GLFWwindow* window = nullptr;
     VkInstance instance = VK_NULL_HANDLE;
+    VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
+    std::atomic<uint32_t> validationMessages{0};
     VkPhysicalDevice physical = VK_NULL_HANDLE;
     VkPhysicalDeviceMemoryProperties memoryProperties{};
     std::string deviceName;
@@ -69,9 +79,60 @@ struct Presenter {
     bool sceneDirty = false;
     bool hasScene = false;
     Buffer readback;
+
+    // The mesh view. The depth buffer follows the swapchain's size.
+    VkFormat depthFormat = VK_FORMAT_UNDEFINED;
+    VkImage depthImage = VK_NULL_HANDLE;
+    VkDeviceMemory depthMemory = VK_NULL_HANDLE;
+    VkImageView depthView = VK_NULL_HANDLE;
+    VkPhysicalDeviceLimits limits{};
+    VkDescriptorSetLayout meshSetLayout = VK_NULL_HANDLE;
+    VkPipelineLayout meshLayout = VK_NULL_HANDLE;
+    VkPipeline meshPipeline = VK_NULL_HANDLE;
+    VkDescriptorPool meshPool = VK_NULL_HANDLE;
+    VkDescriptorSet meshSet = VK_NULL_HANDLE;
+    // Positions, normals, colours and indices, one after the other in one device-local buffer.
+    VkBuffer meshBuffer = VK_NULL_HANDLE;
+    VkDeviceMemory meshMemory = VK_NULL_HANDLE;
+    VkDeviceSize indexOffset = 0;
+    uint32_t indexCount = 0;
+    VkQueryPool timestamps = VK_NULL_HANDLE; // none when the queue cannot time
+    uint64_t timestampMask = 0;
+    double meshMs = -1.0;
+};
+
+// The push constants of shaders/mesh_draw.glsl.
+struct MeshConstants {
+    float eye[4], right[4], up[4], forward[4], line[4];
 };
 
 namespace {
+
+VKAPI_ATTR VkBool32 VKAPI_CALL debugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                             VkDebugUtilsMessageTypeFlagsEXT,
+                                             const VkDebugUtilsMessengerCallbackDataEXT* data,
+                                             void* user) {
+    static_cast<Presenter*>(user)->validationMessages.fetch_add(1);
+    const char* level =
+        (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) ? "error" : "warning";
+    std::fprintf(stderr, "vulkan validation (window) %s: %s\n", level,
+                 data && data->pMessage ? data->pMessage : "(no message)");
+    return VK_FALSE;
+}
+
+// As for the engine's context: SDFCSG_VALIDATION (set by the tests) turns the validation layer
+// on, here for the window's device, when the layer is installed.
+bool wantValidation() {
+    const char* env = std::getenv("SDFCSG_VALIDATION");
+    if (!env || !*env || std::string_view(env) == "0") return false;
+    uint32_t count = 0;
+    vkEnumerateInstanceLayerProperties(&count, nullptr);
+    std::vector<VkLayerProperties> layers(count);
+    vkEnumerateInstanceLayerProperties(&count, layers.data());
+    for (const VkLayerProperties& l : layers)
+        if (std::string_view(l.layerName) == "VK_LAYER_KHRONOS_validation") return true;
+    return false;
+}
 
 uint32_t memoryType(const Presenter& p, uint32_t bits, VkMemoryPropertyFlags flags) {
     for (uint32_t i = 0; i < p.memoryProperties.memoryTypeCount; ++i)
@@ -148,6 +209,39 @@ void destroySwapchainViews(Presenter& p) {
     p.framebuffers.clear();
     p.views.clear();
     p.images.clear();
+    if (p.depthView) vkDestroyImageView(p.device, p.depthView, nullptr);
+    if (p.depthImage) vkDestroyImage(p.device, p.depthImage, nullptr);
+    if (p.depthMemory) vkFreeMemory(p.device, p.depthMemory, nullptr);
+    p.depthView = VK_NULL_HANDLE;
+    p.depthImage = VK_NULL_HANDLE;
+    p.depthMemory = VK_NULL_HANDLE;
+}
+
+void createDepthImage(Presenter& p, VkExtent2D extent) {
+    VkImageCreateInfo info = {VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+    info.imageType = VK_IMAGE_TYPE_2D;
+    info.format = p.depthFormat;
+    info.extent = {extent.width, extent.height, 1};
+    info.mipLevels = 1;
+    info.arrayLayers = 1;
+    info.samples = VK_SAMPLE_COUNT_1_BIT;
+    info.tiling = VK_IMAGE_TILING_OPTIMAL;
+    info.usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT;
+    info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    VK_CHECK(vkCreateImage(p.device, &info, nullptr, &p.depthImage));
+    VkMemoryRequirements req;
+    vkGetImageMemoryRequirements(p.device, p.depthImage, &req);
+    VkMemoryAllocateInfo alloc = {VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    alloc.allocationSize = req.size;
+    alloc.memoryTypeIndex = memoryType(p, req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    VK_CHECK(vkAllocateMemory(p.device, &alloc, nullptr, &p.depthMemory));
+    VK_CHECK(vkBindImageMemory(p.device, p.depthImage, p.depthMemory, 0));
+    VkImageViewCreateInfo view = {VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+    view.image = p.depthImage;
+    view.viewType = VK_IMAGE_VIEW_TYPE_2D;
+    view.format = p.depthFormat;
+    view.subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1};
+    VK_CHECK(vkCreateImageView(p.device, &view, nullptr, &p.depthView));
 }
 
 bool createSwapchain(Presenter& p) {
@@ -195,6 +289,7 @@ bool createSwapchain(Presenter& p) {
     VK_CHECK(vkGetSwapchainImagesKHR(p.device, swapchain, &count, nullptr));
     p.images.resize(count);
     VK_CHECK(vkGetSwapchainImagesKHR(p.device, swapchain, &count, p.images.data()));
+    createDepthImage(p, extent);
     for (VkImage image : p.images) {
         VkImageViewCreateInfo view = {VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
         view.image = image;
@@ -204,10 +299,11 @@ bool createSwapchain(Presenter& p) {
         VkImageView v;
         VK_CHECK(vkCreateImageView(p.device, &view, nullptr, &v));
         p.views.push_back(v);
+        VkImageView attachments[] = {v, p.depthView};
         VkFramebufferCreateInfo fb = {VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
         fb.renderPass = p.renderPass;
-        fb.attachmentCount = 1;
-        fb.pAttachments = &v;
+        fb.attachmentCount = 2;
+        fb.pAttachments = attachments;
         fb.width = extent.width;
         fb.height = extent.height;
         fb.layers = 1;
@@ -234,6 +330,163 @@ void barrier(VkCommandBuffer cmd, VkImage image, VkImageLayout from, VkImageLayo
     vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 0, nullptr, 0, nullptr, 1, &b);
 }
 
+// The first depth-only format the device can render to (D16 always can); float depth first,
+// since the mesh view's depth is reversed and precise only in floating point.
+VkFormat chooseDepthFormat(VkPhysicalDevice physical) {
+    for (VkFormat f : {VK_FORMAT_D32_SFLOAT, VK_FORMAT_X8_D24_UNORM_PACK32}) {
+        VkFormatProperties props;
+        vkGetPhysicalDeviceFormatProperties(physical, f, &props);
+        if (props.optimalTilingFeatures & VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT) return f;
+    }
+    return VK_FORMAT_D16_UNORM;
+}
+
+VkShaderModule createShader(VkDevice device, const uint32_t* code, size_t bytes) {
+    VkShaderModuleCreateInfo info = {VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+    info.codeSize = bytes;
+    info.pCode = code;
+    VkShaderModule module;
+    VK_CHECK(vkCreateShaderModule(device, &info, nullptr, &module));
+    return module;
+}
+
+// The mesh's pipeline, descriptor set and timestamp queries. No vertex input: the vertex shader
+// pulls the vertices from storage buffers, so one pipeline draws both the shaded view (indexed)
+// and the wireframe (three corners per triangle).
+void createMeshPipeline(Presenter& p) {
+    VkDescriptorSetLayoutBinding bindings[4] = {};
+    for (uint32_t i = 0; i < 4; ++i)
+        bindings[i] = {i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_VERTEX_BIT,
+                       nullptr};
+    VkDescriptorSetLayoutCreateInfo setInfo = {
+        VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    setInfo.bindingCount = 4;
+    setInfo.pBindings = bindings;
+    VK_CHECK(vkCreateDescriptorSetLayout(p.device, &setInfo, nullptr, &p.meshSetLayout));
+    VkPushConstantRange push = {VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                                sizeof(MeshConstants)};
+    VkPipelineLayoutCreateInfo layoutInfo = {VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    layoutInfo.setLayoutCount = 1;
+    layoutInfo.pSetLayouts = &p.meshSetLayout;
+    layoutInfo.pushConstantRangeCount = 1;
+    layoutInfo.pPushConstantRanges = &push;
+    VK_CHECK(vkCreatePipelineLayout(p.device, &layoutInfo, nullptr, &p.meshLayout));
+
+    VkDescriptorPoolSize poolSize = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 4};
+    VkDescriptorPoolCreateInfo poolInfo = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+    poolInfo.maxSets = 1;
+    poolInfo.poolSizeCount = 1;
+    poolInfo.pPoolSizes = &poolSize;
+    VK_CHECK(vkCreateDescriptorPool(p.device, &poolInfo, nullptr, &p.meshPool));
+    VkDescriptorSetAllocateInfo alloc = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+    alloc.descriptorPool = p.meshPool;
+    alloc.descriptorSetCount = 1;
+    alloc.pSetLayouts = &p.meshSetLayout;
+    VK_CHECK(vkAllocateDescriptorSets(p.device, &alloc, &p.meshSet));
+
+    VkShaderModule vert = createShader(p.device, kMeshVert, sizeof kMeshVert);
+    VkShaderModule frag = createShader(p.device, kMeshFrag, sizeof kMeshFrag);
+    VkPipelineShaderStageCreateInfo stages[2] = {};
+    stages[0] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
+    stages[0].module = vert;
+    stages[0].pName = "main";
+    stages[1] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
+    stages[1].module = frag;
+    stages[1].pName = "main";
+    VkPipelineVertexInputStateCreateInfo vertexInput = {
+        VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+    VkPipelineInputAssemblyStateCreateInfo assembly = {
+        VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+    assembly.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+    VkPipelineViewportStateCreateInfo viewport = {
+        VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
+    viewport.viewportCount = 1;
+    viewport.scissorCount = 1;
+    VkPipelineRasterizationStateCreateInfo raster = {
+        VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
+    raster.polygonMode = VK_POLYGON_MODE_FILL;
+    // Both sides: bounds that cut the surface open the mesh, and the ray marcher shows no
+    // inside there either, but a hole where a back face is seen would be wrong.
+    raster.cullMode = VK_CULL_MODE_NONE;
+    raster.lineWidth = 1.0f;
+    VkPipelineMultisampleStateCreateInfo multisample = {
+        VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
+    multisample.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
+    VkPipelineDepthStencilStateCreateInfo depth = {
+        VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
+    depth.depthTestEnable = VK_TRUE;
+    depth.depthWriteEnable = VK_TRUE;
+    depth.depthCompareOp = VK_COMPARE_OP_GREATER; // reversed depth: nearer is larger
+    VkPipelineColorBlendAttachmentState blendAttachment = {};
+    blendAttachment.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
+                                     VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
+    VkPipelineColorBlendStateCreateInfo blend = {
+        VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+    blend.attachmentCount = 1;
+    blend.pAttachments = &blendAttachment;
+    VkDynamicState dynamicStates[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+    VkPipelineDynamicStateCreateInfo dynamic = {
+        VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
+    dynamic.dynamicStateCount = 2;
+    dynamic.pDynamicStates = dynamicStates;
+    VkGraphicsPipelineCreateInfo info = {VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
+    info.stageCount = 2;
+    info.pStages = stages;
+    info.pVertexInputState = &vertexInput;
+    info.pInputAssemblyState = &assembly;
+    info.pViewportState = &viewport;
+    info.pRasterizationState = &raster;
+    info.pMultisampleState = &multisample;
+    info.pDepthStencilState = &depth;
+    info.pColorBlendState = &blend;
+    info.pDynamicState = &dynamic;
+    info.layout = p.meshLayout;
+    info.renderPass = p.renderPass;
+    VK_CHECK(vkCreateGraphicsPipelines(p.device, VK_NULL_HANDLE, 1, &info, nullptr,
+                                       &p.meshPipeline));
+    vkDestroyShaderModule(p.device, vert, nullptr);
+    vkDestroyShaderModule(p.device, frag, nullptr);
+
+    uint32_t familyCount = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(p.physical, &familyCount, nullptr);
+    std::vector<VkQueueFamilyProperties> families(familyCount);
+    vkGetPhysicalDeviceQueueFamilyProperties(p.physical, &familyCount, families.data());
+    uint32_t bits = families[p.family].timestampValidBits;
+    if (bits > 0) {
+        p.timestampMask = bits >= 64 ? ~0ull : (1ull << bits) - 1;
+        VkQueryPoolCreateInfo query = {VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+        query.queryType = VK_QUERY_TYPE_TIMESTAMP;
+        query.queryCount = 2;
+        VK_CHECK(vkCreateQueryPool(p.device, &query, nullptr, &p.timestamps));
+    }
+}
+
+void destroyMesh(Presenter& p) {
+    if (p.meshBuffer) vkDestroyBuffer(p.device, p.meshBuffer, nullptr);
+    if (p.meshMemory) vkFreeMemory(p.device, p.meshMemory, nullptr);
+    p.meshBuffer = VK_NULL_HANDLE;
+    p.meshMemory = VK_NULL_HANDLE;
+    p.indexCount = 0;
+}
+
+// Runs one command buffer's worth of work now and waits for it (uploads between frames).
+template <typename Record> void submitNow(Presenter& p, Record record) {
+    VK_CHECK(vkResetCommandBuffer(p.cmd, 0));
+    VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    VK_CHECK(vkBeginCommandBuffer(p.cmd, &begin));
+    record(p.cmd);
+    VK_CHECK(vkEndCommandBuffer(p.cmd));
+    VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    submit.commandBufferCount = 1;
+    submit.pCommandBuffers = &p.cmd;
+    VK_CHECK(vkQueueSubmit(p.queue, 1, &submit, p.fence));
+    VK_CHECK(vkWaitForFences(p.device, 1, &p.fence, VK_TRUE, UINT64_MAX));
+    VK_CHECK(vkResetFences(p.device, 1, &p.fence));
+}
+
 } // namespace
 
 PresenterPtr createPresenter(GLFWwindow* window, std::string& error) {
@@ -248,13 +501,36 @@ PresenterPtr createPresenter(GLFWwindow* window, std::string& error) {
     VkApplicationInfo app = {VK_STRUCTURE_TYPE_APPLICATION_INFO};
     app.pApplicationName = "sdfcsg-viewer";
     app.apiVersion = VK_API_VERSION_1_1;
+    std::vector<const char*> instanceExtensions(extensions, extensions + extensionCount);
+    const bool validation = wantValidation();
+    const char* layer = "VK_LAYER_KHRONOS_validation";
+    VkDebugUtilsMessengerCreateInfoEXT messengerInfo = {
+        VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+    messengerInfo.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
+                                    VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    messengerInfo.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
+                                VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                                VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+    messengerInfo.pfnUserCallback = debugCallback;
+    messengerInfo.pUserData = p.get();
     VkInstanceCreateInfo instanceInfo = {VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
     instanceInfo.pApplicationInfo = &app;
-    instanceInfo.enabledExtensionCount = extensionCount;
-    instanceInfo.ppEnabledExtensionNames = extensions;
+    if (validation) {
+        instanceExtensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+        instanceInfo.enabledLayerCount = 1;
+        instanceInfo.ppEnabledLayerNames = &layer;
+        instanceInfo.pNext = &messengerInfo;
+    }
+    instanceInfo.enabledExtensionCount = uint32_t(instanceExtensions.size());
+    instanceInfo.ppEnabledExtensionNames = instanceExtensions.data();
     if (vkCreateInstance(&instanceInfo, nullptr, &p->instance) != VK_SUCCESS) {
         error = "could not create a Vulkan instance with window-system extensions";
         return nullptr;
+    }
+    if (validation) {
+        auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+            vkGetInstanceProcAddr(p->instance, "vkCreateDebugUtilsMessengerEXT"));
+        VK_CHECK(create(p->instance, &messengerInfo, nullptr, &p->messenger));
     }
     if (glfwCreateWindowSurface(p->instance, window, nullptr, &p->surface) != VK_SUCCESS) {
         error = "could not create a Vulkan surface for the window";
@@ -332,28 +608,53 @@ PresenterPtr createPresenter(GLFWwindow* window, std::string& error) {
     attachment.stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
     attachment.initialLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
     attachment.finalLayout = VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
+    // The mesh view's depth: cleared every frame, never kept.
+    p->depthFormat = chooseDepthFormat(p->physical);
+    VkAttachmentDescription depthAttachment = {};
+    depthAttachment.format = p->depthFormat;
+    depthAttachment.samples = VK_SAMPLE_COUNT_1_BIT;
+    depthAttachment.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    depthAttachment.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+    depthAttachment.stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE;
+    depthAttachment.stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+    depthAttachment.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    depthAttachment.finalLayout = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+    VkAttachmentDescription attachments[] = {attachment, depthAttachment};
     VkAttachmentReference ref = {0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL};
+    VkAttachmentReference depthRef = {1, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL};
     VkSubpassDescription subpass = {};
     subpass.pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
     subpass.colorAttachmentCount = 1;
     subpass.pColorAttachments = &ref;
+    subpass.pDepthStencilAttachment = &depthRef;
+    // The clear and blit before the pass, and the previous frame's depth tests on the same
+    // depth image (its clear is a write after their writes).
     VkSubpassDependency dependency = {};
     dependency.srcSubpass = VK_SUBPASS_EXTERNAL;
     dependency.dstSubpass = 0;
     dependency.srcStageMask =
-        VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
-    dependency.dstStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
-    dependency.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+        VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT |
+        VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT;
+    dependency.dstStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT |
+                              VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT |
+                              VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT;
+    dependency.srcAccessMask =
+        VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
     dependency.dstAccessMask =
-        VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT;
+        VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT |
+        VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
     VkRenderPassCreateInfo passInfo = {VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO};
-    passInfo.attachmentCount = 1;
-    passInfo.pAttachments = &attachment;
+    passInfo.attachmentCount = 2;
+    passInfo.pAttachments = attachments;
     passInfo.subpassCount = 1;
     passInfo.pSubpasses = &subpass;
     passInfo.dependencyCount = 1;
     passInfo.pDependencies = &dependency;
     VK_CHECK(vkCreateRenderPass(p->device, &passInfo, nullptr, &p->renderPass));
+    VkPhysicalDeviceProperties properties;
+    vkGetPhysicalDeviceProperties(p->physical, &properties);
+    p->limits = properties.limits;
+    createMeshPipeline(*p);
 
     VkDescriptorPoolSize poolSize = {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 16};
     VkDescriptorPoolCreateInfo poolInfo = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
@@ -416,7 +717,13 @@ void destroyPresenter(Presenter* p) {
         destroyBuffer(*p, p->staging);
         destroyBuffer(*p, p->readback);
         destroySceneImage(*p);
+        destroyMesh(*p);
         destroySwapchainViews(*p);
+        if (p->timestamps) vkDestroyQueryPool(p->device, p->timestamps, nullptr);
+        vkDestroyPipeline(p->device, p->meshPipeline, nullptr);
+        vkDestroyPipelineLayout(p->device, p->meshLayout, nullptr);
+        vkDestroyDescriptorPool(p->device, p->meshPool, nullptr);
+        vkDestroyDescriptorSetLayout(p->device, p->meshSetLayout, nullptr);
         if (p->swapchain) vkDestroySwapchainKHR(p->device, p->swapchain, nullptr);
         vkDestroySemaphore(p->device, p->acquired, nullptr);
         vkDestroySemaphore(p->device, p->rendered, nullptr);
@@ -427,6 +734,11 @@ void destroyPresenter(Presenter* p) {
         vkDestroyDevice(p->device, nullptr);
     }
     if (p->surface) vkDestroySurfaceKHR(p->instance, p->surface, nullptr);
+    if (p->messenger) {
+        auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+            vkGetInstanceProcAddr(p->instance, "vkDestroyDebugUtilsMessengerEXT"));
+        destroy(p->instance, p->messenger, nullptr);
+    }
     if (p->instance) vkDestroyInstance(p->instance, nullptr);
     delete p;
 }
@@ -442,7 +754,144 @@ void setImage(Presenter& p, const Image& image) {
     p.hasScene = true;
 }
 
-bool drawFrame(Presenter& p, ImDrawData* ui, const float background[3], Image* capture) {
+bool setMesh(Presenter& p, const Mesh& mesh, std::string& error) {
+    VK_CHECK(vkDeviceWaitIdle(p.device)); // the last frame may still read the old buffer
+    destroyMesh(p);
+    if (mesh.indices.empty() || mesh.positions.empty()) return true;
+    const VkDeviceSize align = std::max<VkDeviceSize>(p.limits.minStorageBufferOffsetAlignment, 4);
+    const VkDeviceSize vertexBytes = VkDeviceSize(mesh.vertexCount()) * sizeof(glm::vec3);
+    const VkDeviceSize indexBytes = VkDeviceSize(mesh.indices.size()) * sizeof(uint32_t);
+    const VkDeviceSize stride = (vertexBytes + align - 1) / align * align;
+    const VkDeviceSize total = 3 * stride + indexBytes;
+    if (std::max(vertexBytes, indexBytes) > p.limits.maxStorageBufferRange) {
+        error = "the mesh is too large to draw on " + p.deviceName + " (" +
+                std::to_string(std::max(vertexBytes, indexBytes) >> 20) + " MiB in one buffer)";
+        return false;
+    }
+    // Through a staging buffer into device-local memory: the mesh is read every frame, and on a
+    // discrete GPU host-visible memory would be read across the bus each time.
+    auto allocate = [&](VkBufferUsageFlags usage, VkMemoryPropertyFlags flags, VkBuffer& buffer,
+                        VkDeviceMemory& memory) {
+        VkBufferCreateInfo info = {VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+        info.size = total;
+        info.usage = usage;
+        VK_CHECK(vkCreateBuffer(p.device, &info, nullptr, &buffer));
+        VkMemoryRequirements req;
+        vkGetBufferMemoryRequirements(p.device, buffer, &req);
+        VkMemoryAllocateInfo alloc = {VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+        alloc.allocationSize = req.size;
+        alloc.memoryTypeIndex = memoryType(p, req.memoryTypeBits, flags);
+        // A fine mesh can exhaust the memory: the user's choice of resolution, not a bug.
+        VkResult result = vkAllocateMemory(p.device, &alloc, nullptr, &memory);
+        if (result == VK_ERROR_OUT_OF_DEVICE_MEMORY || result == VK_ERROR_OUT_OF_HOST_MEMORY) {
+            error = "not enough memory to draw the mesh (" + std::to_string(total >> 20) +
+                    " MiB)";
+            return false;
+        }
+        VK_CHECK(result);
+        VK_CHECK(vkBindBufferMemory(p.device, buffer, memory, 0));
+        return true;
+    };
+    VkBuffer staging = VK_NULL_HANDLE;
+    VkDeviceMemory stagingMemory = VK_NULL_HANDLE;
+    bool ok = allocate(VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                       VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
+                       staging, stagingMemory) &&
+              allocate(VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDEX_BUFFER_BIT |
+                           VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                       VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, p.meshBuffer, p.meshMemory);
+    if (ok) {
+        void* mapped = nullptr;
+        VK_CHECK(vkMapMemory(p.device, stagingMemory, 0, VK_WHOLE_SIZE, 0, &mapped));
+        auto* bytes = static_cast<unsigned char*>(mapped);
+        std::memcpy(bytes, mesh.positions.data(), vertexBytes);
+        std::memcpy(bytes + stride, mesh.normals.data(), vertexBytes);
+        if (mesh.colors.size() == mesh.positions.size()) {
+            std::memcpy(bytes + 2 * stride, mesh.colors.data(), vertexBytes);
+        } else { // a mesh without colours is drawn light grey
+            std::vector<glm::vec3> grey(mesh.vertexCount(), glm::vec3(0.8f));
+            std::memcpy(bytes + 2 * stride, grey.data(), vertexBytes);
+        }
+        std::memcpy(bytes + 3 * stride, mesh.indices.data(), indexBytes);
+        vkUnmapMemory(p.device, stagingMemory);
+        submitNow(p, [&](VkCommandBuffer cmd) {
+            VkBufferCopy region = {0, 0, total};
+            vkCmdCopyBuffer(cmd, staging, p.meshBuffer, 1, &region);
+            VkBufferMemoryBarrier b = {VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
+            b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+            b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_INDEX_READ_BIT;
+            b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+            b.buffer = p.meshBuffer;
+            b.size = VK_WHOLE_SIZE;
+            vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                                 VK_PIPELINE_STAGE_VERTEX_INPUT_BIT |
+                                     VK_PIPELINE_STAGE_VERTEX_SHADER_BIT,
+                                 0, 0, nullptr, 1, &b, 0, nullptr);
+        });
+    }
+    if (staging) vkDestroyBuffer(p.device, staging, nullptr);
+    if (stagingMemory) vkFreeMemory(p.device, stagingMemory, nullptr);
+    if (!ok) {
+        destroyMesh(p);
+        return false;
+    }
+    VkDescriptorBufferInfo ranges[4] = {{p.meshBuffer, 0, vertexBytes},
+                                        {p.meshBuffer, stride, vertexBytes},
+                                        {p.meshBuffer, 2 * stride, vertexBytes},
+                                        {p.meshBuffer, 3 * stride, indexBytes}};
+    VkWriteDescriptorSet writes[4] = {};
+    for (uint32_t i = 0; i < 4; ++i) {
+        writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+        writes[i].dstSet = p.meshSet;
+        writes[i].dstBinding = i;
+        writes[i].descriptorCount = 1;
+        writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        writes[i].pBufferInfo = &ranges[i];
+    }
+    vkUpdateDescriptorSets(p.device, 4, writes, 0, nullptr);
+    p.indexOffset = 3 * stride;
+    p.indexCount = uint32_t(mesh.indices.size());
+    return true;
+}
+
+namespace {
+
+void drawMesh(Presenter& p, const MeshView& view) {
+    VkViewport viewport = {0, 0, float(p.extent.width), float(p.extent.height), 0, 1};
+    VkRect2D scissor = {{0, 0}, p.extent};
+    vkCmdSetViewport(p.cmd, 0, 1, &viewport);
+    vkCmdSetScissor(p.cmd, 0, 1, &scissor);
+    detail::RayCamera rc = detail::makeRayCamera(view.camera, p.extent.width, p.extent.height);
+    glm::vec3 right = rc.right / (rc.tanHalfFov * rc.aspect), up = rc.up / rc.tanHalfFov;
+    // Reversed float depth is precise at any distance, so the near plane can sit very close.
+    float nearPlane =
+        std::max(1e-6f, 1e-4f * glm::length(view.camera.target - view.camera.eye));
+    MeshConstants c = {{rc.eye.x, rc.eye.y, rc.eye.z, nearPlane},
+                       {right.x, right.y, right.z, 0},
+                       {up.x, up.y, up.z, 0},
+                       {rc.forward.x, rc.forward.y, rc.forward.z, view.wireframe ? 1.0f : 0.0f},
+                       {0.05f, 0.05f, 0.05f, 1.0f}};
+    vkCmdBindPipeline(p.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p.meshPipeline);
+    vkCmdBindDescriptorSets(p.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p.meshLayout, 0, 1,
+                            &p.meshSet, 0, nullptr);
+    vkCmdPushConstants(p.cmd, p.meshLayout,
+                       VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof c, &c);
+    if (p.timestamps)
+        vkCmdWriteTimestamp(p.cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, p.timestamps, 0);
+    if (view.wireframe) {
+        vkCmdDraw(p.cmd, p.indexCount, 1, 0, 0);
+    } else {
+        vkCmdBindIndexBuffer(p.cmd, p.meshBuffer, p.indexOffset, VK_INDEX_TYPE_UINT32);
+        vkCmdDrawIndexed(p.cmd, p.indexCount, 1, 0, 0, 0);
+    }
+    if (p.timestamps)
+        vkCmdWriteTimestamp(p.cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, p.timestamps, 1);
+}
+
+} // namespace
+
+bool drawFrame(Presenter& p, ImDrawData* ui, const float background[3], const MeshView* mesh,
+               Image* capture) {
     if (p.rebuild && !createSwapchain(p)) return false;
     uint32_t index = 0;
     VkResult acquired = vkAcquireNextImageKHR(p.device, p.swapchain, UINT64_MAX, p.acquired,
@@ -458,6 +907,8 @@ bool drawFrame(Presenter& p, ImDrawData* ui, const float background[3], Image* c
     VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
     VK_CHECK(vkBeginCommandBuffer(p.cmd, &begin));
+    const bool drawsMesh = mesh && p.indexCount > 0;
+    if (drawsMesh && p.timestamps) vkCmdResetQueryPool(p.cmd, p.timestamps, 0, 2);
     if (p.sceneDirty) {
         barrier(p.cmd, p.sceneImage, VK_IMAGE_LAYOUT_UNDEFINED,
                 VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0, VK_ACCESS_TRANSFER_WRITE_BIT,
@@ -479,7 +930,7 @@ bool drawFrame(Presenter& p, ImDrawData* ui, const float background[3], Image* c
     VkClearColorValue clear = {{background[0], background[1], background[2], 1.0f}};
     VkImageSubresourceRange range = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
     vkCmdClearColorImage(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &clear, 1, &range);
-    if (p.hasScene) {
+    if (p.hasScene && !drawsMesh) {
         // The engine renders at the window's aspect ratio, at full or reduced size; stretching
         // fills the window either way. Same size: a plain copy of every pixel.
         barrier(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
@@ -504,7 +955,12 @@ bool drawFrame(Presenter& p, ImDrawData* ui, const float background[3], Image* c
     pass.renderPass = p.renderPass;
     pass.framebuffer = p.framebuffers[index];
     pass.renderArea.extent = p.extent;
+    VkClearValue clears[2] = {};
+    clears[1].depthStencil = {0.0f, 0}; // reversed depth: 0 is infinitely far
+    pass.clearValueCount = 2;
+    pass.pClearValues = clears;
     vkCmdBeginRenderPass(p.cmd, &pass, VK_SUBPASS_CONTENTS_INLINE);
+    if (drawsMesh) drawMesh(p, *mesh);
     if (ui) ImGui_ImplVulkan_RenderDrawData(ui, p.cmd);
     vkCmdEndRenderPass(p.cmd);
     bool capturing = capture && p.canCapture;
@@ -558,6 +1014,15 @@ bool drawFrame(Presenter& p, ImDrawData* ui, const float background[3], Image* c
     // One frame in flight: the image takes ~ms to draw, the engine's render is the slow part.
     VK_CHECK(vkWaitForFences(p.device, 1, &p.fence, VK_TRUE, UINT64_MAX));
     VK_CHECK(vkResetFences(p.device, 1, &p.fence));
+    p.meshMs = -1.0;
+    if (drawsMesh && p.timestamps) {
+        uint64_t ticks[2];
+        VK_CHECK(vkGetQueryPoolResults(p.device, p.timestamps, 0, 2, sizeof ticks, ticks,
+                                       sizeof(uint64_t),
+                                       VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+        p.meshMs = double((ticks[1] - ticks[0]) & p.timestampMask) *
+                   double(p.limits.timestampPeriod) * 1e-6;
+    }
 
     if (capturing) {
         capture->width = p.extent.width;
@@ -574,6 +1039,14 @@ bool drawFrame(Presenter& p, ImDrawData* ui, const float background[3], Image* c
         capture->width = capture->height = 0; // this surface cannot be read back
     }
     return true;
+}
+
+double meshDrawMilliseconds(const Presenter& p) {
+    return p.meshMs;
+}
+
+uint32_t presenterValidationMessages(const Presenter& p) {
+    return p.validationMessages.load();
 }
 
 std::string presenterDeviceName(const Presenter& p) {

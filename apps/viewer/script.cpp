@@ -34,6 +34,9 @@ const std::vector<Verb>& verbs() {
         {"screenshot", 1, 1, false, {}},
         {"generate", 1, -1, false, {}, "the scene"},
         {"edit-scene", 1, -1, false, {}, "the change"},
+        {"mesh", 2, 2, false, {"extract", "export"}},
+        {"view", 1, 1, false, {"mesh", "march"}},
+        {"wireframe", 1, 1, false, {"on", "off"}},
     };
     return table;
 }
@@ -118,6 +121,15 @@ Result<std::vector<Command>> parseScript(std::string_view text, std::string_view
                 c.numbers.push_back(v);
             }
             if (!ok) continue;
+        }
+        if (c.verb == "mesh" && c.args[0] == "extract") {
+            float cells = 0;
+            if (!parseFloat(c.args[1], cells) || cells < 1 || cells != float(int(cells))) {
+                problem("mesh extract: expected a whole number of cells, got \"" + c.args[1] +
+                        "\"");
+                continue;
+            }
+            c.numbers.push_back(cells);
         }
         commands.push_back(std::move(c));
     }

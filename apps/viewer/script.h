@@ -14,10 +14,15 @@
 //   generate TEXT...         ask the language model for a new scene described by TEXT, wait
 //                            for it, and make it the current scene (one undo step)
 //   edit-scene TEXT...       the same, sending the current scene to be changed as TEXT says
+//   mesh extract CELLS       extract a mesh with CELLS along the longest axis, wait for it and
+//                            show it (the mesh panel's resolution)
+//   mesh export PATH         write the mesh (.ply, .obj, .stl, .glb) and wait for the file
+//   view mesh|march          the extracted mesh or the ray-marched image
+//   wireframe on|off         the mesh view's edges
 //
 // The text of generate and edit-scene is the rest of the line, so it cannot hold a '#'. A
-// generation that fails (no valid scene after the repair rounds, a network error) fails the
-// script.
+// generation, extraction or export that fails (no valid scene after the repair rounds, a network
+// error, a mesh too large for the memory) fails the script.
 #pragma once
 
 #include <sdfcsg/error.h>
