@@ -172,7 +172,9 @@ struct Viewer {
     // the device.
     std::shared_ptr<const Mesh> mesh;
     MeshStats meshStats;
-    double meshFrameMs = 0.0, meshDrawMs = -1.0; // the last mesh frame: whole / the draw alone
+    // The last mesh frame's time (a blit when the view did not change) and the device time of the
+    // last drawing of the mesh.
+    double meshFrameMs = 0.0, meshDrawMs = -1.0;
     std::string meshScript, exportScript; // "file:line: " while a script's extraction or write runs
     bool meshView = false, wireframe = false;
     int meshResolution = 128;
@@ -806,7 +808,7 @@ void meshPanel(Viewer& v) {
     ImGui::SameLine();
     ImGui::Checkbox("wireframe", &v.wireframe);
     if (v.meshView)
-        ImGui::Text("mesh frame %.1f ms (draw %.1f ms)", v.meshFrameMs, v.meshDrawMs);
+        ImGui::Text("mesh frame %.1f ms, last drawn in %.1f ms", v.meshFrameMs, v.meshDrawMs);
     ImGui::InputText("file", v.exportPath, sizeof v.exportPath);
     ImGui::SameLine();
     if (v.exporter->running()) {
@@ -1138,6 +1140,7 @@ int main(int argc, char** argv) {
         MeshView meshView;
         meshView.camera = toCamera(v.camera);
         meshView.wireframe = v.wireframe;
+        meshView.closed = !v.meshStats.surfaceCut;
         const bool drawsMesh = v.meshView && v.mesh;
         const double frameStart = now();
         bool drawn = drawFrame(*v.presenter, ImGui::GetDrawData(), bg,

@@ -41,6 +41,13 @@ struct Buffer {
     VkDeviceSize size = 0;
 };
 
+// An image the mesh is drawn into, with its memory and view.
+struct Target {
+    VkImage image = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    VkImageView view = VK_NULL_HANDLE;
+};
+
 } // namespace
 
 struct Presenter {
@@ -80,15 +87,20 @@ struct Presenter {
     bool hasScene = false;
     Buffer readback;
 
-    // The mesh view. The depth buffer follows the swapchain's size.
+    // The mesh view is drawn into an image of the window's size, then blitted as the engine's
+    // image is: a frame whose camera, mesh and size are those of the last draw only blits it,
+    // so panels stay quick over a mesh that takes long to draw (a CPU device).
     VkFormat depthFormat = VK_FORMAT_UNDEFINED;
-    VkImage depthImage = VK_NULL_HANDLE;
-    VkDeviceMemory depthMemory = VK_NULL_HANDLE;
-    VkImageView depthView = VK_NULL_HANDLE;
+    VkRenderPass meshPass = VK_NULL_HANDLE;
+    Target meshColor, meshDepth;
+    VkExtent2D meshExtent{};
+    VkFramebuffer meshFramebuffer = VK_NULL_HANDLE;
     VkPhysicalDeviceLimits limits{};
     VkDescriptorSetLayout meshSetLayout = VK_NULL_HANDLE;
     VkPipelineLayout meshLayout = VK_NULL_HANDLE;
-    VkPipeline meshPipeline = VK_NULL_HANDLE;
+    VkPipeline meshPipelines[2] = {}; // both sides, back faces culled
+    bool meshDrawn = false;            // meshColor holds the drawing described by drawnKey
+    std::vector<float> drawnKey;
     VkDescriptorPool meshPool = VK_NULL_HANDLE;
     VkDescriptorSet meshSet = VK_NULL_HANDLE;
     // Positions, normals, colours and indices, one after the other in one device-local buffer.
@@ -209,39 +221,43 @@ void destroySwapchainViews(Presenter& p) {
     p.framebuffers.clear();
     p.views.clear();
     p.images.clear();
-    if (p.depthView) vkDestroyImageView(p.device, p.depthView, nullptr);
-    if (p.depthImage) vkDestroyImage(p.device, p.depthImage, nullptr);
-    if (p.depthMemory) vkFreeMemory(p.device, p.depthMemory, nullptr);
-    p.depthView = VK_NULL_HANDLE;
-    p.depthImage = VK_NULL_HANDLE;
-    p.depthMemory = VK_NULL_HANDLE;
 }
 
-void createDepthImage(Presenter& p, VkExtent2D extent) {
+void destroyTarget(Presenter& p, Target& t) {
+    if (t.view) vkDestroyImageView(p.device, t.view, nullptr);
+    if (t.image) vkDestroyImage(p.device, t.image, nullptr);
+    if (t.memory) vkFreeMemory(p.device, t.memory, nullptr);
+    t = {};
+}
+
+Target createTarget(Presenter& p, VkExtent2D extent, VkFormat format, VkImageUsageFlags usage,
+                    VkImageAspectFlags aspect) {
+    Target t;
     VkImageCreateInfo info = {VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
     info.imageType = VK_IMAGE_TYPE_2D;
-    info.format = p.depthFormat;
+    info.format = format;
     info.extent = {extent.width, extent.height, 1};
     info.mipLevels = 1;
     info.arrayLayers = 1;
     info.samples = VK_SAMPLE_COUNT_1_BIT;
     info.tiling = VK_IMAGE_TILING_OPTIMAL;
-    info.usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT;
+    info.usage = usage;
     info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    VK_CHECK(vkCreateImage(p.device, &info, nullptr, &p.depthImage));
+    VK_CHECK(vkCreateImage(p.device, &info, nullptr, &t.image));
     VkMemoryRequirements req;
-    vkGetImageMemoryRequirements(p.device, p.depthImage, &req);
+    vkGetImageMemoryRequirements(p.device, t.image, &req);
     VkMemoryAllocateInfo alloc = {VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
     alloc.allocationSize = req.size;
     alloc.memoryTypeIndex = memoryType(p, req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-    VK_CHECK(vkAllocateMemory(p.device, &alloc, nullptr, &p.depthMemory));
-    VK_CHECK(vkBindImageMemory(p.device, p.depthImage, p.depthMemory, 0));
+    VK_CHECK(vkAllocateMemory(p.device, &alloc, nullptr, &t.memory));
+    VK_CHECK(vkBindImageMemory(p.device, t.image, t.memory, 0));
     VkImageViewCreateInfo view = {VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
-    view.image = p.depthImage;
+    view.image = t.image;
     view.viewType = VK_IMAGE_VIEW_TYPE_2D;
-    view.format = p.depthFormat;
-    view.subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1};
-    VK_CHECK(vkCreateImageView(p.device, &view, nullptr, &p.depthView));
+    view.format = format;
+    view.subresourceRange = {aspect, 0, 1, 0, 1};
+    VK_CHECK(vkCreateImageView(p.device, &view, nullptr, &t.view));
+    return t;
 }
 
 bool createSwapchain(Presenter& p) {
@@ -289,7 +305,6 @@ bool createSwapchain(Presenter& p) {
     VK_CHECK(vkGetSwapchainImagesKHR(p.device, swapchain, &count, nullptr));
     p.images.resize(count);
     VK_CHECK(vkGetSwapchainImagesKHR(p.device, swapchain, &count, p.images.data()));
-    createDepthImage(p, extent);
     for (VkImage image : p.images) {
         VkImageViewCreateInfo view = {VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
         view.image = image;
@@ -299,11 +314,10 @@ bool createSwapchain(Presenter& p) {
         VkImageView v;
         VK_CHECK(vkCreateImageView(p.device, &view, nullptr, &v));
         p.views.push_back(v);
-        VkImageView attachments[] = {v, p.depthView};
         VkFramebufferCreateInfo fb = {VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
         fb.renderPass = p.renderPass;
-        fb.attachmentCount = 2;
-        fb.pAttachments = attachments;
+        fb.attachmentCount = 1;
+        fb.pAttachments = &v;
         fb.width = extent.width;
         fb.height = extent.height;
         fb.layers = 1;
@@ -384,6 +398,58 @@ void createMeshPipeline(Presenter& p) {
     alloc.pSetLayouts = &p.meshSetLayout;
     VK_CHECK(vkAllocateDescriptorSets(p.device, &alloc, &p.meshSet));
 
+    // Colour cleared to the background and left ready for the blit; depth cleared, never kept.
+    p.depthFormat = chooseDepthFormat(p.physical);
+    VkAttachmentDescription attachments[2] = {};
+    attachments[0].format = VK_FORMAT_R8G8B8A8_UNORM; // as the engine's image
+    attachments[0].samples = VK_SAMPLE_COUNT_1_BIT;
+    attachments[0].loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    attachments[0].storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    attachments[0].stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE;
+    attachments[0].stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+    attachments[0].initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    attachments[0].finalLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+    attachments[1] = attachments[0];
+    attachments[1].format = p.depthFormat;
+    attachments[1].storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+    attachments[1].finalLayout = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+    VkAttachmentReference colorRef = {0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL};
+    VkAttachmentReference depthRef = {1, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL};
+    VkSubpassDescription subpass = {};
+    subpass.pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
+    subpass.colorAttachmentCount = 1;
+    subpass.pColorAttachments = &colorRef;
+    subpass.pDepthStencilAttachment = &depthRef;
+    VkSubpassDependency dependencies[2] = {};
+    // Before: the last blit that read the colour image, the last draw's depth writes.
+    dependencies[0].srcSubpass = VK_SUBPASS_EXTERNAL;
+    dependencies[0].dstSubpass = 0;
+    dependencies[0].srcStageMask = VK_PIPELINE_STAGE_TRANSFER_BIT |
+                                   VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT |
+                                   VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT;
+    dependencies[0].dstStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT |
+                                   VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT |
+                                   VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT;
+    dependencies[0].srcAccessMask = VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+    dependencies[0].dstAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT |
+                                    VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+                                    VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+    // After: the blit into the window's image.
+    dependencies[1].srcSubpass = 0;
+    dependencies[1].dstSubpass = VK_SUBPASS_EXTERNAL;
+    dependencies[1].srcStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
+    dependencies[1].dstStageMask = VK_PIPELINE_STAGE_TRANSFER_BIT;
+    dependencies[1].srcAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT;
+    dependencies[1].dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+    VkRenderPassCreateInfo passInfo = {VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO};
+    passInfo.attachmentCount = 2;
+    passInfo.pAttachments = attachments;
+    passInfo.subpassCount = 1;
+    passInfo.pSubpasses = &subpass;
+    passInfo.dependencyCount = 2;
+    passInfo.pDependencies = dependencies;
+    VK_CHECK(vkCreateRenderPass(p.device, &passInfo, nullptr, &p.meshPass));
+
     VkShaderModule vert = createShader(p.device, kMeshVert, sizeof kMeshVert);
     VkShaderModule frag = createShader(p.device, kMeshFrag, sizeof kMeshFrag);
     VkPipelineShaderStageCreateInfo stages[2] = {};
@@ -407,9 +473,7 @@ void createMeshPipeline(Presenter& p) {
     VkPipelineRasterizationStateCreateInfo raster = {
         VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
     raster.polygonMode = VK_POLYGON_MODE_FILL;
-    // Both sides: bounds that cut the surface open the mesh, and the ray marcher shows no
-    // inside there either, but a hole where a back face is seen would be wrong.
-    raster.cullMode = VK_CULL_MODE_NONE;
+    raster.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE; // seen from outside, as y points down
     raster.lineWidth = 1.0f;
     VkPipelineMultisampleStateCreateInfo multisample = {
         VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
@@ -443,9 +507,14 @@ void createMeshPipeline(Presenter& p) {
     info.pColorBlendState = &blend;
     info.pDynamicState = &dynamic;
     info.layout = p.meshLayout;
-    info.renderPass = p.renderPass;
-    VK_CHECK(vkCreateGraphicsPipelines(p.device, VK_NULL_HANDLE, 1, &info, nullptr,
-                                       &p.meshPipeline));
+    info.renderPass = p.meshPass;
+    // Culling back faces halves the triangles a CPU device sets up; only a closed mesh may,
+    // since where bounds cut the surface open its inside shows.
+    for (int cull = 0; cull < 2; ++cull) {
+        raster.cullMode = cull ? VK_CULL_MODE_BACK_BIT : VK_CULL_MODE_NONE;
+        VK_CHECK(vkCreateGraphicsPipelines(p.device, VK_NULL_HANDLE, 1, &info, nullptr,
+                                           &p.meshPipelines[cull]));
+    }
     vkDestroyShaderModule(p.device, vert, nullptr);
     vkDestroyShaderModule(p.device, frag, nullptr);
 
@@ -461,6 +530,40 @@ void createMeshPipeline(Presenter& p) {
         query.queryCount = 2;
         VK_CHECK(vkCreateQueryPool(p.device, &query, nullptr, &p.timestamps));
     }
+}
+
+void destroyMeshTarget(Presenter& p) {
+    if (p.meshFramebuffer) vkDestroyFramebuffer(p.device, p.meshFramebuffer, nullptr);
+    p.meshFramebuffer = VK_NULL_HANDLE;
+    destroyTarget(p, p.meshColor);
+    destroyTarget(p, p.meshDepth);
+    p.meshExtent = {};
+    p.meshDrawn = false;
+}
+
+// Called between frames (the previous frame has finished), so the old images are free.
+void ensureMeshTarget(Presenter& p) {
+    if (p.meshFramebuffer && p.meshExtent.width == p.extent.width &&
+        p.meshExtent.height == p.extent.height)
+        return;
+    destroyMeshTarget(p);
+    p.meshColor = createTarget(p, p.extent, VK_FORMAT_R8G8B8A8_UNORM,
+                               VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT |
+                                   VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                               VK_IMAGE_ASPECT_COLOR_BIT);
+    p.meshDepth = createTarget(p, p.extent, p.depthFormat,
+                               VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
+                               VK_IMAGE_ASPECT_DEPTH_BIT);
+    VkImageView views[] = {p.meshColor.view, p.meshDepth.view};
+    VkFramebufferCreateInfo fb = {VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
+    fb.renderPass = p.meshPass;
+    fb.attachmentCount = 2;
+    fb.pAttachments = views;
+    fb.width = p.extent.width;
+    fb.height = p.extent.height;
+    fb.layers = 1;
+    VK_CHECK(vkCreateFramebuffer(p.device, &fb, nullptr, &p.meshFramebuffer));
+    p.meshExtent = p.extent;
 }
 
 void destroyMesh(Presenter& p) {
@@ -608,44 +711,23 @@ PresenterPtr createPresenter(GLFWwindow* window, std::string& error) {
     attachment.stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
     attachment.initialLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
     attachment.finalLayout = VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
-    // The mesh view's depth: cleared every frame, never kept.
-    p->depthFormat = chooseDepthFormat(p->physical);
-    VkAttachmentDescription depthAttachment = {};
-    depthAttachment.format = p->depthFormat;
-    depthAttachment.samples = VK_SAMPLE_COUNT_1_BIT;
-    depthAttachment.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-    depthAttachment.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
-    depthAttachment.stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE;
-    depthAttachment.stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
-    depthAttachment.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    depthAttachment.finalLayout = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
-    VkAttachmentDescription attachments[] = {attachment, depthAttachment};
     VkAttachmentReference ref = {0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL};
-    VkAttachmentReference depthRef = {1, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL};
     VkSubpassDescription subpass = {};
     subpass.pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
     subpass.colorAttachmentCount = 1;
     subpass.pColorAttachments = &ref;
-    subpass.pDepthStencilAttachment = &depthRef;
-    // The clear and blit before the pass, and the previous frame's depth tests on the same
-    // depth image (its clear is a write after their writes).
     VkSubpassDependency dependency = {};
     dependency.srcSubpass = VK_SUBPASS_EXTERNAL;
     dependency.dstSubpass = 0;
     dependency.srcStageMask =
-        VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT |
-        VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT;
-    dependency.dstStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT |
-                              VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT |
-                              VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT;
-    dependency.srcAccessMask =
-        VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+        VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
+    dependency.dstStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
+    dependency.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
     dependency.dstAccessMask =
-        VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT |
-        VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+        VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT;
     VkRenderPassCreateInfo passInfo = {VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO};
-    passInfo.attachmentCount = 2;
-    passInfo.pAttachments = attachments;
+    passInfo.attachmentCount = 1;
+    passInfo.pAttachments = &attachment;
     passInfo.subpassCount = 1;
     passInfo.pSubpasses = &subpass;
     passInfo.dependencyCount = 1;
@@ -718,9 +800,12 @@ void destroyPresenter(Presenter* p) {
         destroyBuffer(*p, p->readback);
         destroySceneImage(*p);
         destroyMesh(*p);
+        destroyMeshTarget(*p);
         destroySwapchainViews(*p);
         if (p->timestamps) vkDestroyQueryPool(p->device, p->timestamps, nullptr);
-        vkDestroyPipeline(p->device, p->meshPipeline, nullptr);
+        for (VkPipeline pipeline : p->meshPipelines)
+            vkDestroyPipeline(p->device, pipeline, nullptr);
+        vkDestroyRenderPass(p->device, p->meshPass, nullptr);
         vkDestroyPipelineLayout(p->device, p->meshLayout, nullptr);
         vkDestroyDescriptorPool(p->device, p->meshPool, nullptr);
         vkDestroyDescriptorSetLayout(p->device, p->meshSetLayout, nullptr);
@@ -757,6 +842,7 @@ void setImage(Presenter& p, const Image& image) {
 bool setMesh(Presenter& p, const Mesh& mesh, std::string& error) {
     VK_CHECK(vkDeviceWaitIdle(p.device)); // the last frame may still read the old buffer
     destroyMesh(p);
+    p.meshDrawn = false;
     if (mesh.indices.empty() || mesh.positions.empty()) return true;
     const VkDeviceSize align = std::max<VkDeviceSize>(p.limits.minStorageBufferOffsetAlignment, 4);
     const VkDeviceSize vertexBytes = VkDeviceSize(mesh.vertexCount()) * sizeof(glm::vec3);
@@ -856,7 +942,30 @@ bool setMesh(Presenter& p, const Mesh& mesh, std::string& error) {
 
 namespace {
 
-void drawMesh(Presenter& p, const MeshView& view) {
+// What a drawing of the mesh depends on besides the mesh and the size.
+std::vector<float> meshKey(const MeshView& view, const float background[3]) {
+    const Camera& c = view.camera;
+    return {c.eye.x,         c.eye.y,          c.eye.z,       c.target.x,    c.target.y,
+            c.target.z,      c.up.x,           c.up.y,        c.up.z,        c.fov,
+            background[0],   background[1],    background[2], float(view.wireframe),
+            float(view.closed)};
+}
+
+// The mesh pass into meshColor, timed when the queue can.
+void drawMesh(Presenter& p, const MeshView& view, const float background[3]) {
+    if (p.timestamps) vkCmdResetQueryPool(p.cmd, p.timestamps, 0, 2);
+    VkRenderPassBeginInfo pass = {VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
+    pass.renderPass = p.meshPass;
+    pass.framebuffer = p.meshFramebuffer;
+    pass.renderArea.extent = p.extent;
+    VkClearValue clears[2] = {};
+    clears[0].color = {{background[0], background[1], background[2], 1.0f}};
+    clears[1].depthStencil = {0.0f, 0}; // reversed depth: 0 is infinitely far
+    pass.clearValueCount = 2;
+    pass.pClearValues = clears;
+    if (p.timestamps)
+        vkCmdWriteTimestamp(p.cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, p.timestamps, 0);
+    vkCmdBeginRenderPass(p.cmd, &pass, VK_SUBPASS_CONTENTS_INLINE);
     VkViewport viewport = {0, 0, float(p.extent.width), float(p.extent.height), 0, 1};
     VkRect2D scissor = {{0, 0}, p.extent};
     vkCmdSetViewport(p.cmd, 0, 1, &viewport);
@@ -871,19 +980,18 @@ void drawMesh(Presenter& p, const MeshView& view) {
                        {up.x, up.y, up.z, 0},
                        {rc.forward.x, rc.forward.y, rc.forward.z, view.wireframe ? 1.0f : 0.0f},
                        {0.05f, 0.05f, 0.05f, 1.0f}};
-    vkCmdBindPipeline(p.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p.meshPipeline);
+    vkCmdBindPipeline(p.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p.meshPipelines[view.closed]);
     vkCmdBindDescriptorSets(p.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p.meshLayout, 0, 1,
                             &p.meshSet, 0, nullptr);
     vkCmdPushConstants(p.cmd, p.meshLayout,
                        VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof c, &c);
-    if (p.timestamps)
-        vkCmdWriteTimestamp(p.cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, p.timestamps, 0);
     if (view.wireframe) {
         vkCmdDraw(p.cmd, p.indexCount, 1, 0, 0);
     } else {
         vkCmdBindIndexBuffer(p.cmd, p.meshBuffer, p.indexOffset, VK_INDEX_TYPE_UINT32);
         vkCmdDrawIndexed(p.cmd, p.indexCount, 1, 0, 0, 0);
     }
+    vkCmdEndRenderPass(p.cmd);
     if (p.timestamps)
         vkCmdWriteTimestamp(p.cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, p.timestamps, 1);
 }
@@ -908,7 +1016,16 @@ bool drawFrame(Presenter& p, ImDrawData* ui, const float background[3], const Me
     begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
     VK_CHECK(vkBeginCommandBuffer(p.cmd, &begin));
     const bool drawsMesh = mesh && p.indexCount > 0;
-    if (drawsMesh && p.timestamps) vkCmdResetQueryPool(p.cmd, p.timestamps, 0, 2);
+    bool meshDrawn = false; // this frame
+    if (drawsMesh) {
+        ensureMeshTarget(p);
+        std::vector<float> key = meshKey(*mesh, background);
+        if (!p.meshDrawn || key != p.drawnKey) {
+            drawMesh(p, *mesh, background);
+            p.drawnKey = std::move(key);
+            p.meshDrawn = meshDrawn = true;
+        }
+    }
     if (p.sceneDirty) {
         barrier(p.cmd, p.sceneImage, VK_IMAGE_LAYOUT_UNDEFINED,
                 VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0, VK_ACCESS_TRANSFER_WRITE_BIT,
@@ -930,20 +1047,24 @@ bool drawFrame(Presenter& p, ImDrawData* ui, const float background[3], const Me
     VkClearColorValue clear = {{background[0], background[1], background[2], 1.0f}};
     VkImageSubresourceRange range = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
     vkCmdClearColorImage(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &clear, 1, &range);
-    if (p.hasScene && !drawsMesh) {
+    if (p.hasScene || drawsMesh) {
         // The engine renders at the window's aspect ratio, at full or reduced size; stretching
-        // fills the window either way. Same size: a plain copy of every pixel.
+        // fills the window either way. Same size (always so for the mesh): a plain copy of
+        // every pixel.
+        const VkImage source = drawsMesh ? p.meshColor.image : p.sceneImage;
+        const uint32_t width = drawsMesh ? p.meshExtent.width : p.sceneWidth;
+        const uint32_t height = drawsMesh ? p.meshExtent.height : p.sceneHeight;
         barrier(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                 VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
                 VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
                 VK_PIPELINE_STAGE_TRANSFER_BIT);
         VkImageBlit blit = {};
         blit.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-        blit.srcOffsets[1] = {int32_t(p.sceneWidth), int32_t(p.sceneHeight), 1};
+        blit.srcOffsets[1] = {int32_t(width), int32_t(height), 1};
         blit.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
         blit.dstOffsets[1] = {int32_t(p.extent.width), int32_t(p.extent.height), 1};
-        bool same = p.sceneWidth == p.extent.width && p.sceneHeight == p.extent.height;
-        vkCmdBlitImage(p.cmd, p.sceneImage, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, target,
+        bool same = width == p.extent.width && height == p.extent.height;
+        vkCmdBlitImage(p.cmd, source, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, target,
                        VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &blit,
                        same ? VK_FILTER_NEAREST : VK_FILTER_LINEAR);
     }
@@ -955,12 +1076,7 @@ bool drawFrame(Presenter& p, ImDrawData* ui, const float background[3], const Me
     pass.renderPass = p.renderPass;
     pass.framebuffer = p.framebuffers[index];
     pass.renderArea.extent = p.extent;
-    VkClearValue clears[2] = {};
-    clears[1].depthStencil = {0.0f, 0}; // reversed depth: 0 is infinitely far
-    pass.clearValueCount = 2;
-    pass.pClearValues = clears;
     vkCmdBeginRenderPass(p.cmd, &pass, VK_SUBPASS_CONTENTS_INLINE);
-    if (drawsMesh) drawMesh(p, *mesh);
     if (ui) ImGui_ImplVulkan_RenderDrawData(ui, p.cmd);
     vkCmdEndRenderPass(p.cmd);
     bool capturing = capture && p.canCapture;
@@ -1014,8 +1130,8 @@ bool drawFrame(Presenter& p, ImDrawData* ui, const float background[3], const Me
     // One frame in flight: the image takes ~ms to draw, the engine's render is the slow part.
     VK_CHECK(vkWaitForFences(p.device, 1, &p.fence, VK_TRUE, UINT64_MAX));
     VK_CHECK(vkResetFences(p.device, 1, &p.fence));
-    p.meshMs = -1.0;
-    if (drawsMesh && p.timestamps) {
+    if (meshDrawn) p.meshMs = -1.0;
+    if (meshDrawn && p.timestamps) {
         uint64_t ticks[2];
         VK_CHECK(vkGetQueryPoolResults(p.device, p.timestamps, 0, 2, sizeof ticks, ticks,
                                        sizeof(uint64_t),

@@ -41,17 +41,19 @@ bool setMesh(Presenter& presenter, const Mesh& mesh, std::string& error);
 struct MeshView {
     Camera camera; // as for the ray marcher: the mesh lies where the ray-marched surface is
     bool wireframe = false; // edges of constant width in pixels over the shaded surface
+    bool closed = false;    // no bounds cut the surface: back faces never show, skip them
 };
 
 // Draws a frame: the background colour, then the image scaled to fill the window, or with `mesh`
-// set the mesh instead of the image, then ImGui. With `capture` set, the finished frame is read
+// set the mesh instead of the image (drawn again only when the view or the size changed), then
+// ImGui. With `capture` set, the finished frame is read
 // back into it (RGBA). False when the window cannot be drawn right now (minimised); the
 // swapchain follows size changes by itself.
 bool drawFrame(Presenter& presenter, ImDrawData* ui, const float background[3],
                const MeshView* mesh, Image* capture);
 
-// The device time of the last frame's mesh draw in milliseconds, from timestamps; negative when
-// that frame drew no mesh or the queue has no timestamps.
+// The device time of the last drawing of the mesh in milliseconds, from timestamps; negative
+// before the first or when the queue has no timestamps.
 double meshDrawMilliseconds(const Presenter& presenter);
 
 std::string presenterDeviceName(const Presenter& presenter);
