@@ -143,6 +143,7 @@ Options:
   --no-shadows          disable soft shadows
   --no-ao               disable ambient occlusion
   --boxes all|none      overlay every node's bounding box
+  --grid                a ground grid under the solid (lines a power of ten apart)
   --skip, --no-skip     force bounds skipping on or off (default: on for GPUs, off for
                         CPU devices, where it only adds work; the image is the same)
   --device NAME         Vulkan device: index or part of its name (also SDFCSG_DEVICE)
@@ -177,7 +178,8 @@ int cmdRender(int argc, char** argv) {
     Args args("render", argc, argv,
               {"-o", "--output", "--width", "--height", "--mode", "--eye", "--target", "--fov",
                "--aa", "--boxes", "--device"},
-              {"--no-shadows", "--no-ao", "--skip", "--no-skip", "--validation", "--help", "-h"});
+              {"--no-shadows", "--no-ao", "--grid", "--skip", "--no-skip", "--validation", "--help",
+               "-h"});
     if (args.has("--help") || args.has("-h")) return std::fputs(kRenderHelp, stdout), kOk;
     if (!args.error.empty()) return usageError("render", args.error);
     if (args.positional.size() != 1) return usageError("render", "expected one SCENE file");
@@ -205,6 +207,7 @@ int cmdRender(int argc, char** argv) {
     }
     options.shadows = !args.has("--no-shadows");
     options.ambientOcclusion = !args.has("--no-ao");
+    options.grid = args.has("--grid");
     if (args.has("--skip")) options.boundsSkipping = true;
     if (args.has("--no-skip")) options.boundsSkipping = false;
 

@@ -7,9 +7,12 @@
 //            the host fills the rest of the band with the colour of a miss;
 //   shade:   one invocation per listed hit (an indirect dispatch): normal, occlusion, shadows
 //            and lighting;
-//   resolve: with several samples per pixel, one invocation per pixel averages them.
+//   resolve: with several samples per pixel, one invocation per pixel averages them;
+//   overlay: with the ground grid or the box overlay on, one invocation per pixel draws them.
 // CPU drivers such as lavapipe run invocations in SIMD lanes and execute every branch that any
 // lane takes; split this way, misses never pay for shading and every shading lane has a hit.
+// Each pass is its own pipeline (kPass), and the driver compiles only the code its pass reaches:
+// the overlays, used by the viewer, cost the march and shade kernels nothing.
 //
 // Rays are generated and clipped exactly as engine/src/camera.h does on the CPU (the tests trace
 // the same rays with the reference evaluator). Normals use the four-tap tetrahedral difference
@@ -48,6 +51,7 @@ layout(std140, set = 0, binding = SDFCSG_BINDING_FRAME) uniform Frame {
     uvec4 surfaceBoxCount; // x: regions that hold every surface (0: use the clip box alone)
     // Pairs: a box (min, w = 0; max), or a half-space dot(p, n) < offset (n, w = 1; offset, ...).
     vec4 surfaceBoxes[2 * SDFCSG_MAX_CLIP_BOXES];
+    vec4 grid; // ground grid: xy: centre (x, z); z: height of its plane; w: line spacing
 } frame;
 
 // The band this dispatch computes (engine/src/render.cpp): its first pixel row, and where its
@@ -57,11 +61,12 @@ layout(push_constant) uniform Band {
     uint colorOffset;
 } band;
 
-layout(std430, set = 0, binding = SDFCSG_BINDING_PIXELS) writeonly buffer Pixels {
+layout(std430, set = 0, binding = SDFCSG_BINDING_PIXELS) buffer Pixels {
     uint pixels[];
 };
 
-layout(std430, set = 0, binding = SDFCSG_BINDING_INFO) writeonly buffer Info {
+// Per pixel, from its first sample: x: ray parameter of the hit (negative: a miss), y: steps.
+layout(std430, set = 0, binding = SDFCSG_BINDING_INFO) buffer Info {
     vec2 info[];
 };
 
@@ -379,6 +384,25 @@ vec4 boxOverlay(vec3 ro, vec3 rd, float tHit) {
     return result;
 }
 
+// How much of the sample the ground grid covers where the ray meets the grid's plane in front
+// of the hit (tHit < 0: a miss): lines frame.grid.w apart, 2 SDFCSG_GRID_HALF_LINES + 1 each
+// way, about a pixel wide, fading out where a pixel spans so much of the spacing that they
+// would alias.
+float gridCoverage(vec3 ro, vec3 rd, float tHit) {
+    float spacing = frame.grid.w;
+    float tPlane = (frame.grid.z - ro.y) / (abs(rd.y) < 1.0e-20 ? 1.0e-20 : rd.y);
+    if (tPlane <= 0.0 || (tHit >= 0.0 && tPlane > tHit) || tPlane > frame.clipMin.w) return 0.0;
+    vec2 q = (ro.xz + rd.xz * tPlane - frame.grid.xy) / spacing; // in spacings from the centre
+    if (any(greaterThan(abs(q), vec2(float(SDFCSG_GRID_HALF_LINES) + 0.5)))) return 0.0;
+    vec2 toLine = abs(q - round(q));
+    float width = tPlane * frame.up.w / spacing; // a pixel, in spacings, across the ray
+    float along = width / max(abs(rd.y), 0.05);  // ... and along it, where the plane tilts away
+    float line = 1.0 - smoothstep(0.5 * width, 1.5 * width, min(toLine.x, toLine.y));
+    bool axis = (abs(round(q.x)) < 0.5 && toLine.x <= toLine.y) ||
+                (abs(round(q.y)) < 0.5 && toLine.y <= toLine.x);
+    return line * (axis ? 0.7 : 0.4) * (1.0 - smoothstep(0.1, 0.3, along));
+}
+
 uint packColor(vec3 c) {
     uvec3 u = uvec3(clamp(c, 0.0, 1.0) * 255.0 + 0.5);
     return u.r | (u.g << 8) | (u.b << 16) | (255u << 24);
@@ -397,14 +421,6 @@ void sampleRay(uint sampleIndex, out uvec2 pixel, out vec3 rd) {
     rd = rayDirection(vec2(pixel) + offset);
 }
 
-// The sample's final colour: the box overlay drawn over it.
-uint finish(vec3 c, vec3 ro, vec3 rd, float t) {
-    if ((frame.size.w & (SDFCSG_FLAG_BOXES_ALL | SDFCSG_FLAG_BOXES_SELECTED)) != 0u) {
-        vec4 o = boxOverlay(ro, rd, t);
-        c = mix(c, o.rgb, o.a);
-    }
-    return packColor(c);
-}
 
 void marchPass() {
     uint aa = max(frame.counts.x, 1u);
@@ -423,7 +439,7 @@ void marchPass() {
         if (slot % (SDFCSG_RAYMARCH_GROUP_X * SDFCSG_RAYMARCH_GROUP_Y) == 0u) atomicAdd(groups, 1u);
         hits[slot] = uvec2(sampleIndex, floatBitsToUint(r.t));
     } else {
-        colors[band.colorOffset + sampleIndex] = finish(plainColor(r), ro, rd, r.t);
+        colors[band.colorOffset + sampleIndex] = packColor(plainColor(r));
     }
 }
 
@@ -438,7 +454,7 @@ void shadePass() {
     vec3 ro = frame.eye.xyz;
     Trace r = Trace(uintBitsToFloat(hit.y), 0u, vec3(0.0), 1.0, vec4(1.0));
     surface(ro, rd, r);
-    colors[band.colorOffset + hit.x] = finish(shade(ro, rd, r), ro, rd, r.t);
+    colors[band.colorOffset + hit.x] = packColor(shade(ro, rd, r));
 }
 
 void resolvePass() {
@@ -454,8 +470,26 @@ void resolvePass() {
     pixels[pixel.y * frame.size.x + pixel.x] = packColor(sum / float(aa * aa));
 }
 
+// The ground grid and the box edges over each pixel of the band, along the ray through the
+// pixel's centre and hidden behind its first sample's hit.
+void overlayPass() {
+    uvec2 pixel = gl_GlobalInvocationID.xy + uvec2(0u, band.firstRow);
+    if (any(greaterThanEqual(pixel, frame.size.xy))) return;
+    uint i = pixel.y * frame.size.x + pixel.x;
+    vec3 ro = frame.eye.xyz, rd = rayDirection(vec2(pixel) + 0.5);
+    float t = info[i].x;
+    vec3 c = unpackColor(pixels[i]);
+    if ((frame.size.w & SDFCSG_FLAG_GRID) != 0u) c = mix(c, vec3(0.12), gridCoverage(ro, rd, t));
+    if ((frame.size.w & (SDFCSG_FLAG_BOXES_ALL | SDFCSG_FLAG_BOXES_SELECTED)) != 0u) {
+        vec4 o = boxOverlay(ro, rd, t);
+        c = mix(c, o.rgb, o.a);
+    }
+    pixels[i] = packColor(c);
+}
+
 void main() {
     if (kPass == SDFCSG_RAYMARCH_PASS_MARCH) marchPass();
     else if (kPass == SDFCSG_RAYMARCH_PASS_SHADE) shadePass();
-    else resolvePass();
+    else if (kPass == SDFCSG_RAYMARCH_PASS_RESOLVE) resolvePass();
+    else overlayPass();
 }

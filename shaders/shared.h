@@ -65,6 +65,8 @@
 #define SDFCSG_FLAG_AO 2
 #define SDFCSG_FLAG_BOXES_ALL 4
 #define SDFCSG_FLAG_BOXES_SELECTED 8
+#define SDFCSG_FLAG_GRID 16
+#define SDFCSG_GRID_HALF_LINES 10 // ground grid lines on each side of the middle ones
 
 // Bounds that are infinite (planes) are stored as +-SDFCSG_HUGE to keep arithmetic finite.
 #define SDFCSG_HUGE 1.0e30
@@ -78,6 +80,7 @@
 #define SDFCSG_RAYMARCH_PASS_MARCH 0
 #define SDFCSG_RAYMARCH_PASS_SHADE 1
 #define SDFCSG_RAYMARCH_PASS_RESOLVE 2
+#define SDFCSG_RAYMARCH_PASS_OVERLAY 3
 
 #define SDFCSG_MESH_PASS_CULL 0
 #define SDFCSG_MESH_PASS_CLASSIFY 1

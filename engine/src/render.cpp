@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstring>
 #include <string>
 #include <thread>
@@ -41,9 +42,10 @@ struct FrameUniform {
     FrameLight lights[SDFCSG_MAX_LIGHTS];
     glm::uvec4 surfaceBoxCount; // x
     glm::vec4 surfaceBoxes[2 * SDFCSG_MAX_CLIP_BOXES]; // surface parts, as in raymarch.comp
+    glm::vec4 grid; // centre x, z; plane height; spacing
 };
 static_assert(sizeof(FrameUniform) ==
-              12 * 16 + SDFCSG_MAX_LIGHTS * 48 + SDFCSG_MAX_CLIP_BOXES * 32);
+              13 * 16 + SDFCSG_MAX_LIGHTS * 48 + SDFCSG_MAX_CLIP_BOXES * 32);
 static_assert(SDFCSG_MAX_LIGHTS == 4, "raymarch.comp reads the lights into four locals");
 
 constexpr detail::Binding kBindings[] = {
@@ -93,7 +95,7 @@ struct Renderer::Impl {
     VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
     VkPipelineLayout pipelineLayout = VK_NULL_HANDLE;
     // [pass][bounds skipping], made on first use; the resolve pass does not evaluate the scene.
-    VkPipeline pipelines[3][2] = {};
+    VkPipeline pipelines[4][2] = {};
     VkDescriptorPool pool = VK_NULL_HANDLE;
     VkDescriptorSet set = VK_NULL_HANDLE;
 
@@ -154,7 +156,8 @@ struct Renderer::Impl {
 
     // The pipeline of a pass and skipping choice, created and warmed up on first use.
     VkPipeline pipeline(uint32_t pass, bool skipping) {
-        if (pass == SDFCSG_RAYMARCH_PASS_RESOLVE) skipping = false;
+        if (pass == SDFCSG_RAYMARCH_PASS_RESOLVE || pass == SDFCSG_RAYMARCH_PASS_OVERLAY)
+            skipping = false; // no scene evaluation
         VkPipeline& p = pipelines[pass][skipping ? 1 : 0];
         if (!p) {
             p = createPass(pass, skipping);
@@ -319,6 +322,11 @@ struct Renderer::Impl {
         if (render.ambientOcclusion) flags |= SDFCSG_FLAG_AO;
         if (render.boxes == BoxOverlay::All) flags |= SDFCSG_FLAG_BOXES_ALL;
         if (render.boxes == BoxOverlay::Selected) flags |= SDFCSG_FLAG_BOXES_SELECTED;
+        if (render.grid) {
+            flags |= SDFCSG_FLAG_GRID;
+            const GroundGrid g = groundGrid(*evaluator);
+            f.grid = glm::vec4(g.centreX, g.centreZ, g.height, g.spacing);
+        }
         f.size = glm::uvec4(render.width, render.height, uint32_t(render.mode), flags);
 
         std::vector<Light> lights = scene.lights.empty() ? defaultLights() : scene.lights;
@@ -336,6 +344,18 @@ struct Renderer::Impl {
         return f;
     }
 };
+
+GroundGrid groundGrid(const Evaluator& evaluator) {
+    const Aabb box = detail::finiteSceneBounds(evaluator);
+    const float width = std::max(box.max.x - box.min.x, box.max.z - box.min.z);
+    GroundGrid g;
+    g.spacing = std::pow(10.0f, std::floor(std::log10(std::max(width, 1e-3f) / 2.0f)));
+    g.centreX = std::round(0.5f * (box.min.x + box.max.x) / g.spacing) * g.spacing;
+    g.centreZ = std::round(0.5f * (box.min.z + box.max.z) / g.spacing) * g.spacing;
+    g.height = box.min.y;
+    g.halfLines = SDFCSG_GRID_HALF_LINES;
+    return g;
+}
 
 std::optional<RenderMode> parseRenderMode(std::string_view name) {
     if (name == "shaded") return RenderMode::Shaded;
@@ -451,17 +471,19 @@ Result<Image> Renderer::render(const RenderOptions& options) {
     VkPipeline march = r.pipeline(SDFCSG_RAYMARCH_PASS_MARCH, skipping);
     VkPipeline shade = shading ? r.pipeline(SDFCSG_RAYMARCH_PASS_SHADE, skipping) : VK_NULL_HANDLE;
     VkPipeline resolve = aa > 1 ? r.pipeline(SDFCSG_RAYMARCH_PASS_RESOLVE, false) : VK_NULL_HANDLE;
+    VkPipeline overlay = options.grid || options.boxes != BoxOverlay::None
+                             ? r.pipeline(SDFCSG_RAYMARCH_PASS_OVERLAY, false)
+                             : VK_NULL_HANDLE;
     const detail::RayCamera rc = detail::makeRayCamera(camera, options.width, options.height);
     const detail::ClipVolume clip = detail::makeClipVolume(*r.evaluator, rc.eye);
     FrameUniform f = r.frameUniform(options, rc, clip);
     detail::uploadBuffer(r.ctx, r.frame, &f, sizeof(f));
 
     // Workgroups whose rays cannot meet a surface are not marched; the band is filled with the
-    // colour and info of a miss first (t = -1; the steps word too, read back as 0). The box
-    // overlay draws outside the surfaces and the steps mode colours misses by their steps,
-    // so those trace every ray.
+    // colour and info of a miss first (t = -1; the steps word too, read back as 0). The steps
+    // mode colours misses by their steps, so it traces every ray.
     std::vector<detail::ScreenRect> rects;
-    const bool culling = options.boxes == BoxOverlay::None && options.mode != RenderMode::Steps &&
+    const bool culling = options.mode != RenderMode::Steps &&
                          detail::surfaceRects(rc, clip, options.width, options.height, rects);
     auto packed = [](glm::vec3 c) {
         glm::uvec3 u(glm::clamp(c, 0.0f, 1.0f) * 255.0f + 0.5f);
@@ -519,9 +541,11 @@ Result<Image> Renderer::render(const RenderOptions& options) {
             vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, shade);
             vkCmdDispatchIndirect(cmd, r.hits.buffer, 4);
         }
-        if (resolve) {
+        // One invocation per pixel of the band each.
+        for (VkPipeline perPixel : {resolve, overlay}) {
+            if (!perPixel) continue;
             detail::recordComputeBarrier(cmd);
-            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, resolve);
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, perPixel);
             vkCmdDispatch(cmd, detail::groupCount(options.width, SDFCSG_RAYMARCH_GROUP_X), groups,
                           1);
         }

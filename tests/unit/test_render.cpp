@@ -401,6 +401,58 @@ TEST_F(Render, BoxOverlayDrawsEdges) {
     EXPECT_EQ(bad.error().kind, ErrorKind::Usage);
 }
 
+// The grid lies on its plane under the solid, only where that plane is nearer than the surface,
+// within its lines' extent and near a line; it darkens what it covers.
+TEST_F(Render, GroundGridLiesOnItsPlaneInFrontOfSurfaces) {
+    auto scene = parseScene(R"({"version": 1, "background": [0.9, 0.9, 0.9],
+        "root": {"type": "union", "children": [
+            {"type": "sphere", "radius": 1},
+            {"type": "box", "size": [0.5, 0.5, 0.5], "translate": [1.0, -0.5, 0]}]}})");
+    ASSERT_TRUE(scene) << scene.error().str();
+    auto renderer = Renderer::create(context(), *scene);
+    ASSERT_TRUE(renderer) << renderer.error().str();
+    RenderOptions options;
+    options.width = 160, options.height = 120;
+    options.camera = Camera{glm::vec3(1.0f, 2.0f, 5.0f), glm::vec3(0.5f, -0.5f, 0.0f)};
+    auto plain = (*renderer)->render(options);
+    ASSERT_TRUE(plain);
+    const std::vector<PixelInfo> info = (*renderer)->lastPixelInfo();
+    options.grid = true;
+    auto grid = (*renderer)->render(options);
+    ASSERT_TRUE(grid);
+
+    const GroundGrid g = groundGrid(Evaluator(*scene));
+    EXPECT_NEAR(g.height, -1.0f, 1e-3f); // the sphere's bottom and the box's
+    EXPECT_FLOAT_EQ(g.spacing, 1.0f); // the solid is about 2.5 wide
+    EXPECT_FLOAT_EQ(g.centreX, 0.0f); // its middle, rounded to the spacing
+    const detail::RayCamera rc = detail::makeRayCamera(*options.camera, 160, 120);
+    size_t changed = 0, onLines = 0;
+    for (uint32_t y = 0; y < 120; ++y)
+        for (uint32_t x = 0; x < 160; ++x) {
+            const size_t i = y * 160 + x;
+            glm::vec3 dir = detail::rayDirection(rc, x + 0.5f, y + 0.5f, 160, 120);
+            float tPlane = (g.height - rc.eye.y) / dir.y;
+            glm::vec3 p = rc.eye + dir * tPlane;
+            glm::vec2 q = (glm::vec2(p.x, p.z) - glm::vec2(g.centreX, g.centreZ)) / g.spacing;
+            glm::vec2 toLine = glm::abs(q - glm::round(q)) * g.spacing;
+            float pixelWidth = tPlane * rc.footprint;
+            bool inFront = tPlane > 0 && (info[i].depth < 0 || tPlane <= info[i].depth * 1.001f);
+            bool inside = std::max(std::abs(q.x), std::abs(q.y)) <= g.halfLines + 0.5f;
+            bool nearLine = std::min(toLine.x, toLine.y) < 2.0f * pixelWidth / std::abs(dir.y);
+            bool differs = pixel(*grid, i) != pixel(*plain, i);
+            changed += differs;
+            if (differs) {
+                ASSERT_TRUE(inFront && inside && nearLine) << "pixel " << x << ", " << y;
+                glm::vec3 a = pixel(*plain, i), b = pixel(*grid, i);
+                ASSERT_LE(b.r + b.g + b.b, a.r + a.g + a.b) << "pixel " << x << ", " << y;
+            }
+            onLines += inFront && inside && std::min(toLine.x, toLine.y) < 0.25f * pixelWidth &&
+                       std::abs(dir.y) > 0.3f;
+        }
+    EXPECT_GT(onLines, 100u);
+    EXPECT_GT(changed, onLines / 2);
+}
+
 // Grows the first sphere found; returns false if the scene has none.
 bool growFirstSphere(Scene& scene) {
     for (Node& node : scene.nodes)

@@ -20,6 +20,17 @@ std::optional<RenderMode> parseRenderMode(std::string_view name);
 
 enum class BoxOverlay : uint32_t { None, All, Selected };
 
+class Evaluator;
+
+// The ground grid that RenderOptions::grid draws, on the plane under the solid's finite bounds.
+struct GroundGrid {
+    float centreX = 0.0f, centreZ = 0.0f; // where the middle lines cross
+    float height = 0.0f;                  // y of the plane: the bottom of the bounds
+    float spacing = 1.0f; // a power of ten, from a twentieth to a half of the bounds' width
+    int halfLines = 0;    // lines on each side of the middle ones
+};
+GroundGrid groundGrid(const Evaluator& evaluator);
+
 struct RenderOptions {
     uint32_t width = 800, height = 600;
     RenderMode mode = RenderMode::Shaded;
@@ -33,6 +44,7 @@ struct RenderOptions {
     std::optional<bool> boundsSkipping;
     BoxOverlay boxes = BoxOverlay::None;
     int selectedNode = -1;        // for BoxOverlay::Selected
+    bool grid = false;            // ground grid (groundGrid()), hidden behind surfaces
     // The image is computed in bands of rows, one submission each, so no single dispatch runs
     // for long. Called after each band with the fraction done; returning false stops the
     // render (ErrorKind::Cancelled).
