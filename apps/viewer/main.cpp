@@ -121,7 +121,7 @@ struct ViewKey {
     uint64_t sceneVersion = 0;
     Camera camera;
     RenderMode mode = RenderMode::Shaded;
-    bool shadows = true, ao = true;
+    bool shadows = true, ao = true, grid = false;
     BoxOverlay boxes = BoxOverlay::None;
     int selected = -1;
     uint32_t width = 0, height = 0;
@@ -129,8 +129,9 @@ struct ViewKey {
     bool operator==(const ViewKey& o) const {
         return sceneVersion == o.sceneVersion && camera.eye == o.camera.eye &&
                camera.target == o.camera.target && camera.fov == o.camera.fov && mode == o.mode &&
-               shadows == o.shadows && ao == o.ao && boxes == o.boxes && selected == o.selected &&
-               width == o.width && height == o.height && mesh == o.mesh && wireframe == o.wireframe;
+               shadows == o.shadows && ao == o.ao && grid == o.grid && boxes == o.boxes &&
+               selected == o.selected && width == o.width && height == o.height &&
+               mesh == o.mesh && wireframe == o.wireframe;
     }
 };
 
@@ -371,6 +372,7 @@ ViewKey wantedKey(Viewer& v, bool full) {
     k.mode = v.mode;
     k.shadows = v.shadows;
     k.ao = v.ao;
+    k.grid = v.grid;
     k.boxes = v.boxes;
     k.selected = v.boxes == BoxOverlay::None ? -1 : v.selected;
     int w = 1, h = 1;
@@ -433,6 +435,7 @@ void updateImage(Viewer& v) {
     job.options.mode = want.mode;
     job.options.shadows = want.shadows;
     job.options.ambientOcclusion = want.ao;
+    job.options.grid = want.grid;
     job.options.boxes =
         want.selected < 0 && want.boxes == BoxOverlay::Selected ? BoxOverlay::None : want.boxes;
     job.options.selectedNode = want.selected;
@@ -450,12 +453,19 @@ bool settled(Viewer& v) {
 // ---- Input -----------------------------------------------------------------------------------
 
 void pick(Viewer& v, double x, double y) {
-    if (!v.last.scene || v.last.image.rgba.empty() || !v.evaluator || (v.meshView && v.mesh))
-        return;
     int w = 1, h = 1;
     glfwGetFramebufferSize(v.window, &w, &h);
     int ww = 1, wh = 1;
     glfwGetWindowSize(v.window, &ww, &wh);
+    if (v.meshView && v.mesh && v.evaluator) {
+        // The mesh view has no depths from the engine, but it shares the ray marcher's camera:
+        // the ray through the pixel meets the scene's surface where the mesh shows it.
+        auto p = castRay(*v.evaluator, toCamera(v.camera), uint32_t(w), uint32_t(h),
+                         float(x) * float(w) / float(ww), float(y) * float(h) / float(wh));
+        v.selected = p ? nearestPrimitive(*v.evaluator, *p) : -1;
+        return;
+    }
+    if (!v.last.scene || v.last.image.rgba.empty() || !v.evaluator) return;
     // Window coordinates -> image pixels (the image fills the window).
     float ix = float(x) * float(w) / float(ww) * float(v.last.image.width) / float(w);
     float iy = float(y) * float(h) / float(wh) * float(v.last.image.height) / float(h);
@@ -546,56 +556,6 @@ void handleInput(Viewer& v) {
     if (hit(GLFW_KEY_M) && v.mesh) v.meshView = !v.meshView;
     if (hit(GLFW_KEY_B)) v.boxes = BoxOverlay((uint32_t(v.boxes) + 1) % 3);
     if (hit(GLFW_KEY_ESCAPE)) v.selected = -1;
-}
-
-// ---- Overlays --------------------------------------------------------------------------------
-
-// A ground grid under the finite part of the scene, drawn over the image (not depth-tested).
-void drawGrid(Viewer& v) {
-    if (!v.grid || !v.evaluator) return;
-    Aabb box;
-    for (const FlatNode& n : v.evaluator->nodes())
-        if (!kindInfo(n.kind).operation && n.bounds.finite() && !n.bounds.empty())
-            box.min = glm::min(box.min, n.bounds.min), box.max = glm::max(box.max, n.bounds.max);
-    if (box.empty()) return;
-    float extent = std::max(box.max.x - box.min.x, box.max.z - box.min.z);
-    float spacing = std::pow(10.0f, std::floor(std::log10(std::max(extent, 1e-3f) / 2.0f)));
-    int lines = 20;
-    glm::vec3 c = 0.5f * (box.min + box.max);
-    float y = box.min.y;
-    c.x = std::round(c.x / spacing) * spacing, c.z = std::round(c.z / spacing) * spacing;
-    Camera cam = toCamera(v.camera);
-    ImVec2 size = ImGui::GetIO().DisplaySize;
-    glm::vec3 f = glm::normalize(cam.target - cam.eye);
-    glm::vec3 r = glm::normalize(glm::cross(f, cam.up));
-    glm::vec3 u = glm::cross(r, f);
-    float t = std::tan(glm::radians(cam.fov) * 0.5f), aspect = size.x / size.y;
-    auto project = [&](glm::vec3 p, ImVec2& out) {
-        glm::vec3 d = p - cam.eye;
-        float z = glm::dot(d, f);
-        if (z < 1e-3f) return false;
-        out = ImVec2((glm::dot(d, r) / (z * t * aspect) + 1.0f) * 0.5f * size.x,
-                     (1.0f - glm::dot(d, u) / (z * t)) * 0.5f * size.y);
-        return true;
-    };
-    ImDrawList* draw = ImGui::GetBackgroundDrawList();
-    float half = spacing * float(lines) / 2;
-    for (int i = 0; i <= lines; ++i) {
-        float o = -half + spacing * float(i);
-        ImU32 colour = i == lines / 2 ? IM_COL32(40, 40, 40, 160) : IM_COL32(60, 60, 60, 90);
-        // Short pieces, so lines that pass behind the eye still show their visible part.
-        for (int axis = 0; axis < 2; ++axis)
-            for (int s = 0; s < 20; ++s) {
-                float a = -half + 2 * half * float(s) / 20,
-                      b = -half + 2 * half * float(s + 1) / 20;
-                glm::vec3 p0 =
-                    axis ? glm::vec3(c.x + o, y, c.z + a) : glm::vec3(c.x + a, y, c.z + o);
-                glm::vec3 p1 =
-                    axis ? glm::vec3(c.x + o, y, c.z + b) : glm::vec3(c.x + b, y, c.z + o);
-                ImVec2 q0, q1;
-                if (project(p0, q0) && project(p1, q1)) draw->AddLine(q0, q1, colour);
-            }
-    }
 }
 
 // ---- Panels ----------------------------------------------------------------------------------
@@ -1124,7 +1084,6 @@ int main(int argc, char** argv) {
         handleInput(v);
         syncScene(v);
         if (v.showUi) panels(v);
-        drawGrid(v);
         ImGui::Render();
         syncScene(v);
         updateImage(v);
@@ -1141,6 +1100,7 @@ int main(int argc, char** argv) {
         meshView.camera = toCamera(v.camera);
         meshView.wireframe = v.wireframe;
         meshView.closed = !v.meshStats.surfaceCut;
+        if (v.grid && v.evaluator) meshView.grid = groundGrid(*v.evaluator);
         const bool drawsMesh = v.meshView && v.mesh;
         const double frameStart = now();
         bool drawn = drawFrame(*v.presenter, ImGui::GetDrawData(), bg,
@@ -1161,8 +1121,14 @@ int main(int argc, char** argv) {
                 v.exitCode = 3;
                 break;
             }
-            std::printf("wrote %s (%u x %u)\n", v.pendingShot.string().c_str(), capture.width,
-                        capture.height);
+            // With the mesh's device time, so scripts can time the mesh view.
+            if (drawsMesh && v.meshDrawMs >= 0.0)
+                std::printf("wrote %s (%u x %u), mesh drawn in %.1f ms\n",
+                            v.pendingShot.string().c_str(), capture.width, capture.height,
+                            v.meshDrawMs);
+            else
+                std::printf("wrote %s (%u x %u)\n", v.pendingShot.string().c_str(),
+                            capture.width, capture.height);
             v.pendingShot.clear();
             if (v.exitAfterShot) break;
         }

@@ -7,6 +7,7 @@
 #include <imgui_impl_vulkan.h>
 
 #include <algorithm>
+#include <cstddef>
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
@@ -18,7 +19,10 @@ namespace sdfcsg::viewer {
 
 namespace {
 
-// SPIR-V of shaders/mesh.vert and mesh.frag, compiled by glslangValidator during the build.
+// SPIR-V of shaders/mesh.vert, mesh.frag, grid.vert and grid.frag, compiled by
+// glslangValidator during the build.
+#include "grid_frag.h"
+#include "grid_vert.h"
 #include "mesh_frag.h"
 #include "mesh_vert.h"
 
@@ -96,17 +100,18 @@ struct Presenter {
     VkExtent2D meshExtent{};
     VkFramebuffer meshFramebuffer = VK_NULL_HANDLE;
     VkPhysicalDeviceLimits limits{};
-    VkDescriptorSetLayout meshSetLayout = VK_NULL_HANDLE;
     VkPipelineLayout meshLayout = VK_NULL_HANDLE;
     VkPipeline meshPipelines[2] = {}; // both sides, back faces culled
-    bool meshDrawn = false;            // meshColor holds the drawing described by drawnKey
+    VkPipeline gridPipeline = VK_NULL_HANDLE;
+    bool meshDrawn = false; // meshColor holds the drawing described by drawnKey
     std::vector<float> drawnKey;
-    VkDescriptorPool meshPool = VK_NULL_HANDLE;
-    VkDescriptorSet meshSet = VK_NULL_HANDLE;
-    // Positions, normals, colours and indices, one after the other in one device-local buffer.
+    // In one device-local buffer: the vertices (MeshVertex), the triangles' indices, and for the
+    // wireframe the triangles' corners (three MeshVertex per triangle). The corners triple the
+    // memory (about 140 bytes a triangle in all), but lavapipe draws them faster than the welded
+    // vertices' edges as lines (62 against 300 ms at 717k triangles).
     VkBuffer meshBuffer = VK_NULL_HANDLE;
     VkDeviceMemory meshMemory = VK_NULL_HANDLE;
-    VkDeviceSize indexOffset = 0;
+    VkDeviceSize indexOffset = 0, cornerOffset = 0;
     uint32_t indexCount = 0;
     VkQueryPool timestamps = VK_NULL_HANDLE; // none when the queue cannot time
     uint64_t timestampMask = 0;
@@ -115,8 +120,16 @@ struct Presenter {
 
 // The push constants of shaders/mesh_draw.glsl.
 struct MeshConstants {
-    float eye[4], right[4], up[4], forward[4], line[4];
+    float eye[4], right[4], up[4], forward[4], line[4], grid[4];
 };
+
+// One vertex of the mesh as the vertex shader's inputs read it: the engine's Mesh keeps the
+// three in arrays of their own, but one interleaved record reads a single cache line per
+// vertex where three arrays would read three.
+struct MeshVertex {
+    glm::vec3 position, normal, color;
+};
+static_assert(sizeof(MeshVertex) == 36, "the vertex input reads tightly packed floats");
 
 namespace {
 
@@ -364,39 +377,16 @@ VkShaderModule createShader(VkDevice device, const uint32_t* code, size_t bytes)
     return module;
 }
 
-// The mesh's pipeline, descriptor set and timestamp queries. No vertex input: the vertex shader
-// pulls the vertices from storage buffers, so one pipeline draws both the shaded view (indexed)
-// and the wireframe (three corners per triangle).
+// The mesh view's render pass, pipelines and timestamp queries. The mesh comes in through
+// fixed-function vertex input, one pipeline (per culling choice) for the shaded view and the
+// wireframe; the ground grid is a line list that its vertex shader makes from the vertex index.
 void createMeshPipeline(Presenter& p) {
-    VkDescriptorSetLayoutBinding bindings[4] = {};
-    for (uint32_t i = 0; i < 4; ++i)
-        bindings[i] = {i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_VERTEX_BIT,
-                       nullptr};
-    VkDescriptorSetLayoutCreateInfo setInfo = {
-        VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-    setInfo.bindingCount = 4;
-    setInfo.pBindings = bindings;
-    VK_CHECK(vkCreateDescriptorSetLayout(p.device, &setInfo, nullptr, &p.meshSetLayout));
     VkPushConstantRange push = {VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
                                 sizeof(MeshConstants)};
     VkPipelineLayoutCreateInfo layoutInfo = {VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-    layoutInfo.setLayoutCount = 1;
-    layoutInfo.pSetLayouts = &p.meshSetLayout;
     layoutInfo.pushConstantRangeCount = 1;
     layoutInfo.pPushConstantRanges = &push;
     VK_CHECK(vkCreatePipelineLayout(p.device, &layoutInfo, nullptr, &p.meshLayout));
-
-    VkDescriptorPoolSize poolSize = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 4};
-    VkDescriptorPoolCreateInfo poolInfo = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-    poolInfo.maxSets = 1;
-    poolInfo.poolSizeCount = 1;
-    poolInfo.pPoolSizes = &poolSize;
-    VK_CHECK(vkCreateDescriptorPool(p.device, &poolInfo, nullptr, &p.meshPool));
-    VkDescriptorSetAllocateInfo alloc = {VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-    alloc.descriptorPool = p.meshPool;
-    alloc.descriptorSetCount = 1;
-    alloc.pSetLayouts = &p.meshSetLayout;
-    VK_CHECK(vkAllocateDescriptorSets(p.device, &alloc, &p.meshSet));
 
     // Colour cleared to the background and left ready for the blit; depth cleared, never kept.
     p.depthFormat = chooseDepthFormat(p.physical);
@@ -452,6 +442,8 @@ void createMeshPipeline(Presenter& p) {
 
     VkShaderModule vert = createShader(p.device, kMeshVert, sizeof kMeshVert);
     VkShaderModule frag = createShader(p.device, kMeshFrag, sizeof kMeshFrag);
+    VkShaderModule gridVert = createShader(p.device, kGridVert, sizeof kGridVert);
+    VkShaderModule gridFrag = createShader(p.device, kGridFrag, sizeof kGridFrag);
     VkPipelineShaderStageCreateInfo stages[2] = {};
     stages[0] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
     stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
@@ -461,8 +453,18 @@ void createMeshPipeline(Presenter& p) {
     stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
     stages[1].module = frag;
     stages[1].pName = "main";
+    VkVertexInputBindingDescription binding = {0, sizeof(MeshVertex),
+                                               VK_VERTEX_INPUT_RATE_VERTEX};
+    VkVertexInputAttributeDescription attributes[3] = {
+        {0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(MeshVertex, position)},
+        {1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(MeshVertex, normal)},
+        {2, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(MeshVertex, color)}};
     VkPipelineVertexInputStateCreateInfo vertexInput = {
         VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+    vertexInput.vertexBindingDescriptionCount = 1;
+    vertexInput.pVertexBindingDescriptions = &binding;
+    vertexInput.vertexAttributeDescriptionCount = 3;
+    vertexInput.pVertexAttributeDescriptions = attributes;
     VkPipelineInputAssemblyStateCreateInfo assembly = {
         VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
     assembly.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
@@ -515,8 +517,26 @@ void createMeshPipeline(Presenter& p) {
         VK_CHECK(vkCreateGraphicsPipelines(p.device, VK_NULL_HANDLE, 1, &info, nullptr,
                                            &p.meshPipelines[cull]));
     }
-    vkDestroyShaderModule(p.device, vert, nullptr);
-    vkDestroyShaderModule(p.device, frag, nullptr);
+    // The grid: blended over the mesh, hidden behind it, writing no depth.
+    raster.cullMode = VK_CULL_MODE_NONE;
+    assembly.topology = VK_PRIMITIVE_TOPOLOGY_LINE_LIST;
+    depth.depthWriteEnable = VK_FALSE;
+    blendAttachment.blendEnable = VK_TRUE;
+    blendAttachment.srcColorBlendFactor = VK_BLEND_FACTOR_SRC_ALPHA;
+    blendAttachment.dstColorBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
+    blendAttachment.colorBlendOp = VK_BLEND_OP_ADD;
+    blendAttachment.srcAlphaBlendFactor = VK_BLEND_FACTOR_ZERO;
+    blendAttachment.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
+    blendAttachment.alphaBlendOp = VK_BLEND_OP_ADD;
+    VkPipelineVertexInputStateCreateInfo noInput = {
+        VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+    info.pVertexInputState = &noInput;
+    stages[0].module = gridVert;
+    stages[1].module = gridFrag;
+    VK_CHECK(
+        vkCreateGraphicsPipelines(p.device, VK_NULL_HANDLE, 1, &info, nullptr, &p.gridPipeline));
+    for (VkShaderModule m : {vert, frag, gridVert, gridFrag})
+        vkDestroyShaderModule(p.device, m, nullptr);
 
     uint32_t familyCount = 0;
     vkGetPhysicalDeviceQueueFamilyProperties(p.physical, &familyCount, nullptr);
@@ -805,10 +825,9 @@ void destroyPresenter(Presenter* p) {
         if (p->timestamps) vkDestroyQueryPool(p->device, p->timestamps, nullptr);
         for (VkPipeline pipeline : p->meshPipelines)
             vkDestroyPipeline(p->device, pipeline, nullptr);
+        vkDestroyPipeline(p->device, p->gridPipeline, nullptr);
         vkDestroyRenderPass(p->device, p->meshPass, nullptr);
         vkDestroyPipelineLayout(p->device, p->meshLayout, nullptr);
-        vkDestroyDescriptorPool(p->device, p->meshPool, nullptr);
-        vkDestroyDescriptorSetLayout(p->device, p->meshSetLayout, nullptr);
         if (p->swapchain) vkDestroySwapchainKHR(p->device, p->swapchain, nullptr);
         vkDestroySemaphore(p->device, p->acquired, nullptr);
         vkDestroySemaphore(p->device, p->rendered, nullptr);
@@ -844,16 +863,15 @@ bool setMesh(Presenter& p, const Mesh& mesh, std::string& error) {
     destroyMesh(p);
     p.meshDrawn = false;
     if (mesh.indices.empty() || mesh.positions.empty()) return true;
-    const VkDeviceSize align = std::max<VkDeviceSize>(p.limits.minStorageBufferOffsetAlignment, 4);
-    const VkDeviceSize vertexBytes = VkDeviceSize(mesh.vertexCount()) * sizeof(glm::vec3);
-    const VkDeviceSize indexBytes = VkDeviceSize(mesh.indices.size()) * sizeof(uint32_t);
-    const VkDeviceSize stride = (vertexBytes + align - 1) / align * align;
-    const VkDeviceSize total = 3 * stride + indexBytes;
-    if (std::max(vertexBytes, indexBytes) > p.limits.maxStorageBufferRange) {
-        error = "the mesh is too large to draw on " + p.deviceName + " (" +
-                std::to_string(std::max(vertexBytes, indexBytes) >> 20) + " MiB in one buffer)";
+    if (mesh.vertexCount() - 1 > p.limits.maxDrawIndexedIndexValue) {
+        error = "the mesh has too many vertices to draw on " + p.deviceName + " (" +
+                std::to_string(mesh.vertexCount()) + ")";
         return false;
     }
+    const VkDeviceSize vertexBytes = VkDeviceSize(mesh.vertexCount()) * sizeof(MeshVertex);
+    const VkDeviceSize indexBytes = VkDeviceSize(mesh.indices.size()) * sizeof(uint32_t);
+    const VkDeviceSize cornerBytes = VkDeviceSize(mesh.indices.size()) * sizeof(MeshVertex);
+    const VkDeviceSize total = vertexBytes + indexBytes + cornerBytes; // multiples of 4
     // Through a staging buffer into device-local memory: the mesh is read every frame, and on a
     // discrete GPU host-visible memory would be read across the bus each time.
     auto allocate = [&](VkBufferUsageFlags usage, VkMemoryPropertyFlags flags, VkBuffer& buffer,
@@ -883,36 +901,39 @@ bool setMesh(Presenter& p, const Mesh& mesh, std::string& error) {
     bool ok = allocate(VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                        VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
                        staging, stagingMemory) &&
-              allocate(VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDEX_BUFFER_BIT |
+              allocate(VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_INDEX_BUFFER_BIT |
                            VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                        VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, p.meshBuffer, p.meshMemory);
     if (ok) {
         void* mapped = nullptr;
         VK_CHECK(vkMapMemory(p.device, stagingMemory, 0, VK_WHOLE_SIZE, 0, &mapped));
         auto* bytes = static_cast<unsigned char*>(mapped);
-        std::memcpy(bytes, mesh.positions.data(), vertexBytes);
-        std::memcpy(bytes + stride, mesh.normals.data(), vertexBytes);
-        if (mesh.colors.size() == mesh.positions.size()) {
-            std::memcpy(bytes + 2 * stride, mesh.colors.data(), vertexBytes);
-        } else { // a mesh without colours is drawn light grey
-            std::vector<glm::vec3> grey(mesh.vertexCount(), glm::vec3(0.8f));
-            std::memcpy(bytes + 2 * stride, grey.data(), vertexBytes);
-        }
-        std::memcpy(bytes + 3 * stride, mesh.indices.data(), indexBytes);
+        // Written from the mesh, never read back: mapped memory may be uncached.
+        const bool coloured = mesh.colors.size() == mesh.positions.size();
+        auto vertex = [&](size_t i) { // a mesh without colours is light grey
+            return MeshVertex{mesh.positions[i], mesh.normals[i],
+                              coloured ? mesh.colors[i] : glm::vec3(0.8f)};
+        };
+        auto* vertices = reinterpret_cast<MeshVertex*>(bytes);
+        for (size_t i = 0; i < mesh.vertexCount(); ++i)
+            vertices[i] = vertex(i);
+        std::memcpy(bytes + vertexBytes, mesh.indices.data(), indexBytes);
+        auto* corners = reinterpret_cast<MeshVertex*>(bytes + vertexBytes + indexBytes);
+        for (size_t i = 0; i < mesh.indices.size(); ++i)
+            corners[i] = vertex(mesh.indices[i]);
         vkUnmapMemory(p.device, stagingMemory);
         submitNow(p, [&](VkCommandBuffer cmd) {
             VkBufferCopy region = {0, 0, total};
             vkCmdCopyBuffer(cmd, staging, p.meshBuffer, 1, &region);
             VkBufferMemoryBarrier b = {VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
             b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-            b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_INDEX_READ_BIT;
+            b.dstAccessMask = VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT | VK_ACCESS_INDEX_READ_BIT;
             b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
             b.buffer = p.meshBuffer;
             b.size = VK_WHOLE_SIZE;
             vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                                 VK_PIPELINE_STAGE_VERTEX_INPUT_BIT |
-                                     VK_PIPELINE_STAGE_VERTEX_SHADER_BIT,
-                                 0, 0, nullptr, 1, &b, 0, nullptr);
+                                 VK_PIPELINE_STAGE_VERTEX_INPUT_BIT, 0, 0, nullptr, 1, &b, 0,
+                                 nullptr);
         });
     }
     if (staging) vkDestroyBuffer(p.device, staging, nullptr);
@@ -921,22 +942,9 @@ bool setMesh(Presenter& p, const Mesh& mesh, std::string& error) {
         destroyMesh(p);
         return false;
     }
-    VkDescriptorBufferInfo ranges[4] = {{p.meshBuffer, 0, vertexBytes},
-                                        {p.meshBuffer, stride, vertexBytes},
-                                        {p.meshBuffer, 2 * stride, vertexBytes},
-                                        {p.meshBuffer, 3 * stride, indexBytes}};
-    VkWriteDescriptorSet writes[4] = {};
-    for (uint32_t i = 0; i < 4; ++i) {
-        writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-        writes[i].dstSet = p.meshSet;
-        writes[i].dstBinding = i;
-        writes[i].descriptorCount = 1;
-        writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-        writes[i].pBufferInfo = &ranges[i];
-    }
-    vkUpdateDescriptorSets(p.device, 4, writes, 0, nullptr);
-    p.indexOffset = 3 * stride;
+    p.indexOffset = vertexBytes;
     p.indexCount = uint32_t(mesh.indices.size());
+    p.cornerOffset = vertexBytes + indexBytes;
     return true;
 }
 
@@ -945,10 +953,12 @@ namespace {
 // What a drawing of the mesh depends on besides the mesh and the size.
 std::vector<float> meshKey(const MeshView& view, const float background[3]) {
     const Camera& c = view.camera;
+    const GroundGrid g = view.grid.value_or(GroundGrid{});
     return {c.eye.x,         c.eye.y,          c.eye.z,       c.target.x,    c.target.y,
             c.target.z,      c.up.x,           c.up.y,        c.up.z,        c.fov,
             background[0],   background[1],    background[2], float(view.wireframe),
-            float(view.closed)};
+            float(view.closed), float(view.grid.has_value()), g.centreX, g.centreZ, g.height,
+            g.spacing,       float(g.halfLines)};
 }
 
 // The mesh pass into meshColor, timed when the queue can.
@@ -975,21 +985,28 @@ void drawMesh(Presenter& p, const MeshView& view, const float background[3]) {
     // Reversed float depth is precise at any distance, so the near plane can sit very close.
     float nearPlane =
         std::max(1e-6f, 1e-4f * glm::length(view.camera.target - view.camera.eye));
+    const GroundGrid g = view.grid.value_or(GroundGrid{});
     MeshConstants c = {{rc.eye.x, rc.eye.y, rc.eye.z, nearPlane},
-                       {right.x, right.y, right.z, 0},
-                       {up.x, up.y, up.z, 0},
+                       {right.x, right.y, right.z, rc.footprint},
+                       {up.x, up.y, up.z, float(g.halfLines)},
                        {rc.forward.x, rc.forward.y, rc.forward.z, view.wireframe ? 1.0f : 0.0f},
-                       {0.05f, 0.05f, 0.05f, 1.0f}};
+                       {0.05f, 0.05f, 0.05f, 1.0f},
+                       {g.centreX, g.centreZ, g.height, g.spacing}};
+    const VkShaderStageFlags stages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
+    vkCmdPushConstants(p.cmd, p.meshLayout, stages, 0, sizeof c, &c);
     vkCmdBindPipeline(p.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p.meshPipelines[view.closed]);
-    vkCmdBindDescriptorSets(p.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p.meshLayout, 0, 1,
-                            &p.meshSet, 0, nullptr);
-    vkCmdPushConstants(p.cmd, p.meshLayout,
-                       VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof c, &c);
     if (view.wireframe) {
+        vkCmdBindVertexBuffers(p.cmd, 0, 1, &p.meshBuffer, &p.cornerOffset);
         vkCmdDraw(p.cmd, p.indexCount, 1, 0, 0);
     } else {
+        const VkDeviceSize start = 0;
+        vkCmdBindVertexBuffers(p.cmd, 0, 1, &p.meshBuffer, &start);
         vkCmdBindIndexBuffer(p.cmd, p.meshBuffer, p.indexOffset, VK_INDEX_TYPE_UINT32);
         vkCmdDrawIndexed(p.cmd, p.indexCount, 1, 0, 0, 0);
+    }
+    if (view.grid) { // two lines of two vertices each per step along each axis
+        vkCmdBindPipeline(p.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p.gridPipeline);
+        vkCmdDraw(p.cmd, 4 * uint32_t(2 * g.halfLines + 1), 1, 0, 0);
     }
     vkCmdEndRenderPass(p.cmd);
     if (p.timestamps)

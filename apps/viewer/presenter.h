@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 struct GLFWwindow;
@@ -33,15 +34,17 @@ void setImage(Presenter& presenter, const Image& image);
 
 // Copies a mesh to the device for the mesh view, replacing the previous one (an empty mesh
 // frees it). Waits for the device: call it once per extracted mesh, not per frame. False with a
-// message when the device cannot hold the mesh (memory, or a buffer beyond its storage-buffer
-// range); the previous mesh is gone then too.
+// message when the device cannot hold the mesh (memory, or more vertices than it can index); the
+// previous mesh is gone then too.
 bool setMesh(Presenter& presenter, const Mesh& mesh, std::string& error);
 
 // How the mesh view draws the mesh given to setMesh().
 struct MeshView {
     Camera camera; // as for the ray marcher: the mesh lies where the ray-marched surface is
-    bool wireframe = false; // edges of constant width in pixels over the shaded surface
+    bool wireframe = false; // one-pixel edges over the shaded surface
     bool closed = false;    // no bounds cut the surface: back faces never show, skip them
+    // The ray marcher's ground grid (RenderOptions::grid), hidden behind the mesh.
+    std::optional<GroundGrid> grid;
 };
 
 // Draws a frame: the background colour, then the image scaled to fill the window, or with `mesh`

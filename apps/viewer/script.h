@@ -11,6 +11,7 @@
 //   undo    redo
 //   save PATH                write the scene as JSON
 //   screenshot PATH          wait for the full-resolution image, then write the window as PNG
+//                            (in the mesh view the printed line gives the mesh's drawing time)
 //   generate TEXT...         ask the language model for a new scene described by TEXT, wait
 //                            for it, and make it the current scene (one undo step)
 //   edit-scene TEXT...       the same, sending the current scene to be changed as TEXT says

@@ -180,6 +180,22 @@ TEST(ViewerPicking, PointFromDepth) {
     EXPECT_FALSE(pickPoint(camera, 4, 4, pixels, 4.0f, 0.5f)); // outside
 }
 
+TEST(ViewerPicking, PointFromTracedRay) {
+    Scene scene = twoSpheres();
+    Evaluator evaluator(scene);
+    Camera camera;
+    camera.eye = {-1, 0, 5};
+    camera.target = {-1, 0, 0};
+    camera.fov = 45;
+    // The image's centre looks at the front of the left sphere (radius 0.5).
+    auto p = castRay(evaluator, camera, 64, 48, 32.0f, 24.0f);
+    ASSERT_TRUE(p);
+    expectNear(*p, {-1.0f, 0.0f, 0.5f}, 1e-3f);
+    EXPECT_EQ(nearestPrimitive(evaluator, *p), int(*findNode(scene, "left")));
+    EXPECT_FALSE(castRay(evaluator, camera, 64, 48, 1.0f, 1.0f)); // above the spheres: a miss
+    EXPECT_FALSE(castRay(evaluator, camera, 64, 48, 64.0f, 24.0f)); // outside
+}
+
 TEST(ViewerPicking, NearestPrimitiveIncludingCarvedFaces) {
     Scene scene = twoSpheres();
     Evaluator evaluator(scene);

@@ -23,6 +23,14 @@ run "$scene" --screenshot viewer.png --frames 3 --size 320x240 --no-ui || fail "
 "$cli" render "$scene" -o headless.png --width 320 --height 240 || fail "headless render"
 # Kernels with values inlined or read from a buffer may round differently by a step or two.
 "$diff" viewer.png headless.png same 6 0.002 || fail "viewer image differs from the headless render"
+# The ground grid is the renderer's own (RenderOptions::grid), so it matches `render --grid`.
+printf 'grid on\nscreenshot grid.png\n' > grid.txt
+run "$scene" --script grid.txt --size 320x240 --no-ui || fail "viewer grid screenshot"
+"$cli" render "$scene" -o headless-grid.png --width 320 --height 240 --grid ||
+    fail "headless render with the grid"
+"$diff" viewer.png grid.png differ 0.005 || fail "the grid changed nothing"
+"$diff" grid.png headless-grid.png same 6 0.002 ||
+    fail "viewer image with the grid differs from the headless render"
 
 # 2. A scripted session; every step must change the image, and undo must bring it back.
 cp "$src/assets/scenes/snowman.json" edit.json
@@ -64,13 +72,18 @@ grep -q "bad.txt:2:1: mode: expected one of shaded, normals, depth, steps, got \
     fail "unexpected message: $(cat bad.err)"
 # 4. Mesh mode: the extracted mesh, shaded and as a wireframe, covers the pixels the ray marcher
 # shows as the object (shading differs, the silhouette must not, up to the cells' size), the
-# export writes the file in the background, and the ray-marched view comes back unchanged.
+# ground grid is drawn in the mesh view too, the export writes the file in the background, and
+# the ray-marched view comes back unchanged.
 cat > mesh.txt <<'SCRIPT'
 screenshot m0-march.png
 mesh extract 128
 screenshot m1-mesh.png
 wireframe on
 screenshot m2-wire.png
+wireframe off
+grid on
+screenshot m4-grid.png
+grid off
 mesh export mesh.obj
 view march
 screenshot m3-march.png
@@ -79,6 +92,7 @@ run "$scene" --script mesh.txt --size 320x240 --no-ui || fail "scripted mesh ses
 "$diff" m0-march.png m1-mesh.png mask 3 0.98 || fail "the mesh's silhouette is not the scene's"
 "$diff" m0-march.png m2-wire.png mask 3 0.98 || fail "the wireframe's silhouette is not the scene's"
 "$diff" m1-mesh.png m2-wire.png differ 0.01 || fail "the wireframe shows no edges"
+"$diff" m1-mesh.png m4-grid.png differ 0.005 || fail "the mesh view shows no grid"
 "$diff" m3-march.png m0-march.png same 0 0 || fail "the ray-marched view did not come back"
 grep -q "^f " mesh.obj || fail "the exported mesh has no faces"
 printf 'view mesh\n' > no-mesh.txt
