@@ -7,7 +7,6 @@
 #include "orbit_camera.h"
 #include "picking.h"
 #include "presenter.h"
-#include "raster.h"
 #include "script.h"
 #include "workers.h"
 
@@ -123,7 +122,7 @@ struct ViewKey {
     uint64_t sceneVersion = 0;
     Camera camera;
     RenderMode mode = RenderMode::Shaded;
-    bool shadows = true, ao = true;
+    bool shadows = true, ao = true, grid = false;
     BoxOverlay boxes = BoxOverlay::None;
     int selected = -1;
     uint32_t width = 0, height = 0;
@@ -131,8 +130,9 @@ struct ViewKey {
     bool operator==(const ViewKey& o) const {
         return sceneVersion == o.sceneVersion && camera.eye == o.camera.eye &&
                camera.target == o.camera.target && camera.fov == o.camera.fov && mode == o.mode &&
-               shadows == o.shadows && ao == o.ao && boxes == o.boxes && selected == o.selected &&
-               width == o.width && height == o.height && mesh == o.mesh && wireframe == o.wireframe;
+               shadows == o.shadows && ao == o.ao && grid == o.grid && boxes == o.boxes &&
+               selected == o.selected && width == o.width && height == o.height &&
+               mesh == o.mesh && wireframe == o.wireframe;
     }
 };
 
@@ -143,6 +143,7 @@ struct Viewer {
     std::unique_ptr<Context> liveContext; // the live renderer's own device (RenderWorker)
     std::unique_ptr<RenderWorker> renderer;
     std::unique_ptr<MeshWorker> mesher;
+    std::unique_ptr<ExportWorker> exporter;
     Document doc;
     std::shared_ptr<const Scene> scene; // doc.scene() as handed to the workers
     uint64_t sceneVersion = ~0ull;
@@ -171,15 +172,21 @@ struct Viewer {
     double pressX = 0, pressY = 0, lastX = 0, lastY = 0;
     bool dragged = false;
 
-    // Mesh mode.
-    std::optional<Mesh> mesh;
+    // Mesh mode. The mesh is shared with the export thread; the presenter holds its own copy on
+    // the device.
+    std::shared_ptr<const Mesh> mesh;
     MeshStats meshStats;
+    // The last mesh frame's time (a blit when the view did not change) and the device time of the
+    // last drawing of the mesh.
+    double meshFrameMs = 0.0, meshDrawMs = -1.0;
+    std::string meshScript, exportScript; // "file:line: " while a script's extraction or write runs
     bool meshView = false, wireframe = false;
     int meshResolution = 128;
     bool customBounds = false;
     float boundsMin[3] = {-1, -1, -1}, boundsMax[3] = {1, 1, 1};
     std::string meshMessage;
     char exportPath[512] = "mesh.glb";
+    fs::path exporting; // the file the export worker writes
 
     // Generation.
     std::unique_ptr<GenerateWorker> generator;
@@ -368,6 +375,7 @@ ViewKey wantedKey(Viewer& v, bool full) {
     k.mode = v.mode;
     k.shadows = v.shadows;
     k.ao = v.ao;
+    k.grid = v.grid;
     k.boxes = v.boxes;
     k.selected = v.selected; // its box, and its highlight in full-resolution frames
     int w = 1, h = 1;
@@ -410,19 +418,10 @@ void updateImage(Viewer& v) {
     }
     if (!v.scene) return;
     ViewKey want = wantedKey(v, !moving(v));
-    if (want.mesh) {
-        if (!v.haveShown || !(v.shown == want)) {
-            RasterOptions o;
-            o.width = want.width;
-            o.height = want.height;
-            o.camera = want.camera;
-            o.wireframe = want.wireframe;
-            o.background = v.scene->background;
-            setImage(*v.presenter, rasterize(*v.mesh, o));
-            v.shown = want;
-            v.haveShown = true;
-            v.haveSubmitted = false;
-        }
+    if (want.mesh) { // the presenter draws the mesh itself, every frame
+        v.shown = want;
+        v.haveShown = true;
+        v.haveSubmitted = false;
         return;
     }
     // A value edit drawn by the live renderer is drawn again once its baked kernel is built:
@@ -447,6 +446,7 @@ void updateImage(Viewer& v) {
     job.options.mode = want.mode;
     job.options.shadows = want.shadows;
     job.options.ambientOcclusion = want.ao;
+    job.options.grid = want.grid;
     job.options.boxes =
         want.selected < 0 && want.boxes == BoxOverlay::Selected ? BoxOverlay::None : want.boxes;
     job.options.selectedNode = want.selected;
@@ -467,12 +467,19 @@ bool settled(Viewer& v) {
 // ---- Input -----------------------------------------------------------------------------------
 
 void pick(Viewer& v, double x, double y) {
-    if (!v.last.scene || v.last.image.rgba.empty() || !v.evaluator || (v.meshView && v.mesh))
-        return;
     int w = 1, h = 1;
     glfwGetFramebufferSize(v.window, &w, &h);
     int ww = 1, wh = 1;
     glfwGetWindowSize(v.window, &ww, &wh);
+    if (v.meshView && v.mesh && v.evaluator) {
+        // The mesh view has no depths from the engine, but it shares the ray marcher's camera:
+        // the ray through the pixel meets the scene's surface where the mesh shows it.
+        auto p = castRay(*v.evaluator, toCamera(v.camera), uint32_t(w), uint32_t(h),
+                         float(x) * float(w) / float(ww), float(y) * float(h) / float(wh));
+        v.selected = p ? nearestPrimitive(*v.evaluator, *p) : -1;
+        return;
+    }
+    if (!v.last.scene || v.last.image.rgba.empty() || !v.evaluator) return;
     // Window coordinates -> image pixels (the image fills the window).
     float ix = float(x) * float(w) / float(ww) * float(v.last.image.width) / float(w);
     float iy = float(y) * float(h) / float(wh) * float(v.last.image.height) / float(h);
@@ -563,56 +570,6 @@ void handleInput(Viewer& v) {
     if (hit(GLFW_KEY_M) && v.mesh) v.meshView = !v.meshView;
     if (hit(GLFW_KEY_B)) v.boxes = BoxOverlay((uint32_t(v.boxes) + 1) % 3);
     if (hit(GLFW_KEY_ESCAPE)) v.selected = -1;
-}
-
-// ---- Overlays --------------------------------------------------------------------------------
-
-// A ground grid under the finite part of the scene, drawn over the image (not depth-tested).
-void drawGrid(Viewer& v) {
-    if (!v.grid || !v.evaluator) return;
-    Aabb box;
-    for (const FlatNode& n : v.evaluator->nodes())
-        if (!kindInfo(n.kind).operation && n.bounds.finite() && !n.bounds.empty())
-            box.min = glm::min(box.min, n.bounds.min), box.max = glm::max(box.max, n.bounds.max);
-    if (box.empty()) return;
-    float extent = std::max(box.max.x - box.min.x, box.max.z - box.min.z);
-    float spacing = std::pow(10.0f, std::floor(std::log10(std::max(extent, 1e-3f) / 2.0f)));
-    int lines = 20;
-    glm::vec3 c = 0.5f * (box.min + box.max);
-    float y = box.min.y;
-    c.x = std::round(c.x / spacing) * spacing, c.z = std::round(c.z / spacing) * spacing;
-    Camera cam = toCamera(v.camera);
-    ImVec2 size = ImGui::GetIO().DisplaySize;
-    glm::vec3 f = glm::normalize(cam.target - cam.eye);
-    glm::vec3 r = glm::normalize(glm::cross(f, cam.up));
-    glm::vec3 u = glm::cross(r, f);
-    float t = std::tan(glm::radians(cam.fov) * 0.5f), aspect = size.x / size.y;
-    auto project = [&](glm::vec3 p, ImVec2& out) {
-        glm::vec3 d = p - cam.eye;
-        float z = glm::dot(d, f);
-        if (z < 1e-3f) return false;
-        out = ImVec2((glm::dot(d, r) / (z * t * aspect) + 1.0f) * 0.5f * size.x,
-                     (1.0f - glm::dot(d, u) / (z * t)) * 0.5f * size.y);
-        return true;
-    };
-    ImDrawList* draw = ImGui::GetBackgroundDrawList();
-    float half = spacing * float(lines) / 2;
-    for (int i = 0; i <= lines; ++i) {
-        float o = -half + spacing * float(i);
-        ImU32 colour = i == lines / 2 ? IM_COL32(40, 40, 40, 160) : IM_COL32(60, 60, 60, 90);
-        // Short pieces, so lines that pass behind the eye still show their visible part.
-        for (int axis = 0; axis < 2; ++axis)
-            for (int s = 0; s < 20; ++s) {
-                float a = -half + 2 * half * float(s) / 20,
-                      b = -half + 2 * half * float(s + 1) / 20;
-                glm::vec3 p0 =
-                    axis ? glm::vec3(c.x + o, y, c.z + a) : glm::vec3(c.x + a, y, c.z + o);
-                glm::vec3 p1 =
-                    axis ? glm::vec3(c.x + o, y, c.z + b) : glm::vec3(c.x + b, y, c.z + o);
-                ImVec2 q0, q1;
-                if (project(p0, q0) && project(p1, q1)) draw->AddLine(q0, q1, colour);
-            }
-    }
 }
 
 // ---- Panels ----------------------------------------------------------------------------------
@@ -755,6 +712,60 @@ void fileBrowser(Viewer& v) {
     ImGui::End();
 }
 
+// Starts writing the mesh in the background; the problem when it cannot start.
+std::optional<std::string> startExport(Viewer& v, const fs::path& path) {
+    auto format = meshFormatFromPath(path);
+    if (!format)
+        return path.string() + ": the extension names no mesh format (.ply, .obj, .stl, .glb)";
+    if (!v.exporter->start(v.mesh, path, *format)) return "a mesh is being written";
+    v.exporting = path;
+    v.meshMessage = "writing " + path.string() + "...";
+    return std::nullopt;
+}
+
+// Takes a finished extraction (the mesh goes to the device once, here) and a finished export.
+// False when one that a script started failed.
+bool finishMesh(Viewer& v) {
+    bool ok = true;
+    auto report = [&](std::string& where, const std::string& message, bool failed) {
+        if (!where.empty() && failed) {
+            std::fprintf(stderr, "%s%s\n", where.c_str(), message.c_str());
+            v.exitCode = 1;
+            ok = false;
+        }
+        where.clear();
+    };
+    if (auto done = v.mesher->take()) {
+        if (*done) {
+            auto mesh = std::make_shared<const Mesh>(std::move(**done));
+            v.meshStats = v.mesher->stats();
+            std::string error;
+            if (setMesh(*v.presenter, *mesh, error)) {
+                v.mesh = std::move(mesh);
+                char text[160];
+                std::snprintf(text, sizeof text, "%zu vertices, %zu triangles, %.2f s%s",
+                              v.mesh->vertexCount(), v.mesh->triangleCount(),
+                              v.meshStats.totalSeconds,
+                              v.meshStats.surfaceCut ? " (cut by bounds)" : "");
+                v.meshMessage = text;
+                v.meshView = true;
+            } else {
+                v.mesh.reset();
+                v.meshView = false;
+                v.meshMessage = error;
+            }
+        } else {
+            v.meshMessage = done->error().str();
+        }
+        report(v.meshScript, v.meshMessage, !v.mesh || !*done);
+    }
+    if (auto written = v.exporter->take()) {
+        v.meshMessage = *written ? "wrote " + v.exporting.string() : written->error().str();
+        report(v.exportScript, v.meshMessage, !*written);
+    }
+    return ok;
+}
+
 void meshPanel(Viewer& v) {
     ImGui::SliderInt("resolution", &v.meshResolution, 16, 512);
     ImGui::Checkbox("custom bounds", &v.customBounds);
@@ -774,36 +785,19 @@ void meshPanel(Viewer& v) {
         v.mesher->start(v.scene, o);
         v.meshMessage = "extracting...";
     }
-    if (auto done = v.mesher->take()) {
-        if (*done) {
-            v.mesh = std::move(**done);
-            v.meshStats = v.mesher->stats();
-            char text[160];
-            std::snprintf(text, sizeof text, "%zu vertices, %zu triangles, %.2f s%s",
-                          v.mesh->vertexCount(), v.mesh->triangleCount(), v.meshStats.totalSeconds,
-                          v.meshStats.surfaceCut ? " (cut by bounds)" : "");
-            v.meshMessage = text;
-            v.meshView = true;
-        } else {
-            v.meshMessage = done->error().str();
-        }
-    }
     if (!v.meshMessage.empty()) ImGui::TextWrapped("%s", v.meshMessage.c_str());
     if (!v.mesh) return;
     ImGui::Checkbox("show mesh (M)", &v.meshView);
     ImGui::SameLine();
     ImGui::Checkbox("wireframe", &v.wireframe);
+    if (v.meshView)
+        ImGui::Text("mesh frame %.1f ms, last drawn in %.1f ms", v.meshFrameMs, v.meshDrawMs);
     ImGui::InputText("file", v.exportPath, sizeof v.exportPath);
     ImGui::SameLine();
-    if (ImGui::Button("export")) {
-        auto format = meshFormatFromPath(v.exportPath);
-        if (!format) {
-            v.meshMessage = std::string(v.exportPath) +
-                            ": the extension names no mesh format (.ply, .obj, .stl, .glb)";
-        } else {
-            auto written = writeMesh(*v.mesh, v.exportPath, *format);
-            v.meshMessage = written ? "wrote " + std::string(v.exportPath) : written.error().str();
-        }
+    if (v.exporter->running()) {
+        ImGui::TextDisabled("writing...");
+    } else if (ImGui::Button("export")) {
+        if (auto problem = startExport(v, v.exportPath)) v.meshMessage = *problem;
     }
 }
 
@@ -927,7 +921,9 @@ void panels(Viewer& v) {
 
 // Runs commands until one has to wait for an image. False when a command failed.
 bool runScript(Viewer& v) {
-    while (!v.script.empty() && v.pendingShot.empty() && !v.generating) {
+    // A script's extraction or write is waited for until finishMesh() has taken its result.
+    while (!v.script.empty() && v.pendingShot.empty() && !v.generating && v.meshScript.empty() &&
+           v.exportScript.empty()) {
         Command c = v.script.front();
         v.script.pop_front();
         std::string where = v.scriptFile + ":" + std::to_string(c.line) + ": ";
@@ -1053,6 +1049,21 @@ bool runScript(Viewer& v) {
         } else if (c.verb == "screenshot") {
             v.pendingShot = arg;
             v.waitStart = now();
+        } else if (c.verb == "mesh" && arg == "extract") {
+            MeshOptions o;
+            o.resolution = uint32_t(c.numbers[0]);
+            v.meshResolution = int(o.resolution); // as if set in the panel
+            v.mesher->start(v.scene, o);
+            v.meshScript = where;
+        } else if (c.verb == "mesh") { // export
+            if (!v.mesh) return fail("mesh export: no mesh extracted");
+            if (auto problem = startExport(v, c.args[1])) return fail(*problem);
+            v.exportScript = where;
+        } else if (c.verb == "view") {
+            if (arg == "mesh" && !v.mesh) return fail("view mesh: no mesh extracted");
+            v.meshView = arg == "mesh";
+        } else if (c.verb == "wireframe") {
+            v.wireframe = arg == "on";
         } else if (c.verb == "generate" || c.verb == "edit-scene") {
             std::snprintf(v.prompt, sizeof v.prompt, "%s", c.text.c_str()); // as if typed
             startGeneration(v, c.text, c.verb == "edit-scene");
@@ -1103,6 +1114,7 @@ int main(int argc, char** argv) {
     if (auto live = Context::create()) v.liveContext = std::move(*live);
     v.renderer = std::make_unique<RenderWorker>(*v.context, v.liveContext.get());
     v.mesher = std::make_unique<MeshWorker>(*v.context);
+    v.exporter = std::make_unique<ExportWorker>();
     v.generator = std::make_unique<GenerateWorker>();
     describeEndpoint(v);
     v.startedEmpty = args.scene.empty();
@@ -1150,7 +1162,8 @@ int main(int argc, char** argv) {
     double lastPoll = 0;
     while (!glfwWindowShouldClose(v.window)) {
         // Automated runs never sleep; interactive ones wait for input while nothing is pending.
-        if (automated || !v.renderer->idle() || v.mesher->running() || moving(v))
+        if (automated || !v.renderer->idle() || v.mesher->running() || v.exporter->running() ||
+            moving(v))
             glfwPollEvents();
         else
             glfwWaitEventsTimeout(0.1);
@@ -1168,18 +1181,14 @@ int main(int argc, char** argv) {
             }
         }
         syncScene(v);
-        if (!finishGeneration(v) || !runScript(v)) break;
+        if (!finishGeneration(v) || !finishMesh(v) || !runScript(v)) break;
 
         ImGui_ImplVulkan_NewFrame();
         ImGui_ImplGlfw_NewFrame();
         ImGui::NewFrame();
         handleInput(v);
         syncScene(v);
-        if (v.showUi)
-            panels(v);
-        else if (v.mesher->running())
-            v.mesher->take(); // keep the panel's state simple
-        drawGrid(v);
+        if (v.showUi) panels(v);
         ImGui::Render();
         syncScene(v);
         updateImage(v);
@@ -1192,7 +1201,19 @@ int main(int argc, char** argv) {
         if (v.scene)
             bg[0] = v.scene->background.r, bg[1] = v.scene->background.g,
             bg[2] = v.scene->background.b;
-        bool drawn = drawFrame(*v.presenter, ImGui::GetDrawData(), bg, shoot ? &capture : nullptr);
+        MeshView meshView;
+        meshView.camera = toCamera(v.camera);
+        meshView.wireframe = v.wireframe;
+        meshView.closed = !v.meshStats.surfaceCut;
+        if (v.grid && v.evaluator) meshView.grid = groundGrid(*v.evaluator);
+        const bool drawsMesh = v.meshView && v.mesh;
+        const double frameStart = now();
+        bool drawn = drawFrame(*v.presenter, ImGui::GetDrawData(), bg,
+                               drawsMesh ? &meshView : nullptr, shoot ? &capture : nullptr);
+        if (drawn && drawsMesh) {
+            v.meshFrameMs = (now() - frameStart) * 1000.0;
+            v.meshDrawMs = meshDrawMilliseconds(*v.presenter);
+        }
         if (drawn && v.framesLeft > 0) --v.framesLeft;
         if (shoot && drawn) {
             if (capture.rgba.empty()) {
@@ -1205,8 +1226,14 @@ int main(int argc, char** argv) {
                 v.exitCode = 3;
                 break;
             }
-            std::printf("wrote %s (%u x %u)\n", v.pendingShot.string().c_str(), capture.width,
-                        capture.height);
+            // With the mesh's device time, so scripts can time the mesh view.
+            if (drawsMesh && v.meshDrawMs >= 0.0)
+                std::printf("wrote %s (%u x %u), mesh drawn in %.1f ms\n",
+                            v.pendingShot.string().c_str(), capture.width, capture.height,
+                            v.meshDrawMs);
+            else
+                std::printf("wrote %s (%u x %u)\n", v.pendingShot.string().c_str(),
+                            capture.width, capture.height);
             v.pendingShot.clear();
             if (v.exitAfterShot) break;
         }
@@ -1216,14 +1243,21 @@ int main(int argc, char** argv) {
             break;
         }
         if (!args.script.empty() && v.script.empty() && v.pendingShot.empty() && !v.generating &&
-            !v.exitAfterShot)
+            v.meshScript.empty() && v.exportScript.empty() && !v.exitAfterShot)
             break;
     }
     if (automated && v.renderError && v.exitCode == 0) {
         std::fprintf(stderr, "%s\n", v.renderError->str().c_str());
         v.exitCode = 1;
     }
+    // Under the tests' validation layer, any message fails an automated run.
+    if (automated && v.exitCode == 0 &&
+        (presenterValidationMessages(*v.presenter) || v.context->validationMessageCount())) {
+        std::fprintf(stderr, "sdfcsg-viewer: the validation layer reported problems\n");
+        v.exitCode = 1;
+    }
     glfwHideWindow(v.window);
+    v.exporter.reset(); // waits for a file being written
     v.generator.reset(); // cancels a generation in flight
     v.mesher.reset();    // cancels an extraction
     if (v.renderer->compiling()) {

@@ -22,6 +22,23 @@ std::optional<glm::vec3> pickPoint(const Camera& camera, uint32_t width, uint32_
     return rc.eye + t * dir;
 }
 
+std::optional<glm::vec3> castRay(const Evaluator& evaluator, const Camera& camera, uint32_t width,
+                                 uint32_t height, float x, float y) {
+    if (x < 0.0f || y < 0.0f || x >= float(width) || y >= float(height)) return std::nullopt;
+    detail::RayCamera rc = detail::makeRayCamera(camera, width, height);
+    glm::vec3 dir = detail::rayDirection(rc, x, y, width, height);
+    const detail::ClipVolume clip = detail::makeClipVolume(evaluator, rc.eye);
+    float t, tFar;
+    if (!detail::rayInterval(clip, rc.eye, dir, t, tFar)) return std::nullopt;
+    // The loop of march() in shaders/raymarch.comp.
+    for (uint32_t i = 0; i < SDFCSG_MAX_STEPS && t <= tFar; ++i) {
+        float d = evaluator.distance(rc.eye + t * dir);
+        if (d < detail::hitEpsilon(rc, t)) return rc.eye + t * dir;
+        t += d;
+    }
+    return std::nullopt;
+}
+
 int nearestPrimitive(const Evaluator& evaluator, glm::vec3 p) {
     int best = -1;
     float bestDistance = std::numeric_limits<float>::infinity();

@@ -1,4 +1,5 @@
-// Selecting a node by clicking in the ray-marched image, and showing the selection in it.
+// Selecting a node by clicking in the ray-marched image or the mesh view, and showing the
+// selection in the ray-marched image.
 #pragma once
 
 #include <sdfcsg/eval.h>
@@ -17,6 +18,13 @@ namespace sdfcsg::viewer {
 // the ray missed or (x, y) lies outside the image.
 std::optional<glm::vec3> pickPoint(const Camera& camera, uint32_t width, uint32_t height,
                                    const std::vector<PixelInfo>& pixels, float x, float y);
+
+// The surface point seen through image point (x, y) of a width x height view with `camera`,
+// found by tracing the ray on the CPU as the ray marcher traces it: for views without depths
+// from the engine (the mesh view, which shares the ray marcher's camera). nullopt where the ray
+// misses or (x, y) lies outside the image.
+std::optional<glm::vec3> castRay(const Evaluator& evaluator, const Camera& camera, uint32_t width,
+                                 uint32_t height, float x, float y);
 
 // The primitive whose own surface lies nearest to p (smallest |distance|), or -1 when the scene
 // has none. A point on a carved face picks the primitive that carved it.

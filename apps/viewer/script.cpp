@@ -62,6 +62,9 @@ const std::vector<Verb>& verbs() {
         {"expect-error", 1, -1, false, {}, "the error"},
         {"expect-selected", 1, 1, false, {}},
         {"print-bounds", 1, 1, false, {}},
+        {"mesh", 2, 2, false, {"extract", "export"}},
+        {"view", 1, 1, false, {"mesh", "march"}},
+        {"wireframe", 1, 1, false, {"on", "off"}},
     };
     return table;
 }
@@ -151,6 +154,15 @@ Result<std::vector<Command>> parseScript(std::string_view text, std::string_view
                 problem("zoom: expected a positive factor, got \"" + c.args[0] + "\"");
                 continue;
             }
+        }
+        if (c.verb == "mesh" && c.args[0] == "extract") {
+            float cells = 0;
+            if (!parseFloat(c.args[1], cells) || cells < 1 || cells != float(int(cells))) {
+                problem("mesh extract: expected a whole number of cells, got \"" + c.args[1] +
+                        "\"");
+                continue;
+            }
+            c.numbers.push_back(cells);
         }
         commands.push_back(std::move(c));
     }

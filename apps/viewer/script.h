@@ -22,6 +22,7 @@
 //   pick X Y                 wait for the full-resolution image, then click window pixel X, Y
 //   ui on|off                show or hide the panels (H)
 //   screenshot PATH          wait for the full-resolution image, then write the window as PNG
+//                            (in the mesh view the printed line gives the mesh's drawing time)
 //   print-bounds NODE        wait for the full-resolution image, then print the window pixels
 //                            NODE's bounds cover: "bounds NODE X0 Y0 X1 Y1" (end exclusive)
 //   expect-error TEXT...     fail unless the shown error holds TEXT ("none": unless none shows)
@@ -29,10 +30,16 @@
 //   generate TEXT...         ask the language model for a new scene described by TEXT, wait
 //                            for it, and make it the current scene (one undo step)
 //   edit-scene TEXT...       the same, sending the current scene to be changed as TEXT says
+//   mesh extract CELLS       extract a mesh with CELLS along the longest axis, wait for it and
+//                            show it (the mesh panel's resolution)
+//   mesh export PATH         write the mesh (.ply, .obj, .stl, .glb) and wait for the file
+//   view mesh|march          the extracted mesh or the ray-marched image
+//   wireframe on|off         the mesh view's edges
 //
 // Numbers must be finite. The text of generate, edit-scene and expect-error is the rest of the
-// line, so it cannot hold a '#'. A generation that fails (no valid scene after the repair
-// rounds, a network error) fails the script.
+// line, so it cannot hold a '#'. A generation, extraction or export that fails (no valid
+// scene after the repair rounds, a network error, a mesh too large for the memory) fails
+// the script.
 #pragma once
 
 #include <sdfcsg/error.h>

@@ -341,6 +341,33 @@ MeshStats MeshWorker::stats() const {
     return stats_;
 }
 
+ExportWorker::~ExportWorker() {
+    if (thread_.joinable()) thread_.join();
+}
+
+bool ExportWorker::start(std::shared_ptr<const Mesh> mesh, std::filesystem::path path,
+                         MeshFormat format) {
+    if (running_) return false;
+    if (thread_.joinable()) thread_.join();
+    running_ = true;
+    thread_ = std::thread([this, mesh = std::move(mesh), path = std::move(path), format] {
+        Status written = writeMesh(*mesh, path, format);
+        {
+            std::lock_guard lock(mutex_);
+            done_ = std::move(written);
+        }
+        running_ = false;
+    });
+    return true;
+}
+
+std::optional<Status> ExportWorker::take() {
+    std::lock_guard lock(mutex_);
+    auto out = std::move(done_);
+    done_.reset();
+    return out;
+}
+
 GenerateWorker::~GenerateWorker() {
     cancel_ = true;
     if (thread_.joinable()) thread_.join();

@@ -7,7 +7,6 @@
 #include "history.h"
 #include "orbit_camera.h"
 #include "picking.h"
-#include "raster.h"
 #include "script.h"
 #include "workers.h"
 
@@ -202,6 +201,22 @@ TEST(ViewerPicking, PointFromDepth) {
     EXPECT_GT(p->y, 0.0f);
     EXPECT_FALSE(pickPoint(camera, 4, 4, pixels, 0.5f, 0.5f)); // a miss
     EXPECT_FALSE(pickPoint(camera, 4, 4, pixels, 4.0f, 0.5f)); // outside
+}
+
+TEST(ViewerPicking, PointFromTracedRay) {
+    Scene scene = twoSpheres();
+    Evaluator evaluator(scene);
+    Camera camera;
+    camera.eye = {-1, 0, 5};
+    camera.target = {-1, 0, 0};
+    camera.fov = 45;
+    // The image's centre looks at the front of the left sphere (radius 0.5).
+    auto p = castRay(evaluator, camera, 64, 48, 32.0f, 24.0f);
+    ASSERT_TRUE(p);
+    expectNear(*p, {-1.0f, 0.0f, 0.5f}, 1e-3f);
+    EXPECT_EQ(nearestPrimitive(evaluator, *p), int(*findNode(scene, "left")));
+    EXPECT_FALSE(castRay(evaluator, camera, 64, 48, 1.0f, 1.0f)); // above the spheres: a miss
+    EXPECT_FALSE(castRay(evaluator, camera, 64, 48, 64.0f, 24.0f)); // outside
 }
 
 TEST(ViewerPicking, NearestPrimitiveIncludingCarvedFaces) {
@@ -609,7 +624,7 @@ TEST(ViewerScript, ReportsEveryProblem) {
               "s.txt:2:1: unknown command \"fly\" (known: select, set, mode, shadows, ao, grid, "
               "boxes, orbit, zoom, frame, reset, undo, redo, save, screenshot, generate, "
               "edit-scene, add, remove, kind, op, move, open, pick, wait-reload, ui, "
-              "expect-error, expect-selected, print-bounds)\n"
+              "expect-error, expect-selected, print-bounds, mesh, view, wireframe)\n"
               "s.txt:3:1: set: expected a finite number, got \"big\"\n"
               "s.txt:4:1: zoom: expected 1 arguments, got 0\n"
               "s.txt:5:1: undo: expected 0 arguments, got 1");
@@ -750,34 +765,50 @@ TEST(ViewerResolution, PreviewScaleAimsAtTheTargetTime) {
     EXPECT_FLOAT_EQ(previewScale(0.0, 0, 1000000, 0.1), 0.5f);
 }
 
-TEST(ViewerRaster, DrawsTheMeshWhereTheCameraSeesIt) {
-    Mesh mesh; // one triangle facing +z around the origin
-    mesh.positions = {{-1, -1, 0}, {1, -1, 0}, {0, 1, 0}};
-    mesh.normals = {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}};
-    mesh.colors = {{1, 0, 0}, {1, 0, 0}, {1, 0, 0}};
-    mesh.indices = {0, 1, 2};
-    RasterOptions o;
-    o.width = 64;
-    o.height = 64;
-    o.camera.eye = {0, 0, 5};
-    o.background = {0, 0, 1};
-    Image image = rasterize(mesh, o);
-    ASSERT_EQ(image.rgba.size(), 64u * 64u * 4u);
-    auto at = [&](int x, int y) { return &image.rgba[(size_t(y) * 64 + size_t(x)) * 4]; };
-    EXPECT_EQ(at(32, 34)[0], 255); // lit straight on: the full colour
-    EXPECT_EQ(at(32, 34)[2], 0);
-    EXPECT_EQ(at(2, 2)[2], 255); // background
-    o.wireframe = true;
-    o.shaded = false;
-    Image wire = rasterize(mesh, o);
-    // The bottom edge (y = -1) lies about 13 pixels below the centre.
-    int dark = 0;
-    for (int y = 40; y < 50; ++y)
-        dark += wire.rgba[(size_t(y) * 64 + 32) * 4] < 40;
-    EXPECT_GE(dark, 1);
-    // Behind the eye: nothing is drawn.
-    o.camera.eye = {0, 0, -5};
-    o.camera.target = {0, 0, -10};
-    Image behind = rasterize(mesh, o);
-    EXPECT_EQ(behind.rgba[(size_t(32) * 64 + 32) * 4 + 2], 255);
+TEST(ViewerScript, MeshCommands) {
+    auto script = parseScript("mesh extract 64\nview mesh\nwireframe on\nmesh export out.obj\n"
+                              "view march\n",
+                              "s.txt");
+    ASSERT_TRUE(script) << script.error().str();
+    ASSERT_EQ(script->size(), 5u);
+    EXPECT_EQ((*script)[0].numbers, std::vector<float>{64});
+    EXPECT_EQ((*script)[3].args, (std::vector<std::string>{"export", "out.obj"}));
+    auto bad = parseScript("mesh extract fine\nmesh extract 2.5\nmesh render x\nview both\n",
+                           "s.txt");
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error().str(),
+              "s.txt:1:1: mesh extract: expected a whole number of cells, got \"fine\"\n"
+              "s.txt:2:1: mesh extract: expected a whole number of cells, got \"2.5\"\n"
+              "s.txt:3:1: mesh: expected one of extract, export, got \"render\"\n"
+              "s.txt:4:1: view: expected one of mesh, march, got \"both\"");
+}
+
+TEST(ViewerExport, WritesOnItsOwnThread) {
+    auto mesh = std::make_shared<Mesh>(); // one triangle
+    mesh->positions = {{-1, -1, 0}, {1, -1, 0}, {0, 1, 0}};
+    mesh->normals = {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}};
+    mesh->colors = {{1, 0, 0}, {1, 0, 0}, {1, 0, 0}};
+    mesh->indices = {0, 1, 2};
+    fs::path dir = tempDir("viewer_export");
+    ExportWorker worker;
+    auto finished = [&] {
+        const auto start = std::chrono::steady_clock::now();
+        while (worker.running() && secondsSince(start) < 30.0)
+            std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        return worker.take();
+    };
+    ASSERT_TRUE(worker.start(mesh, dir / "tri.obj", MeshFormat::Obj));
+    mesh.reset(); // the worker holds its own reference
+    auto written = finished();
+    ASSERT_TRUE(written);
+    EXPECT_TRUE(*written) << written->error().str();
+    std::ifstream in(dir / "tri.obj");
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find("f 1//1 2//2 3//3"), std::string::npos) << text;
+    EXPECT_FALSE(worker.take()); // once
+
+    ASSERT_TRUE(worker.start(std::make_shared<Mesh>(), dir / "missing" / "x.ply", MeshFormat::Ply));
+    written = finished();
+    ASSERT_TRUE(written);
+    EXPECT_FALSE(*written);
 }

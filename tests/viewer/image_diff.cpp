@@ -6,6 +6,11 @@
 //                                                    exit 0 when every differing pixel lies in
 //                                                    [X0, X1) x [Y0, Y1) grown by MARGIN, and at
 //                                                    least MINFRACTION of that rectangle differs
+//   image_diff A.png B.png mask MAXDIFF MINFRACTION  exit 0 when the silhouettes agree on at
+//                                                    least MINFRACTION of the pixels: a pixel
+//                                                    is background when it is within MAXDIFF
+//                                                    of A's top-left pixel (keep that corner
+//                                                    empty), in both images or in neither
 // Prints the sizes and the fraction of differing pixels either way; 1 when the check fails,
 // 2 on bad arguments or unreadable files.
 #define STB_IMAGE_IMPLEMENTATION
@@ -31,7 +36,8 @@
 
 int main(int argc, char** argv) {
     if (argc < 5) {
-        std::fputs("usage: image_diff A.png B.png same MAXDIFF MAXFRACTION | differ MINFRACTION\n",
+        std::fputs("usage: image_diff A.png B.png same MAXDIFF MAXFRACTION | differ MINFRACTION |"
+                   " within X0 Y0 X1 Y1 MARGIN MINFRACTION | mask MAXDIFF MINFRACTION\n",
                    stderr);
         return 2;
     }
@@ -48,6 +54,22 @@ int main(int argc, char** argv) {
     if (wa != wb || ha != hb) {
         std::printf("sizes differ: %dx%d and %dx%d\n", wa, ha, wb, hb);
         return 1;
+    }
+    if (check == "mask" && argc == 6) {
+        // Shading differs between a ray-marched and a rasterised view; where the object is
+        // must not.
+        const int tolerance = std::atoi(argv[4]);
+        auto background = [&](const unsigned char* image, long i) {
+            for (int c = 0; c < 3; ++c)
+                if (std::abs(int(image[4 * i + c]) - int(a[c])) > tolerance) return false;
+            return true;
+        };
+        long disagree = 0;
+        for (long i = 0; i < long(wa) * ha; ++i)
+            disagree += background(a, i) != background(b, i);
+        double agreement = 1.0 - double(disagree) / (double(wa) * ha);
+        std::printf("%dx%d: the silhouettes agree on %.4f of the pixels\n", wa, ha, agreement);
+        return agreement >= std::atof(argv[5]) ? 0 : 1;
     }
     int threshold = check == "same" ? std::atoi(argv[4]) : 8;
     long differing = 0, maxDiff = 0;
@@ -82,7 +104,8 @@ int main(int argc, char** argv) {
     }
     if (check == "same" && argc == 6) return fraction <= std::atof(argv[5]) ? 0 : 1;
     if (check == "differ") return fraction >= std::atof(argv[4]) ? 0 : 1;
-    std::fputs("image_diff: expected \"same MAXDIFF MAXFRACTION\" or \"differ MINFRACTION\"\n",
+    std::fputs("image_diff: expected \"same MAXDIFF MAXFRACTION\", \"differ MINFRACTION\", "
+               "\"within X0 Y0 X1 Y1 MARGIN MINFRACTION\" or \"mask MAXDIFF MINFRACTION\"\n",
                stderr);
     return 2;
 }

@@ -1,7 +1,9 @@
 #!/bin/sh
 # The viewer under a virtual X server: its screenshot matches the headless renderer, a scripted
-# session (select, edit, modes, undo, save) changes the image at every step, and a scripted
-# generation against a stand-in language model is one undo step.
+# session (select, edit, modes, undo, save) changes the image at every step, an extracted mesh
+# drawn by the window's pipeline covers the ray-marched silhouette, and a scripted generation
+# against a stand-in language model is one undo step. The validation layer is on (the test's
+# environment sets SDFCSG_VALIDATION), and any message fails the viewer's run.
 # Usage: viewer_test.sh VIEWER CLI IMAGE_DIFF SOURCE_DIR WORK_DIR. Exits 77 (skipped) without
 # xvfb-run.
 set -eu
@@ -22,6 +24,14 @@ run "$scene" --screenshot viewer.png --frames 3 --size 320x240 --no-ui || fail "
 "$cli" render "$scene" -o headless.png --width 320 --height 240 || fail "headless render"
 # Kernels with values inlined or read from a buffer may round differently by a step or two.
 "$diff" viewer.png headless.png same 6 0.002 || fail "viewer image differs from the headless render"
+# The ground grid is the renderer's own (RenderOptions::grid), so it matches `render --grid`.
+printf 'grid on\nscreenshot grid.png\n' > grid.txt
+run "$scene" --script grid.txt --size 320x240 --no-ui || fail "viewer grid screenshot"
+"$cli" render "$scene" -o headless-grid.png --width 320 --height 240 --grid ||
+    fail "headless render with the grid"
+"$diff" viewer.png grid.png differ 0.005 || fail "the grid changed nothing"
+"$diff" grid.png headless-grid.png same 6 0.002 ||
+    fail "viewer image with the grid differs from the headless render"
 
 # 2. A scripted session; every step must change the image, and undo must bring it back.
 cp "$src/assets/scenes/snowman.json" edit.json
@@ -190,7 +200,39 @@ mode shiny" > bad.txt
 if run edit.json --script bad.txt 2> bad.err; then fail "a bad script was accepted"; fi
 grep -q "bad.txt:2:1: mode: expected one of shaded, normals, depth, steps, got \"shiny\"" bad.err ||
     fail "unexpected message: $(cat bad.err)"
-# 4. Scripted generation against a stand-in language model (skipped without python3): the new
+# 4. Mesh mode: the extracted mesh, shaded and as a wireframe, covers the pixels the ray marcher
+# shows as the object (shading differs, the silhouette must not, up to the cells' size), the
+# ground grid is drawn in the mesh view too, the export writes the file in the background, and
+# the ray-marched view comes back unchanged.
+cat > mesh.txt <<'SCRIPT'
+screenshot m0-march.png
+mesh extract 128
+screenshot m1-mesh.png
+wireframe on
+screenshot m2-wire.png
+wireframe off
+grid on
+screenshot m4-grid.png
+grid off
+mesh export mesh.obj
+view march
+screenshot m3-march.png
+SCRIPT
+run "$scene" --script mesh.txt --size 320x240 --no-ui || fail "scripted mesh session"
+"$diff" m0-march.png m1-mesh.png mask 3 0.98 || fail "the mesh's silhouette is not the scene's"
+"$diff" m0-march.png m2-wire.png mask 3 0.98 || fail "the wireframe's silhouette is not the scene's"
+"$diff" m1-mesh.png m2-wire.png differ 0.01 || fail "the wireframe shows no edges"
+"$diff" m1-mesh.png m4-grid.png differ 0.005 || fail "the mesh view shows no grid"
+"$diff" m3-march.png m0-march.png same 0 0 || fail "the ray-marched view did not come back"
+grep -q "^f " mesh.obj || fail "the exported mesh has no faces"
+printf 'view mesh\n' > no-mesh.txt
+if run "$scene" --script no-mesh.txt --size 320x240 --no-ui 2> no-mesh.err; then
+    fail "showing a mesh before extracting one was accepted"
+fi
+grep -q "no-mesh.txt:1: view mesh: no mesh extracted" no-mesh.err ||
+    fail "unexpected message: $(cat no-mesh.err)"
+
+# 5. Scripted generation against a stand-in language model (skipped without python3): the new
 # scene replaces the old one as one undo step, and an answer that never loads fails the script
 # while the scene stays.
 if command -v python3 >/dev/null 2>&1; then
