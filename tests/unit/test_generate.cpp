@@ -41,7 +41,7 @@ Scripted openAiError(int status, const std::string& message, const std::string& 
                         R"(, "code": )" + orNull(code) + "}}"};
 }
 
-struct Fixture : ::testing::Test {
+struct Generate : ::testing::Test {
     FakeServer server;
     std::vector<double> sleeps;
     std::vector<std::string> progress;
@@ -86,7 +86,7 @@ bool has(simdjson::dom::element object, std::string_view key) {
 
 } // namespace
 
-TEST_F(Fixture, FirstTrySuccess) {
+TEST_F(Generate, FirstTrySuccess) {
     server.script({openAi(kSphere)});
     GenerateStats stats;
     auto g = generateScene("a sphere", options(), &stats);
@@ -106,7 +106,7 @@ TEST_F(Fixture, FirstTrySuccess) {
     EXPECT_EQ(progress, std::vector<std::string>{"asking test-model (json_schema)"});
 }
 
-TEST_F(Fixture, FencedAndThinkWrappedAnswers) {
+TEST_F(Generate, FencedAndThinkWrappedAnswers) {
     server.script({openAi("<think>A sphere {radius 1}, in ```json```?</think>\nHere:\n```json\n" +
                           kSphere + "\n```\nDone."),
                    openAi("Sure, here it is: " + kSphere)});
@@ -114,7 +114,7 @@ TEST_F(Fixture, FencedAndThinkWrappedAnswers) {
     EXPECT_TRUE(generateScene("a sphere", options()));
 }
 
-TEST_F(Fixture, NullMembersAreDropped) {
+TEST_F(Generate, NullMembersAreDropped) {
     // What strict structured output sends for optional keys.
     server.script({openAi(R"({"version": 1, "name": null, "camera": null, "root": {"type":
         "union", "smooth": null, "color": null, "children": [{"type": "sphere", "radius": 1,
@@ -124,7 +124,7 @@ TEST_F(Fixture, NullMembersAreDropped) {
     EXPECT_EQ(g->scene.nodes[1].name, "ball");
 }
 
-TEST_F(Fixture, InvalidJsonThenRepaired) {
+TEST_F(Generate, InvalidJsonThenRepaired) {
     const std::string broken = R"({"version": 1, "root": {"type": "sphere", "radius": 1})";
     server.script({openAi(broken), openAi(kSphere)});
     GenerateStats stats;
@@ -144,7 +144,7 @@ TEST_F(Fixture, InvalidJsonThenRepaired) {
     EXPECT_NE(lastMessage(second).find("- line 1, column "), std::string_view::npos);
 }
 
-TEST_F(Fixture, SemanticallyInvalidThenRepaired) {
+TEST_F(Generate, SemanticallyInvalidThenRepaired) {
     server.script({openAi(kBadSphere), openAi(kSphere)});
     GenerateStats stats;
     ASSERT_TRUE(generateScene("a sphere", options(), &stats));
@@ -154,7 +154,7 @@ TEST_F(Fixture, SemanticallyInvalidThenRepaired) {
     EXPECT_EQ(progress[2], "asking test-model for a correction, round 1 of 3 (json_schema)");
 }
 
-TEST_F(Fixture, RepairLimitReached) {
+TEST_F(Generate, RepairLimitReached) {
     server.script({openAi(kBadSphere), openAi(kBadSphere), openAi(kBadSphere), openAi(kSphere)});
     GenerateOptions o = options();
     o.maxRepairs = 2;
@@ -170,7 +170,7 @@ TEST_F(Fixture, RepairLimitReached) {
     EXPECT_EQ(server.received().size(), 3u);
 }
 
-TEST_F(Fixture, UntrustedAnswerLimits) {
+TEST_F(Generate, UntrustedAnswerLimits) {
     // Too many nodes, and a key that would name a file: both refused by the validator.
     std::string many = R"({"version": 1, "root": {"type": "union", "children": [)";
     for (int i = 0; i < 10; ++i)
@@ -189,7 +189,7 @@ TEST_F(Fixture, UntrustedAnswerLimits) {
 }
 
 // The answer's size is limited before it is read whole: the transfer stops at the limit.
-TEST_F(Fixture, AnswerLargerThanTheLimitIsRefused) {
+TEST_F(Generate, AnswerLargerThanTheLimitIsRefused) {
     server.script({openAi(std::string(R"({"version": 1, "name": ")") + std::string(3000, 'x') +
                           R"(", "root": {"type": "sphere", "radius": 1}})")});
     GenerateOptions o = options();
@@ -201,7 +201,7 @@ TEST_F(Fixture, AnswerLargerThanTheLimitIsRefused) {
               server.url() + "/chat/completions: the answer exceeds the limit of 2048 bytes");
 }
 
-TEST_F(Fixture, FinishReasonLength) {
+TEST_F(Generate, FinishReasonLength) {
     server.script({openAi(R"({"version": 1, "root": {"type": "uni)", "length")});
     auto g = generateScene("a sphere", options());
     ASSERT_FALSE(g);
@@ -211,7 +211,7 @@ TEST_F(Fixture, FinishReasonLength) {
                                               "or raise the limit");
 }
 
-TEST_F(Fixture, Refusal) {
+TEST_F(Generate, Refusal) {
     server.script({{200, R"({"choices": [{"index": 0, "message": {"role": "assistant",
         "content": null, "refusal": "I'm sorry, I can't help with that."}, "finish_reason":
         "stop"}]})"}});
@@ -222,7 +222,7 @@ TEST_F(Fixture, Refusal) {
               "the model refused: I'm sorry, I can't help with that.");
 }
 
-TEST_F(Fixture, ResponseFormatRejectedThenJsonMode) {
+TEST_F(Generate, ResponseFormatRejectedThenJsonMode) {
     server.script({openAiError(400,
                                "Invalid parameter: 'response_format' of type 'json_schema' is not "
                                "supported with this model.",
@@ -238,7 +238,7 @@ TEST_F(Fixture, ResponseFormatRejectedThenJsonMode) {
     EXPECT_EQ(progress[1], "the server rejects json_schema output; falling back to json_object");
 }
 
-TEST_F(Fixture, JsonModeRejectedThenText) {
+TEST_F(Generate, JsonModeRejectedThenText) {
     // llama.cpp-style error objects, without a param.
     server.script(
         {{400,
@@ -253,7 +253,7 @@ TEST_F(Fixture, JsonModeRejectedThenText) {
     EXPECT_FALSE(has(body(2), "response_format"));
 }
 
-TEST_F(Fixture, MaxTokensRejectedThenResent) {
+TEST_F(Generate, MaxTokensRejectedThenResent) {
     server.script({openAiError(400,
                                "Unsupported parameter: 'max_tokens' is not supported with this "
                                "model. Use 'max_completion_tokens' instead.",
@@ -277,7 +277,7 @@ TEST_F(Fixture, MaxTokensRejectedThenResent) {
     EXPECT_EQ(mode, "json_schema");
 }
 
-TEST_F(Fixture, Unauthorized) {
+TEST_F(Generate, Unauthorized) {
     server.script({openAiError(401,
                                "Incorrect API key provided: sk-test-****6789. You can find your "
                                "API key at https://platform.openai.com/account/api-keys.",
@@ -295,7 +295,7 @@ TEST_F(Fixture, Unauthorized) {
 
 // A server that quotes the key back, in a body that is no answer and in a scene key: neither
 // message carries it (fuzz_llm found the first).
-TEST_F(Fixture, KeyEchoedByTheServerIsRedacted) {
+TEST_F(Generate, KeyEchoedByTheServerIsRedacted) {
     server.script({{200, std::string("<html>bad key ") + kKey + "</html>"}});
     auto g = generateScene("a sphere", options());
     ASSERT_FALSE(g);
@@ -312,7 +312,7 @@ TEST_F(Fixture, KeyEchoedByTheServerIsRedacted) {
     EXPECT_NE(g.error().str().find("[redacted]"), std::string::npos) << g.error().str();
 }
 
-TEST_F(Fixture, RateLimitedHonoursRetryAfter) {
+TEST_F(Generate, RateLimitedHonoursRetryAfter) {
     server.script(
         {{429, R"({"error": {"message": "Rate limit reached", "code": "rate_limit_exceeded"}})",
           "3"},
@@ -327,7 +327,7 @@ TEST_F(Fixture, RateLimitedHonoursRetryAfter) {
     EXPECT_EQ(progress[1], "HTTP 429: Rate limit reached; retrying in 3 s (attempt 2 of 5)");
 }
 
-TEST_F(Fixture, QuotaExhaustedIsNotRetried) {
+TEST_F(Generate, QuotaExhaustedIsNotRetried) {
     server.script({openAiError(429, "You exceeded your current quota.", "", "insufficient_quota")});
     auto g = generateScene("a sphere", options());
     ASSERT_FALSE(g);
@@ -335,7 +335,7 @@ TEST_F(Fixture, QuotaExhaustedIsNotRetried) {
     EXPECT_TRUE(sleeps.empty());
 }
 
-TEST_F(Fixture, ServerErrorThenSuccess) {
+TEST_F(Generate, ServerErrorThenSuccess) {
     server.script({{500, R"({"error": {"message": "The server had an error"}})"}, openAi(kSphere)});
     GenerateStats stats;
     ASSERT_TRUE(generateScene("a sphere", options(), &stats));
@@ -343,7 +343,7 @@ TEST_F(Fixture, ServerErrorThenSuccess) {
     EXPECT_EQ(sleeps, std::vector<double>{0.5});
 }
 
-TEST_F(Fixture, ServerErrorsGiveUp) {
+TEST_F(Generate, ServerErrorsGiveUp) {
     server.script(
         {{503, "Service Unavailable"}, {502, "Bad Gateway"}, {503, "Service Unavailable"}});
     GenerateOptions o = options();
@@ -355,7 +355,7 @@ TEST_F(Fixture, ServerErrorsGiveUp) {
     EXPECT_EQ(sleeps, (std::vector<double>{0.5, 1.0}));
 }
 
-TEST_F(Fixture, Timeout) {
+TEST_F(Generate, Timeout) {
     server.script({{200, "{}", "", true}});
     GenerateOptions o = options();
     o.llm.timeoutSeconds = 0.3;
@@ -367,7 +367,7 @@ TEST_F(Fixture, Timeout) {
                                               "0.3 s (the request timeout)");
 }
 
-TEST_F(Fixture, CancelDuringASlowAnswer) {
+TEST_F(Generate, CancelDuringASlowAnswer) {
     server.script({{200, "{}", "", true}}); // would answer after 20 s
     std::atomic<bool> cancel{false};
     GenerateOptions o = options();
@@ -387,7 +387,7 @@ TEST_F(Fixture, CancelDuringASlowAnswer) {
     EXPECT_LT(seconds, 10.0);
 }
 
-TEST_F(Fixture, CancelDuringTheRetryWait) {
+TEST_F(Generate, CancelDuringTheRetryWait) {
     server.script({openAiError(503, "Service Unavailable"), openAi(kSphere)});
     bool cancel = false;
     GenerateOptions o = options();
@@ -416,7 +416,7 @@ TEST_F(Fixture, CancelDuringTheRetryWait) {
               30.0);
 }
 
-TEST_F(Fixture, ConnectionRefused) {
+TEST_F(Generate, ConnectionRefused) {
     GenerateOptions o = options();
     o.llm.baseUrl = "http://127.0.0.1:1/v1";
     auto g = generateScene("a sphere", o);
@@ -427,7 +427,7 @@ TEST_F(Fixture, ConnectionRefused) {
         << g.error().str();
 }
 
-TEST_F(Fixture, OllamaNativeApi) {
+TEST_F(Generate, OllamaNativeApi) {
     server.script({{200, R"({"model": "test-model", "created_at": "2025-01-01T00:00:00Z",
         "message": {"role": "assistant", "content": )" +
                              jsonQuote(kSphere) + R"(}, "done": true,
@@ -464,7 +464,7 @@ TEST_F(Fixture, OllamaNativeApi) {
     EXPECT_EQ(r->url, "http://localhost:11434/api/chat");
 }
 
-TEST_F(Fixture, EditSendsTheCurrentScene) {
+TEST_F(Generate, EditSendsTheCurrentScene) {
     server.script({openAi(kSphere)});
     GenerateOptions o = options();
     o.currentScene = toJson(*parseScene(kSphere));
@@ -474,7 +474,7 @@ TEST_F(Fixture, EditSendsTheCurrentScene) {
         lastMessage(body(0)).starts_with("Here is the current scene:\n{\n  \"version\": 1"));
 }
 
-TEST_F(Fixture, RequestBodyGolden) {
+TEST_F(Generate, RequestBodyGolden) {
     server.script({openAi(kSphere)});
     ASSERT_TRUE(generateScene("a red sphere", options()));
     std::string golden =
@@ -491,7 +491,7 @@ TEST_F(Fixture, RequestBodyGolden) {
     EXPECT_EQ(preview->url, server.url() + "/chat/completions");
 }
 
-TEST_F(Fixture, KeyOnlyInTheAuthorizationHeader) {
+TEST_F(Generate, KeyOnlyInTheAuthorizationHeader) {
     server.script(
         {{500, R"({"error": {"message": "oops"}})"}, openAi(kBadSphere), openAi(kSphere)});
     std::vector<HttpExchange> recording;
@@ -527,7 +527,7 @@ TEST_F(Fixture, KeyOnlyInTheAuthorizationHeader) {
     EXPECT_FALSE(server.received().back().headers.count("Authorization"));
 }
 
-TEST_F(Fixture, RecordReplayRoundTrip) {
+TEST_F(Generate, RecordReplayRoundTrip) {
     server.script({{429, R"({"error": {"message": "slow down"}})", "1"},
                    openAi(kBadSphere),
                    openAi(kSphere)});
