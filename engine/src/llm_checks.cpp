@@ -4,6 +4,8 @@
 #include "sdfcsg/eval.h"
 #include "sdfcsg/generate.h"
 
+#include "parse_util.h"
+
 #include <glm/geometric.hpp>
 
 #include <algorithm>
@@ -20,8 +22,10 @@ bool overlap(const Aabb& a, const Aabb& b, float margin) {
     return true;
 }
 
+// A name is the model's text: quoted as the validator quotes strings, so it cannot forge a line
+// or drive the terminal.
 std::string label(const Node& node) {
-    return node.name.empty() ? node.path : node.path + " (\"" + node.name + "\")";
+    return node.name.empty() ? node.path : node.path + " (" + detail::quote(node.name) + ")";
 }
 
 std::string number(float v) {

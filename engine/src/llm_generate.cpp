@@ -28,6 +28,7 @@ using detail::asObject;
 using detail::formatFloat;
 using detail::formatNumber;
 using detail::jsonQuote;
+using detail::printable;
 namespace dom = simdjson::dom;
 using Clock = std::chrono::steady_clock;
 
@@ -54,6 +55,14 @@ std::string seconds(double s) {
     char text[32];
     std::snprintf(text, sizeof text, "%g", std::round(s * 10.0) / 10.0);
     return text;
+}
+
+// The first `size` bytes of `text` or a little fewer, cut between UTF-8 sequences.
+std::string_view head(std::string_view text, size_t size) {
+    if (text.size() <= size) return text;
+    while (size > 0 && (static_cast<unsigned char>(text[size]) & 0xC0) == 0x80)
+        --size;
+    return text.substr(0, size);
 }
 
 Error remote(const std::string& url, std::string message) {
@@ -155,7 +164,7 @@ ServerError serverError(std::string_view body) {
     dom::parser parser;
     dom::element top;
     if (parser.parse(body.data(), body.size()).get(top) || !top.is_object()) {
-        out.message = std::string(body.substr(0, 300));
+        out.message = head(body, 300);
         return out;
     }
     std::string_view text;
@@ -172,7 +181,7 @@ ServerError serverError(std::string_view body) {
         out.message = text;
         if (!top["param"].get(text)) out.param = text;
     }
-    if (out.message.empty()) out.message = std::string(body.substr(0, 300));
+    if (out.message.empty()) out.message = head(body, 300);
     return out;
 }
 
@@ -187,9 +196,10 @@ std::string redact(std::string text, const std::string& key) {
             at += 3;
             continue;
         }
+        // Key characters only, so that a key quoted in JSON leaves the quotes and braces intact.
         size_t end = at;
-        while (end < text.size() && !std::isspace(static_cast<unsigned char>(text[end])) &&
-               text[end] != '.' && text[end] != ',')
+        while (end < text.size() && (std::isalnum(static_cast<unsigned char>(text[end])) ||
+                                     text[end] == '-' || text[end] == '_' || text[end] == '*'))
             ++end;
         text.replace(at, end - at, "[redacted]");
         at += 10;
@@ -215,12 +225,12 @@ struct Answer {
     uint64_t promptTokens = 0, completionTokens = 0;
 };
 
-Result<Answer> readAnswer(const LlmEndpoint& e, std::string_view body) {
+Result<Answer> readAnswer(const LlmEndpoint& e, std::string_view body, const std::string& key) {
     dom::parser parser;
     dom::element top;
     auto unexpected = [&](const std::string& what) {
-        return remote(e.url,
-                      "unexpected answer (" + what + "): " + std::string(body.substr(0, 200)));
+        return remote(e.url, "unexpected answer (" + what +
+                                 "): " + printable(redact(std::string(head(body, 200)), key)));
     };
     if (parser.parse(body.data(), body.size()).get(top) || !top.is_object())
         return unexpected("not a JSON object");
@@ -332,11 +342,11 @@ class Conversation {
             auto response = exchange(body, status);
             if (!response) return response.error();
             const long code = response->status;
-            if (code >= 200 && code < 300) return readAnswer(e_, response->body);
+            if (code >= 200 && code < 300) return readAnswer(e_, response->body, config.apiKey);
 
             const ServerError error = serverError(response->body);
-            const std::string reason =
-                "HTTP " + std::to_string(code) + ": " + redact(error.message, config.apiKey);
+            const std::string reason = "HTTP " + std::to_string(code) + ": " +
+                                       printable(redact(error.message, config.apiKey));
             if ((code == 429 && error.code != "insufficient_quota") || code >= 500) {
                 if (retries >= config.maxRetries)
                     return remote(e_.url, reason + " (gave up after " +
@@ -507,7 +517,8 @@ Result<Generated> generate(std::string_view request, const GenerateOptions& opti
         ++stats.answers;
         stats.promptTokens += answer->promptTokens;
         stats.completionTokens += answer->completionTokens;
-        if (!answer->refusal.empty()) return remote(url, "the model refused: " + answer->refusal);
+        if (!answer->refusal.empty())
+            return remote(url, "the model refused: " + printable(answer->refusal));
         if (answer->finishReason == "content_filter")
             return remote(url, "the server's content filter withheld the answer");
         if (answer->finishReason == "length")
@@ -551,15 +562,16 @@ Result<Generated> generate(std::string_view request, const GenerateOptions& opti
 } // namespace
 
 // A server or a model may quote the key back, a hostile one on purpose (the fuzz target
-// fuzz_llm found a body quoted in an error): nothing that leaves here carries it.
+// fuzz_llm found a body quoted in an error): nothing that leaves here carries it. Nor can
+// remote text in a message drive the terminal it is printed on.
 Result<Generated> generateScene(std::string_view request, const GenerateOptions& options,
                                 GenerateStats* stats) {
     auto result = generate(request, options, stats);
     const std::string& key = options.llm.apiKey;
     auto clean = [&](std::vector<Diagnostic>& diagnostics) {
         for (Diagnostic& d : diagnostics) {
-            d.path = redact(std::move(d.path), key);
-            d.message = redact(std::move(d.message), key);
+            d.path = printable(redact(std::move(d.path), key));
+            d.message = printable(redact(std::move(d.message), key));
         }
     };
     if (result) {

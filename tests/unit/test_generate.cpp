@@ -312,6 +312,51 @@ TEST_F(Generate, KeyEchoedByTheServerIsRedacted) {
     EXPECT_NE(g.error().str().find("[redacted]"), std::string::npos) << g.error().str();
 }
 
+// Error messages, a refusal, a body that is no answer and the validator's problems all carry
+// the server's or the model's text: none reaches the terminal with an ESC sequence, a forged
+// line or bytes that are not UTF-8.
+TEST_F(Generate, RemoteTextCannotDriveTheTerminal) {
+    const std::string url = server.url() + "/chat/completions: ";
+    server.script({openAiError(400, "\x1b[2J\x1b[31mbad request\nsdfcsg: wrote scene.json")});
+    auto g = generateScene("a sphere", options());
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().str(),
+              url + "HTTP 400: \\u001b[2J\\u001b[31mbad request\\nsdfcsg: wrote scene.json");
+
+    server.script({{200, "\xff\xfe<html>\x1b]0;owned\x07\xc2\x9b"
+                         "31m\x7f"}});
+    g = generateScene("a sphere", options());
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().str(), url + "unexpected answer (not a JSON object): "
+                                     "\\xff\\xfe<html>\\u001b]0;owned\\u0007\\u009b31m\\u007f");
+
+    server.script({{200, R"({"choices": [{"index": 0, "message": {"role": "assistant",
+        "content": null, "refusal": "no\u001b[8m"}, "finish_reason": "stop"}]})"}});
+    g = generateScene("a sphere", options());
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().str(), url + "the model refused: no\\u001b[8m");
+
+    // Retried errors are shown while waiting.
+    server.script({openAiError(503, "busy\r\x1b[1A"), openAi(kSphere)});
+    progress.clear();
+    ASSERT_TRUE(generateScene("a sphere", options()));
+    ASSERT_GE(progress.size(), 2u);
+    EXPECT_EQ(progress[1], "HTTP 503: busy\\r\\u001b[1A; retrying in 0.5 s (attempt 2 of 5)");
+
+    // A scene key in the answer, quoted by the validator.
+    auto o = options();
+    o.maxRepairs = 0;
+    server.script({openAi(R"({"version": 1, "root": {"type": "sphere", "radius": 1,
+        "\u001b[2J": 1}})")});
+    g = generateScene("a sphere", o);
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().diagnostics.back().str(),
+              "answer: root: unknown key \"\\u001b[2J\" for a sphere; valid keys: radius, type, "
+              "name, translate, rotate, scale and color");
+    for (const Diagnostic& d : g.error().diagnostics)
+        EXPECT_EQ(d.str().find('\x1b'), std::string::npos) << d.str();
+}
+
 TEST_F(Generate, RateLimitedHonoursRetryAfter) {
     server.script(
         {{429, R"({"error": {"message": "Rate limit reached", "code": "rate_limit_exceeded"}})",

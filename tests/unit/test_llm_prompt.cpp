@@ -215,6 +215,16 @@ TEST(LlmSanity, DifferenceThatRemovesNothing) {
                                        "from"});
 }
 
+// A name is the model's text: quoted and escaped as the validator quotes strings.
+TEST(LlmSanity, NamesAreQuotedAndEscaped) {
+    EXPECT_EQ(warnings(R"({"version": 1, "root": {"type": "difference", "children": [
+        {"type": "box", "name": "block\u001b[2J\nroot: fine \"", "size": [1, 1, 1]},
+        {"type": "sphere", "radius": 0.3, "translate": [3, 0, 0]}]}})"),
+              std::vector<std::string>{"root.children[1]: removes nothing: it does not reach "
+                                       "root.children[0] (\"block\\u001b[2J\\nroot: fine \\\"\"), "
+                                       "the part it is subtracted from"});
+}
+
 TEST(LlmSanity, PartsFloatingApart) {
     EXPECT_EQ(
         warnings(R"({"version": 1, "root": {"type": "union", "children": [{"type": "union",
