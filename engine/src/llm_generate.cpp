@@ -207,6 +207,15 @@ std::string redact(std::string text, const std::string& key) {
     return text;
 }
 
+// The strings of a loaded scene. The answer's text was redacted before it was parsed, but a key
+// written with JSON escapes ("\u0073k-...") reads back as the key itself.
+void redactStrings(Scene& scene, const std::string& key) {
+    scene.name = redact(std::move(scene.name), key);
+    scene.description = redact(std::move(scene.description), key);
+    for (Node& node : scene.nodes)
+        node.name = redact(std::move(node.name), key);
+}
+
 // Seconds to wait for a Retry-After value: delta-seconds, or an HTTP date.
 std::optional<double> retryAfterSeconds(const std::string& value) {
     if (value.empty()) return std::nullopt;
@@ -410,7 +419,7 @@ class Conversation {
                                           std::to_string(options_.replay->size()) +
                                           " exchanges, and a further request was made");
             const HttpExchange& x = (*options_.replay)[replayed_++];
-            if (options_.record) options_.record->push_back(x);
+            if (options_.record) keep(x);
             return detail::HttpResponse{x.status, x.response, x.retryAfter};
         }
         detail::HttpPost post;
@@ -424,9 +433,19 @@ class Conversation {
         post.cancelled = options_.cancelled;
         auto response = detail::httpPost(post);
         if (response && options_.record)
-            options_.record->push_back(
-                {e_.url, body, response->status, response->retryAfter, response->body});
+            keep({e_.url, body, response->status, response->retryAfter, response->body});
         return response;
+    }
+
+    // A recording is a file that gets shared: a key that the server echoed (in a 400 that
+    // quotes the request's headers, say) or that the model repeated does not go into it.
+    void keep(HttpExchange x) {
+        const std::string& key = options_.llm.apiKey;
+        x.url = redact(std::move(x.url), key);
+        x.request = redact(std::move(x.request), key);
+        x.retryAfter = redact(std::move(x.retryAfter), key);
+        x.response = redact(std::move(x.response), key);
+        options_.record->push_back(std::move(x));
     }
 
     bool cancelled() const { return options_.cancelled && options_.cancelled(); }
@@ -526,11 +545,15 @@ Result<Generated> generate(std::string_view request, const GenerateOptions& opti
                                    std::to_string(options.llm.maxTokens) +
                                    " tokens); ask for a simpler scene or raise the limit");
 
+        // A model may repeat the key (a prompt injection may ask it to): it goes neither into
+        // the scene nor back into the conversation.
+        answer->content = redact(std::move(answer->content), options.llm.apiKey);
         const std::string json = withoutNulls(extractJson(answer->content), options.limits);
         auto scene = parseScene(json, kAnswerFile, options.limits);
         if (scene) {
             stats.valid = true;
             stats.firstTryValid = round == 0;
+            redactStrings(*scene, options.llm.apiKey);
             Generated out;
             out.warnings = sceneSanityWarnings(*scene);
             out.json = toJson(*scene);

@@ -6,8 +6,8 @@
 // the response body.
 //
 // Whatever the answer, the result is a scene that loads again from its own JSON, or an Error
-// with a message, and the API key appears in no message (a hostile server may echo it back). The
-// scene itself is the model's answer and is kept as it came.
+// with a message, and the API key appears in no message, warning or scene (a hostile server may
+// echo it back).
 #include <sdfcsg/generate.h>
 
 #include <cstdint>
@@ -52,6 +52,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         if (text.find(kKey) != std::string::npos) fail("the API key is in an error", text);
         return 0;
     }
+    if (generated->json.find(kKey) != std::string::npos)
+        fail("the API key is in the scene", generated->json);
     for (const sdfcsg::Diagnostic& warning : generated->warnings)
         if (warning.str().find(kKey) != std::string::npos)
             fail("the API key is in a warning", warning.str());

@@ -294,7 +294,8 @@ TEST_F(Generate, Unauthorized) {
 }
 
 // A server that quotes the key back, in a body that is no answer and in a scene key: neither
-// message carries it (fuzz_llm found the first).
+// message carries it (fuzz_llm found the first). Nor does a recording of a server that echoes
+// the Authorization header, or a scene whose model repeated the key.
 TEST_F(Generate, KeyEchoedByTheServerIsRedacted) {
     server.script({{200, std::string("<html>bad key ") + kKey + "</html>"}});
     auto g = generateScene("a sphere", options());
@@ -310,6 +311,56 @@ TEST_F(Generate, KeyEchoedByTheServerIsRedacted) {
     ASSERT_FALSE(g);
     EXPECT_EQ(g.error().str().find(kKey), std::string::npos) << g.error().str();
     EXPECT_NE(g.error().str().find("[redacted]"), std::string::npos) << g.error().str();
+
+    // The header echoed in a 400, with OpenAI's masked form of the key at the end.
+    std::vector<HttpExchange> recording;
+    o.record = &recording;
+    Scripted echo = openAiError(
+        400, "invalid header 'Authorization: $AUTHORIZATION'; the key is sk-test-****6789");
+    echo.echo = true;
+    server.script({echo});
+    g = generateScene("a sphere", o);
+    ASSERT_FALSE(g);
+    const std::string expected = server.url() + "/chat/completions: HTTP 400: invalid header "
+                                                "'Authorization: Bearer [redacted]'; the key is "
+                                                "[redacted]";
+    EXPECT_EQ(g.error().str(), expected);
+    ASSERT_EQ(recording.size(), 1u);
+    ASSERT_NE(server.received().back().headers.count("Authorization"), 0u);
+    EXPECT_NE(recording[0].response.find("Bearer [redacted]"), std::string::npos)
+        << recording[0].response;
+    EXPECT_EQ(recordingToJson(recording).find(kKey), std::string::npos);
+    EXPECT_EQ(recordingToJson(recording).find("sk-test-"), std::string::npos);
+    // The redacted body is still the server's JSON, so a replay fails the same way.
+    auto replay = parseRecording(recordingToJson(recording));
+    ASSERT_TRUE(replay);
+    auto r = o;
+    r.record = nullptr;
+    r.replay = &*replay;
+    auto replayed = generateScene("a sphere", r);
+    ASSERT_FALSE(replayed);
+    EXPECT_EQ(replayed.error().str(), expected);
+
+    // A model that repeats the key, as it is and with a JSON escape: the scene, the recording
+    // and the next request keep none of it.
+    recording.clear();
+    o.maxRepairs = 1;
+    server.script(
+        {openAi(std::string(R"({"version": 1, "root": {"type": "sphere", "radius": -1,
+        "name": ")") +
+                kKey + R"("}})"),
+         openAi(std::string(R"({"version": 1, "name": ")") + kKey +
+                R"(", "description": "key: \u0073)" + (kKey + 1) +
+                R"(", "root": {"type": "sphere", "radius": 1, "name": ")" + kKey + R"("}})")});
+    g = generateScene("a sphere", o);
+    ASSERT_TRUE(g) << g.error().str();
+    EXPECT_EQ(g->json.find(kKey), std::string::npos) << g->json;
+    EXPECT_EQ(g->scene.name, "[redacted]");
+    EXPECT_EQ(g->scene.description, "key: [redacted]");
+    EXPECT_EQ(g->scene.nodes[0].name, "[redacted]");
+    EXPECT_EQ(g->json, toJson(g->scene));
+    EXPECT_EQ(recordingToJson(recording).find(kKey), std::string::npos);
+    EXPECT_EQ(server.received().back().body.find(kKey), std::string::npos);
 }
 
 // Error messages, a refusal, a body that is no answer and the validator's problems all carry

@@ -9,7 +9,8 @@
 //
 // Model output is untrusted: it is parsed under Limits (size, node count, nesting), and a scene
 // names no files, so an answer cannot make the program read or write anything. The API key is
-// sent in the Authorization header only; it is never printed, logged or recorded.
+// sent in the Authorization header only; it is never printed, logged or recorded, and where a
+// server echoes it or a model repeats it, messages, recordings and scenes say "[redacted]".
 #pragma once
 
 #include "sdfcsg/error.h"
@@ -67,7 +68,8 @@ struct LlmEndpoint {
 };
 Result<LlmEndpoint> llmEndpoint(const LlmConfig& config);
 
-// One HTTP exchange, as recorded and replayed. It holds no headers, so never the API key.
+// One HTTP exchange, as recorded and replayed. It holds no headers, and the API key is redacted
+// from what it holds (a server may echo the key in a body).
 struct HttpExchange {
     std::string url;
     std::string request; // request body
