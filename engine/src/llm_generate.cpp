@@ -33,6 +33,12 @@ namespace dom = simdjson::dom;
 using Clock = std::chrono::steady_clock;
 
 constexpr std::string_view kAnswerFile = "answer";
+// An HTTP answer holds one scene, escaped as a JSON string (quotes and newlines double), and
+// perhaps the model's reasoning: four times the scene limit leaves room for both, and a server
+// cannot make a client whose scenes are limited to 1 MiB read 16 MiB.
+constexpr size_t kResponsesPerScene = 4;
+// How much of an oversized answer goes back in a repair round.
+constexpr size_t kEchoExcerpt = 1000;
 
 struct Message {
     std::string role;
@@ -330,6 +336,24 @@ std::string withoutNulls(const std::string& text, const Limits& limits) {
     return out;
 }
 
+// The HTTP answer limit: LlmConfig::maxResponseBytes, or less where the scene limit is small.
+size_t responseLimit(const GenerateOptions& options) {
+    const size_t scene = options.limits.maxFileBytes;
+    if (scene > SIZE_MAX / kResponsesPerScene) return options.llm.maxResponseBytes;
+    return std::min(options.llm.maxResponseBytes, kResponsesPerScene * scene);
+}
+
+// The assistant turn of a repair round. Every later request carries it again, so an answer
+// larger than a scene may be (which the validator refused for its size alone) goes back as an
+// excerpt: in full, a 10 MB answer made the three repair requests 10, 21 and 31 MB long.
+std::string echoedAnswer(const std::string& content, const Limits& limits) {
+    if (content.size() <= limits.maxFileBytes) return content;
+    return std::string(head(content, kEchoExcerpt)) +
+           "\n[the rest of this answer is left out: " + std::to_string(content.size()) +
+           " bytes in all, more than a scene may have (" + std::to_string(limits.maxFileBytes) +
+           ")]";
+}
+
 // One conversation: sends requests, retries, adapts to the server, counts.
 class Conversation {
   public:
@@ -428,7 +452,7 @@ class Conversation {
         post.apiKey = options_.llm.apiKey;
         post.timeoutSeconds = options_.llm.timeoutSeconds;
         post.connectTimeoutSeconds = options_.llm.connectTimeoutSeconds;
-        post.maxResponseBytes = options_.llm.maxResponseBytes;
+        post.maxResponseBytes = responseLimit(options_);
         post.tick = [&](double elapsed) { progress(status, elapsed, true); };
         post.cancelled = options_.cancelled;
         auto response = detail::httpPost(post);
@@ -577,7 +601,7 @@ Result<Generated> generate(std::string_view request, const GenerateOptions& opti
                                   (problems.diagnostics.size() == 1 ? " problem" : " problems") +
                                   "); asking for a correction",
                               0.0, false});
-        messages.push_back({"assistant", answer->content});
+        messages.push_back({"assistant", echoedAnswer(answer->content, options.limits)});
         messages.push_back({"user", sceneRepairPrompt(problems)});
     }
 }

@@ -201,6 +201,42 @@ TEST_F(Generate, AnswerLargerThanTheLimitIsRefused) {
               server.url() + "/chat/completions: the answer exceeds the limit of 2048 bytes");
 }
 
+// An answer too large for a scene goes back in the repair round as an excerpt, since every later
+// request carries it again; an HTTP answer beyond four times the scene limit is not read at all.
+TEST_F(Generate, OversizedAnswerIsNotEchoedBack) {
+    GenerateOptions o = options();
+    o.limits.maxFileBytes = 4096;
+    const std::string big = R"({"version": 1, "name": ")" + std::string(12000, 'x') +
+                            R"(", "root": {"type": "sphere", "radius": 1}})";
+    server.script({openAi(big), openAi(big), openAi(kSphere)});
+    GenerateStats stats;
+    auto g = generateScene("a sphere", o, &stats);
+    ASSERT_TRUE(g) << g.error().str();
+    EXPECT_EQ(stats.answers, 3);
+    auto received = server.received();
+    ASSERT_EQ(received.size(), 3u);
+    EXPECT_LT(received[1].body.size(), received[0].body.size() + 2000);
+    EXPECT_LT(received[2].body.size(), received[0].body.size() + 4000);
+    simdjson::dom::array messages = body(1)["messages"];
+    ASSERT_EQ(messages.size(), 4u);
+    std::string_view echoed = messages.at(2)["content"];
+    EXPECT_EQ(echoed, big.substr(0, 1000) +
+                          "\n[the rest of this answer is left out: " + std::to_string(big.size()) +
+                          " bytes in all, more than a scene may have (4096)]");
+    EXPECT_EQ(lastMessage(body(1)),
+              "Your scene does not load. The validator reported:\n"
+              "- file too large: " +
+                  std::to_string(big.size()) +
+                  " bytes (the limit is 4096 bytes)\n"
+                  "Answer with the whole corrected scene as one JSON object, and nothing else.");
+
+    server.script({openAi(std::string(20000, ' ') + kSphere)});
+    g = generateScene("a sphere", o);
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().str(),
+              server.url() + "/chat/completions: the answer exceeds the limit of 16384 bytes");
+}
+
 TEST_F(Generate, FinishReasonLength) {
     server.script({openAi(R"({"version": 1, "root": {"type": "uni)", "length")});
     auto g = generateScene("a sphere", options());

@@ -51,7 +51,9 @@ struct LlmConfig {
     uint32_t maxTokens = 8192;        // answer length limit
     std::optional<float> temperature = 0.2f; // unset: the server's default
     uint32_t contextTokens = 16384; // Ollama's options.num_ctx (its default is far too small)
-    size_t maxResponseBytes = 16u << 20; // a longer HTTP answer is cut off with a Remote error
+    // A longer HTTP answer is cut off with a Remote error. generateScene() stops at four times
+    // GenerateOptions::limits.maxFileBytes if that is less (4 MiB for its default limits).
+    size_t maxResponseBytes = 16u << 20;
 };
 
 // Settings from the environment: OPENAI_BASE_URL and OPENAI_API_KEY, overridden by
