@@ -244,3 +244,25 @@ TEST(LlmSanity, AbsurdBounds) {
               std::vector<std::string>{"root: absurd bounds: the scene lies 4000 units from the "
                                        "origin"});
 }
+
+// Bounds at the edge of single precision and beyond it: the size or the distance that the scene
+// really has, never an empty solid or silence.
+TEST(LlmSanity, AbsurdBoundsBeyondSinglePrecision) {
+    EXPECT_EQ(warnings(R"({"version": 1, "root": {"type": "sphere", "radius": 3e38}})"),
+              std::vector<std::string>{
+                  "root: absurd bounds: the scene is 6e+38 units across (expected 0.001 to 1000)"});
+    EXPECT_EQ(warnings(R"({"version": 1, "root": {"type": "sphere", "radius": 1,
+        "translate": [3e38, 0, 0]}})"),
+              std::vector<std::string>{
+                  "root: absurd bounds: the scene lies 3e+38 units from the origin"});
+    EXPECT_EQ(warnings(R"({"version": 1, "root": {"type": "sphere", "radius": 1e30,
+        "scale": 1e30}})"),
+              std::vector<std::string>{
+                  "root: absurd bounds: the scene is 2e+60 units across (expected 0.001 to 1000)"});
+    // With a plane, whose bounds are infinite anyway.
+    EXPECT_EQ(warnings(R"({"version": 1, "root": {"type": "union", "children": [
+        {"type": "plane", "normal": [0, 1, 0]},
+        {"type": "sphere", "radius": 1e30, "scale": 1e30, "translate": [0, 1e-29, 0]}]}})"),
+              std::vector<std::string>{
+                  "root: absurd bounds: the scene is 2e+60 units across (expected 0.001 to 1000)"});
+}
