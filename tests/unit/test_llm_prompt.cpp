@@ -4,6 +4,7 @@
 #include <sdfcsg/generate.h>
 
 #include "embedded_shaders.h"
+#include "shared.h"
 
 #include <gtest/gtest.h>
 
@@ -71,6 +72,28 @@ TEST(LlmPrompt, SystemPromptHoldsTheGeneratedReference) {
                       std::string::npos)
                 << kind.name << "." << p.name;
     }
+}
+
+// The top-level keys come from the scene schema: every one is listed with its shape, and so are
+// the limits that the schema states (the number of lights).
+TEST(LlmPrompt, SystemPromptListsEveryTopLevelKey) {
+    const std::string prompt = sceneSystemPrompt();
+    const std::string schema = sceneJsonSchema();
+    simdjson::dom::parser parser;
+    simdjson::dom::element top = parser.parse(schema);
+    for (auto [key, value] : simdjson::dom::object(top["properties"]))
+        EXPECT_NE(prompt.find("\n- \"" + std::string(key) + "\": "), std::string::npos) << key;
+    for (const char* def : {"camera", "light"})
+        for (auto [key, value] : simdjson::dom::object(top["$defs"][def]["properties"]))
+            EXPECT_NE(prompt.find("\"" + std::string(key) + "\": "), std::string::npos)
+                << def << "." << key;
+    EXPECT_NE(prompt.find("- \"lights\": up to " + std::to_string(SDFCSG_MAX_LIGHTS) +
+                          " of {\"direction\": [x, y, z], \"color\": [r, g, b], \"intensity\": "
+                          "number}. "),
+              std::string::npos);
+    EXPECT_NE(prompt.find("- \"camera\": {\"eye\": [x, y, z], \"target\": [x, y, z], \"up\": "
+                          "[x, y, z], \"fov\": degrees}. "),
+              std::string::npos);
 }
 
 TEST(LlmPrompt, UserPromptForAnEdit) {
