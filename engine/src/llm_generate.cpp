@@ -63,6 +63,11 @@ std::string seconds(double s) {
     return text;
 }
 
+// "1 request", "2 requests".
+std::string counted(size_t n, std::string_view noun) {
+    return std::to_string(n) + " " + std::string(noun) + (n == 1 ? "" : "s");
+}
+
 // The first `size` bytes of `text` or a little fewer, cut between UTF-8 sequences.
 std::string_view head(std::string_view text, size_t size) {
     if (text.size() <= size) return text;
@@ -383,7 +388,7 @@ class Conversation {
             if ((code == 429 && error.code != "insufficient_quota") || code >= 500) {
                 if (retries >= config.maxRetries)
                     return remote(e_.url, reason + " (gave up after " +
-                                              std::to_string(retries + 1) + " attempts)");
+                                              counted(size_t(retries) + 1, "attempt") + ")");
                 double delay = config.retryBaseSeconds * std::pow(2.0, retries);
                 if (auto after = retryAfterSeconds(response->retryAfter)) delay = *after;
                 delay = std::min(delay, config.maxRetryDelaySeconds);
@@ -440,8 +445,8 @@ class Conversation {
         if (options_.replay) {
             if (replayed_ >= options_.replay->size())
                 return remote(e_.url, "the recording holds " +
-                                          std::to_string(options_.replay->size()) +
-                                          " exchanges, and a further request was made");
+                                          counted(options_.replay->size(), "exchange") +
+                                          ", and a further request was made");
             const HttpExchange& x = (*options_.replay)[replayed_++];
             if (options_.record) keep(x);
             return detail::HttpResponse{x.status, x.response, x.retryAfter};
@@ -573,7 +578,12 @@ Result<Generated> generate(std::string_view request, const GenerateOptions& opti
         // the scene nor back into the conversation.
         answer->content = redact(std::move(answer->content), options.llm.apiKey);
         const std::string json = withoutNulls(extractJson(answer->content), options.limits);
-        auto scene = parseScene(json, kAnswerFile, options.limits);
+        // Null content (or none, or not a string) would read as an empty scene file.
+        auto scene =
+            json.empty()
+                ? Result<Scene>(Error::message(ErrorKind::Validation, std::string(kAnswerFile),
+                                               "the model returned no text"))
+                : parseScene(json, kAnswerFile, options.limits);
         if (scene) {
             stats.valid = true;
             stats.firstTryValid = round == 0;
@@ -591,14 +601,14 @@ Result<Generated> generate(std::string_view request, const GenerateOptions& opti
             e.diagnostics.insert(e.diagnostics.begin(),
                                  Diagnostic{std::string(kAnswerFile),
                                             {},
-                                            "no answer loaded after " + std::to_string(rounds) +
-                                                " repair rounds; the last one's problems:"});
+                                            "no answer loaded after " +
+                                                counted(size_t(rounds), "repair round") +
+                                                "; the last one's problems:"});
             return e;
         }
         if (options.progress)
             options.progress({"the answer does not load (" +
-                                  std::to_string(problems.diagnostics.size()) +
-                                  (problems.diagnostics.size() == 1 ? " problem" : " problems") +
+                                  counted(problems.diagnostics.size(), "problem") +
                                   "); asking for a correction",
                               0.0, false});
         messages.push_back({"assistant", echoedAnswer(answer->content, options.limits)});
@@ -632,16 +642,16 @@ Result<Generated> generateScene(std::string_view request, const GenerateOptions&
 
 std::string generationSummary(const Generated& generated, const GenerateStats& stats) {
     const int repairs = stats.answers - 1;
-    const std::string validity = stats.firstTryValid
-                                     ? "valid on the first try"
-                                     : "valid after " + std::to_string(repairs) +
-                                           (repairs == 1 ? " repair round" : " repair rounds");
+    const std::string validity =
+        stats.firstTryValid
+            ? "valid on the first try"
+            : "valid after " + counted(size_t(std::max(repairs, 0)), "repair round");
     char text[256];
-    std::snprintf(text, sizeof text,
-                  "%zu nodes, %s (%.*s, %d requests, %llu + %llu tokens, %.1f s)",
-                  generated.scene.nodes.size(), validity.c_str(),
+    std::snprintf(text, sizeof text, "%s, %s (%.*s, %s, %llu + %llu tokens, %.1f s)",
+                  counted(generated.scene.nodes.size(), "node").c_str(), validity.c_str(),
                   int(outputModeName(stats.mode).size()), outputModeName(stats.mode).data(),
-                  stats.requests, static_cast<unsigned long long>(stats.promptTokens),
+                  counted(size_t(std::max(stats.requests, 0)), "request").c_str(),
+                  static_cast<unsigned long long>(stats.promptTokens),
                   static_cast<unsigned long long>(stats.completionTokens), stats.seconds);
     return text;
 }

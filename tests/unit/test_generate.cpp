@@ -170,6 +170,71 @@ TEST_F(Generate, RepairLimitReached) {
     EXPECT_EQ(server.received().size(), 3u);
 }
 
+// No text is no scene file: the message says so, instead of "expected a JSON value, got end of
+// input".
+TEST_F(Generate, AnswerWithoutTextSaysSo) {
+    GenerateOptions o = options();
+    o.maxRepairs = 0;
+    for (const char* content : {"null", "42", R"([{"type": "text"}])", R"("  ")"}) {
+        SCOPED_TRACE(content);
+        server.script({{200, std::string(R"({"choices": [{"index": 0, "message": {"role":
+            "assistant", "content": )") +
+                                 content + R"(}, "finish_reason": "stop"}]})"}});
+        auto g = generateScene("a sphere", o);
+        ASSERT_FALSE(g);
+        EXPECT_EQ(g.error().str(), "answer: no answer loaded after 0 repair rounds; the last "
+                                   "one's problems:\nanswer: the model returned no text");
+    }
+    server.script({{200, R"({"message": {"role": "assistant"}, "done": true})"},
+                   {200, R"({"message": {"role": "assistant", "content": )" + jsonQuote(kSphere) +
+                             R"(}, "done": true})"}});
+    o.maxRepairs = 1;
+    o.llm.baseUrl = server.url("");
+    o.llm.api = LlmApi::Ollama;
+    ASSERT_TRUE(generateScene("a sphere", o));
+    EXPECT_EQ(progress.back(), "asking test-model for a correction, round 1 of 1 (json_schema)");
+    EXPECT_EQ(lastMessage(body(server.received().size() - 1)),
+              "Your scene does not load. The validator reported:\n- the model returned no "
+              "text\nAnswer with the whole corrected scene as one JSON object, and nothing else.");
+}
+
+// One of a thing is said in the singular.
+TEST_F(Generate, CountsInTheSingular) {
+    server.script({openAi(kSphere)});
+    GenerateStats stats;
+    auto g = generateScene("a sphere", options(), &stats);
+    ASSERT_TRUE(g);
+    EXPECT_TRUE(generationSummary(*g, stats).starts_with(
+        "1 node, valid on the first try (json_schema, 1 request, 100 + 20 "
+        "tokens, "))
+        << generationSummary(*g, stats);
+    stats.firstTryValid = false;
+    stats.answers = 2;
+    EXPECT_NE(generationSummary(*g, stats).find("valid after 1 repair round ("), std::string::npos);
+
+    GenerateOptions o = options();
+    o.maxRepairs = 1;
+    server.script({openAi(kBadSphere), openAi(kBadSphere)});
+    g = generateScene("a sphere", o);
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().diagnostics[0].message,
+              "no answer loaded after 1 repair round; the last one's problems:");
+
+    o.llm.maxRetries = 0;
+    server.script({{503, "Service Unavailable"}});
+    g = generateScene("a sphere", o);
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().diagnostics[0].message,
+              "HTTP 503: Service Unavailable (gave up after 1 attempt)");
+
+    std::vector<HttpExchange> one = {{"", "", 200, "", openAi(kBadSphere).body}};
+    o.replay = &one;
+    g = generateScene("a sphere", o);
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().diagnostics[0].message,
+              "the recording holds 1 exchange, and a further request was made");
+}
+
 TEST_F(Generate, UntrustedAnswerLimits) {
     // Too many nodes, and a key that would name a file: both refused by the validator.
     std::string many = R"({"version": 1, "root": {"type": "union", "children": [)";
