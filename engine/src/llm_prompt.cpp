@@ -220,6 +220,17 @@ std::string sceneSystemPrompt() {
     out += "\n";
     out += kRules;
     out += "\n## Examples\n";
+    const std::vector<std::string> requests = sceneExampleRequests();
+    const auto examples = detail::embeddedExampleScenes();
+    for (size_t i = 0; i < examples.size(); ++i) {
+        out += "\nRequest: " + requests[i] + "\nAnswer:\n" + std::string(examples[i].text);
+        if (!examples[i].text.ends_with('\n')) out += "\n";
+    }
+    return out;
+}
+
+std::vector<std::string> sceneExampleRequests() {
+    std::vector<std::string> out;
     for (const detail::EmbeddedFile& example : detail::embeddedExampleScenes()) {
         // Each example's request is its own description.
         std::string request = "a scene";
@@ -229,8 +240,7 @@ std::string sceneSystemPrompt() {
             std::string_view d;
             if (!top["description"].get(d)) request = d;
         }
-        out += "\nRequest: " + request + "\nAnswer:\n" + std::string(example.text);
-        if (!example.text.ends_with('\n')) out += "\n";
+        out.push_back(std::move(request));
     }
     return out;
 }

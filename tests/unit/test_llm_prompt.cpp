@@ -47,13 +47,17 @@ TEST(LlmPrompt, ExamplesAreBundledScenesThatValidate) {
     auto examples = detail::embeddedExampleScenes();
     ASSERT_GE(examples.size(), 2u);
     ASSERT_LE(examples.size(), 3u);
-    for (const detail::EmbeddedFile& example : examples) {
+    const std::vector<std::string> requests = sceneExampleRequests();
+    ASSERT_EQ(requests.size(), examples.size());
+    for (size_t i = 0; i < examples.size(); ++i) {
+        const detail::EmbeddedFile& example = examples[i];
         SCOPED_TRACE(std::string(example.name));
         EXPECT_EQ(example.text, readFile(fs::path(SDFCSG_SOURCE_DIR) / "assets/scenes" /
                                          std::string(example.name)));
         auto scene = parseScene(example.text, example.name);
         ASSERT_TRUE(scene) << scene.error().str();
         EXPECT_FALSE(scene->description.empty()); // it is the example's request
+        EXPECT_EQ(requests[i], scene->description);
         EXPECT_TRUE(sceneSanityWarnings(*scene).empty());
         EXPECT_NE(sceneSystemPrompt().find("Request: " + scene->description + "\nAnswer:\n" +
                                            std::string(example.text)),

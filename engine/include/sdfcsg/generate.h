@@ -142,6 +142,9 @@ std::string generationSummary(const Generated& generated, const GenerateStats& s
 
 // The system prompt: the format reference, the composition rules and the examples.
 std::string sceneSystemPrompt();
+// The requests that the system prompt's examples answer (each example scene's description), in
+// order. A request close to one of them is no fair test of the model (`sdfcsg eval-prompts`).
+std::vector<std::string> sceneExampleRequests();
 // The first user message for a request (and, when editing, the current scene).
 std::string sceneUserPrompt(std::string_view request, std::string_view currentScene = {});
 // The message that asks for a corrected scene, quoting the validator's problems.
