@@ -11,10 +11,15 @@
 
 #include <simdjson.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <deque>
+#include <filesystem>
+#include <fstream>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -22,6 +27,7 @@
 using namespace sdfcsg;
 using namespace sdfcsg::test;
 using detail::jsonQuote;
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -671,21 +677,44 @@ TEST_F(Generate, EditSendsTheCurrentScene) {
         lastMessage(body(0)).starts_with("Here is the current scene:\n{\n  \"version\": 1"));
 }
 
+// The whole first request, byte for byte, against a checked-in file, so that any change to the
+// prompt, the schema or the body shows as a change of tests/data/llm/first_request.json. On a
+// difference the body sent is written to SDFCSG_TEST_OUTPUT_DIR/llm/first_request.actual.json;
+// SDFCSG_UPDATE_GOLDEN=1 rewrites the checked-in file instead, as for the golden images.
 TEST_F(Generate, RequestBodyGolden) {
     server.script({openAi(kSphere)});
     ASSERT_TRUE(generateScene("a red sphere", options()));
-    std::string golden =
-        R"({"model":"test-model","messages":[{"role":"system","content":SYSTEM},)"
-        R"({"role":"user","content":"Request: a red sphere"}],"temperature":0.2,"max_tokens":8192,)"
-        R"("response_format":{"type":"json_schema","json_schema":{"name":"sdfcsg_scene",)"
-        R"("strict":true,"schema":SCHEMA}}})";
-    golden.replace(golden.find("SYSTEM"), 6, jsonQuote(sceneSystemPrompt()));
-    golden.replace(golden.find("SCHEMA"), 6, sceneLlmSchema());
-    EXPECT_EQ(server.received()[0].body, golden);
+    const std::string sent = server.received().at(0).body;
     auto preview = firstLlmRequest("a red sphere", options());
     ASSERT_TRUE(preview);
-    EXPECT_EQ(preview->body, golden);
+    EXPECT_TRUE(preview->body == sent); // not EXPECT_EQ: it would print 40 kB twice
     EXPECT_EQ(preview->url, server.url() + "/chat/completions");
+
+    const fs::path golden = fs::path(SDFCSG_SOURCE_DIR) / "tests/data/llm/first_request.json";
+    if (const char* update = std::getenv("SDFCSG_UPDATE_GOLDEN");
+        update && std::string(update) == "1") {
+        std::ofstream(golden, std::ios::binary) << sent;
+        std::printf("updated %s\n", golden.string().c_str());
+        return;
+    }
+    std::ifstream in(golden, std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    const std::string expected = text.str();
+    const fs::path actual = fs::path(SDFCSG_TEST_OUTPUT_DIR) / "llm" / "first_request.actual.json";
+    fs::remove(actual);
+    if (sent == expected) return;
+    fs::create_directories(actual.parent_path());
+    std::ofstream(actual, std::ios::binary) << sent;
+    const size_t at =
+        size_t(std::mismatch(sent.begin(), sent.end(), expected.begin(), expected.end()).first -
+               sent.begin());
+    ADD_FAILURE() << "the first request differs from " << golden << " from byte " << at
+                  << ":\n  sent:     ..." << sent.substr(at > 40 ? at - 40 : 0, 120)
+                  << "\n  expected: ..." << expected.substr(at > 40 ? at - 40 : 0, 120)
+                  << "\n  The whole body sent is in " << actual
+                  << ".\n  If the change is intended, run with SDFCSG_UPDATE_GOLDEN=1 "
+                     "(SDFCSG_UPDATE_GOLDEN=1 ctest -R Generate.RequestBodyGolden).";
 }
 
 TEST_F(Generate, KeyOnlyInTheAuthorizationHeader) {
