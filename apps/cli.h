@@ -15,7 +15,7 @@ enum Exit : int {
     kIo = 3,           // a file could not be read or written
     kGpu = 4,          // no usable Vulkan device, or a shader failed to compile
     kRemote = 5,       // the language model endpoint failed, refused or answered unusably
-    kInterrupted = 130, // Ctrl-C (SIGINT) or SIGTERM; nothing was written
+    kInterrupted = 130, // Ctrl-C (SIGINT) or SIGTERM; nothing written but a recording or report
 };
 
 int exitCode(const Error& e);

@@ -17,6 +17,7 @@
 #include <fstream>
 #include <memory>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -92,6 +93,11 @@ bool parseNumber(const std::string& s, double lo, double hi, double& out) {
     if (s.empty() || *end || errno || !(v >= lo && v <= hi)) return false;
     out = v;
     return true;
+}
+
+// "1 prompt", "2 prompts".
+std::string counted(size_t n, std::string_view noun) {
+    return std::to_string(n) + " " + std::string(noun) + (n == 1 ? "" : "s");
 }
 
 Result<std::string> readFile(const std::string& path) {
@@ -174,7 +180,7 @@ class ProgressPrinter {
     bool ticking_ = false;
 };
 
-// One Vulkan context for all renders of a command, made on first use.
+// One Vulkan context for all renders of a command, made on first use. Ctrl-C stops a render.
 class Renders {
   public:
     Result<Image> render(const Scene& scene, uint32_t width, uint32_t height) {
@@ -188,6 +194,7 @@ class Renders {
         RenderOptions options;
         options.width = width;
         options.height = height;
+        options.progress = [](float) { return !interrupted(); };
         return (*renderer)->render(options);
     }
 
@@ -248,11 +255,24 @@ int generateAndWrite(std::string_view command, std::string_view request, Generat
     if (auto ready = recording.setUp(args, options); !ready) return fail(ready.error());
     ProgressPrinter printer;
     options.progress = [&printer](const GenerateProgress& p) { printer(p); };
+    catchInterrupts();
+    options.cancelled = [] { return interrupted(); };
     GenerateStats stats;
     auto generated = generateScene(request, options, &stats);
     printer.clear();
+    // Also when interrupted or failed: the exchanges so far are what a bug report needs.
     if (auto saved = recording.save(); !saved) return fail(saved.error());
-    if (!generated) return fail(generated.error());
+    if (!generated) {
+        if (generated.error().kind == ErrorKind::Cancelled && interrupted() &&
+            !recording.recordPath.empty()) {
+            std::fprintf(stderr,
+                         "sdfcsg: interrupted; %s was not written, the exchanges so far "
+                         "are in %s\n",
+                         out.c_str(), recording.recordPath.c_str());
+            return kInterrupted;
+        }
+        return fail(generated.error());
+    }
 
     if (auto written = writeFileAtomic(out, generated->json); !written)
         return fail(written.error());
@@ -260,6 +280,11 @@ int generateAndWrite(std::string_view command, std::string_view request, Generat
     if (const std::string png = args.get("--render"); !png.empty()) {
         Renders renders;
         auto image = renders.render(generated->scene, 800, 600);
+        if (!image && image.error().kind == ErrorKind::Cancelled && interrupted()) {
+            std::fprintf(stderr, "sdfcsg: interrupted; %s was written, %s was not\n", out.c_str(),
+                         png.c_str());
+            return kInterrupted;
+        }
         if (!image) return fail(image.error());
         if (auto written = writePng(*image, png); !written) return fail(written.error());
     }
@@ -331,19 +356,26 @@ const char* kEvalHelp = R"(Usage: sdfcsg eval-prompts PROMPTS.txt --out DIR [opt
 Runs every prompt of PROMPTS.txt (one per line; blank lines and lines starting with # are
 skipped) through 'sdfcsg generate' against the configured endpoint. Writes DIR/NN.json and a
 256 x 256 render DIR/NN.png per valid scene, a contact sheet of the renders in prompt order
-(DIR/contact-sheet.png; a red tile for a prompt without a scene), and a report (DIR/report.txt,
-also printed): per prompt, whether the first answer was valid, validity after repair, repair
-rounds, tokens, seconds and output mode; then first-try validity, validity after repair, mean
-repair rounds, tokens and time over all prompts.
+(DIR/contact-sheet.png; each tile numbered in its corner, a red tile for a prompt without a
+scene), and a report (DIR/report.txt, also printed): per prompt, whether the first answer was
+valid, validity after repair, repair rounds, tokens, seconds and output mode, and the first
+problems of a prompt without a scene; then first-try validity, validity after repair, mean
+repair rounds, tokens and time over all prompts. A prompt that nearly repeats the request of
+one of the system prompt's examples is named in the report, as its first try is no fair test.
+Ctrl-C stops after the prompt in progress is abandoned; the report and the contact sheet then
+cover the prompts done (exit code 130).
 
 Options:
   --out DIR  output folder (created if missing; required)
 )";
 
+// A prompt without a scene shows the error's first line and this many of its problems.
+constexpr size_t kProblemsShown = 3;
+
 struct EvalRow {
     std::string prompt;
     GenerateStats stats;
-    std::string error; // first line of the error, if any
+    std::vector<std::string> error; // the error's first lines, if any
     std::optional<Image> image;
 };
 
@@ -366,10 +398,85 @@ std::string twoDigits(size_t i) {
     return text;
 }
 
+// The words of a text that carry its meaning: lower case, three letters or more, without the
+// commonest.
+std::set<std::string> contentWords(std::string_view text) {
+    static const std::set<std::string> kCommon = {"and", "the", "with", "its", "for", "from"};
+    std::set<std::string> out;
+    std::string word;
+    auto flush = [&] {
+        if (word.size() >= 3 && !kCommon.count(word)) out.insert(word);
+        word.clear();
+    };
+    for (char c : text) {
+        if (std::isalnum(static_cast<unsigned char>(c)))
+            word += char(std::tolower(static_cast<unsigned char>(c)));
+        else
+            flush();
+    }
+    flush();
+    return out;
+}
+
+// The example request that `prompt` nearly repeats: one holding at least 80% of its words
+// ("A robot with a square body, two legs" in "A robot with a square body, two legs, two arms and
+// an antenna."). The model has seen that request answered, so its first try is no fair test.
+const std::string* repeatedExample(const std::string& prompt,
+                                   const std::vector<std::string>& examples) {
+    const std::set<std::string> words = contentWords(prompt);
+    if (words.empty()) return nullptr;
+    for (const std::string& example : examples) {
+        const std::set<std::string> known = contentWords(example);
+        size_t shared = 0;
+        for (const std::string& w : words)
+            shared += known.count(w);
+        if (5 * shared >= 4 * words.size()) return &example;
+    }
+    return nullptr;
+}
+
+// Tiles per row of the contact sheet.
+uint32_t sheetColumns(size_t tiles) {
+    return uint32_t(std::ceil(std::sqrt(double(std::max<size_t>(tiles, 1)))));
+}
+
+// Digits 3 x 5, for the tile numbers.
+constexpr const char* kDigits[10][5] = {
+    {"###", "#.#", "#.#", "#.#", "###"}, {".#.", "##.", ".#.", ".#.", "###"},
+    {"###", "..#", "###", "#..", "###"}, {"###", "..#", "###", "..#", "###"},
+    {"#.#", "#.#", "###", "..#", "..#"}, {"###", "#..", "###", "..#", "###"},
+    {"###", "#..", "###", "#.#", "###"}, {"###", "..#", "..#", "..#", "..#"},
+    {"###", "#.#", "###", "#.#", "###"}, {"###", "#.#", "###", "..#", "###"},
+};
+
+// `number` in white on a dark label at (x0, y0), each font pixel `scale` pixels wide.
+void drawNumber(Image& image, uint32_t x0, uint32_t y0, size_t number, uint32_t scale) {
+    const std::string digits = std::to_string(number);
+    const uint32_t pad = scale, advance = 4 * scale;
+    const uint32_t width = pad + uint32_t(digits.size()) * advance, height = 2 * pad + 5 * scale;
+    auto put = [&](uint32_t x, uint32_t y, uint8_t v) {
+        if (x >= image.width || y >= image.height) return;
+        uint8_t* p = &image.rgba[(size_t(y) * image.width + x) * 4];
+        p[0] = p[1] = p[2] = v;
+        p[3] = 255;
+    };
+    for (uint32_t y = 0; y < height; ++y)
+        for (uint32_t x = 0; x < width; ++x)
+            put(x0 + x, y0 + y, 20);
+    for (size_t d = 0; d < digits.size(); ++d)
+        for (uint32_t row = 0; row < 5; ++row)
+            for (uint32_t col = 0; col < 3; ++col)
+                if (kDigits[digits[d] - '0'][row][col] == '#')
+                    for (uint32_t y = 0; y < scale; ++y)
+                        for (uint32_t x = 0; x < scale; ++x)
+                            put(x0 + pad + uint32_t(d) * advance + col * scale + x,
+                                y0 + pad + row * scale + y, 255);
+}
+
 Image contactSheet(const std::vector<EvalRow>& rows, uint32_t tile) {
     constexpr uint32_t kGap = 4;
     const uint32_t n = uint32_t(std::max<size_t>(rows.size(), 1));
-    const uint32_t columns = uint32_t(std::ceil(std::sqrt(double(n))));
+    const uint32_t columns = sheetColumns(n);
     const uint32_t lines = (n + columns - 1) / columns;
     Image sheet;
     sheet.width = columns * tile + (columns + 1) * kGap;
@@ -391,13 +498,25 @@ Image contactSheet(const std::vector<EvalRow>& rows, uint32_t tile) {
                     std::copy_n(failed, 4, dst);
                 }
             }
+        drawNumber(sheet, x0 + 4, y0 + 4, i + 1, std::max(2u, tile / 64));
     }
     return sheet;
 }
 
-std::string evalReport(const std::vector<EvalRow>& rows) {
+// `total` is the number of prompts in the file; fewer rows mean the run was interrupted.
+std::string evalReport(const std::vector<EvalRow>& rows, size_t total) {
     std::string out;
     char line[512];
+    if (rows.size() < total)
+        out += "interrupted after " + counted(rows.size(), "prompt") + " of " +
+               std::to_string(total) + "; what follows covers those\n";
+    const std::vector<std::string> examples = sceneExampleRequests();
+    for (size_t i = 0; i < rows.size(); ++i)
+        if (const std::string* example = repeatedExample(rows[i].prompt, examples))
+            out += "note: prompt " + std::to_string(i + 1) +
+                   " nearly repeats the request of an example in the system prompt (\"" + *example +
+                   "\"), so its first-try validity is inflated\n";
+    if (!out.empty()) out += "\n";
     std::snprintf(line, sizeof line, "%-3s %-50s %-6s %-6s %-8s %-16s %-8s %s\n", "#", "prompt",
                   "first", "valid", "repairs", "tokens in+out", "seconds", "mode");
     out += line;
@@ -415,7 +534,8 @@ std::string evalReport(const std::vector<EvalRow>& rows) {
                       std::max(0, s.answers - 1), tokens.c_str(), s.seconds,
                       int(outputModeName(s.mode).size()), outputModeName(s.mode).data());
         out += line;
-        if (!rows[i].error.empty()) out += "    error: " + rows[i].error + "\n";
+        for (size_t k = 0; k < rows[i].error.size(); ++k)
+            out += (k == 0 ? "    error: " : "           ") + rows[i].error[k] + "\n";
         firstTry += s.firstTryValid;
         valid += s.valid;
         if (s.answers > 0) {
@@ -430,13 +550,30 @@ std::string evalReport(const std::vector<EvalRow>& rows) {
     std::snprintf(line, sizeof line,
                   "\nprompts: %zu\nfirst-try validity: %d of %zu (%.0f%%)\n"
                   "validity after repair: %d of %zu (%.0f%%)\n"
-                  "mean repair rounds: %.2f (over %d prompts with an answer)\n"
+                  "mean repair rounds: %.2f (over %s with an answer)\n"
                   "tokens: %llu prompt + %llu completion\ntime: %.1f s in all, %.1f s per prompt\n",
                   rows.size(), firstTry, rows.size(), 100.0 * firstTry / n, valid, rows.size(),
-                  100.0 * valid / n, answered ? double(repairs) / answered : 0.0, answered,
-                  static_cast<unsigned long long>(in), static_cast<unsigned long long>(outTokens),
-                  seconds, seconds / n);
-    return out + line;
+                  100.0 * valid / n, answered ? double(repairs) / answered : 0.0,
+                  counted(size_t(answered), "prompt").c_str(), static_cast<unsigned long long>(in),
+                  static_cast<unsigned long long>(outTokens), seconds, seconds / n);
+    out += line;
+    const uint32_t columns = sheetColumns(rows.size());
+    return out + "contact sheet: the prompts' renders in order, " + counted(columns, "tile") +
+           " a row, each numbered in its top-left corner" +
+           (columns > 1 ? " (prompt " + std::to_string(columns + 1) + " starts the second row)"
+                        : std::string()) +
+           "; red: no scene\n";
+}
+
+// The error's first line and the first few of its problems, for the report.
+std::vector<std::string> errorLines(const Error& error) {
+    std::vector<std::string> out;
+    const auto& all = error.diagnostics;
+    for (size_t k = 0; k < all.size() && k <= kProblemsShown; ++k)
+        out.push_back(all[k].str());
+    if (all.size() > kProblemsShown + 1)
+        out.push_back("(" + counted(all.size() - kProblemsShown - 1, "more problem") + ")");
+    return out;
 }
 
 } // namespace
@@ -465,16 +602,19 @@ int runEvalPrompts(int argc, char** argv) {
     if (auto ready = recording.setUp(args, options); !ready) return fail(ready.error());
     ProgressPrinter printer;
     options.progress = [&printer](const GenerateProgress& p) { printer(p); };
+    catchInterrupts();
+    options.cancelled = [] { return interrupted(); };
     Renders renders;
     std::vector<EvalRow> rows;
-    for (size_t i = 0; i < prompts.size(); ++i) {
+    for (size_t i = 0; i < prompts.size() && !interrupted(); ++i) {
         std::fprintf(stderr, "[%zu/%zu] %s\n", i + 1, prompts.size(), prompts[i].c_str());
         EvalRow row{prompts[i], {}, {}, std::nullopt};
         auto generated = generateScene(prompts[i], options, &row.stats);
         printer.clear();
+        if (interrupted()) break; // the prompt in progress was abandoned: it has no result
         if (!generated) {
             if (generated.error().kind == ErrorKind::Usage) return fail(generated.error());
-            row.error = generated.error().diagnostics.front().str();
+            row.error = errorLines(generated.error());
             std::fprintf(stderr, "%s\n", generated.error().str().c_str());
         } else {
             const std::string base = (fs::path(dir) / twoDigits(i + 1)).string();
@@ -483,8 +623,13 @@ int runEvalPrompts(int argc, char** argv) {
             for (const Diagnostic& w : generated->warnings)
                 std::fprintf(stderr, "warning: %s: %s\n", w.path.c_str(), w.message.c_str());
             auto image = renders.render(generated->scene, 256, 256);
+            if (!image && interrupted()) {
+                row.error = {"render: interrupted"}; // its scene was written
+                rows.push_back(std::move(row));
+                break;
+            }
             if (!image) {
-                row.error = "render: " + image.error().diagnostics.front().message;
+                row.error = {"render: " + image.error().diagnostics.front().message};
             } else {
                 if (auto w = writePng(*image, base + ".png"); !w) return fail(w.error());
                 row.image = std::move(*image);
@@ -493,12 +638,17 @@ int runEvalPrompts(int argc, char** argv) {
         rows.push_back(std::move(row));
     }
     if (auto saved = recording.save(); !saved) return fail(saved.error());
-    const std::string report = evalReport(rows);
+    const std::string report = evalReport(rows, prompts.size());
     std::fputs(report.c_str(), stdout);
     if (auto w = writeFileAtomic((fs::path(dir) / "report.txt").string(), report); !w)
         return fail(w.error());
     if (auto w = writePng(contactSheet(rows, 256), fs::path(dir) / "contact-sheet.png"); !w)
         return fail(w.error());
+    if (interrupted()) {
+        std::fprintf(stderr, "sdfcsg: interrupted after %s of %zu; the report covers those\n",
+                     counted(rows.size(), "prompt").c_str(), prompts.size());
+        return kInterrupted;
+    }
     return kOk;
 }
 

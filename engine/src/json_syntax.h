@@ -23,6 +23,10 @@ struct SyntaxProblem {
 std::optional<SyntaxProblem> findSyntaxProblem(std::string_view text, size_t maxDepth,
                                                bool checkNumberRange);
 
+// Length of the well-formed UTF-8 sequence at text[i], or 0 (RFC 3629: no overlong forms, no
+// surrogates, nothing above U+10FFFF).
+size_t utf8Length(std::string_view text, size_t i);
+
 // 1-based line and column (in characters, not bytes) of a byte offset.
 void lineColumn(std::string_view text, size_t offset, int& line, int& column);
 

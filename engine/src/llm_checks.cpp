@@ -4,11 +4,18 @@
 #include "sdfcsg/eval.h"
 #include "sdfcsg/generate.h"
 
+#include "parse_util.h"
+#include "sdf.h"
+
 #include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
+#include <glm/matrix.hpp>
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numeric>
 
 namespace sdfcsg {
@@ -20,26 +27,88 @@ bool overlap(const Aabb& a, const Aabb& b, float margin) {
     return true;
 }
 
+// A name is the model's text: quoted as the validator quotes strings, so it cannot forge a line
+// or drive the terminal.
 std::string label(const Node& node) {
-    return node.name.empty() ? node.path : node.path + " (\"" + node.name + "\")";
+    return node.name.empty() ? node.path : node.path + " (" + detail::quote(node.name) + ")";
 }
 
-std::string number(float v) {
+std::string number(double v) {
     char text[32];
-    std::snprintf(text, sizeof text, v >= 100.0f ? "%.0f" : "%.3g", double(v));
+    std::snprintf(text, sizeof text, v >= 100.0 && v < 1e7 ? "%.0f" : "%.3g", v);
     return text;
 }
 
-// The finite part of the scene's bounds: planes reach to infinity.
-Aabb finiteBounds(const Evaluator& evaluator) {
-    if (evaluator.bounds().finite()) return evaluator.bounds();
-    Aabb box;
-    for (const FlatNode& n : evaluator.nodes()) {
-        if (!n.children.empty() || !n.bounds.finite()) continue;
-        box.min = glm::min(box.min, n.bounds.min);
-        box.max = glm::max(box.max, n.bounds.max);
+// Bounds in double precision, so that their size and distance can be told beyond the range of
+// single precision.
+struct Extent {
+    glm::dvec3 min{std::numeric_limits<double>::infinity()};
+    glm::dvec3 max{-std::numeric_limits<double>::infinity()};
+
+    bool empty() const { return min.x > max.x || min.y > max.y || min.z > max.z; }
+    void add(glm::dvec3 lo, glm::dvec3 hi) {
+        min = glm::min(min, lo);
+        max = glm::max(max, hi);
     }
-    return box;
+    double size() const { return std::max({max.x - min.x, max.y - min.y, max.z - min.z}); }
+    double away() const { return glm::length(0.5 * (min + max)); }
+};
+
+// The world box of a primitive whose float bounds overflowed (a radius of 1e30 scaled by 1e30),
+// from its transform, which single precision still holds; infinite where that is lost too.
+Extent overflowedBounds(const FlatNode& n) {
+    Extent e;
+    glm::vec3 lo, hi;
+    if (!sdf::localBounds(n.kind, n.params, lo, hi)) return e; // a plane
+    const glm::dmat3 toWorld = glm::inverse(glm::dmat3(n.toLocal));
+    const glm::dvec3 origin = -(toWorld * glm::dvec3(n.offset));
+    for (int c = 0; c < 8; ++c) {
+        const glm::dvec3 corner(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z);
+        const glm::dvec3 w = toWorld * corner + origin;
+        e.add(w, w);
+    }
+    for (int i = 0; i < 3; ++i)
+        if (!std::isfinite(e.min[i]) || !std::isfinite(e.max[i])) {
+            e.min[i] = -std::numeric_limits<double>::infinity();
+            e.max[i] = std::numeric_limits<double>::infinity();
+        }
+    return e;
+}
+
+// The scene's bounds where they are finite (planes reach to infinity): the root's, else those
+// of its bounded primitives.
+Extent sceneExtent(const Evaluator& evaluator) {
+    Extent e;
+    const Aabb& root = evaluator.bounds();
+    if (root.finite() && !root.empty()) {
+        e.add(root.min, root.max);
+        return e;
+    }
+    for (const FlatNode& n : evaluator.nodes()) {
+        if (!n.children.empty() || n.kind == NodeKind::Plane) continue;
+        if (n.bounds.finite()) {
+            e.add(n.bounds.min, n.bounds.max);
+        } else {
+            const Extent o = overflowedBounds(n);
+            e.add(o.min, o.max);
+        }
+    }
+    return e;
+}
+
+// What is absurd about the bounds, or "". Far from the origin the bounds are padded by about
+// 1e-5 of the distance, so a size below that says nothing: a sphere of radius 1 at x = 3e38
+// has bounds 6e33 across, and lies far away.
+std::string absurdBounds(const Extent& box) {
+    if (box.empty()) return {};
+    const double size = box.size(), away = box.away();
+    if (!std::isfinite(size) || !std::isfinite(away))
+        return "the scene reaches beyond single precision (about 3.4e+38 units)";
+    const bool resolved = size > 1e-3 * away;
+    if ((size > 1000.0 && resolved) || (size < 0.001 && away <= 1000.0))
+        return "the scene is " + number(size) + " units across (expected 0.001 to 1000)";
+    if (away > 1000.0) return "the scene lies " + number(away) + " units from the origin";
+    return {};
 }
 
 // True when no grid sample over the bounds comes close enough to the surface to hide a solid:
@@ -72,23 +141,20 @@ std::vector<Diagnostic> sceneSanityWarnings(const Scene& scene) {
     Evaluator evaluator(scene);
     const auto& flat = evaluator.nodes();
 
+    // Bounds first: beyond single precision the field that the emptiness check samples means
+    // nothing (a radius of 3e38 made every sample NaN, and the solid was called empty).
+    const Extent box = sceneExtent(evaluator);
+    const double size = box.empty() ? 0.0 : box.size();
+    const std::string absurd = absurdBounds(box);
+    if (!box.empty() && !(size <= FLT_MAX && box.away() <= FLT_MAX)) {
+        warn("root", "absurd bounds: " + absurd);
+        return out;
+    }
     if (provablyEmpty(evaluator)) {
         warn("root", "the solid is empty: no point lies inside it");
         return out; // the other checks would only repeat it
     }
-
-    const Aabb box = finiteBounds(evaluator);
-    if (!box.empty()) {
-        const float size =
-            std::max({box.max.x - box.min.x, box.max.y - box.min.y, box.max.z - box.min.z});
-        const float away = glm::length(0.5f * (box.min + box.max));
-        if (size > 1000.0f || size < 0.001f)
-            warn("root", "absurd bounds: the scene is " + number(size) +
-                             " units across (expected 0.001 to 1000)");
-        else if (away > 1000.0f)
-            warn("root",
-                 "absurd bounds: the scene lies " + number(away) + " units from the origin");
-    }
+    if (!absurd.empty()) warn("root", "absurd bounds: " + absurd);
 
     for (size_t i = 0; i < flat.size(); ++i) {
         if (flat[i].kind != NodeKind::Difference) continue;
@@ -108,8 +174,7 @@ std::vector<Diagnostic> sceneSanityWarnings(const Scene& scene) {
         top = flat[top].children[0];
     const auto& parts = flat[top].children;
     if (flat[top].kind == NodeKind::Union && parts.size() > 1 && !box.empty()) {
-        const float margin =
-            0.01f * std::max({box.max.x - box.min.x, box.max.y - box.min.y, box.max.z - box.min.z});
+        const float margin = float(0.01 * size);
         std::vector<size_t> group(parts.size());
         std::iota(group.begin(), group.end(), 0);
         auto find = [&](size_t a) {

@@ -28,10 +28,17 @@ using detail::asObject;
 using detail::formatFloat;
 using detail::formatNumber;
 using detail::jsonQuote;
+using detail::printable;
 namespace dom = simdjson::dom;
 using Clock = std::chrono::steady_clock;
 
 constexpr std::string_view kAnswerFile = "answer";
+// An HTTP answer holds one scene, escaped as a JSON string (quotes and newlines double), and
+// perhaps the model's reasoning: four times the scene limit leaves room for both, and a server
+// cannot make a client whose scenes are limited to 1 MiB read 16 MiB.
+constexpr size_t kResponsesPerScene = 4;
+// How much of an oversized answer goes back in a repair round.
+constexpr size_t kEchoExcerpt = 1000;
 
 struct Message {
     std::string role;
@@ -54,6 +61,19 @@ std::string seconds(double s) {
     char text[32];
     std::snprintf(text, sizeof text, "%g", std::round(s * 10.0) / 10.0);
     return text;
+}
+
+// "1 request", "2 requests".
+std::string counted(size_t n, std::string_view noun) {
+    return std::to_string(n) + " " + std::string(noun) + (n == 1 ? "" : "s");
+}
+
+// The first `size` bytes of `text` or a little fewer, cut between UTF-8 sequences.
+std::string_view head(std::string_view text, size_t size) {
+    if (text.size() <= size) return text;
+    while (size > 0 && (static_cast<unsigned char>(text[size]) & 0xC0) == 0x80)
+        --size;
+    return text.substr(0, size);
 }
 
 Error remote(const std::string& url, std::string message) {
@@ -155,7 +175,7 @@ ServerError serverError(std::string_view body) {
     dom::parser parser;
     dom::element top;
     if (parser.parse(body.data(), body.size()).get(top) || !top.is_object()) {
-        out.message = std::string(body.substr(0, 300));
+        out.message = head(body, 300);
         return out;
     }
     std::string_view text;
@@ -172,7 +192,7 @@ ServerError serverError(std::string_view body) {
         out.message = text;
         if (!top["param"].get(text)) out.param = text;
     }
-    if (out.message.empty()) out.message = std::string(body.substr(0, 300));
+    if (out.message.empty()) out.message = head(body, 300);
     return out;
 }
 
@@ -187,14 +207,24 @@ std::string redact(std::string text, const std::string& key) {
             at += 3;
             continue;
         }
+        // Key characters only, so that a key quoted in JSON leaves the quotes and braces intact.
         size_t end = at;
-        while (end < text.size() && !std::isspace(static_cast<unsigned char>(text[end])) &&
-               text[end] != '.' && text[end] != ',')
+        while (end < text.size() && (std::isalnum(static_cast<unsigned char>(text[end])) ||
+                                     text[end] == '-' || text[end] == '_' || text[end] == '*'))
             ++end;
         text.replace(at, end - at, "[redacted]");
         at += 10;
     }
     return text;
+}
+
+// The strings of a loaded scene. The answer's text was redacted before it was parsed, but a key
+// written with JSON escapes ("\u0073k-...") reads back as the key itself.
+void redactStrings(Scene& scene, const std::string& key) {
+    scene.name = redact(std::move(scene.name), key);
+    scene.description = redact(std::move(scene.description), key);
+    for (Node& node : scene.nodes)
+        node.name = redact(std::move(node.name), key);
 }
 
 // Seconds to wait for a Retry-After value: delta-seconds, or an HTTP date.
@@ -215,12 +245,12 @@ struct Answer {
     uint64_t promptTokens = 0, completionTokens = 0;
 };
 
-Result<Answer> readAnswer(const LlmEndpoint& e, std::string_view body) {
+Result<Answer> readAnswer(const LlmEndpoint& e, std::string_view body, const std::string& key) {
     dom::parser parser;
     dom::element top;
     auto unexpected = [&](const std::string& what) {
-        return remote(e.url,
-                      "unexpected answer (" + what + "): " + std::string(body.substr(0, 200)));
+        return remote(e.url, "unexpected answer (" + what +
+                                 "): " + printable(redact(std::string(head(body, 200)), key)));
     };
     if (parser.parse(body.data(), body.size()).get(top) || !top.is_object())
         return unexpected("not a JSON object");
@@ -311,6 +341,24 @@ std::string withoutNulls(const std::string& text, const Limits& limits) {
     return out;
 }
 
+// The HTTP answer limit: LlmConfig::maxResponseBytes, or less where the scene limit is small.
+size_t responseLimit(const GenerateOptions& options) {
+    const size_t scene = options.limits.maxFileBytes;
+    if (scene > SIZE_MAX / kResponsesPerScene) return options.llm.maxResponseBytes;
+    return std::min(options.llm.maxResponseBytes, kResponsesPerScene * scene);
+}
+
+// The assistant turn of a repair round. Every later request carries it again, so an answer
+// larger than a scene may be (which the validator refused for its size alone) goes back as an
+// excerpt: in full, a 10 MB answer made the three repair requests 10, 21 and 31 MB long.
+std::string echoedAnswer(const std::string& content, const Limits& limits) {
+    if (content.size() <= limits.maxFileBytes) return content;
+    return std::string(head(content, kEchoExcerpt)) +
+           "\n[the rest of this answer is left out: " + std::to_string(content.size()) +
+           " bytes in all, more than a scene may have (" + std::to_string(limits.maxFileBytes) +
+           ")]";
+}
+
 // One conversation: sends requests, retries, adapts to the server, counts.
 class Conversation {
   public:
@@ -332,15 +380,15 @@ class Conversation {
             auto response = exchange(body, status);
             if (!response) return response.error();
             const long code = response->status;
-            if (code >= 200 && code < 300) return readAnswer(e_, response->body);
+            if (code >= 200 && code < 300) return readAnswer(e_, response->body, config.apiKey);
 
             const ServerError error = serverError(response->body);
-            const std::string reason =
-                "HTTP " + std::to_string(code) + ": " + redact(error.message, config.apiKey);
+            const std::string reason = "HTTP " + std::to_string(code) + ": " +
+                                       printable(redact(error.message, config.apiKey));
             if ((code == 429 && error.code != "insufficient_quota") || code >= 500) {
                 if (retries >= config.maxRetries)
                     return remote(e_.url, reason + " (gave up after " +
-                                              std::to_string(retries + 1) + " attempts)");
+                                              counted(size_t(retries) + 1, "attempt") + ")");
                 double delay = config.retryBaseSeconds * std::pow(2.0, retries);
                 if (auto after = retryAfterSeconds(response->retryAfter)) delay = *after;
                 delay = std::min(delay, config.maxRetryDelaySeconds);
@@ -397,10 +445,10 @@ class Conversation {
         if (options_.replay) {
             if (replayed_ >= options_.replay->size())
                 return remote(e_.url, "the recording holds " +
-                                          std::to_string(options_.replay->size()) +
-                                          " exchanges, and a further request was made");
+                                          counted(options_.replay->size(), "exchange") +
+                                          ", and a further request was made");
             const HttpExchange& x = (*options_.replay)[replayed_++];
-            if (options_.record) options_.record->push_back(x);
+            if (options_.record) keep(x);
             return detail::HttpResponse{x.status, x.response, x.retryAfter};
         }
         detail::HttpPost post;
@@ -409,14 +457,24 @@ class Conversation {
         post.apiKey = options_.llm.apiKey;
         post.timeoutSeconds = options_.llm.timeoutSeconds;
         post.connectTimeoutSeconds = options_.llm.connectTimeoutSeconds;
-        post.maxResponseBytes = options_.llm.maxResponseBytes;
+        post.maxResponseBytes = responseLimit(options_);
         post.tick = [&](double elapsed) { progress(status, elapsed, true); };
         post.cancelled = options_.cancelled;
         auto response = detail::httpPost(post);
         if (response && options_.record)
-            options_.record->push_back(
-                {e_.url, body, response->status, response->retryAfter, response->body});
+            keep({e_.url, body, response->status, response->retryAfter, response->body});
         return response;
+    }
+
+    // A recording is a file that gets shared: a key that the server echoed (in a 400 that
+    // quotes the request's headers, say) or that the model repeated does not go into it.
+    void keep(HttpExchange x) {
+        const std::string& key = options_.llm.apiKey;
+        x.url = redact(std::move(x.url), key);
+        x.request = redact(std::move(x.request), key);
+        x.retryAfter = redact(std::move(x.retryAfter), key);
+        x.response = redact(std::move(x.response), key);
+        options_.record->push_back(std::move(x));
     }
 
     bool cancelled() const { return options_.cancelled && options_.cancelled(); }
@@ -507,7 +565,8 @@ Result<Generated> generate(std::string_view request, const GenerateOptions& opti
         ++stats.answers;
         stats.promptTokens += answer->promptTokens;
         stats.completionTokens += answer->completionTokens;
-        if (!answer->refusal.empty()) return remote(url, "the model refused: " + answer->refusal);
+        if (!answer->refusal.empty())
+            return remote(url, "the model refused: " + printable(answer->refusal));
         if (answer->finishReason == "content_filter")
             return remote(url, "the server's content filter withheld the answer");
         if (answer->finishReason == "length")
@@ -515,11 +574,20 @@ Result<Generated> generate(std::string_view request, const GenerateOptions& opti
                                    std::to_string(options.llm.maxTokens) +
                                    " tokens); ask for a simpler scene or raise the limit");
 
+        // A model may repeat the key (a prompt injection may ask it to): it goes neither into
+        // the scene nor back into the conversation.
+        answer->content = redact(std::move(answer->content), options.llm.apiKey);
         const std::string json = withoutNulls(extractJson(answer->content), options.limits);
-        auto scene = parseScene(json, kAnswerFile, options.limits);
+        // Null content (or none, or not a string) would read as an empty scene file.
+        auto scene =
+            json.empty()
+                ? Result<Scene>(Error::message(ErrorKind::Validation, std::string(kAnswerFile),
+                                               "the model returned no text"))
+                : parseScene(json, kAnswerFile, options.limits);
         if (scene) {
             stats.valid = true;
             stats.firstTryValid = round == 0;
+            redactStrings(*scene, options.llm.apiKey);
             Generated out;
             out.warnings = sceneSanityWarnings(*scene);
             out.json = toJson(*scene);
@@ -533,17 +601,17 @@ Result<Generated> generate(std::string_view request, const GenerateOptions& opti
             e.diagnostics.insert(e.diagnostics.begin(),
                                  Diagnostic{std::string(kAnswerFile),
                                             {},
-                                            "no answer loaded after " + std::to_string(rounds) +
-                                                " repair rounds; the last one's problems:"});
+                                            "no answer loaded after " +
+                                                counted(size_t(rounds), "repair round") +
+                                                "; the last one's problems:"});
             return e;
         }
         if (options.progress)
             options.progress({"the answer does not load (" +
-                                  std::to_string(problems.diagnostics.size()) +
-                                  (problems.diagnostics.size() == 1 ? " problem" : " problems") +
+                                  counted(problems.diagnostics.size(), "problem") +
                                   "); asking for a correction",
                               0.0, false});
-        messages.push_back({"assistant", answer->content});
+        messages.push_back({"assistant", echoedAnswer(answer->content, options.limits)});
         messages.push_back({"user", sceneRepairPrompt(problems)});
     }
 }
@@ -551,15 +619,16 @@ Result<Generated> generate(std::string_view request, const GenerateOptions& opti
 } // namespace
 
 // A server or a model may quote the key back, a hostile one on purpose (the fuzz target
-// fuzz_llm found a body quoted in an error): nothing that leaves here carries it.
+// fuzz_llm found a body quoted in an error): nothing that leaves here carries it. Nor can
+// remote text in a message drive the terminal it is printed on.
 Result<Generated> generateScene(std::string_view request, const GenerateOptions& options,
                                 GenerateStats* stats) {
     auto result = generate(request, options, stats);
     const std::string& key = options.llm.apiKey;
     auto clean = [&](std::vector<Diagnostic>& diagnostics) {
         for (Diagnostic& d : diagnostics) {
-            d.path = redact(std::move(d.path), key);
-            d.message = redact(std::move(d.message), key);
+            d.path = printable(redact(std::move(d.path), key));
+            d.message = printable(redact(std::move(d.message), key));
         }
     };
     if (result) {
@@ -573,16 +642,16 @@ Result<Generated> generateScene(std::string_view request, const GenerateOptions&
 
 std::string generationSummary(const Generated& generated, const GenerateStats& stats) {
     const int repairs = stats.answers - 1;
-    const std::string validity = stats.firstTryValid
-                                     ? "valid on the first try"
-                                     : "valid after " + std::to_string(repairs) +
-                                           (repairs == 1 ? " repair round" : " repair rounds");
+    const std::string validity =
+        stats.firstTryValid
+            ? "valid on the first try"
+            : "valid after " + counted(size_t(std::max(repairs, 0)), "repair round");
     char text[256];
-    std::snprintf(text, sizeof text,
-                  "%zu nodes, %s (%.*s, %d requests, %llu + %llu tokens, %.1f s)",
-                  generated.scene.nodes.size(), validity.c_str(),
+    std::snprintf(text, sizeof text, "%s, %s (%.*s, %s, %llu + %llu tokens, %.1f s)",
+                  counted(generated.scene.nodes.size(), "node").c_str(), validity.c_str(),
                   int(outputModeName(stats.mode).size()), outputModeName(stats.mode).data(),
-                  stats.requests, static_cast<unsigned long long>(stats.promptTokens),
+                  counted(size_t(std::max(stats.requests, 0)), "request").c_str(),
+                  static_cast<unsigned long long>(stats.promptTokens),
                   static_cast<unsigned long long>(stats.completionTokens), stats.seconds);
     return text;
 }

@@ -1,11 +1,13 @@
 #include "parse_util.h"
 
+#include "json_syntax.h"
 #include "json_writer.h"
 
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 
 namespace sdfcsg::detail {
 
@@ -27,14 +29,65 @@ Error Problems::error() const {
     return Error(kind_, std::move(all));
 }
 
+namespace {
+
+// Appends `text` with C0 controls, DEL and C1 controls (U+0080 to U+009F, which some terminals
+// obey as ESC sequences) escaped as in JSON, and bytes that are not UTF-8 as \xNN. `quoted`
+// escapes quotes and backslashes too, for text between quotes.
+void appendEscaped(std::string& out, std::string_view text, bool quoted) {
+    for (size_t i = 0; i < text.size();) {
+        const auto b = static_cast<unsigned char>(text[i]);
+        const size_t n = utf8Length(text, i);
+        char buf[8];
+        if (n == 0) {
+            std::snprintf(buf, sizeof buf, "\\x%02x", b);
+            out += buf;
+            ++i;
+            continue;
+        }
+        const unsigned c1 = n == 2 && b == 0xC2 ? static_cast<unsigned char>(text[i + 1]) : 0;
+        if (b < 0x20 || b == 0x7F || (c1 >= 0x80 && c1 <= 0x9F)) {
+            const char* named = b == '\n'   ? "\\n"
+                                : b == '\r' ? "\\r"
+                                : b == '\t' ? "\\t"
+                                : b == '\b' ? "\\b"
+                                : b == '\f' ? "\\f"
+                                            : nullptr;
+            if (named) {
+                out += named;
+            } else {
+                std::snprintf(buf, sizeof buf, "\\u%04x", c1 ? c1 : b);
+                out += buf;
+            }
+        } else if (quoted && (b == '"' || b == '\\')) {
+            out += '\\';
+            out += char(b);
+        } else {
+            out.append(text.substr(i, n));
+        }
+        i += n;
+    }
+}
+
+} // namespace
+
 std::string quote(std::string_view text) {
     constexpr size_t kMax = 40;
-    if (text.size() <= kMax) return jsonQuote(text);
-    size_t cut = kMax - 3;
-    while (cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80)
-        --cut;
-    std::string out = jsonQuote(text.substr(0, cut));
-    out.insert(out.size() - 1, "...");
+    size_t cut = text.size();
+    if (text.size() > kMax) {
+        cut = kMax - 3;
+        while (cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80)
+            --cut;
+    }
+    std::string out = "\"";
+    appendEscaped(out, text.substr(0, cut), true);
+    return out + (cut < text.size() ? "...\"" : "\"");
+}
+
+std::string printable(std::string_view text) {
+    std::string out;
+    out.reserve(text.size());
+    appendEscaped(out, text, false);
     return out;
 }
 

@@ -53,8 +53,15 @@ class Problems {
 
 // A JSON value as it appears in "got ...": -1, "abc", true, [1, 2], an object, ...
 std::string describe(element value);
-// A string as it appears in messages: quoted, escaped and cut short when long.
+// A string as it appears in messages: quoted, escaped as printable() escapes it (and quotes
+// and backslashes as in JSON), and cut short when long.
 std::string quote(std::string_view text);
+// Text from outside (a server's error message, a model's answer) as it may go into a message
+// for a terminal: control characters (C0, DEL, C1) become \u001b and the like (\n for a
+// newline), and bytes that are not UTF-8 become \xNN, so that the text cannot move the cursor,
+// recolour the terminal or forge a line of output. Backslashes are kept, so a second pass
+// changes nothing.
+std::string printable(std::string_view text);
 // "a.b" / "a[3]" path building.
 std::string member(std::string_view path, std::string_view key);
 std::string item(std::string_view path, size_t index);

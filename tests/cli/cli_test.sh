@@ -143,6 +143,13 @@ expect_text "eval first try" eval/report.txt "first-try validity: 0 of 1 (0%)"
 expect_text "eval after repair" eval/report.txt "validity after repair: 1 of 1 (100%)"
 [ -s eval/01.json ] && [ -s eval/01.png ] && [ -s eval/contact-sheet.png ] ||
     { echo "FAIL eval-prompts outputs"; ls eval; failures=$((failures + 1)); }
+expect_text "eval contact sheet" eval/report.txt "contact sheet: the prompts' renders in order, 1 tile a row, each numbered in its top-left corner; red: no scene"
+# A prompt without a scene shows the problems, not only the line that introduces them; a prompt
+# that repeats an example's request is named.
+printf 'A snowman\nA robot with a square body, two legs\n' >prompts.txt
+check "eval-prompts replay without repairs" 0 "$bin" eval-prompts prompts.txt --out eval-bad $llm --replay "$recording" --max-repairs 0
+expect_text "eval problems" eval-bad/report.txt "           answer: root.children[1].radius: expected a positive number, got -0.6"
+expect_text "eval repeated example" eval-bad/report.txt "note: prompt 2 nearly repeats the request of an example in the system prompt (\"A robot with a square body, two legs, two arms and an antenna.\"), so its first-try validity is inflated"
 
 # Ctrl-C: long work stops at its next progress check (or, before the handler is installed, the
 # signal ends the process), exits 130 and leaves neither the output nor a temporary behind. Each
@@ -168,6 +175,37 @@ interrupt "mesh interrupted" big.ply "$bin" mesh "$src/assets/scenes/house.json"
     --resolution 2048
 interrupt "render interrupted" big.png "$bin" render "$src/assets/scenes/house.json" -o big.png \
     --width 4096 --height 4096 --aa 2
+
+# Ctrl-C while a language model is awaited (skipped without python3): a stand-in answers the
+# first request and holds the next. generate keeps the exchanges so far in its --record file;
+# eval-prompts reports the prompts done.
+if command -v python3 >/dev/null 2>&1; then
+    echo '{"version": 1, "root": {"type": "sphere", "radius": -1}}' >answer.json
+    slow_llm() { # slow_llm ANSWERED: starts the stand-in, sets $llm_pid and $slow
+        rm -f port.txt
+        python3 "$src/tests/viewer/fake_llm.py" answer.json port.txt "$1" &
+        llm_pid=$!
+        tries=0
+        while [ ! -s port.txt ] && [ $tries -lt 100 ]; do sleep 0.1; tries=$((tries + 1)); done
+        slow="--base-url http://127.0.0.1:$(cat port.txt)/v1 --model test-model"
+    }
+    slow_llm 1
+    interrupt "generate interrupted" int.json "$bin" generate "a ball" -o int.json $slow --record int-rec.json
+    expect_text "generate interrupted message" err.txt "sdfcsg: interrupted; int.json was not written, the exchanges so far are in int-rec.json"
+    [ "$(grep -c '"url":' int-rec.json)" = 1 ] ||
+        { echo "FAIL the recording of an interrupted generate"; cat int-rec.json; failures=$((failures + 1)); }
+    kill "$llm_pid"
+    echo '{"version": 1, "root": {"type": "sphere", "radius": 1}}' >answer.json
+    slow_llm 1
+    printf 'A ball\nA snowman\n' >prompts.txt
+    interrupt "eval-prompts interrupted" eval-int/02.json "$bin" eval-prompts prompts.txt --out eval-int $slow
+    expect_text "eval-prompts interrupted report" eval-int/report.txt "interrupted after 1 prompt of 2; what follows covers those"
+    [ -s eval-int/01.json ] && [ -s eval-int/contact-sheet.png ] ||
+        { echo "FAIL eval-prompts interrupted outputs"; ls eval-int; failures=$((failures + 1)); }
+    kill "$llm_pid"
+else
+    echo "skipped the interrupted generation: python3 not found"
+fi
 
 echo "$passed passed, $failures failed"
 [ "$failures" -eq 0 ]

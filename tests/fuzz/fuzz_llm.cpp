@@ -6,10 +6,12 @@
 // the response body.
 //
 // Whatever the answer, the result is a scene that loads again from its own JSON, or an Error
-// with a message, and the API key appears in no message (a hostile server may echo it back). The
-// scene itself is the model's answer and is kept as it came.
+// with a message, and the API key appears in no message, warning or scene (a hostile server may
+// echo it back). No message or warning holds a control character, which could drive the
+// terminal it is printed on.
 #include <sdfcsg/generate.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -23,6 +25,13 @@ constexpr const char* kKey = "sk-fuzz-0123456789abcdef";
 [[noreturn]] void fail(const char* what, const std::string& detail) {
     std::fprintf(stderr, "fuzz_llm: %s\n%s\n", what, detail.c_str());
     std::abort();
+}
+
+bool printable(const std::string& text) {
+    return std::none_of(text.begin(), text.end(), [](char c) {
+        const auto b = static_cast<unsigned char>(c);
+        return b < 0x20 || b == 0x7f;
+    });
 }
 
 } // namespace
@@ -50,11 +59,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         if (generated.error().diagnostics.empty()) fail("an error without a message", "");
         const std::string text = generated.error().str();
         if (text.find(kKey) != std::string::npos) fail("the API key is in an error", text);
+        for (const sdfcsg::Diagnostic& d : generated.error().diagnostics)
+            if (!printable(d.str())) fail("a control character in an error", d.str());
         return 0;
     }
+    if (generated->json.find(kKey) != std::string::npos)
+        fail("the API key is in the scene", generated->json);
     for (const sdfcsg::Diagnostic& warning : generated->warnings)
-        if (warning.str().find(kKey) != std::string::npos)
-            fail("the API key is in a warning", warning.str());
+        if (warning.str().find(kKey) != std::string::npos || !printable(warning.str()))
+            fail("the API key or a control character is in a warning", warning.str());
     auto again = sdfcsg::parseScene(generated->json, "fuzz.json", options.limits);
     if (!again) fail("a generated scene does not load again", again.error().str());
     return 0;

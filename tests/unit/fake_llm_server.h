@@ -23,6 +23,7 @@ struct Scripted {
     std::string body;
     std::string retryAfter;
     bool hang = false; // answer only once the test releases the server
+    bool echo = false; // "$AUTHORIZATION" in the body becomes the request's Authorization header
 };
 
 struct Received {
@@ -48,6 +49,13 @@ class FakeServer {
                 }
                 if (next.hang)
                     released_.wait_for(lock, std::chrono::seconds(20), [this] { return release_; });
+            }
+            if (next.echo) {
+                const std::string value = req.get_header_value("Authorization");
+                for (size_t at = 0;
+                     (at = next.body.find("$AUTHORIZATION", at)) != std::string::npos;
+                     at += value.size())
+                    next.body.replace(at, 14, value);
             }
             res.status = next.status;
             if (!next.retryAfter.empty()) res.set_header("Retry-After", next.retryAfter);

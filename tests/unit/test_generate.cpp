@@ -11,10 +11,15 @@
 
 #include <simdjson.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <deque>
+#include <filesystem>
+#include <fstream>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -22,6 +27,7 @@
 using namespace sdfcsg;
 using namespace sdfcsg::test;
 using detail::jsonQuote;
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -41,7 +47,7 @@ Scripted openAiError(int status, const std::string& message, const std::string& 
                         R"(, "code": )" + orNull(code) + "}}"};
 }
 
-struct Fixture : ::testing::Test {
+struct Generate : ::testing::Test {
     FakeServer server;
     std::vector<double> sleeps;
     std::vector<std::string> progress;
@@ -86,7 +92,7 @@ bool has(simdjson::dom::element object, std::string_view key) {
 
 } // namespace
 
-TEST_F(Fixture, FirstTrySuccess) {
+TEST_F(Generate, FirstTrySuccess) {
     server.script({openAi(kSphere)});
     GenerateStats stats;
     auto g = generateScene("a sphere", options(), &stats);
@@ -106,7 +112,7 @@ TEST_F(Fixture, FirstTrySuccess) {
     EXPECT_EQ(progress, std::vector<std::string>{"asking test-model (json_schema)"});
 }
 
-TEST_F(Fixture, FencedAndThinkWrappedAnswers) {
+TEST_F(Generate, FencedAndThinkWrappedAnswers) {
     server.script({openAi("<think>A sphere {radius 1}, in ```json```?</think>\nHere:\n```json\n" +
                           kSphere + "\n```\nDone."),
                    openAi("Sure, here it is: " + kSphere)});
@@ -114,7 +120,7 @@ TEST_F(Fixture, FencedAndThinkWrappedAnswers) {
     EXPECT_TRUE(generateScene("a sphere", options()));
 }
 
-TEST_F(Fixture, NullMembersAreDropped) {
+TEST_F(Generate, NullMembersAreDropped) {
     // What strict structured output sends for optional keys.
     server.script({openAi(R"({"version": 1, "name": null, "camera": null, "root": {"type":
         "union", "smooth": null, "color": null, "children": [{"type": "sphere", "radius": 1,
@@ -124,7 +130,7 @@ TEST_F(Fixture, NullMembersAreDropped) {
     EXPECT_EQ(g->scene.nodes[1].name, "ball");
 }
 
-TEST_F(Fixture, InvalidJsonThenRepaired) {
+TEST_F(Generate, InvalidJsonThenRepaired) {
     const std::string broken = R"({"version": 1, "root": {"type": "sphere", "radius": 1})";
     server.script({openAi(broken), openAi(kSphere)});
     GenerateStats stats;
@@ -144,7 +150,7 @@ TEST_F(Fixture, InvalidJsonThenRepaired) {
     EXPECT_NE(lastMessage(second).find("- line 1, column "), std::string_view::npos);
 }
 
-TEST_F(Fixture, SemanticallyInvalidThenRepaired) {
+TEST_F(Generate, SemanticallyInvalidThenRepaired) {
     server.script({openAi(kBadSphere), openAi(kSphere)});
     GenerateStats stats;
     ASSERT_TRUE(generateScene("a sphere", options(), &stats));
@@ -154,7 +160,7 @@ TEST_F(Fixture, SemanticallyInvalidThenRepaired) {
     EXPECT_EQ(progress[2], "asking test-model for a correction, round 1 of 3 (json_schema)");
 }
 
-TEST_F(Fixture, RepairLimitReached) {
+TEST_F(Generate, RepairLimitReached) {
     server.script({openAi(kBadSphere), openAi(kBadSphere), openAi(kBadSphere), openAi(kSphere)});
     GenerateOptions o = options();
     o.maxRepairs = 2;
@@ -170,7 +176,72 @@ TEST_F(Fixture, RepairLimitReached) {
     EXPECT_EQ(server.received().size(), 3u);
 }
 
-TEST_F(Fixture, UntrustedAnswerLimits) {
+// No text is no scene file: the message says so, instead of "expected a JSON value, got end of
+// input".
+TEST_F(Generate, AnswerWithoutTextSaysSo) {
+    GenerateOptions o = options();
+    o.maxRepairs = 0;
+    for (const char* content : {"null", "42", R"([{"type": "text"}])", R"("  ")"}) {
+        SCOPED_TRACE(content);
+        server.script({{200, std::string(R"({"choices": [{"index": 0, "message": {"role":
+            "assistant", "content": )") +
+                                 content + R"(}, "finish_reason": "stop"}]})"}});
+        auto g = generateScene("a sphere", o);
+        ASSERT_FALSE(g);
+        EXPECT_EQ(g.error().str(), "answer: no answer loaded after 0 repair rounds; the last "
+                                   "one's problems:\nanswer: the model returned no text");
+    }
+    server.script({{200, R"({"message": {"role": "assistant"}, "done": true})"},
+                   {200, R"({"message": {"role": "assistant", "content": )" + jsonQuote(kSphere) +
+                             R"(}, "done": true})"}});
+    o.maxRepairs = 1;
+    o.llm.baseUrl = server.url("");
+    o.llm.api = LlmApi::Ollama;
+    ASSERT_TRUE(generateScene("a sphere", o));
+    EXPECT_EQ(progress.back(), "asking test-model for a correction, round 1 of 1 (json_schema)");
+    EXPECT_EQ(lastMessage(body(server.received().size() - 1)),
+              "Your scene does not load. The validator reported:\n- the model returned no "
+              "text\nAnswer with the whole corrected scene as one JSON object, and nothing else.");
+}
+
+// One of a thing is said in the singular.
+TEST_F(Generate, CountsInTheSingular) {
+    server.script({openAi(kSphere)});
+    GenerateStats stats;
+    auto g = generateScene("a sphere", options(), &stats);
+    ASSERT_TRUE(g);
+    EXPECT_TRUE(generationSummary(*g, stats).starts_with(
+        "1 node, valid on the first try (json_schema, 1 request, 100 + 20 "
+        "tokens, "))
+        << generationSummary(*g, stats);
+    stats.firstTryValid = false;
+    stats.answers = 2;
+    EXPECT_NE(generationSummary(*g, stats).find("valid after 1 repair round ("), std::string::npos);
+
+    GenerateOptions o = options();
+    o.maxRepairs = 1;
+    server.script({openAi(kBadSphere), openAi(kBadSphere)});
+    g = generateScene("a sphere", o);
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().diagnostics[0].message,
+              "no answer loaded after 1 repair round; the last one's problems:");
+
+    o.llm.maxRetries = 0;
+    server.script({{503, "Service Unavailable"}});
+    g = generateScene("a sphere", o);
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().diagnostics[0].message,
+              "HTTP 503: Service Unavailable (gave up after 1 attempt)");
+
+    std::vector<HttpExchange> one = {{"", "", 200, "", openAi(kBadSphere).body}};
+    o.replay = &one;
+    g = generateScene("a sphere", o);
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().diagnostics[0].message,
+              "the recording holds 1 exchange, and a further request was made");
+}
+
+TEST_F(Generate, UntrustedAnswerLimits) {
     // Too many nodes, and a key that would name a file: both refused by the validator.
     std::string many = R"({"version": 1, "root": {"type": "union", "children": [)";
     for (int i = 0; i < 10; ++i)
@@ -189,7 +260,7 @@ TEST_F(Fixture, UntrustedAnswerLimits) {
 }
 
 // The answer's size is limited before it is read whole: the transfer stops at the limit.
-TEST_F(Fixture, AnswerLargerThanTheLimitIsRefused) {
+TEST_F(Generate, AnswerLargerThanTheLimitIsRefused) {
     server.script({openAi(std::string(R"({"version": 1, "name": ")") + std::string(3000, 'x') +
                           R"(", "root": {"type": "sphere", "radius": 1}})")});
     GenerateOptions o = options();
@@ -201,7 +272,43 @@ TEST_F(Fixture, AnswerLargerThanTheLimitIsRefused) {
               server.url() + "/chat/completions: the answer exceeds the limit of 2048 bytes");
 }
 
-TEST_F(Fixture, FinishReasonLength) {
+// An answer too large for a scene goes back in the repair round as an excerpt, since every later
+// request carries it again; an HTTP answer beyond four times the scene limit is not read at all.
+TEST_F(Generate, OversizedAnswerIsNotEchoedBack) {
+    GenerateOptions o = options();
+    o.limits.maxFileBytes = 4096;
+    const std::string big = R"({"version": 1, "name": ")" + std::string(12000, 'x') +
+                            R"(", "root": {"type": "sphere", "radius": 1}})";
+    server.script({openAi(big), openAi(big), openAi(kSphere)});
+    GenerateStats stats;
+    auto g = generateScene("a sphere", o, &stats);
+    ASSERT_TRUE(g) << g.error().str();
+    EXPECT_EQ(stats.answers, 3);
+    auto received = server.received();
+    ASSERT_EQ(received.size(), 3u);
+    EXPECT_LT(received[1].body.size(), received[0].body.size() + 2000);
+    EXPECT_LT(received[2].body.size(), received[0].body.size() + 4000);
+    simdjson::dom::array messages = body(1)["messages"];
+    ASSERT_EQ(messages.size(), 4u);
+    std::string_view echoed = messages.at(2)["content"];
+    EXPECT_EQ(echoed, big.substr(0, 1000) +
+                          "\n[the rest of this answer is left out: " + std::to_string(big.size()) +
+                          " bytes in all, more than a scene may have (4096)]");
+    EXPECT_EQ(lastMessage(body(1)),
+              "Your scene does not load. The validator reported:\n"
+              "- file too large: " +
+                  std::to_string(big.size()) +
+                  " bytes (the limit is 4096 bytes)\n"
+                  "Answer with the whole corrected scene as one JSON object, and nothing else.");
+
+    server.script({openAi(std::string(20000, ' ') + kSphere)});
+    g = generateScene("a sphere", o);
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().str(),
+              server.url() + "/chat/completions: the answer exceeds the limit of 16384 bytes");
+}
+
+TEST_F(Generate, FinishReasonLength) {
     server.script({openAi(R"({"version": 1, "root": {"type": "uni)", "length")});
     auto g = generateScene("a sphere", options());
     ASSERT_FALSE(g);
@@ -211,7 +318,7 @@ TEST_F(Fixture, FinishReasonLength) {
                                               "or raise the limit");
 }
 
-TEST_F(Fixture, Refusal) {
+TEST_F(Generate, Refusal) {
     server.script({{200, R"({"choices": [{"index": 0, "message": {"role": "assistant",
         "content": null, "refusal": "I'm sorry, I can't help with that."}, "finish_reason":
         "stop"}]})"}});
@@ -222,7 +329,7 @@ TEST_F(Fixture, Refusal) {
               "the model refused: I'm sorry, I can't help with that.");
 }
 
-TEST_F(Fixture, ResponseFormatRejectedThenJsonMode) {
+TEST_F(Generate, ResponseFormatRejectedThenJsonMode) {
     server.script({openAiError(400,
                                "Invalid parameter: 'response_format' of type 'json_schema' is not "
                                "supported with this model.",
@@ -238,7 +345,7 @@ TEST_F(Fixture, ResponseFormatRejectedThenJsonMode) {
     EXPECT_EQ(progress[1], "the server rejects json_schema output; falling back to json_object");
 }
 
-TEST_F(Fixture, JsonModeRejectedThenText) {
+TEST_F(Generate, JsonModeRejectedThenText) {
     // llama.cpp-style error objects, without a param.
     server.script(
         {{400,
@@ -253,7 +360,7 @@ TEST_F(Fixture, JsonModeRejectedThenText) {
     EXPECT_FALSE(has(body(2), "response_format"));
 }
 
-TEST_F(Fixture, MaxTokensRejectedThenResent) {
+TEST_F(Generate, MaxTokensRejectedThenResent) {
     server.script({openAiError(400,
                                "Unsupported parameter: 'max_tokens' is not supported with this "
                                "model. Use 'max_completion_tokens' instead.",
@@ -277,7 +384,7 @@ TEST_F(Fixture, MaxTokensRejectedThenResent) {
     EXPECT_EQ(mode, "json_schema");
 }
 
-TEST_F(Fixture, Unauthorized) {
+TEST_F(Generate, Unauthorized) {
     server.script({openAiError(401,
                                "Incorrect API key provided: sk-test-****6789. You can find your "
                                "API key at https://platform.openai.com/account/api-keys.",
@@ -294,8 +401,9 @@ TEST_F(Fixture, Unauthorized) {
 }
 
 // A server that quotes the key back, in a body that is no answer and in a scene key: neither
-// message carries it (fuzz_llm found the first).
-TEST_F(Fixture, KeyEchoedByTheServerIsRedacted) {
+// message carries it (fuzz_llm found the first). Nor does a recording of a server that echoes
+// the Authorization header, or a scene whose model repeated the key.
+TEST_F(Generate, KeyEchoedByTheServerIsRedacted) {
     server.script({{200, std::string("<html>bad key ") + kKey + "</html>"}});
     auto g = generateScene("a sphere", options());
     ASSERT_FALSE(g);
@@ -310,9 +418,104 @@ TEST_F(Fixture, KeyEchoedByTheServerIsRedacted) {
     ASSERT_FALSE(g);
     EXPECT_EQ(g.error().str().find(kKey), std::string::npos) << g.error().str();
     EXPECT_NE(g.error().str().find("[redacted]"), std::string::npos) << g.error().str();
+
+    // The header echoed in a 400, with OpenAI's masked form of the key at the end.
+    std::vector<HttpExchange> recording;
+    o.record = &recording;
+    Scripted echo = openAiError(
+        400, "invalid header 'Authorization: $AUTHORIZATION'; the key is sk-test-****6789");
+    echo.echo = true;
+    server.script({echo});
+    g = generateScene("a sphere", o);
+    ASSERT_FALSE(g);
+    const std::string expected = server.url() + "/chat/completions: HTTP 400: invalid header "
+                                                "'Authorization: Bearer [redacted]'; the key is "
+                                                "[redacted]";
+    EXPECT_EQ(g.error().str(), expected);
+    ASSERT_EQ(recording.size(), 1u);
+    ASSERT_NE(server.received().back().headers.count("Authorization"), 0u);
+    EXPECT_NE(recording[0].response.find("Bearer [redacted]"), std::string::npos)
+        << recording[0].response;
+    EXPECT_EQ(recordingToJson(recording).find(kKey), std::string::npos);
+    EXPECT_EQ(recordingToJson(recording).find("sk-test-"), std::string::npos);
+    // The redacted body is still the server's JSON, so a replay fails the same way.
+    auto replay = parseRecording(recordingToJson(recording));
+    ASSERT_TRUE(replay);
+    auto r = o;
+    r.record = nullptr;
+    r.replay = &*replay;
+    auto replayed = generateScene("a sphere", r);
+    ASSERT_FALSE(replayed);
+    EXPECT_EQ(replayed.error().str(), expected);
+
+    // A model that repeats the key, as it is and with a JSON escape: the scene, the recording
+    // and the next request keep none of it.
+    recording.clear();
+    o.maxRepairs = 1;
+    server.script(
+        {openAi(std::string(R"({"version": 1, "root": {"type": "sphere", "radius": -1,
+        "name": ")") +
+                kKey + R"("}})"),
+         openAi(std::string(R"({"version": 1, "name": ")") + kKey +
+                R"(", "description": "key: \u0073)" + (kKey + 1) +
+                R"(", "root": {"type": "sphere", "radius": 1, "name": ")" + kKey + R"("}})")});
+    g = generateScene("a sphere", o);
+    ASSERT_TRUE(g) << g.error().str();
+    EXPECT_EQ(g->json.find(kKey), std::string::npos) << g->json;
+    EXPECT_EQ(g->scene.name, "[redacted]");
+    EXPECT_EQ(g->scene.description, "key: [redacted]");
+    EXPECT_EQ(g->scene.nodes[0].name, "[redacted]");
+    EXPECT_EQ(g->json, toJson(g->scene));
+    EXPECT_EQ(recordingToJson(recording).find(kKey), std::string::npos);
+    EXPECT_EQ(server.received().back().body.find(kKey), std::string::npos);
 }
 
-TEST_F(Fixture, RateLimitedHonoursRetryAfter) {
+// Error messages, a refusal, a body that is no answer and the validator's problems all carry
+// the server's or the model's text: none reaches the terminal with an ESC sequence, a forged
+// line or bytes that are not UTF-8.
+TEST_F(Generate, RemoteTextCannotDriveTheTerminal) {
+    const std::string url = server.url() + "/chat/completions: ";
+    server.script({openAiError(400, "\x1b[2J\x1b[31mbad request\nsdfcsg: wrote scene.json")});
+    auto g = generateScene("a sphere", options());
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().str(),
+              url + "HTTP 400: \\u001b[2J\\u001b[31mbad request\\nsdfcsg: wrote scene.json");
+
+    server.script({{200, "\xff\xfe<html>\x1b]0;owned\x07\xc2\x9b"
+                         "31m\x7f"}});
+    g = generateScene("a sphere", options());
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().str(), url + "unexpected answer (not a JSON object): "
+                                     "\\xff\\xfe<html>\\u001b]0;owned\\u0007\\u009b31m\\u007f");
+
+    server.script({{200, R"({"choices": [{"index": 0, "message": {"role": "assistant",
+        "content": null, "refusal": "no\u001b[8m"}, "finish_reason": "stop"}]})"}});
+    g = generateScene("a sphere", options());
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().str(), url + "the model refused: no\\u001b[8m");
+
+    // Retried errors are shown while waiting.
+    server.script({openAiError(503, "busy\r\x1b[1A"), openAi(kSphere)});
+    progress.clear();
+    ASSERT_TRUE(generateScene("a sphere", options()));
+    ASSERT_GE(progress.size(), 2u);
+    EXPECT_EQ(progress[1], "HTTP 503: busy\\r\\u001b[1A; retrying in 0.5 s (attempt 2 of 5)");
+
+    // A scene key in the answer, quoted by the validator.
+    auto o = options();
+    o.maxRepairs = 0;
+    server.script({openAi(R"({"version": 1, "root": {"type": "sphere", "radius": 1,
+        "\u001b[2J": 1}})")});
+    g = generateScene("a sphere", o);
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().diagnostics.back().str(),
+              "answer: root: unknown key \"\\u001b[2J\" for a sphere; valid keys: radius, type, "
+              "name, translate, rotate, scale and color");
+    for (const Diagnostic& d : g.error().diagnostics)
+        EXPECT_EQ(d.str().find('\x1b'), std::string::npos) << d.str();
+}
+
+TEST_F(Generate, RateLimitedHonoursRetryAfter) {
     server.script(
         {{429, R"({"error": {"message": "Rate limit reached", "code": "rate_limit_exceeded"}})",
           "3"},
@@ -327,7 +530,7 @@ TEST_F(Fixture, RateLimitedHonoursRetryAfter) {
     EXPECT_EQ(progress[1], "HTTP 429: Rate limit reached; retrying in 3 s (attempt 2 of 5)");
 }
 
-TEST_F(Fixture, QuotaExhaustedIsNotRetried) {
+TEST_F(Generate, QuotaExhaustedIsNotRetried) {
     server.script({openAiError(429, "You exceeded your current quota.", "", "insufficient_quota")});
     auto g = generateScene("a sphere", options());
     ASSERT_FALSE(g);
@@ -335,7 +538,7 @@ TEST_F(Fixture, QuotaExhaustedIsNotRetried) {
     EXPECT_TRUE(sleeps.empty());
 }
 
-TEST_F(Fixture, ServerErrorThenSuccess) {
+TEST_F(Generate, ServerErrorThenSuccess) {
     server.script({{500, R"({"error": {"message": "The server had an error"}})"}, openAi(kSphere)});
     GenerateStats stats;
     ASSERT_TRUE(generateScene("a sphere", options(), &stats));
@@ -343,7 +546,7 @@ TEST_F(Fixture, ServerErrorThenSuccess) {
     EXPECT_EQ(sleeps, std::vector<double>{0.5});
 }
 
-TEST_F(Fixture, ServerErrorsGiveUp) {
+TEST_F(Generate, ServerErrorsGiveUp) {
     server.script(
         {{503, "Service Unavailable"}, {502, "Bad Gateway"}, {503, "Service Unavailable"}});
     GenerateOptions o = options();
@@ -355,7 +558,7 @@ TEST_F(Fixture, ServerErrorsGiveUp) {
     EXPECT_EQ(sleeps, (std::vector<double>{0.5, 1.0}));
 }
 
-TEST_F(Fixture, Timeout) {
+TEST_F(Generate, Timeout) {
     server.script({{200, "{}", "", true}});
     GenerateOptions o = options();
     o.llm.timeoutSeconds = 0.3;
@@ -367,7 +570,7 @@ TEST_F(Fixture, Timeout) {
                                               "0.3 s (the request timeout)");
 }
 
-TEST_F(Fixture, CancelDuringASlowAnswer) {
+TEST_F(Generate, CancelDuringASlowAnswer) {
     server.script({{200, "{}", "", true}}); // would answer after 20 s
     std::atomic<bool> cancel{false};
     GenerateOptions o = options();
@@ -387,7 +590,7 @@ TEST_F(Fixture, CancelDuringASlowAnswer) {
     EXPECT_LT(seconds, 10.0);
 }
 
-TEST_F(Fixture, CancelDuringTheRetryWait) {
+TEST_F(Generate, CancelDuringTheRetryWait) {
     server.script({openAiError(503, "Service Unavailable"), openAi(kSphere)});
     bool cancel = false;
     GenerateOptions o = options();
@@ -416,7 +619,7 @@ TEST_F(Fixture, CancelDuringTheRetryWait) {
               30.0);
 }
 
-TEST_F(Fixture, ConnectionRefused) {
+TEST_F(Generate, ConnectionRefused) {
     GenerateOptions o = options();
     o.llm.baseUrl = "http://127.0.0.1:1/v1";
     auto g = generateScene("a sphere", o);
@@ -427,7 +630,7 @@ TEST_F(Fixture, ConnectionRefused) {
         << g.error().str();
 }
 
-TEST_F(Fixture, OllamaNativeApi) {
+TEST_F(Generate, OllamaNativeApi) {
     server.script({{200, R"({"model": "test-model", "created_at": "2025-01-01T00:00:00Z",
         "message": {"role": "assistant", "content": )" +
                              jsonQuote(kSphere) + R"(}, "done": true,
@@ -464,7 +667,7 @@ TEST_F(Fixture, OllamaNativeApi) {
     EXPECT_EQ(r->url, "http://localhost:11434/api/chat");
 }
 
-TEST_F(Fixture, EditSendsTheCurrentScene) {
+TEST_F(Generate, EditSendsTheCurrentScene) {
     server.script({openAi(kSphere)});
     GenerateOptions o = options();
     o.currentScene = toJson(*parseScene(kSphere));
@@ -474,24 +677,47 @@ TEST_F(Fixture, EditSendsTheCurrentScene) {
         lastMessage(body(0)).starts_with("Here is the current scene:\n{\n  \"version\": 1"));
 }
 
-TEST_F(Fixture, RequestBodyGolden) {
+// The whole first request, byte for byte, against a checked-in file, so that any change to the
+// prompt, the schema or the body shows as a change of tests/data/llm/first_request.json. On a
+// difference the body sent is written to SDFCSG_TEST_OUTPUT_DIR/llm/first_request.actual.json;
+// SDFCSG_UPDATE_GOLDEN=1 rewrites the checked-in file instead, as for the golden images.
+TEST_F(Generate, RequestBodyGolden) {
     server.script({openAi(kSphere)});
     ASSERT_TRUE(generateScene("a red sphere", options()));
-    std::string golden =
-        R"({"model":"test-model","messages":[{"role":"system","content":SYSTEM},)"
-        R"({"role":"user","content":"Request: a red sphere"}],"temperature":0.2,"max_tokens":8192,)"
-        R"("response_format":{"type":"json_schema","json_schema":{"name":"sdfcsg_scene",)"
-        R"("strict":true,"schema":SCHEMA}}})";
-    golden.replace(golden.find("SYSTEM"), 6, jsonQuote(sceneSystemPrompt()));
-    golden.replace(golden.find("SCHEMA"), 6, sceneLlmSchema());
-    EXPECT_EQ(server.received()[0].body, golden);
+    const std::string sent = server.received().at(0).body;
     auto preview = firstLlmRequest("a red sphere", options());
     ASSERT_TRUE(preview);
-    EXPECT_EQ(preview->body, golden);
+    EXPECT_TRUE(preview->body == sent); // not EXPECT_EQ: it would print 40 kB twice
     EXPECT_EQ(preview->url, server.url() + "/chat/completions");
+
+    const fs::path golden = fs::path(SDFCSG_SOURCE_DIR) / "tests/data/llm/first_request.json";
+    if (const char* update = std::getenv("SDFCSG_UPDATE_GOLDEN");
+        update && std::string(update) == "1") {
+        std::ofstream(golden, std::ios::binary) << sent;
+        std::printf("updated %s\n", golden.string().c_str());
+        return;
+    }
+    std::ifstream in(golden, std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    const std::string expected = text.str();
+    const fs::path actual = fs::path(SDFCSG_TEST_OUTPUT_DIR) / "llm" / "first_request.actual.json";
+    fs::remove(actual);
+    if (sent == expected) return;
+    fs::create_directories(actual.parent_path());
+    std::ofstream(actual, std::ios::binary) << sent;
+    const size_t at =
+        size_t(std::mismatch(sent.begin(), sent.end(), expected.begin(), expected.end()).first -
+               sent.begin());
+    ADD_FAILURE() << "the first request differs from " << golden << " from byte " << at
+                  << ":\n  sent:     ..." << sent.substr(at > 40 ? at - 40 : 0, 120)
+                  << "\n  expected: ..." << expected.substr(at > 40 ? at - 40 : 0, 120)
+                  << "\n  The whole body sent is in " << actual
+                  << ".\n  If the change is intended, run with SDFCSG_UPDATE_GOLDEN=1 "
+                     "(SDFCSG_UPDATE_GOLDEN=1 ctest -R Generate.RequestBodyGolden).";
 }
 
-TEST_F(Fixture, KeyOnlyInTheAuthorizationHeader) {
+TEST_F(Generate, KeyOnlyInTheAuthorizationHeader) {
     server.script(
         {{500, R"({"error": {"message": "oops"}})"}, openAi(kBadSphere), openAi(kSphere)});
     std::vector<HttpExchange> recording;
@@ -527,7 +753,7 @@ TEST_F(Fixture, KeyOnlyInTheAuthorizationHeader) {
     EXPECT_FALSE(server.received().back().headers.count("Authorization"));
 }
 
-TEST_F(Fixture, RecordReplayRoundTrip) {
+TEST_F(Generate, RecordReplayRoundTrip) {
     server.script({{429, R"({"error": {"message": "slow down"}})", "1"},
                    openAi(kBadSphere),
                    openAi(kSphere)});

@@ -4,6 +4,7 @@
 #include <sdfcsg/generate.h>
 
 #include "embedded_shaders.h"
+#include "shared.h"
 
 #include <gtest/gtest.h>
 
@@ -46,13 +47,17 @@ TEST(LlmPrompt, ExamplesAreBundledScenesThatValidate) {
     auto examples = detail::embeddedExampleScenes();
     ASSERT_GE(examples.size(), 2u);
     ASSERT_LE(examples.size(), 3u);
-    for (const detail::EmbeddedFile& example : examples) {
+    const std::vector<std::string> requests = sceneExampleRequests();
+    ASSERT_EQ(requests.size(), examples.size());
+    for (size_t i = 0; i < examples.size(); ++i) {
+        const detail::EmbeddedFile& example = examples[i];
         SCOPED_TRACE(std::string(example.name));
         EXPECT_EQ(example.text, readFile(fs::path(SDFCSG_SOURCE_DIR) / "assets/scenes" /
                                          std::string(example.name)));
         auto scene = parseScene(example.text, example.name);
         ASSERT_TRUE(scene) << scene.error().str();
         EXPECT_FALSE(scene->description.empty()); // it is the example's request
+        EXPECT_EQ(requests[i], scene->description);
         EXPECT_TRUE(sceneSanityWarnings(*scene).empty());
         EXPECT_NE(sceneSystemPrompt().find("Request: " + scene->description + "\nAnswer:\n" +
                                            std::string(example.text)),
@@ -71,6 +76,28 @@ TEST(LlmPrompt, SystemPromptHoldsTheGeneratedReference) {
                       std::string::npos)
                 << kind.name << "." << p.name;
     }
+}
+
+// The top-level keys come from the scene schema: every one is listed with its shape, and so are
+// the limits that the schema states (the number of lights).
+TEST(LlmPrompt, SystemPromptListsEveryTopLevelKey) {
+    const std::string prompt = sceneSystemPrompt();
+    const std::string schema = sceneJsonSchema();
+    simdjson::dom::parser parser;
+    simdjson::dom::element top = parser.parse(schema);
+    for (auto [key, value] : simdjson::dom::object(top["properties"]))
+        EXPECT_NE(prompt.find("\n- \"" + std::string(key) + "\": "), std::string::npos) << key;
+    for (const char* def : {"camera", "light"})
+        for (auto [key, value] : simdjson::dom::object(top["$defs"][def]["properties"]))
+            EXPECT_NE(prompt.find("\"" + std::string(key) + "\": "), std::string::npos)
+                << def << "." << key;
+    EXPECT_NE(prompt.find("- \"lights\": up to " + std::to_string(SDFCSG_MAX_LIGHTS) +
+                          " of {\"direction\": [x, y, z], \"color\": [r, g, b], \"intensity\": "
+                          "number}. "),
+              std::string::npos);
+    EXPECT_NE(prompt.find("- \"camera\": {\"eye\": [x, y, z], \"target\": [x, y, z], \"up\": "
+                          "[x, y, z], \"fov\": degrees}. "),
+              std::string::npos);
 }
 
 TEST(LlmPrompt, UserPromptForAnEdit) {
@@ -215,6 +242,16 @@ TEST(LlmSanity, DifferenceThatRemovesNothing) {
                                        "from"});
 }
 
+// A name is the model's text: quoted and escaped as the validator quotes strings.
+TEST(LlmSanity, NamesAreQuotedAndEscaped) {
+    EXPECT_EQ(warnings(R"({"version": 1, "root": {"type": "difference", "children": [
+        {"type": "box", "name": "block\u001b[2J\nroot: fine \"", "size": [1, 1, 1]},
+        {"type": "sphere", "radius": 0.3, "translate": [3, 0, 0]}]}})"),
+              std::vector<std::string>{"root.children[1]: removes nothing: it does not reach "
+                                       "root.children[0] (\"block\\u001b[2J\\nroot: fine \\\"\"), "
+                                       "the part it is subtracted from"});
+}
+
 TEST(LlmSanity, PartsFloatingApart) {
     EXPECT_EQ(
         warnings(R"({"version": 1, "root": {"type": "union", "children": [{"type": "union",
@@ -233,4 +270,26 @@ TEST(LlmSanity, AbsurdBounds) {
         "translate": [0, 0, 4000]}})"),
               std::vector<std::string>{"root: absurd bounds: the scene lies 4000 units from the "
                                        "origin"});
+}
+
+// Bounds at the edge of single precision and beyond it: the size or the distance that the scene
+// really has, never an empty solid or silence.
+TEST(LlmSanity, AbsurdBoundsBeyondSinglePrecision) {
+    EXPECT_EQ(warnings(R"({"version": 1, "root": {"type": "sphere", "radius": 3e38}})"),
+              std::vector<std::string>{
+                  "root: absurd bounds: the scene is 6e+38 units across (expected 0.001 to 1000)"});
+    EXPECT_EQ(warnings(R"({"version": 1, "root": {"type": "sphere", "radius": 1,
+        "translate": [3e38, 0, 0]}})"),
+              std::vector<std::string>{
+                  "root: absurd bounds: the scene lies 3e+38 units from the origin"});
+    EXPECT_EQ(warnings(R"({"version": 1, "root": {"type": "sphere", "radius": 1e30,
+        "scale": 1e30}})"),
+              std::vector<std::string>{
+                  "root: absurd bounds: the scene is 2e+60 units across (expected 0.001 to 1000)"});
+    // With a plane, whose bounds are infinite anyway.
+    EXPECT_EQ(warnings(R"({"version": 1, "root": {"type": "union", "children": [
+        {"type": "plane", "normal": [0, 1, 0]},
+        {"type": "sphere", "radius": 1e30, "scale": 1e30, "translate": [0, 1e-29, 0]}]}})"),
+              std::vector<std::string>{
+                  "root: absurd bounds: the scene is 2e+60 units across (expected 0.001 to 1000)"});
 }

@@ -262,6 +262,10 @@ std::vector<BadInput> badInputs() {
         {"key of another kind", scene(R"({"type": "sphere", "size": [1, 1, 1], "radius": 1})"),
          "scene.json: root: unknown key \"size\" for a sphere; valid keys: radius, type, name, "
          "translate, rotate, scale and color"},
+        {"unknown key with DEL and a C1 control, escaped",
+         scene(R"({"type": "sphere", "radius": 1, "\u007f\u009b2J": 1})"),
+         "scene.json: root: unknown key \"\\u007f\\u009b2J\" for a sphere; valid keys: radius, "
+         "type, name, translate, rotate, scale and color"},
         {"another word for translate",
          scene(R"({"type": "sphere", "radius": 1, "position": [0, 1, 0]})"),
          R"(scene.json: root: unknown key "position"; did you mean "translate"?)"},

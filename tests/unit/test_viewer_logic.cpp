@@ -731,7 +731,7 @@ TEST(ViewerGenerate, AnAnswerThatNeverLoadsIsAnError) {
     ASSERT_FALSE(*done);
     EXPECT_EQ(done->error().kind, ErrorKind::Validation);
     EXPECT_EQ(done->error().str(),
-              "answer: no answer loaded after 1 repair rounds; the last one's problems:\n"
+              "answer: no answer loaded after 1 repair round; the last one's problems:\n"
               "answer: root.radius: expected a positive number, got -1");
     EXPECT_EQ(server.received().size(), 2u);
     EXPECT_EQ(toJson(doc.scene()), before);

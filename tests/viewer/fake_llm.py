@@ -1,18 +1,28 @@
-# A stand-in for a language model endpoint, for the viewer's scripted generation test: every POST
-# gets an OpenAI Chat Completions answer whose content is the file ANSWER, read anew for each
-# request so the test can change it. Writes the port it listens on to PORT_FILE.
-# Usage: fake_llm.py ANSWER PORT_FILE
+# A stand-in for a language model endpoint, for the viewer's scripted generation test and the
+# command line's Ctrl-C tests: every POST gets an OpenAI Chat Completions answer whose content is
+# the file ANSWER, read anew for each request so the test can change it. With ANSWERED, only the
+# first ANSWERED requests are answered and the next one is held for a minute, so that a client
+# can be interrupted while it waits. Writes the port it listens on to PORT_FILE.
+# Usage: fake_llm.py ANSWER PORT_FILE [ANSWERED]
 import http.server
 import json
 import os
 import sys
+import time
 
 answer_path, port_path = sys.argv[1], sys.argv[2]
+answered = int(sys.argv[3]) if len(sys.argv) > 3 else None
+requests = 0
 
 
 class Handler(http.server.BaseHTTPRequestHandler):
     def do_POST(self):
+        global requests
         self.rfile.read(int(self.headers.get("Content-Length", 0)))
+        requests += 1
+        if answered is not None and requests > answered:
+            time.sleep(60)
+            return
         with open(answer_path, encoding="utf-8") as f:
             content = f.read()
         body = json.dumps({

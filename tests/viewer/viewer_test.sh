@@ -256,7 +256,7 @@ screenshot g2-undone.png
 SCRIPT
     run edit.json --script generate.txt --size 320x240 --no-ui 2> generate.err ||
         fail "scripted generation: $(cat generate.err)"
-    grep -q "generate.txt:2: 1 nodes, valid on the first try" generate.err ||
+    grep -q "generate.txt:2: 1 node, valid on the first try" generate.err ||
         fail "no summary of the generation: $(cat generate.err)"
     grep -q '"name": "ball"' generated.json || fail "the generated scene was not the current one"
     "$diff" g0-start.png g1-generated.png differ 0.05 || fail "the generated scene is not shown"

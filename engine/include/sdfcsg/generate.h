@@ -9,7 +9,8 @@
 //
 // Model output is untrusted: it is parsed under Limits (size, node count, nesting), and a scene
 // names no files, so an answer cannot make the program read or write anything. The API key is
-// sent in the Authorization header only; it is never printed, logged or recorded.
+// sent in the Authorization header only; it is never printed, logged or recorded, and where a
+// server echoes it or a model repeats it, messages, recordings and scenes say "[redacted]".
 #pragma once
 
 #include "sdfcsg/error.h"
@@ -50,7 +51,9 @@ struct LlmConfig {
     uint32_t maxTokens = 8192;        // answer length limit
     std::optional<float> temperature = 0.2f; // unset: the server's default
     uint32_t contextTokens = 16384; // Ollama's options.num_ctx (its default is far too small)
-    size_t maxResponseBytes = 16u << 20; // a longer HTTP answer is cut off with a Remote error
+    // A longer HTTP answer is cut off with a Remote error. generateScene() stops at four times
+    // GenerateOptions::limits.maxFileBytes if that is less (4 MiB for its default limits).
+    size_t maxResponseBytes = 16u << 20;
 };
 
 // Settings from the environment: OPENAI_BASE_URL and OPENAI_API_KEY, overridden by
@@ -67,7 +70,8 @@ struct LlmEndpoint {
 };
 Result<LlmEndpoint> llmEndpoint(const LlmConfig& config);
 
-// One HTTP exchange, as recorded and replayed. It holds no headers, so never the API key.
+// One HTTP exchange, as recorded and replayed. It holds no headers, and the API key is redacted
+// from what it holds (a server may echo the key in a body).
 struct HttpExchange {
     std::string url;
     std::string request; // request body
@@ -138,6 +142,9 @@ std::string generationSummary(const Generated& generated, const GenerateStats& s
 
 // The system prompt: the format reference, the composition rules and the examples.
 std::string sceneSystemPrompt();
+// The requests that the system prompt's examples answer (each example scene's description), in
+// order. A request close to one of them is no fair test of the model (`sdfcsg eval-prompts`).
+std::vector<std::string> sceneExampleRequests();
 // The first user message for a request (and, when editing, the current scene).
 std::string sceneUserPrompt(std::string_view request, std::string_view currentScene = {});
 // The message that asks for a corrected scene, quoting the validator's problems.
