@@ -414,7 +414,8 @@ int cmdValidate(int argc, char** argv) {
             worst = std::max(worst, int(code == kIo ? kIo : kInvalidScene));
             continue;
         }
-        std::printf("%s: ok (%zu nodes)\n", path.c_str(), scene->nodes.size());
+        std::printf("%s: ok (%zu node%s)\n", path.c_str(), scene->nodes.size(),
+                    scene->nodes.size() == 1 ? "" : "s");
     }
     return worst;
 }

@@ -37,6 +37,9 @@ expect_text "unknown command message" err.txt "sdfcsg: unknown command 'frobnica
 
 check "validate bundled" 0 "$bin" validate "$src"/assets/scenes/*.json
 expect_text "validate ok line" out.txt "$src/assets/scenes/house.json: ok (34 nodes)"
+printf '{"version": 1, "root": {"type": "sphere", "radius": 1}}' >one.json
+check "validate one node" 0 "$bin" validate one.json
+expect_text "validate counts in the singular" out.txt "one.json: ok (1 node)"
 
 printf '{"version": 1, "root": {"type": "sphere", "radius": -1}}' >bad.json
 check "validate bad" 1 "$bin" validate bad.json
