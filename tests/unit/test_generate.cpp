@@ -558,6 +558,25 @@ TEST_F(Generate, ServerErrorsGiveUp) {
     EXPECT_EQ(sleeps, (std::vector<double>{0.5, 1.0}));
 }
 
+// The standard proxy variables are curl's: a request for a host outside no_proxy goes to the
+// proxy named by http_proxy, in absolute form.
+TEST_F(Generate, RequestsGoThroughTheProxyVariables) {
+    server.script({openAi(kSphere)});
+    const std::string saved = std::getenv("http_proxy") ? std::getenv("http_proxy") : "";
+    ::setenv("http_proxy", server.url("").c_str(), 1);
+    GenerateOptions o = options();
+    o.llm.baseUrl = "http://llm.example.invalid/v1";
+    auto g = generateScene("a sphere", o);
+    if (saved.empty())
+        ::unsetenv("http_proxy");
+    else
+        ::setenv("http_proxy", saved.c_str(), 1);
+    ASSERT_TRUE(g) << g.error().str();
+    auto received = server.received();
+    ASSERT_EQ(received.size(), 1u);
+    EXPECT_EQ(received[0].path, "http://llm.example.invalid/v1/chat/completions");
+}
+
 TEST_F(Generate, Timeout) {
     server.script({{200, "{}", "", true}});
     GenerateOptions o = options();
