@@ -113,6 +113,24 @@ uint32_t loadedIndex(const Scene& scene, uint32_t node) {
     return found;
 }
 
+// The scene with its nodes in the loader's order, which toJson needs (it follows a child only
+// when it comes after its parent): after a node moved to another parent it may not be.
+Scene inLoadedOrder(const Scene& scene) {
+    std::vector<uint32_t> order, index(scene.nodes.size(), 0);
+    forSubtree(scene, 0, [&](uint32_t n) {
+        index[n] = uint32_t(order.size());
+        order.push_back(n);
+    });
+    Scene sorted = scene;
+    sorted.nodes.clear();
+    for (uint32_t n : order) {
+        sorted.nodes.push_back(scene.nodes[n]);
+        for (uint32_t& c : sorted.nodes.back().children)
+            c = index[c];
+    }
+    return sorted;
+}
+
 } // namespace
 
 std::string nodeLabel(const Scene& scene, uint32_t node) {
@@ -264,6 +282,56 @@ Result<Scene> moveNode(const Scene& scene, uint32_t node, int delta, uint32_t* n
     siblings.insert(siblings.begin() + to, moved);
     if (newIndex) *newIndex = loadedIndex(edited, node);
     return revalidate(edited);
+}
+
+Result<Scene> reparentNode(const Scene& scene, uint32_t node, uint32_t parent, uint32_t position,
+                           uint32_t* newIndex) {
+    if (node >= scene.nodes.size()) return badNode(scene, node);
+    if (parent >= scene.nodes.size()) return badNode(scene, parent);
+    int from = parentOf(scene, node);
+    if (from < 0) return usage(scene, node, "the root cannot be moved");
+    if (!kindInfo(scene.nodes[parent].kind).operation)
+        return usage(scene, parent, "only an operation can take children");
+    bool inside = false;
+    forSubtree(scene, node, [&](uint32_t n) { inside = inside || n == parent; });
+    if (inside)
+        return usage(scene, node,
+                     parent == node ? std::string("a node cannot be moved into itself")
+                                    : "a node cannot be moved into its own subtree (" +
+                                          scene.nodes[parent].path + ")");
+    if (uint32_t(from) != parent && scene.nodes[from].children.size() == 1)
+        return usage(scene, node,
+                     "an operation needs at least one child; move or remove the operation "
+                     "instead");
+    Scene edited = scene;
+    auto& old = edited.nodes[from].children;
+    old.erase(std::find(old.begin(), old.end(), node));
+    auto& siblings = edited.nodes[parent].children;
+    if (position == kLastChild) position = uint32_t(siblings.size());
+    if (position > siblings.size())
+        return usage(scene, parent,
+                     "child position " + std::to_string(position) + " is past the end (0 to " +
+                         std::to_string(siblings.size()) + ")");
+    siblings.insert(siblings.begin() + position, node);
+    if (newIndex) *newIndex = loadedIndex(edited, node);
+    return revalidate(inLoadedOrder(edited));
+}
+
+Result<Scene> dropNode(const Scene& scene, uint32_t node, uint32_t target, uint32_t* newIndex) {
+    if (target >= scene.nodes.size()) return badNode(scene, target);
+    if (kindInfo(scene.nodes[target].kind).operation)
+        return reparentNode(scene, node, target, kLastChild, newIndex);
+    int parent = parentOf(scene, target);
+    if (parent < 0) return usage(scene, target, "the root has no siblings");
+    // Positions count the children without the moved node, so a node that now comes before
+    // the target leaves a gap that the target's position closes.
+    const auto& siblings = scene.nodes[parent].children;
+    auto at = [&](uint32_t n) {
+        return uint32_t(std::find(siblings.begin(), siblings.end(), n) - siblings.begin());
+    };
+    uint32_t position = at(target);
+    if (parentOf(scene, node) == parent && at(node) < position) --position;
+    return reparentNode(scene, node, uint32_t(parent), position, newIndex);
 }
 
 } // namespace sdfcsg::viewer

@@ -53,4 +53,22 @@ Result<Scene> changeKind(const Scene& scene, uint32_t node, NodeKind kind);
 // the others are cut from, so order matters). *newIndex receives the node's index afterwards.
 Result<Scene> moveNode(const Scene& scene, uint32_t node, int delta, uint32_t* newIndex = nullptr);
 
+// For reparentNode's position: after the operation's other children.
+inline constexpr uint32_t kLastChild = UINT32_MAX;
+// Moves a node with its subtree to become child number `position` of the operation `parent`,
+// counted among the children it will have (0 puts it first, kLastChild last; its own parent is
+// a legal `parent`, which reorders). There is no default position: at 0 of a difference the
+// node becomes what the others are cut from. The node's transform and colour stay as they are,
+// so it now sits relative to the new parent and inherits that parent's colour where it sets
+// none. Refused for the root, for a `parent` that is not an operation or lies in the node's
+// own subtree, for a position past the end, and when it would leave its old parent without
+// children. *newIndex receives the node's index afterwards.
+Result<Scene> reparentNode(const Scene& scene, uint32_t node, uint32_t parent, uint32_t position,
+                           uint32_t* newIndex = nullptr);
+// What dropping `node` onto `target` in the scene tree does: onto an operation, the node
+// becomes its last child; onto anything else, it goes just before `target` among the target's
+// siblings. So a drag both reparents and reorders. *newIndex as for reparentNode.
+Result<Scene> dropNode(const Scene& scene, uint32_t node, uint32_t target,
+                       uint32_t* newIndex = nullptr);
+
 } // namespace sdfcsg::viewer

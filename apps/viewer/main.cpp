@@ -30,6 +30,7 @@
 #include <cstring>
 #include <deque>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -574,7 +575,12 @@ void handleInput(Viewer& v) {
 
 // ---- Panels ----------------------------------------------------------------------------------
 
-void nodeTree(Viewer& v, uint32_t node) {
+// A dragged tree node's payload: its index in v.scene.
+constexpr const char* kNodePayload = "sdfcsg-node";
+
+// Draws the tree below `node`. A node dropped on another is only recorded in *drop (dragged,
+// target), to apply once the tree is drawn: the edit renumbers the nodes being drawn.
+void nodeTree(Viewer& v, uint32_t node, std::optional<std::pair<uint32_t, uint32_t>>* drop) {
     const Scene& s = *v.scene;
     const Node& n = s.nodes[node];
     bool operation = kindInfo(n.kind).operation;
@@ -587,9 +593,22 @@ void nodeTree(Viewer& v, uint32_t node) {
         label += " smooth " + std::to_string(s.nodes[node].params[0]).substr(0, 5);
     bool open = ImGui::TreeNodeEx((void*)(uintptr_t)node, flags, "%s", label.c_str());
     if (ImGui::IsItemClicked() && !ImGui::IsItemToggledOpen()) v.selected = int(node);
+    if (node != 0 && ImGui::BeginDragDropSource()) { // the root has nowhere to go
+        ImGui::SetDragDropPayload(kNodePayload, &node, sizeof node);
+        ImGui::TextUnformatted(nodeLabel(s, node).c_str());
+        ImGui::EndDragDropSource();
+    }
+    if (ImGui::BeginDragDropTarget()) {
+        if (const ImGuiPayload* payload = ImGui::AcceptDragDropPayload(kNodePayload)) {
+            uint32_t dragged = 0;
+            std::memcpy(&dragged, payload->Data, sizeof dragged);
+            if (dragged != node) *drop = std::pair(dragged, node);
+        }
+        ImGui::EndDragDropTarget();
+    }
     if (operation && open) {
         for (uint32_t c : n.children)
-            nodeTree(v, c);
+            nodeTree(v, c, drop);
         ImGui::TreePop();
     }
 }
@@ -905,8 +924,12 @@ void panels(Viewer& v) {
     }
     if (v.scene && ImGui::CollapsingHeader("Scene", ImGuiTreeNodeFlags_DefaultOpen)) {
         ImGui::BeginChild("tree", ImVec2(0, 220), true);
-        nodeTree(v, 0);
+        std::optional<std::pair<uint32_t, uint32_t>> drop;
+        nodeTree(v, 0, &drop);
         ImGui::EndChild();
+        uint32_t moved = 0;
+        if (drop && commit(v, dropNode(*v.scene, drop->first, drop->second, &moved)))
+            v.selected = int(moved);
     }
     if (v.scene && ImGui::CollapsingHeader("Node", ImGuiTreeNodeFlags_DefaultOpen)) valueEditor(v);
     if (v.scene && ImGui::CollapsingHeader("Mesh")) meshPanel(v);
@@ -998,15 +1021,21 @@ bool runScript(Viewer& v) {
             auto saved = v.doc.save(path);
             if (!saved) return fail(saved.error().str());
         } else if (c.verb == "add" || c.verb == "remove" || c.verb == "kind" || c.verb == "op" ||
-                   c.verb == "move") {
+                   c.verb == "move" || c.verb == "parent") {
             auto node = selectedNode();
             if (!node) return fail(c.verb + ": no node selected");
             uint32_t moved = *node;
-            Result<Scene> edited = c.verb == "add"      ? addChild(*v.scene, *node, kindNamed(arg), &moved)
-                                   : c.verb == "remove" ? removeNode(*v.scene, *node)
-                                   : c.verb == "move"
-                                       ? moveNode(*v.scene, *node, arg == "up" ? -1 : 1, &moved)
-                                       : changeKind(*v.scene, *node, kindNamed(arg));
+            std::optional<uint32_t> parent;
+            if (c.verb == "parent" && !(parent = findNode(*v.scene, arg)))
+                return fail("no node named \"" + arg + "\"");
+            Result<Scene> edited =
+                c.verb == "add" ? addChild(*v.scene, *node, kindNamed(arg), &moved)
+                : c.verb == "parent"
+                    ? reparentNode(*v.scene, *node, *parent,
+                                   c.numbers.empty() ? kLastChild : uint32_t(c.numbers[0]), &moved)
+                : c.verb == "remove" ? removeNode(*v.scene, *node)
+                : c.verb == "move"   ? moveNode(*v.scene, *node, arg == "up" ? -1 : 1, &moved)
+                                     : changeKind(*v.scene, *node, kindNamed(arg));
             if (!edited) return fail(edited.error().str());
             commit(v, std::move(edited));
             // As the Node panel's buttons leave the selection.

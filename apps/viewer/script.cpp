@@ -55,6 +55,7 @@ const std::vector<Verb>& verbs() {
         {"kind", 1, 1, false, allKindNames()},
         {"op", 1, 1, false, kindNames(true)},
         {"move", 1, 1, false, {"up", "down"}},
+        {"parent", 1, 2, false, {}},
         {"open", 1, 1, false, {}},
         {"pick", 2, 2, true, {}},
         {"wait-reload", 0, 0, false, {}},
@@ -163,6 +164,16 @@ Result<std::vector<Command>> parseScript(std::string_view text, std::string_view
                 continue;
             }
             c.numbers.push_back(cells);
+        }
+        if (c.verb == "parent" && n == 2) {
+            float index = 0;
+            if (!parseFloat(c.args[1], index) || !(index >= 0 && index < 1e6f) ||
+                index != std::floor(index)) {
+                problem("parent: expected a whole number for the child's position, got \"" +
+                        c.args[1] + "\"");
+                continue;
+            }
+            c.numbers.push_back(index);
         }
         commands.push_back(std::move(c));
     }

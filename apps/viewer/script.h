@@ -14,6 +14,9 @@
 //   kind KIND                turn the selected primitive (operation) into another one
 //   op union|intersection|difference|...   the same, for operations only
 //   move up|down             the selected node among its siblings
+//   parent NODE [INDEX]      move the selected node and its subtree under the operation NODE,
+//                            as child INDEX (0 first; the first child of a difference is what
+//                            the others are cut from) or last; it stays selected
 //   open PATH                load a scene file as the file panel does (a failure is no
 //                            script error: the scene stays, see expect-error)
 //   save [PATH]              write the scene as JSON (no PATH: where Ctrl+S writes)

@@ -420,6 +420,156 @@ TEST(ViewerEdit, StructuralEditsKeepTheSceneValid) {
     EXPECT_EQ(reordered->nodes[reordered->nodes[cut].children[0]].name, "hole");
 }
 
+constexpr const char* kGroups = R"({
+  "version": 1,
+  "root": {"type": "union", "name": "all", "children": [
+    {"type": "sphere", "name": "a", "radius": 0.5},
+    {"type": "union", "name": "group", "translate": [0, 1, 0], "children": [
+      {"type": "sphere", "name": "b", "radius": 0.4},
+      {"type": "intersection", "name": "inner", "children": [
+        {"type": "sphere", "name": "c", "radius": 0.5},
+        {"type": "box", "name": "d", "size": [0.6, 0.6, 0.6]}
+      ]}
+    ]},
+    {"type": "difference", "name": "cut", "children": [
+      {"type": "box", "name": "block", "size": [1, 1, 1]},
+      {"type": "sphere", "name": "hole", "radius": 0.3}
+    ]},
+    {"type": "union", "name": "solo", "children": [{"type": "sphere", "name": "e", "radius": 0.2}]}
+  ]}
+})";
+
+// The names of a node's children, in order.
+std::vector<std::string> childNames(const Scene& scene, std::string_view node) {
+    std::vector<std::string> names;
+    for (uint32_t c : scene.nodes[*findNode(scene, node)].children)
+        names.push_back(scene.nodes[c].name);
+    return names;
+}
+
+using Names = std::vector<std::string>;
+
+TEST(ViewerEdit, ReparentMovesASubtreeIntoAnotherOperation) {
+    auto loaded = parseScene(kGroups, "g.json");
+    ASSERT_TRUE(loaded) << loaded.error().str();
+    const Scene& s = *loaded;
+    auto at = [&](std::string_view name) { return *findNode(s, name); };
+
+    // Into a sibling union, last: the new index is the moved node's, its path the new one.
+    uint32_t moved = 0;
+    auto edited = reparentNode(s, at("a"), at("group"), kLastChild, &moved);
+    ASSERT_TRUE(edited) << edited.error().str();
+    EXPECT_EQ(edited->nodes[moved].name, "a");
+    EXPECT_EQ(edited->nodes[moved].path, "root.children[0].children[2]");
+    EXPECT_EQ(childNames(*edited, "group"), (Names{"b", "inner", "a"}));
+    EXPECT_EQ(childNames(*edited, "all"), (Names{"group", "cut", "solo"}));
+    // The transform stays the node's own, now relative to the new parent.
+    EXPECT_EQ(edited->nodes[moved].transform.translate, glm::vec3(0));
+
+    // Into a different subtree, with its own subtree, at a position.
+    edited = reparentNode(s, at("inner"), at("cut"), 1, &moved);
+    ASSERT_TRUE(edited) << edited.error().str();
+    EXPECT_EQ(edited->nodes[moved].name, "inner");
+    EXPECT_EQ(edited->nodes[moved].path, "root.children[2].children[1]");
+    EXPECT_EQ(childNames(*edited, "cut"), (Names{"block", "inner", "hole"}));
+    EXPECT_EQ(childNames(*edited, "inner"), (Names{"c", "d"}));
+    EXPECT_EQ(childNames(*edited, "group"), (Names{"b"}));
+
+    // At position 0 of a difference: the node becomes what the others are cut from.
+    edited = reparentNode(s, at("a"), at("cut"), 0, &moved);
+    ASSERT_TRUE(edited) << edited.error().str();
+    EXPECT_EQ(edited->nodes[moved].path, "root.children[1].children[0]");
+    EXPECT_EQ(childNames(*edited, "cut"), (Names{"a", "block", "hole"}));
+    EXPECT_FALSE(sameStructure(s, *edited));
+
+    // Within its own parent, a reorder; the last position counts the moved node.
+    edited = reparentNode(s, at("hole"), at("cut"), 0, &moved);
+    ASSERT_TRUE(edited) << edited.error().str();
+    EXPECT_EQ(childNames(*edited, "cut"), (Names{"hole", "block"}));
+    edited = reparentNode(s, at("block"), at("cut"), 1);
+    ASSERT_TRUE(edited) << edited.error().str();
+    EXPECT_EQ(childNames(*edited, "cut"), (Names{"hole", "block"}));
+}
+
+TEST(ViewerEdit, ReparentRefusals) {
+    auto loaded = parseScene(kGroups, "g.json");
+    ASSERT_TRUE(loaded) << loaded.error().str();
+    const Scene& s = *loaded;
+    auto at = [&](std::string_view name) { return *findNode(s, name); };
+    auto refused = [&](std::string_view node, std::string_view parent, uint32_t position) {
+        auto r = reparentNode(s, at(node), at(parent), position);
+        return r ? std::string("accepted") : r.error().str();
+    };
+    EXPECT_EQ(refused("all", "group", kLastChild), "g.json: root: the root cannot be moved");
+    EXPECT_EQ(refused("group", "group", kLastChild),
+              "g.json: root.children[1]: a node cannot be moved into itself");
+    EXPECT_EQ(refused("group", "inner", 0),
+              "g.json: root.children[1]: a node cannot be moved into its own subtree "
+              "(root.children[1].children[1])");
+    EXPECT_EQ(refused("a", "b", kLastChild),
+              "g.json: root.children[1].children[0]: only an operation can take children");
+    EXPECT_EQ(refused("e", "cut", kLastChild),
+              "g.json: root.children[3].children[0]: an operation needs at least one child; "
+              "move or remove the operation instead");
+    EXPECT_EQ(refused("a", "cut", 3), "g.json: root.children[2]: child position 3 is past the "
+                                      "end (0 to 2)");
+    EXPECT_EQ(refused("hole", "cut", 2), "g.json: root.children[2]: child position 2 is past "
+                                         "the end (0 to 1)");
+    auto missing = reparentNode(s, 99, 0, kLastChild);
+    ASSERT_FALSE(missing);
+    EXPECT_EQ(missing.error().str(), "g.json: no node 99 (the scene has 12)");
+}
+
+TEST(ViewerEdit, DropReparentsOrReorders) {
+    auto loaded = parseScene(kGroups, "g.json");
+    ASSERT_TRUE(loaded) << loaded.error().str();
+    const Scene& s = *loaded;
+    auto at = [&](std::string_view name) { return *findNode(s, name); };
+    uint32_t moved = 0;
+    // Onto an operation: its last child.
+    auto edited = dropNode(s, at("hole"), at("group"), &moved);
+    ASSERT_TRUE(edited) << edited.error().str();
+    EXPECT_EQ(edited->nodes[moved].name, "hole");
+    EXPECT_EQ(childNames(*edited, "group"), (Names{"b", "inner", "hole"}));
+    // Onto a primitive: just before it, from another parent or from the same one, either way.
+    edited = dropNode(s, at("a"), at("hole"), &moved);
+    ASSERT_TRUE(edited) << edited.error().str();
+    EXPECT_EQ(edited->nodes[moved].name, "a");
+    EXPECT_EQ(childNames(*edited, "cut"), (Names{"block", "a", "hole"}));
+    edited = dropNode(s, at("hole"), at("block"));
+    ASSERT_TRUE(edited) << edited.error().str();
+    EXPECT_EQ(childNames(*edited, "cut"), (Names{"hole", "block"}));
+    edited = dropNode(s, at("a"), at("solo"));
+    ASSERT_TRUE(edited) << edited.error().str();
+    EXPECT_EQ(childNames(*edited, "all"), (Names{"group", "cut", "solo"}));
+    EXPECT_EQ(childNames(*edited, "solo"), (Names{"e", "a"}));
+    edited = dropNode(s, at("c"), at("b"));
+    ASSERT_TRUE(edited) << edited.error().str();
+    EXPECT_EQ(childNames(*edited, "group"), (Names{"c", "b", "inner"}));
+    EXPECT_EQ(childNames(*edited, "inner"), (Names{"d"}));
+    // A drop that would put an operation inside itself is refused as reparenting is.
+    auto refused = dropNode(s, at("inner"), at("c"));
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error().str(),
+              "g.json: root.children[1].children[1]: a node cannot be moved into itself");
+}
+
+TEST(ViewerEdit, UndoRestoresTheSceneBeforeAReparent) {
+    auto loaded = parseScene(kGroups, "g.json");
+    ASSERT_TRUE(loaded) << loaded.error().str();
+    const std::string before = toJson(*loaded);
+    History history(*loaded);
+    auto edited = reparentNode(history.current(), *findNode(history.current(), "inner"),
+                               *findNode(history.current(), "cut"), 0);
+    ASSERT_TRUE(edited) << edited.error().str();
+    history.push(std::move(*edited));
+    EXPECT_NE(toJson(history.current()), before);
+    ASSERT_TRUE(history.undo());
+    EXPECT_EQ(toJson(history.current()), before);
+    ASSERT_TRUE(history.redo());
+    EXPECT_EQ(childNames(history.current(), "cut"), (Names{"inner", "block", "hole"}));
+}
+
 TEST(ViewerEdit, SameNodeAfterAReload) {
     Scene before = twoSpheres();
     // Named nodes are found by name wherever they moved; unnamed ones by their JSON path.
@@ -623,7 +773,7 @@ TEST(ViewerScript, ReportsEveryProblem) {
               "s.txt:1:1: mode: expected one of shaded, normals, depth, steps, got \"shiny\"\n"
               "s.txt:2:1: unknown command \"fly\" (known: select, set, mode, shadows, ao, grid, "
               "boxes, orbit, zoom, frame, reset, undo, redo, save, screenshot, generate, "
-              "edit-scene, add, remove, kind, op, move, open, pick, wait-reload, ui, "
+              "edit-scene, add, remove, kind, op, move, parent, open, pick, wait-reload, ui, "
               "expect-error, expect-selected, print-bounds, mesh, view, wireframe)\n"
               "s.txt:3:1: set: expected a finite number, got \"big\"\n"
               "s.txt:4:1: zoom: expected 1 arguments, got 0\n"
@@ -642,6 +792,22 @@ TEST(ViewerScript, RefusesNumbersThatAreNotFinite) {
                                     "s.txt:5:1: zoom: expected a positive factor, got \"0\"\n"
                                     "s.txt:6:1: op: expected one of union, intersection, "
                                     "difference, got \"sphere\"");
+}
+
+TEST(ViewerScript, ParentTakesANodeAndAPosition) {
+    auto script = parseScript("parent group\nparent cut 0\n", "s.txt");
+    ASSERT_TRUE(script) << script.error().str();
+    ASSERT_EQ(script->size(), 2u);
+    EXPECT_EQ((*script)[0].args, std::vector<std::string>{"group"});
+    EXPECT_TRUE((*script)[0].numbers.empty());
+    EXPECT_EQ((*script)[1].numbers, std::vector<float>{0});
+    auto bad = parseScript("parent\nparent cut -1\nparent cut 1.5\nparent cut 1 2\n", "s.txt");
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error().str(),
+              "s.txt:1:1: parent: expected 1 to 2 arguments, got 0\n"
+              "s.txt:2:1: parent: expected a whole number for the child's position, got \"-1\"\n"
+              "s.txt:3:1: parent: expected a whole number for the child's position, got \"1.5\"\n"
+              "s.txt:4:1: parent: expected 1 to 2 arguments, got 3");
 }
 
 TEST(ViewerScript, GenerateTakesTheRestOfTheLine) {

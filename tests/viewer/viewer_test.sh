@@ -120,6 +120,29 @@ run edit.json --script structure.txt --size 320x240 --no-ui || fail "structural 
 "$diff" t0.png m-boxes.png differ 0.005 || fail "boxes all shows nothing"
 "$diff" t0.png t6-end.png same 0 0 || fail "the view options did not go back"
 
+# Moving a node into another operation: the head leaves the smooth white body for the black
+# coal, as its first child, and stays selected; undo restores the image exactly. A target that
+# is no operation fails the script with the edit's message.
+cat > parent.txt <<'SCRIPT'
+screenshot q0.png
+select head
+parent coal 0
+expect-selected head
+select none
+screenshot q1-moved.png
+undo
+screenshot q2-undone.png
+SCRIPT
+run edit.json --script parent.txt --size 320x240 --no-ui || fail "moving a node"
+"$diff" q0.png q1-moved.png differ 0.01 || fail "moving the head into the coal changed nothing"
+"$diff" q0.png q2-undone.png same 0 0 || fail "undo did not restore the moved node"
+printf 'select head\nparent nose\n' > parent-bad.txt
+if run edit.json --script parent-bad.txt --size 320x240 --no-ui 2> parent-bad.err; then
+    fail "moving a node under a primitive was accepted"
+fi
+grep -q "parent-bad.txt:2: .*only an operation can take children" parent-bad.err ||
+    fail "unexpected message: $(cat parent-bad.err)"
+
 # The selection: its highlight and its box lie within the node's projected bounds; a click
 # selects the node under the cursor, and one on the sky clears the selection.
 cat > select.txt <<'SCRIPT'
