@@ -7,12 +7,13 @@
 //            the host fills the rest of the band with the colour of a miss;
 //   shade:   one invocation per listed hit (an indirect dispatch): normal, occlusion, shadows
 //            and lighting;
-//   resolve: with several samples per pixel, one invocation per pixel averages them;
-//   overlay: with the ground grid or the box overlay on, one invocation per pixel draws them.
+//   overlay: with the ground grid or the box overlay on, one invocation per listed hit draws
+//            them over its shaded colour (the march pass draws them over the samples it colours);
+//   resolve: with several samples per pixel, one invocation per pixel averages them.
 // CPU drivers such as lavapipe run invocations in SIMD lanes and execute every branch that any
 // lane takes; split this way, misses never pay for shading and every shading lane has a hit.
 // Each pass is its own pipeline (kPass), and the driver compiles only the code its pass reaches:
-// the overlays, used by the viewer, cost the march and shade kernels nothing.
+// the overlays, which the viewer uses, cost the shade kernel nothing.
 //
 // Rays are generated and clipped exactly as engine/src/camera.h does on the CPU (the tests trace
 // the same rays with the reference evaluator). Normals use the four-tap tetrahedral difference
@@ -61,12 +62,12 @@ layout(push_constant) uniform Band {
     uint colorOffset;
 } band;
 
-layout(std430, set = 0, binding = SDFCSG_BINDING_PIXELS) buffer Pixels {
+layout(std430, set = 0, binding = SDFCSG_BINDING_PIXELS) writeonly buffer Pixels {
     uint pixels[];
 };
 
 // Per pixel, from its first sample: x: ray parameter of the hit (negative: a miss), y: steps.
-layout(std430, set = 0, binding = SDFCSG_BINDING_INFO) buffer Info {
+layout(std430, set = 0, binding = SDFCSG_BINDING_INFO) writeonly buffer Info {
     vec2 info[];
 };
 
@@ -415,6 +416,16 @@ vec3 unpackColor(uint c) {
     return vec3(uvec3(c, c >> 8, c >> 16) & 255u) / 255.0;
 }
 
+// The sample's final colour: the ground grid and the box edges drawn over it.
+uint finish(vec3 c, vec3 ro, vec3 rd, float t) {
+    if ((frame.size.w & SDFCSG_FLAG_GRID) != 0u) c = mix(c, vec3(0.12), gridCoverage(ro, rd, t));
+    if ((frame.size.w & (SDFCSG_FLAG_BOXES_ALL | SDFCSG_FLAG_BOXES_SELECTED)) != 0u) {
+        vec4 o = boxOverlay(ro, rd, t);
+        c = mix(c, o.rgb, o.a);
+    }
+    return packColor(c);
+}
+
 // Sample `sampleIndex` of the band (row-major over its width * aa columns): its pixel and its ray.
 void sampleRay(uint sampleIndex, out uvec2 pixel, out vec3 rd) {
     uint aa = max(frame.counts.x, 1u);
@@ -442,7 +453,7 @@ void marchPass() {
         if (slot % (SDFCSG_RAYMARCH_GROUP_X * SDFCSG_RAYMARCH_GROUP_Y) == 0u) atomicAdd(groups, 1u);
         hits[slot] = uvec2(sampleIndex, floatBitsToUint(r.t));
     } else {
-        colors[band.colorOffset + sampleIndex] = packColor(plainColor(r));
+        colors[band.colorOffset + sampleIndex] = finish(plainColor(r), ro, rd, r.t);
     }
 }
 
@@ -473,21 +484,16 @@ void resolvePass() {
     pixels[pixel.y * frame.size.x + pixel.x] = packColor(sum / float(aa * aa));
 }
 
-// The ground grid and the box edges over each pixel of the band, along the ray through the
-// pixel's centre and hidden behind its first sample's hit.
 void overlayPass() {
-    uvec2 pixel = gl_GlobalInvocationID.xy + uvec2(0u, band.firstRow);
-    if (any(greaterThanEqual(pixel, frame.size.xy))) return;
-    uint i = pixel.y * frame.size.x + pixel.x;
-    vec3 ro = frame.eye.xyz, rd = rayDirection(vec2(pixel) + 0.5);
-    float t = info[i].x;
-    vec3 c = unpackColor(pixels[i]);
-    if ((frame.size.w & SDFCSG_FLAG_GRID) != 0u) c = mix(c, vec3(0.12), gridCoverage(ro, rd, t));
-    if ((frame.size.w & (SDFCSG_FLAG_BOXES_ALL | SDFCSG_FLAG_BOXES_SELECTED)) != 0u) {
-        vec4 o = boxOverlay(ro, rd, t);
-        c = mix(c, o.rgb, o.a);
-    }
-    pixels[i] = packColor(c);
+    uint slot = gl_WorkGroupID.x * (SDFCSG_RAYMARCH_GROUP_X * SDFCSG_RAYMARCH_GROUP_Y) +
+                gl_LocalInvocationIndex;
+    if (slot >= count) return;
+    uvec2 hit = hits[slot];
+    uvec2 pixel;
+    vec3 rd;
+    sampleRay(hit.x, pixel, rd);
+    uint i = band.colorOffset + hit.x;
+    colors[i] = finish(unpackColor(colors[i]), frame.eye.xyz, rd, uintBitsToFloat(hit.y));
 }
 
 void main() {

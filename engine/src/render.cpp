@@ -471,19 +471,20 @@ Result<Image> Renderer::render(const RenderOptions& options) {
     VkPipeline march = r.pipeline(SDFCSG_RAYMARCH_PASS_MARCH, skipping);
     VkPipeline shade = shading ? r.pipeline(SDFCSG_RAYMARCH_PASS_SHADE, skipping) : VK_NULL_HANDLE;
     VkPipeline resolve = aa > 1 ? r.pipeline(SDFCSG_RAYMARCH_PASS_RESOLVE, false) : VK_NULL_HANDLE;
-    VkPipeline overlay = options.grid || options.boxes != BoxOverlay::None
-                             ? r.pipeline(SDFCSG_RAYMARCH_PASS_OVERLAY, false)
-                             : VK_NULL_HANDLE;
+    const bool overlays = options.grid || options.boxes != BoxOverlay::None;
+    VkPipeline overlay = shading && overlays ? r.pipeline(SDFCSG_RAYMARCH_PASS_OVERLAY, false)
+                                             : VK_NULL_HANDLE;
     const detail::RayCamera rc = detail::makeRayCamera(camera, options.width, options.height);
     const detail::ClipVolume clip = detail::makeClipVolume(*r.evaluator, rc.eye);
     FrameUniform f = r.frameUniform(options, rc, clip);
     detail::uploadBuffer(r.ctx, r.frame, &f, sizeof(f));
 
     // Workgroups whose rays cannot meet a surface are not marched; the band is filled with the
-    // colour and info of a miss first (t = -1; the steps word too, read back as 0). The steps
-    // mode colours misses by their steps, so it traces every ray.
+    // colour and info of a miss first (t = -1; the steps word too, read back as 0). The
+    // overlays draw outside the surfaces and the steps mode colours misses by their steps, so
+    // those trace every ray.
     std::vector<detail::ScreenRect> rects;
-    const bool culling = options.mode != RenderMode::Steps &&
+    const bool culling = !overlays && options.mode != RenderMode::Steps &&
                          detail::surfaceRects(rc, clip, options.width, options.height, rects);
     auto packed = [](glm::vec3 c) {
         glm::uvec3 u(glm::clamp(c, 0.0f, 1.0f) * 255.0f + 0.5f);
@@ -536,16 +537,16 @@ Result<Image> Renderer::render(const RenderOptions& options) {
                            &band);
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, march);
         if (!tiles.empty()) vkCmdDispatch(cmd, uint32_t(tiles.size()), 1, 1);
-        if (shade) {
+        // One invocation per listed hit each.
+        for (VkPipeline perHit : {shade, overlay}) {
+            if (!perHit) continue;
             detail::recordComputeBarrier(cmd);
-            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, shade);
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, perHit);
             vkCmdDispatchIndirect(cmd, r.hits.buffer, 4);
         }
-        // One invocation per pixel of the band each.
-        for (VkPipeline perPixel : {resolve, overlay}) {
-            if (!perPixel) continue;
+        if (resolve) {
             detail::recordComputeBarrier(cmd);
-            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, perPixel);
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, resolve);
             vkCmdDispatch(cmd, detail::groupCount(options.width, SDFCSG_RAYMARCH_GROUP_X), groups,
                           1);
         }
