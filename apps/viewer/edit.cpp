@@ -50,18 +50,24 @@ void defaultParams(Node& node) {
 float halfExtent(const Node& node) {
     const auto& p = node.params;
     switch (node.kind) {
-    case NodeKind::Sphere: return p[0];
+    case NodeKind::Sphere:
+        return p[0];
     case NodeKind::Box:
-    case NodeKind::RoundBox: return 0.5f * std::max({p[0], p[1], p[2]});
-    case NodeKind::TriangularPrism: return 0.5f * std::max({p[0], p[1], p[2]});
-    case NodeKind::Torus: return p[0] + p[1];
+    case NodeKind::RoundBox:
+        return 0.5f * std::max({p[0], p[1], p[2]});
+    case NodeKind::TriangularPrism:
+        return 0.5f * std::max({p[0], p[1], p[2]});
+    case NodeKind::Torus:
+        return p[0] + p[1];
     case NodeKind::Cylinder:
-    case NodeKind::Cone: return std::max(p[0], 0.5f * p[1]);
+    case NodeKind::Cone:
+        return std::max(p[0], 0.5f * p[1]);
     case NodeKind::Capsule: {
         glm::vec3 a(p[0], p[1], p[2]), b(p[3], p[4], p[5]);
         return p[6] + 0.5f * glm::length(b - a);
     }
-    default: return 0.5f; // unbounded (a plane): the defaults' scale
+    default:
+        return 0.5f; // unbounded (a plane): the defaults' scale
     }
 }
 
@@ -71,17 +77,30 @@ void sizeLike(Node& node, float h) {
     if (!(h > 0.0f) || !std::isfinite(h)) return;
     auto& p = node.params;
     switch (node.kind) {
-    case NodeKind::Sphere: p[0] = h; break;
-    case NodeKind::Box: p[0] = p[1] = p[2] = 2 * h; break;
-    case NodeKind::RoundBox: p[0] = p[1] = p[2] = 2 * h, p[3] = 0.2f * h; break;
-    case NodeKind::TriangularPrism: p[0] = p[1] = p[2] = 2 * h; break;
-    case NodeKind::Torus: p[0] = 0.7f * h, p[1] = 0.3f * h; break;
+    case NodeKind::Sphere:
+        p[0] = h;
+        break;
+    case NodeKind::Box:
+        p[0] = p[1] = p[2] = 2 * h;
+        break;
+    case NodeKind::RoundBox:
+        p[0] = p[1] = p[2] = 2 * h, p[3] = 0.2f * h;
+        break;
+    case NodeKind::TriangularPrism:
+        p[0] = p[1] = p[2] = 2 * h;
+        break;
+    case NodeKind::Torus:
+        p[0] = 0.7f * h, p[1] = 0.3f * h;
+        break;
     case NodeKind::Cylinder:
-    case NodeKind::Cone: p[0] = h, p[1] = 2 * h; break;
+    case NodeKind::Cone:
+        p[0] = h, p[1] = 2 * h;
+        break;
     case NodeKind::Capsule:
         p[0] = p[2] = p[3] = p[5] = 0.0f, p[1] = -0.5f * h, p[4] = 0.5f * h, p[6] = 0.5f * h;
         break;
-    default: break;
+    default:
+        break;
     }
 }
 

@@ -132,8 +132,8 @@ struct ViewKey {
         return sceneVersion == o.sceneVersion && camera.eye == o.camera.eye &&
                camera.target == o.camera.target && camera.fov == o.camera.fov && mode == o.mode &&
                shadows == o.shadows && ao == o.ao && grid == o.grid && boxes == o.boxes &&
-               selected == o.selected && width == o.width && height == o.height &&
-               mesh == o.mesh && wireframe == o.wireframe;
+               selected == o.selected && width == o.width && height == o.height && mesh == o.mesh &&
+               wireframe == o.wireframe;
     }
 };
 
@@ -163,7 +163,7 @@ struct Viewer {
     std::vector<std::pair<uint64_t, ViewKey>> jobs; // id -> key of jobs in flight
     RenderOutput last;                              // the image on screen, with its depths
     double lastInteraction = -1.0;
-    float scale = 0.5f; // preview resolution while the camera moves
+    float scale = 0.5f;    // preview resolution while the camera moves
     bool refining = false; // a job redraws the live image with its baked kernel
     double renderMs = 0.0, compileMs = 0.0;
     std::optional<Error> renderError;
@@ -225,7 +225,7 @@ struct Viewer {
     int exitCode = 0;
     double waitStart = 0;
     double commandWaitStart = 0; // of a command waiting for an image or a reload
-    int reloads = 0; // not yet answered by the script's wait-reload
+    int reloads = 0;             // not yet answered by the script's wait-reload
 };
 
 float aspectOf(const Viewer& v) {
@@ -1261,8 +1261,8 @@ int main(int argc, char** argv) {
                             v.pendingShot.string().c_str(), capture.width, capture.height,
                             v.meshDrawMs);
             else
-                std::printf("wrote %s (%u x %u)\n", v.pendingShot.string().c_str(),
-                            capture.width, capture.height);
+                std::printf("wrote %s (%u x %u)\n", v.pendingShot.string().c_str(), capture.width,
+                            capture.height);
             v.pendingShot.clear();
             if (v.exitAfterShot) break;
         }
@@ -1286,7 +1286,7 @@ int main(int argc, char** argv) {
         v.exitCode = 1;
     }
     glfwHideWindow(v.window);
-    v.exporter.reset(); // waits for a file being written
+    v.exporter.reset();  // waits for a file being written
     v.generator.reset(); // cancels a generation in flight
     v.mesher.reset();    // cancels an extraction
     if (v.renderer->compiling()) {

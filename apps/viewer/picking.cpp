@@ -77,8 +77,8 @@ PixelRect projectedRect(const Camera& camera, uint32_t width, uint32_t height, c
     return r.empty() ? PixelRect{} : r;
 }
 
-std::vector<uint8_t> selectionMask(const Evaluator& evaluator, uint32_t node,
-                                   const Camera& camera, uint32_t width, uint32_t height,
+std::vector<uint8_t> selectionMask(const Evaluator& evaluator, uint32_t node, const Camera& camera,
+                                   uint32_t width, uint32_t height,
                                    const std::vector<PixelInfo>& pixels) {
     std::vector<uint8_t> mask(size_t(width) * height, 0);
     if (node >= evaluator.nodes().size() || pixels.size() != mask.size()) return mask;
@@ -93,11 +93,13 @@ std::vector<uint8_t> selectionMask(const Evaluator& evaluator, uint32_t node,
             const size_t k = size_t(j) * width + size_t(i);
             const float t = pixels[k].depth;
             if (!(t >= 0.0f)) continue;
-            glm::vec3 dir = detail::rayDirection(rc, float(i) + 0.5f, float(j) + 0.5f, width, height);
+            glm::vec3 dir =
+                detail::rayDirection(rc, float(i) + 0.5f, float(j) + 0.5f, width, height);
             // The march stops within half a footprint of the scene's surface; the node's own
             // surface is that one where it shows, and farther where another node's shows, except
             // within a pixel or two of where the two meet.
-            const float tolerance = std::max(2.0f * t * rc.footprint, 4.0f * detail::kMinHitEpsilon);
+            const float tolerance =
+                std::max(2.0f * t * rc.footprint, 4.0f * detail::kMinHitEpsilon);
             if (std::abs(evaluator.distance(rc.eye + t * dir, node)) <= tolerance) mask[k] = 1;
         }
     return mask;
@@ -107,12 +109,15 @@ void drawHighlight(Image& image, const std::vector<uint8_t>& mask) {
     const int w = int(image.width), h = int(image.height);
     if (mask.size() != size_t(w) * size_t(h) || image.rgba.size() != mask.size() * 4) return;
     const uint8_t colour[3] = {255, 170, 40};
-    auto at = [&](int x, int y) { return x >= 0 && y >= 0 && x < w && y < h && mask[size_t(y) * w + x]; };
+    auto at = [&](int x, int y) {
+        return x >= 0 && y >= 0 && x < w && y < h && mask[size_t(y) * w + x];
+    };
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
             // The outline is drawn just outside the mask, so the tinted surface keeps its shading.
             const bool inside = at(x, y);
-            const bool edge = !inside && (at(x - 1, y) || at(x + 1, y) || at(x, y - 1) || at(x, y + 1));
+            const bool edge =
+                !inside && (at(x - 1, y) || at(x + 1, y) || at(x, y - 1) || at(x, y + 1));
             if (!inside && !edge) continue;
             uint8_t* p = &image.rgba[(size_t(y) * w + x) * 4];
             for (int c = 0; c < 3; ++c)

@@ -45,8 +45,8 @@ PixelRect projectedRect(const Camera& camera, uint32_t width, uint32_t height, c
 // render with `camera`) that lie within a few pixel footprints of that subtree's surface. One
 // byte per pixel, 1 for selected; rows top to bottom. Only pixels within two of the node's
 // projected bounds (projectedRect) are evaluated, so a small node costs little in a large image.
-std::vector<uint8_t> selectionMask(const Evaluator& evaluator, uint32_t node,
-                                   const Camera& camera, uint32_t width, uint32_t height,
+std::vector<uint8_t> selectionMask(const Evaluator& evaluator, uint32_t node, const Camera& camera,
+                                   uint32_t width, uint32_t height,
                                    const std::vector<PixelInfo>& pixels);
 
 // Tints the masked pixels and draws a one-pixel outline around them (an image of the mask's size).

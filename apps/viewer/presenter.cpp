@@ -7,8 +7,8 @@
 #include <imgui_impl_vulkan.h>
 
 #include <algorithm>
-#include <cstddef>
 #include <atomic>
+#include <cstddef>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -453,8 +453,7 @@ void createMeshPipeline(Presenter& p) {
     stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
     stages[1].module = frag;
     stages[1].pName = "main";
-    VkVertexInputBindingDescription binding = {0, sizeof(MeshVertex),
-                                               VK_VERTEX_INPUT_RATE_VERTEX};
+    VkVertexInputBindingDescription binding = {0, sizeof(MeshVertex), VK_VERTEX_INPUT_RATE_VERTEX};
     VkVertexInputAttributeDescription attributes[3] = {
         {0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(MeshVertex, position)},
         {1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(MeshVertex, normal)},
@@ -567,13 +566,13 @@ void ensureMeshTarget(Presenter& p) {
         p.meshExtent.height == p.extent.height)
         return;
     destroyMeshTarget(p);
-    p.meshColor = createTarget(p, p.extent, VK_FORMAT_R8G8B8A8_UNORM,
-                               VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT |
-                                   VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-                               VK_IMAGE_ASPECT_COLOR_BIT);
-    p.meshDepth = createTarget(p, p.extent, p.depthFormat,
-                               VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
-                               VK_IMAGE_ASPECT_DEPTH_BIT);
+    p.meshColor =
+        createTarget(p, p.extent, VK_FORMAT_R8G8B8A8_UNORM,
+                     VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                     VK_IMAGE_ASPECT_COLOR_BIT);
+    p.meshDepth =
+        createTarget(p, p.extent, p.depthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
+                     VK_IMAGE_ASPECT_DEPTH_BIT);
     VkImageView views[] = {p.meshColor.view, p.meshDepth.view};
     VkFramebufferCreateInfo fb = {VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
     fb.renderPass = p.meshPass;
@@ -888,8 +887,7 @@ bool setMesh(Presenter& p, const Mesh& mesh, std::string& error) {
         // A fine mesh can exhaust the memory: the user's choice of resolution, not a bug.
         VkResult result = vkAllocateMemory(p.device, &alloc, nullptr, &memory);
         if (result == VK_ERROR_OUT_OF_DEVICE_MEMORY || result == VK_ERROR_OUT_OF_HOST_MEMORY) {
-            error = "not enough memory to draw the mesh (" + std::to_string(total >> 20) +
-                    " MiB)";
+            error = "not enough memory to draw the mesh (" + std::to_string(total >> 20) + " MiB)";
             return false;
         }
         VK_CHECK(result);
@@ -954,11 +952,27 @@ namespace {
 std::vector<float> meshKey(const MeshView& view, const float background[3]) {
     const Camera& c = view.camera;
     const GroundGrid g = view.grid.value_or(GroundGrid{});
-    return {c.eye.x,         c.eye.y,          c.eye.z,       c.target.x,    c.target.y,
-            c.target.z,      c.up.x,           c.up.y,        c.up.z,        c.fov,
-            background[0],   background[1],    background[2], float(view.wireframe),
-            float(view.closed), float(view.grid.has_value()), g.centreX, g.centreZ, g.height,
-            g.spacing,       float(g.halfLines)};
+    return {c.eye.x,
+            c.eye.y,
+            c.eye.z,
+            c.target.x,
+            c.target.y,
+            c.target.z,
+            c.up.x,
+            c.up.y,
+            c.up.z,
+            c.fov,
+            background[0],
+            background[1],
+            background[2],
+            float(view.wireframe),
+            float(view.closed),
+            float(view.grid.has_value()),
+            g.centreX,
+            g.centreZ,
+            g.height,
+            g.spacing,
+            float(g.halfLines)};
 }
 
 // The mesh pass into meshColor, timed when the queue can.
@@ -983,8 +997,7 @@ void drawMesh(Presenter& p, const MeshView& view, const float background[3]) {
     detail::RayCamera rc = detail::makeRayCamera(view.camera, p.extent.width, p.extent.height);
     glm::vec3 right = rc.right / (rc.tanHalfFov * rc.aspect), up = rc.up / rc.tanHalfFov;
     // Reversed float depth is precise at any distance, so the near plane can sit very close.
-    float nearPlane =
-        std::max(1e-6f, 1e-4f * glm::length(view.camera.target - view.camera.eye));
+    float nearPlane = std::max(1e-6f, 1e-4f * glm::length(view.camera.target - view.camera.eye));
     const GroundGrid g = view.grid.value_or(GroundGrid{});
     MeshConstants c = {{rc.eye.x, rc.eye.y, rc.eye.z, nearPlane},
                        {right.x, right.y, right.z, rc.footprint},

@@ -216,8 +216,8 @@ RenderOutput RenderWorker::process(const RenderJob& job) {
     const double pixels = double(job.options.width) * double(job.options.height);
     const double liveRate =
         liveRate_ > 0 ? liveRate_ : bakedRate_ * (context_.cpuDevice() ? 6.0 : 1.0);
-    const bool bakeSooner = !job.preview && bakedRate_ > 0 &&
-                            bakeSeconds_ + bakedRate_ * pixels < liveRate * pixels;
+    const bool bakeSooner =
+        !job.preview && bakedRate_ > 0 && bakeSeconds_ + bakedRate_ * pixels < liveRate * pixels;
     Renderer* renderer = nullptr;
     if (baked_ && bakedVersion_ == job.sceneVersion) {
         renderer = baked_.get();

@@ -423,8 +423,8 @@ TEST_F(Render, GroundGridLiesOnItsPlaneInFrontOfSurfaces) {
 
     const GroundGrid g = groundGrid(Evaluator(*scene));
     EXPECT_NEAR(g.height, -1.0f, 1e-3f); // the sphere's bottom and the box's
-    EXPECT_FLOAT_EQ(g.spacing, 1.0f); // the solid is about 2.5 wide
-    EXPECT_FLOAT_EQ(g.centreX, 0.0f); // its middle, rounded to the spacing
+    EXPECT_FLOAT_EQ(g.spacing, 1.0f);    // the solid is about 2.5 wide
+    EXPECT_FLOAT_EQ(g.centreX, 0.0f);    // its middle, rounded to the spacing
     const detail::RayCamera rc = detail::makeRayCamera(*options.camera, 160, 120);
     size_t changed = 0, onLines = 0;
     for (uint32_t y = 0; y < 120; ++y)

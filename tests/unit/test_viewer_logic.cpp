@@ -215,7 +215,7 @@ TEST(ViewerPicking, PointFromTracedRay) {
     ASSERT_TRUE(p);
     expectNear(*p, {-1.0f, 0.0f, 0.5f}, 1e-3f);
     EXPECT_EQ(nearestPrimitive(evaluator, *p), int(*findNode(scene, "left")));
-    EXPECT_FALSE(castRay(evaluator, camera, 64, 48, 1.0f, 1.0f)); // above the spheres: a miss
+    EXPECT_FALSE(castRay(evaluator, camera, 64, 48, 1.0f, 1.0f));   // above the spheres: a miss
     EXPECT_FALSE(castRay(evaluator, camera, 64, 48, 64.0f, 24.0f)); // outside
 }
 
@@ -939,8 +939,8 @@ TEST(ViewerScript, MeshCommands) {
     ASSERT_EQ(script->size(), 5u);
     EXPECT_EQ((*script)[0].numbers, std::vector<float>{64});
     EXPECT_EQ((*script)[3].args, (std::vector<std::string>{"export", "out.obj"}));
-    auto bad = parseScript("mesh extract fine\nmesh extract 2.5\nmesh render x\nview both\n",
-                           "s.txt");
+    auto bad =
+        parseScript("mesh extract fine\nmesh extract 2.5\nmesh render x\nview both\n", "s.txt");
     ASSERT_FALSE(bad);
     EXPECT_EQ(bad.error().str(),
               "s.txt:1:1: mesh extract: expected a whole number of cells, got \"fine\"\n"

@@ -94,11 +94,12 @@ int main(int argc, char** argv) {
         for (int k = 0; k < 5; ++k)
             r[k] = std::atoi(argv[4 + k]);
         const int m = r[4];
-        std::printf("differing pixels in [%d, %d) x [%d, %d), expected within [%d, %d) x [%d, %d)\n",
-                    x0, x1, y0, y1, r[0] - m, r[2] + m, r[1] - m, r[3] + m);
+        std::printf(
+            "differing pixels in [%d, %d) x [%d, %d), expected within [%d, %d) x [%d, %d)\n", x0,
+            x1, y0, y1, r[0] - m, r[2] + m, r[1] - m, r[3] + m);
         double area = std::max(1.0, double(r[2] - r[0]) * double(r[3] - r[1]));
-        bool inside = differing == 0 || (x0 >= r[0] - m && y0 >= r[1] - m && x1 <= r[2] + m &&
-                                         y1 <= r[3] + m);
+        bool inside = differing == 0 ||
+                      (x0 >= r[0] - m && y0 >= r[1] - m && x1 <= r[2] + m && y1 <= r[3] + m);
         std::printf("%.3f of the rectangle differs\n", double(differing) / area);
         return inside && double(differing) / area >= std::atof(argv[9]) ? 0 : 1;
     }
