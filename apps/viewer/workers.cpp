@@ -17,8 +17,13 @@ double secondsSince(std::chrono::steady_clock::time_point start) {
 
 } // namespace
 
-RendererBuilder::RendererBuilder(Context& context, RendererOptions options)
-    : context_(context), options_(options) {
+Result<std::unique_ptr<Renderer>> createRenderer(Context& context, const Scene& scene,
+                                                 const RendererOptions& options) {
+    return Renderer::create(context, scene, options);
+}
+
+RendererBuilder::RendererBuilder(Context& context, RendererOptions options, RendererFactory create)
+    : context_(context), options_(options), create_(std::move(create)) {
     thread_ = std::thread([this] { run(); });
 }
 
@@ -91,7 +96,7 @@ void RendererBuilder::run() {
             waiting_ = false;
             running_ = true;
         }
-        auto built = Renderer::create(context_, *scene, options_);
+        auto built = create_(context_, *scene, options_);
         std::lock_guard lock(mutex_);
         done_.emplace(Built{std::move(scene), version, std::move(built)});
         running_ = false;
@@ -112,11 +117,13 @@ bool sameView(const RenderOptions& a, const RenderOptions& b) {
 
 } // namespace
 
-RenderWorker::RenderWorker(Context& context, Context* liveContext) : context_(context) {
+RenderWorker::RenderWorker(Context& context, Context* liveContext, RendererFactory create)
+    : context_(context), create_(create) {
     RendererOptions live;
     live.inlineValues = false;
-    liveBuilder_ = std::make_unique<RendererBuilder>(liveContext ? *liveContext : context, live);
-    bakeBuilder_ = std::make_unique<RendererBuilder>(context, RendererOptions{});
+    liveBuilder_ =
+        std::make_unique<RendererBuilder>(liveContext ? *liveContext : context, live, create);
+    bakeBuilder_ = std::make_unique<RendererBuilder>(context, RendererOptions{}, create);
     thread_ = std::thread([this] { run(); });
 }
 
@@ -239,7 +246,7 @@ RenderOutput RenderWorker::process(const RenderJob& job) {
     } else if (failedVersion_ != job.sceneVersion) { // a scene that failed waits for a change
         auto start = std::chrono::steady_clock::now();
         compilingHere_ = true;
-        auto created = Renderer::create(context_, *job.scene);
+        auto created = create_(context_, *job.scene, RendererOptions{});
         compilingHere_ = false;
         out.compileSeconds = secondsSince(start);
         if (created) {

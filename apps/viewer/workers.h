@@ -16,6 +16,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -41,12 +42,19 @@ struct RenderOutput {
     std::shared_ptr<const Scene> scene; // the scene the image shows (the last that compiled)
     double renderSeconds = 0.0;
     double compileSeconds = 0.0; // 0 when no compile was needed
-    bool live = false; // drawn by the live renderer: new values uploaded, not compiled
+    bool live = false;           // drawn by the live renderer: new values uploaded, not compiled
     std::optional<Error> error;  // the job's scene failed to compile (or the render failed)
 };
 
 // Builds renderers on a thread of its own, one at a time, for the newest scene asked for: a
 // request made while a build runs waits for it, replacing any older waiting request.
+// How the workers build renderers: Renderer::create, or in tests one that fails as a shader
+// compile can.
+using RendererFactory = std::function<Result<std::unique_ptr<Renderer>>(Context&, const Scene&,
+                                                                        const RendererOptions&)>;
+Result<std::unique_ptr<Renderer>> createRenderer(Context& context, const Scene& scene,
+                                                 const RendererOptions& options);
+
 class RendererBuilder {
   public:
     struct Built {
@@ -55,7 +63,8 @@ class RendererBuilder {
         Result<std::unique_ptr<Renderer>> renderer;
     };
     // `context` must outlive the builder.
-    RendererBuilder(Context& context, RendererOptions options);
+    RendererBuilder(Context& context, RendererOptions options,
+                    RendererFactory create = createRenderer);
     ~RendererBuilder(); // waits for a running build: a compile cannot be interrupted
     RendererBuilder(const RendererBuilder&) = delete;
     RendererBuilder& operator=(const RendererBuilder&) = delete;
@@ -77,6 +86,7 @@ class RendererBuilder {
 
     Context& context_;
     RendererOptions options_;
+    RendererFactory create_;
     mutable std::mutex mutex_;
     std::condition_variable wake_;
     std::shared_ptr<const Scene> wanted_; // the newest request, until taken
@@ -102,7 +112,8 @@ class RenderWorker {
   public:
     // The live renderer is built and draws on `liveContext` (null: on `context`). Both must
     // outlive the worker.
-    explicit RenderWorker(Context& context, Context* liveContext = nullptr);
+    explicit RenderWorker(Context& context, Context* liveContext = nullptr,
+                          RendererFactory create = createRenderer);
     ~RenderWorker(); // waits for running compiles (see compiling())
     RenderWorker(const RenderWorker&) = delete;
     RenderWorker& operator=(const RenderWorker&) = delete;
@@ -130,6 +141,7 @@ class RenderWorker {
     void highlight(RenderOutput& out, int node);
 
     Context& context_;
+    RendererFactory create_;
     mutable std::mutex mutex_;
     std::condition_variable wake_;
     std::optional<RenderJob> pending_;

@@ -182,3 +182,48 @@ TEST_F(ViewerGpu, ClickingAPixelSelectsThePrimitiveThere) {
     }
     EXPECT_FALSE(pickPoint(*scene.camera, 160, 120, pixels, 2.0f, 2.0f));
 }
+
+// A scene whose kernel does not build (as a shader compile can fail) reports the error and
+// leaves the last scene that did on screen; the next scene that builds replaces it.
+TEST_F(ViewerGpu, AFailedCompileKeepsTheLastSceneOnScreen) {
+    auto scene = std::make_shared<const Scene>(*parseScene(kScene, "scene.json"));
+    RendererFactory create = [](Context& c, const Scene& s,
+                                const RendererOptions& o) -> Result<std::unique_ptr<Renderer>> {
+        if (s.nodes.size() > 3)
+            return Error::message(ErrorKind::Shader, "<kernel>", "compile failed (test)");
+        return Renderer::create(c, s, o);
+    };
+    RenderWorker worker(context(), nullptr, create);
+    RenderJob job;
+    job.options.width = 64;
+    job.options.height = 48;
+    job.options.camera = scene->camera;
+    auto render = [&](std::shared_ptr<const Scene> s, uint64_t version) {
+        job.scene = std::move(s);
+        job.sceneVersion = version;
+        ++job.id;
+        worker.submit(job);
+        return wait(worker);
+    };
+    RenderOutput good = render(scene, 1);
+    ASSERT_FALSE(good.error) << good.error->str();
+    ASSERT_FALSE(good.image.rgba.empty());
+
+    std::string bigger = kScene;
+    bigger.replace(bigger.find("  ]},"), 5,
+                   R"(  , {"type": "sphere", "radius": 0.3, "translate": [0, 1.5, 0]}]},)");
+    auto broken = std::make_shared<const Scene>(*parseScene(bigger, "scene.json"));
+    RenderOutput failed = render(broken, 2);
+    ASSERT_TRUE(failed.error);
+    EXPECT_EQ(failed.error->str(), "<kernel>: compile failed (test)");
+    EXPECT_EQ(failed.scene, scene);
+    EXPECT_EQ(failed.image.rgba, good.image.rgba);
+
+    float radius = 0.9f;
+    auto fixed =
+        std::make_shared<const Scene>(*setValue(*scene, 1, "radius", std::span(&radius, 1)));
+    RenderOutput again = render(fixed, 3);
+    EXPECT_FALSE(again.error) << again.error->str();
+    EXPECT_EQ(again.scene, fixed);
+    EXPECT_NE(again.image.rgba, good.image.rgba);
+}
