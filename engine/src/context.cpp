@@ -2,6 +2,8 @@
 // accepts CPU devices (lavapipe), one compute queue, a command pool and a fence.
 #include "vk.h"
 
+#include "shader_compile.h"
+
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
@@ -106,6 +108,7 @@ int computeFamily(VkPhysicalDevice device) {
 } // namespace
 
 Context::Impl::~Impl() {
+    if (compilerWarmUp.joinable()) compilerWarmUp.join();
     if (device) {
         vkDeviceWaitIdle(device);
         if (fence) vkDestroyFence(device, fence, nullptr);
@@ -138,6 +141,7 @@ uint32_t Context::validationMessageCount() const {
 
 Result<std::unique_ptr<Context>> Context::create(const ContextOptions& options) {
     auto impl = std::make_unique<Impl>();
+    impl->compilerWarmUp = std::thread(detail::warmUpCompiler);
 
     uint32_t loaderVersion = VK_API_VERSION_1_0;
     auto enumerateVersion = reinterpret_cast<PFN_vkEnumerateInstanceVersion>(

@@ -170,10 +170,20 @@ class Includer : public glslang::TShader::Includer {
     std::string_view scene_;
 };
 
+constexpr auto kMessages = EShMessages(EShMsgSpvRules | EShMsgVulkanRules);
+
+// Every compile's settings, so that all share the built-in symbol tables of the first.
+void setEnvironment(glslang::TShader& shader) {
+    shader.setEnvInput(glslang::EShSourceGlsl, EShLangCompute, glslang::EShClientVulkan, 100);
+    shader.setEnvClient(glslang::EShClientVulkan, glslang::EShTargetVulkan_1_1);
+    shader.setEnvTarget(glslang::EShTargetSpv, glslang::EShTargetSpv_1_3);
+}
+
+std::once_flag compilerReady;
+
 Result<std::vector<uint32_t>> runGlslang(std::string_view kernel, std::string_view source,
                                          std::string_view scene) {
-    static std::once_flag init;
-    std::call_once(init, [] { glslang::InitializeProcess(); });
+    detail::warmUpCompiler();
     std::lock_guard lock(compilerMutex());
 
     const std::string name(kernel);
@@ -182,10 +192,8 @@ Result<std::vector<uint32_t>> runGlslang(std::string_view kernel, std::string_vi
     const char* names = name.c_str();
     glslang::TShader shader(EShLangCompute);
     shader.setStringsWithLengthsAndNames(&text, &length, &names, 1);
-    shader.setEnvInput(glslang::EShSourceGlsl, EShLangCompute, glslang::EShClientVulkan, 100);
-    shader.setEnvClient(glslang::EShClientVulkan, glslang::EShTargetVulkan_1_1);
-    shader.setEnvTarget(glslang::EShTargetSpv, glslang::EShTargetSpv_1_3);
-    const auto messages = EShMessages(EShMsgSpvRules | EShMsgVulkanRules);
+    setEnvironment(shader);
+    const auto messages = kMessages;
     Includer includer(scene);
     auto failure = [&](const char* what, const char* log) {
         std::string message = std::string(what) + "\n" + log;
@@ -270,6 +278,18 @@ namespace detail {
 ShaderCacheStats shaderCacheStats() {
     std::lock_guard lock(cache().mutex);
     return cache().stats;
+}
+
+void warmUpCompiler() {
+    std::call_once(compilerReady, [] {
+        glslang::InitializeProcess();
+        std::lock_guard lock(compilerMutex());
+        const char* text = "#version 450\nlayout(local_size_x = 1) in;\nvoid main() {}\n";
+        glslang::TShader shader(EShLangCompute);
+        shader.setStrings(&text, 1);
+        setEnvironment(shader);
+        shader.parse(GetDefaultResources(), 450, ENoProfile, false, false, kMessages);
+    });
 }
 
 void clearShaderMemoryCache() {

@@ -13,6 +13,11 @@ struct ShaderCacheStats {
 
 ShaderCacheStats shaderCacheStats();
 
+// Sets glslang up for compute shaders, once per process: its first parse builds the tables of
+// built-in symbols (about 0.1 s on lavapipe's machines). Context::create starts it on a thread
+// of its own, so that it overlaps the device's setup; compiles wait for it.
+void warmUpCompiler();
+
 // Forgets the in-memory cache (the disk cache stays), so the next compile reads the disk.
 void clearShaderMemoryCache();
 

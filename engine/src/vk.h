@@ -17,6 +17,7 @@
 #include <mutex>
 #include <span>
 #include <string>
+#include <thread>
 
 namespace sdfcsg::detail {
 
@@ -51,6 +52,7 @@ struct Context::Impl {
     std::mutex submitMutex;
     bool validation = false;
     std::atomic<uint32_t> validationMessages{0};
+    std::thread compilerWarmUp; // detail::warmUpCompiler(), while the device is set up
 
     ~Impl();
 };
