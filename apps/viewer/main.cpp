@@ -128,12 +128,13 @@ struct ViewKey {
     int selected = -1;
     uint32_t width = 0, height = 0;
     bool mesh = false, wireframe = false;
+    bool meshPreview = false; // the mesh's coarse preview, while the camera moves
     bool operator==(const ViewKey& o) const {
         return sceneVersion == o.sceneVersion && camera.eye == o.camera.eye &&
                camera.target == o.camera.target && camera.fov == o.camera.fov && mode == o.mode &&
                shadows == o.shadows && ao == o.ao && grid == o.grid && boxes == o.boxes &&
                selected == o.selected && width == o.width && height == o.height && mesh == o.mesh &&
-               wireframe == o.wireframe;
+               wireframe == o.wireframe && meshPreview == o.meshPreview;
     }
 };
 
@@ -386,6 +387,9 @@ ViewKey wantedKey(Viewer& v, bool full) {
     k.height = std::max(1u, uint32_t(std::lround(float(h) * s)));
     k.mesh = v.meshView && v.mesh;
     k.wireframe = k.mesh && v.wireframe;
+    // As the ray marcher lowers the resolution, the mesh view lowers the triangles: their number,
+    // not the pixels, sets its frame time.
+    k.meshPreview = k.mesh && !full && previewMeshTriangles(*v.presenter) > 0;
     return k;
 }
 
@@ -756,10 +760,11 @@ bool finishMesh(Viewer& v) {
     };
     if (auto done = v.mesher->take()) {
         if (*done) {
-            auto mesh = std::make_shared<const Mesh>(std::move(**done));
+            auto mesh = std::make_shared<const Mesh>(std::move((*done)->mesh));
             v.meshStats = v.mesher->stats();
             std::string error;
-            if (setMesh(*v.presenter, *mesh, error)) {
+            const Mesh* preview = (*done)->preview ? &*(*done)->preview : nullptr;
+            if (setMesh(*v.presenter, *mesh, preview, error)) {
                 v.mesh = std::move(mesh);
                 char text[160];
                 std::snprintf(text, sizeof text, "%zu vertices, %zu triangles, %.2f s%s",
@@ -809,8 +814,13 @@ void meshPanel(Viewer& v) {
     ImGui::Checkbox("show mesh (M)", &v.meshView);
     ImGui::SameLine();
     ImGui::Checkbox("wireframe", &v.wireframe);
-    if (v.meshView)
+    if (v.meshView) {
+        if (v.shown.meshPreview)
+            ImGui::Text("preview mesh: %u triangles", previewMeshTriangles(*v.presenter));
+        else
+            ImGui::Text("full mesh: %zu triangles", v.mesh->triangleCount());
         ImGui::Text("mesh frame %.1f ms, last drawn in %.1f ms", v.meshFrameMs, v.meshDrawMs);
+    }
     ImGui::InputText("file", v.exportPath, sizeof v.exportPath);
     ImGui::SameLine();
     if (v.exporter->running()) {
@@ -1234,6 +1244,8 @@ int main(int argc, char** argv) {
         meshView.camera = toCamera(v.camera);
         meshView.wireframe = v.wireframe;
         meshView.closed = !v.meshStats.surfaceCut;
+        // As updateImage() chose: screenshots wait for a settled view, which draws the full mesh.
+        meshView.preview = v.shown.meshPreview;
         if (v.grid && v.evaluator) meshView.grid = groundGrid(*v.evaluator);
         const bool drawsMesh = v.meshView && v.mesh;
         const double frameStart = now();

@@ -54,6 +54,17 @@ struct Target {
 
 } // namespace
 
+// In one device-local buffer: the vertices (MeshVertex), the triangles' indices, and for the
+// wireframe the triangles' corners (three MeshVertex per triangle). The corners triple the memory
+// (about 140 bytes a triangle in all), but lavapipe draws them faster than the welded vertices'
+// edges as lines (62 against 300 ms at 717k triangles).
+struct DeviceMesh {
+    VkBuffer buffer = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    VkDeviceSize indexOffset = 0, cornerOffset = 0;
+    uint32_t indexCount = 0; // 0: no mesh
+};
+
 struct Presenter {
     GLFWwindow* window = nullptr;
     VkInstance instance = VK_NULL_HANDLE;
@@ -105,14 +116,7 @@ struct Presenter {
     VkPipeline gridPipeline = VK_NULL_HANDLE;
     bool meshDrawn = false; // meshColor holds the drawing described by drawnKey
     std::vector<float> drawnKey;
-    // In one device-local buffer: the vertices (MeshVertex), the triangles' indices, and for the
-    // wireframe the triangles' corners (three MeshVertex per triangle). The corners triple the
-    // memory (about 140 bytes a triangle in all), but lavapipe draws them faster than the welded
-    // vertices' edges as lines (62 against 300 ms at 717k triangles).
-    VkBuffer meshBuffer = VK_NULL_HANDLE;
-    VkDeviceMemory meshMemory = VK_NULL_HANDLE;
-    VkDeviceSize indexOffset = 0, cornerOffset = 0;
-    uint32_t indexCount = 0;
+    DeviceMesh meshes[2];                    // the mesh and its preview (MeshView::preview)
     VkQueryPool timestamps = VK_NULL_HANDLE; // none when the queue cannot time
     uint64_t timestampMask = 0;
     double meshMs = -1.0;
@@ -585,12 +589,10 @@ void ensureMeshTarget(Presenter& p) {
     p.meshExtent = p.extent;
 }
 
-void destroyMesh(Presenter& p) {
-    if (p.meshBuffer) vkDestroyBuffer(p.device, p.meshBuffer, nullptr);
-    if (p.meshMemory) vkFreeMemory(p.device, p.meshMemory, nullptr);
-    p.meshBuffer = VK_NULL_HANDLE;
-    p.meshMemory = VK_NULL_HANDLE;
-    p.indexCount = 0;
+void destroyMesh(Presenter& p, DeviceMesh& m) {
+    if (m.buffer) vkDestroyBuffer(p.device, m.buffer, nullptr);
+    if (m.memory) vkFreeMemory(p.device, m.memory, nullptr);
+    m = DeviceMesh{};
 }
 
 // Runs one command buffer's worth of work now and waits for it (uploads between frames).
@@ -818,7 +820,8 @@ void destroyPresenter(Presenter* p) {
         destroyBuffer(*p, p->staging);
         destroyBuffer(*p, p->readback);
         destroySceneImage(*p);
-        destroyMesh(*p);
+        for (DeviceMesh& m : p->meshes)
+            destroyMesh(*p, m);
         destroyMeshTarget(*p);
         destroySwapchainViews(*p);
         if (p->timestamps) vkDestroyQueryPool(p->device, p->timestamps, nullptr);
@@ -857,10 +860,9 @@ void setImage(Presenter& p, const Image& image) {
     p.hasScene = true;
 }
 
-bool setMesh(Presenter& p, const Mesh& mesh, std::string& error) {
-    VK_CHECK(vkDeviceWaitIdle(p.device)); // the last frame may still read the old buffer
-    destroyMesh(p);
-    p.meshDrawn = false;
+namespace {
+
+bool uploadMesh(Presenter& p, DeviceMesh& m, const Mesh& mesh, std::string& error) {
     if (mesh.indices.empty() || mesh.positions.empty()) return true;
     if (mesh.vertexCount() - 1 > p.limits.maxDrawIndexedIndexValue) {
         error = "the mesh has too many vertices to draw on " + p.deviceName + " (" +
@@ -901,7 +903,7 @@ bool setMesh(Presenter& p, const Mesh& mesh, std::string& error) {
                        staging, stagingMemory) &&
               allocate(VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_INDEX_BUFFER_BIT |
                            VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                       VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, p.meshBuffer, p.meshMemory);
+                       VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, m.buffer, m.memory);
     if (ok) {
         void* mapped = nullptr;
         VK_CHECK(vkMapMemory(p.device, stagingMemory, 0, VK_WHOLE_SIZE, 0, &mapped));
@@ -922,12 +924,12 @@ bool setMesh(Presenter& p, const Mesh& mesh, std::string& error) {
         vkUnmapMemory(p.device, stagingMemory);
         submitNow(p, [&](VkCommandBuffer cmd) {
             VkBufferCopy region = {0, 0, total};
-            vkCmdCopyBuffer(cmd, staging, p.meshBuffer, 1, &region);
+            vkCmdCopyBuffer(cmd, staging, m.buffer, 1, &region);
             VkBufferMemoryBarrier b = {VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
             b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
             b.dstAccessMask = VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT | VK_ACCESS_INDEX_READ_BIT;
             b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-            b.buffer = p.meshBuffer;
+            b.buffer = m.buffer;
             b.size = VK_WHOLE_SIZE;
             vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT,
                                  VK_PIPELINE_STAGE_VERTEX_INPUT_BIT, 0, 0, nullptr, 1, &b, 0,
@@ -937,19 +939,39 @@ bool setMesh(Presenter& p, const Mesh& mesh, std::string& error) {
     if (staging) vkDestroyBuffer(p.device, staging, nullptr);
     if (stagingMemory) vkFreeMemory(p.device, stagingMemory, nullptr);
     if (!ok) {
-        destroyMesh(p);
+        destroyMesh(p, m);
         return false;
     }
-    p.indexOffset = vertexBytes;
-    p.indexCount = uint32_t(mesh.indices.size());
-    p.cornerOffset = vertexBytes + indexBytes;
+    m.indexOffset = vertexBytes;
+    m.indexCount = uint32_t(mesh.indices.size());
+    m.cornerOffset = vertexBytes + indexBytes;
+    return true;
+}
+
+} // namespace
+
+bool setMesh(Presenter& p, const Mesh& mesh, const Mesh* preview, std::string& error) {
+    VK_CHECK(vkDeviceWaitIdle(p.device)); // the last frame may still read the old buffers
+    for (DeviceMesh& m : p.meshes)
+        destroyMesh(p, m);
+    p.meshDrawn = false;
+    if (!uploadMesh(p, p.meshes[0], mesh, error)) return false;
+    // The preview only speeds up moving views: one that does not fit leaves the mesh drawn
+    // while the camera moves too, which is no error.
+    std::string ignored;
+    if (preview && !uploadMesh(p, p.meshes[1], *preview, ignored)) destroyMesh(p, p.meshes[1]);
     return true;
 }
 
 namespace {
 
-// What a drawing of the mesh depends on besides the mesh and the size.
-std::vector<float> meshKey(const MeshView& view, const float background[3]) {
+// Which of the meshes a view draws: the preview while the camera moves, when there is one.
+const DeviceMesh& shownMesh(const Presenter& p, const MeshView& view) {
+    return view.preview && p.meshes[1].indexCount > 0 ? p.meshes[1] : p.meshes[0];
+}
+
+// What a drawing of the mesh depends on besides the meshes and the size.
+std::vector<float> meshKey(const Presenter& p, const MeshView& view, const float background[3]) {
     const Camera& c = view.camera;
     const GroundGrid g = view.grid.value_or(GroundGrid{});
     return {c.eye.x,
@@ -972,7 +994,8 @@ std::vector<float> meshKey(const MeshView& view, const float background[3]) {
             g.centreZ,
             g.height,
             g.spacing,
-            float(g.halfLines)};
+            float(g.halfLines),
+            float(&shownMesh(p, view) == &p.meshes[1])};
 }
 
 // The mesh pass into meshColor, timed when the queue can.
@@ -1008,14 +1031,15 @@ void drawMesh(Presenter& p, const MeshView& view, const float background[3]) {
     const VkShaderStageFlags stages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
     vkCmdPushConstants(p.cmd, p.meshLayout, stages, 0, sizeof c, &c);
     vkCmdBindPipeline(p.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p.meshPipelines[view.closed]);
+    const DeviceMesh& m = shownMesh(p, view);
     if (view.wireframe) {
-        vkCmdBindVertexBuffers(p.cmd, 0, 1, &p.meshBuffer, &p.cornerOffset);
-        vkCmdDraw(p.cmd, p.indexCount, 1, 0, 0);
+        vkCmdBindVertexBuffers(p.cmd, 0, 1, &m.buffer, &m.cornerOffset);
+        vkCmdDraw(p.cmd, m.indexCount, 1, 0, 0);
     } else {
         const VkDeviceSize start = 0;
-        vkCmdBindVertexBuffers(p.cmd, 0, 1, &p.meshBuffer, &start);
-        vkCmdBindIndexBuffer(p.cmd, p.meshBuffer, p.indexOffset, VK_INDEX_TYPE_UINT32);
-        vkCmdDrawIndexed(p.cmd, p.indexCount, 1, 0, 0, 0);
+        vkCmdBindVertexBuffers(p.cmd, 0, 1, &m.buffer, &start);
+        vkCmdBindIndexBuffer(p.cmd, m.buffer, m.indexOffset, VK_INDEX_TYPE_UINT32);
+        vkCmdDrawIndexed(p.cmd, m.indexCount, 1, 0, 0, 0);
     }
     if (view.grid) { // two lines of two vertices each per step along each axis
         vkCmdBindPipeline(p.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p.gridPipeline);
@@ -1045,11 +1069,11 @@ bool drawFrame(Presenter& p, ImDrawData* ui, const float background[3], const Me
     VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
     VK_CHECK(vkBeginCommandBuffer(p.cmd, &begin));
-    const bool drawsMesh = mesh && p.indexCount > 0;
+    const bool drawsMesh = mesh && p.meshes[0].indexCount > 0;
     bool meshDrawn = false; // this frame
     if (drawsMesh) {
         ensureMeshTarget(p);
-        std::vector<float> key = meshKey(*mesh, background);
+        std::vector<float> key = meshKey(p, *mesh, background);
         if (!p.meshDrawn || key != p.drawnKey) {
             drawMesh(p, *mesh, background);
             p.drawnKey = std::move(key);
@@ -1185,6 +1209,10 @@ bool drawFrame(Presenter& p, ImDrawData* ui, const float background[3], const Me
         capture->width = capture->height = 0; // this surface cannot be read back
     }
     return true;
+}
+
+uint32_t previewMeshTriangles(const Presenter& p) {
+    return p.meshes[1].indexCount / 3;
 }
 
 double meshDrawMilliseconds(const Presenter& p) {

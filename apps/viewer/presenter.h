@@ -32,17 +32,22 @@ PresenterPtr createPresenter(GLFWwindow* window, std::string& error);
 // The image to show from the next frame on (copied).
 void setImage(Presenter& presenter, const Image& image);
 
-// Copies a mesh to the device for the mesh view, replacing the previous one (an empty mesh
-// frees it). Waits for the device: call it once per extracted mesh, not per frame. False with a
-// message when the device cannot hold the mesh (memory, or more vertices than it can index); the
-// previous mesh is gone then too.
-bool setMesh(Presenter& presenter, const Mesh& mesh, std::string& error);
+// Copies a mesh, and optionally a coarser preview of it for moving views, to the device for the
+// mesh view, replacing the previous ones (an empty mesh frees them). Waits for the device: call
+// it once per extracted mesh, not per frame. False with a message when the device cannot hold
+// the mesh (memory, or more vertices than it can index); the previous meshes are gone then too.
+// A preview that does not fit is left out.
+bool setMesh(Presenter& presenter, const Mesh& mesh, const Mesh* preview, std::string& error);
+
+// Triangles of the preview given to setMesh(); 0 without one.
+uint32_t previewMeshTriangles(const Presenter& presenter);
 
 // How the mesh view draws the mesh given to setMesh().
 struct MeshView {
     Camera camera; // as for the ray marcher: the mesh lies where the ray-marched surface is
     bool wireframe = false; // one-pixel edges over the shaded surface
     bool closed = false;    // no bounds cut the surface: back faces never show, skip them
+    bool preview = false;   // the camera moves: draw the preview given to setMesh(), if any
     // The ray marcher's ground grid (RenderOptions::grid), hidden behind the mesh.
     std::optional<GroundGrid> grid;
 };

@@ -313,6 +313,12 @@ MeshWorker::~MeshWorker() {
     if (thread_.joinable()) thread_.join();
 }
 
+uint32_t previewMeshResolution(uint32_t resolution, size_t triangles, size_t threshold) {
+    if (triangles <= threshold) return 0;
+    const uint32_t preview = std::max(resolution / 3, 64u);
+    return preview < resolution ? preview : 0;
+}
+
 bool MeshWorker::start(std::shared_ptr<const Scene> scene, MeshOptions options) {
     if (running_) return false;
     if (thread_.joinable()) thread_.join();
@@ -325,10 +331,32 @@ bool MeshWorker::start(std::shared_ptr<const Scene> scene, MeshOptions options) 
             return !cancel_.load();
         };
         MeshStats stats;
-        Result<Mesh> mesh = extractMesh(context_, *scene, options, &stats);
+        Result<ExtractedMesh> out = [&]() -> Result<ExtractedMesh> {
+            auto mesher = Mesher::create(context_, *scene);
+            if (!mesher) return mesher.error();
+            auto mesh = (*mesher)->extract(options, &stats);
+            if (!mesh) return mesh.error();
+            ExtractedMesh extracted{std::move(*mesh), std::nullopt, 0};
+            // With a voxel size the grid's own cell count is the resolution to divide.
+            const uint32_t cells = options.voxelSize
+                                       ? std::max({stats.cells.x, stats.cells.y, stats.cells.z})
+                                       : options.resolution;
+            const uint32_t resolution =
+                previewMeshResolution(cells, extracted.mesh.triangleCount(), previewThreshold_);
+            if (resolution == 0) return extracted;
+            MeshOptions coarse = options;
+            coarse.voxelSize.reset();
+            coarse.resolution = resolution;
+            coarse.progress = [this](float) { return !cancel_.load(); };
+            if (auto preview = (*mesher)->extract(coarse); preview) {
+                extracted.preview = std::move(*preview);
+                extracted.previewResolution = resolution;
+            }
+            return extracted;
+        }();
         {
             std::lock_guard lock(mutex_);
-            done_ = std::move(mesh);
+            done_ = std::move(out);
             stats_ = stats;
         }
         running_ = false;
@@ -336,7 +364,7 @@ bool MeshWorker::start(std::shared_ptr<const Scene> scene, MeshOptions options) 
     return true;
 }
 
-std::optional<Result<Mesh>> MeshWorker::take() {
+std::optional<Result<ExtractedMesh>> MeshWorker::take() {
     std::lock_guard lock(mutex_);
     auto out = std::move(done_);
     done_.reset();

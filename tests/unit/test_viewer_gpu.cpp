@@ -1,5 +1,6 @@
 // The viewer's background renderer and picking on real renders (lavapipe is fine).
 #include "gpu_test.h"
+#include "mesh_checks.h"
 
 #include "edit.h"
 #include "picking.h"
@@ -226,4 +227,39 @@ TEST_F(ViewerGpu, AFailedCompileKeepsTheLastSceneOnScreen) {
     EXPECT_FALSE(again.error) << again.error->str();
     EXPECT_EQ(again.scene, fixed);
     EXPECT_NE(again.image.rgba, good.image.rgba);
+}
+
+// A large mesh comes with a coarser one of the same scene and bounds for moving views; a small
+// one comes alone. The threshold is lowered so that a coarse grid stands for a fine one.
+TEST_F(ViewerGpu, MeshWorkerExtractsAPreviewOfALargeMesh) {
+    auto scene = std::make_shared<const Scene>(*parseScene(kScene, "scene.json"));
+    auto extract = [&](size_t threshold, uint32_t resolution) {
+        MeshWorker worker(context(), threshold);
+        MeshOptions options;
+        options.resolution = resolution;
+        EXPECT_TRUE(worker.start(scene, options));
+        while (worker.running())
+            std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        auto done = worker.take();
+        EXPECT_TRUE(done && *done) << (done && !*done ? done->error().str() : "no result");
+        return done && *done ? std::move(**done) : ExtractedMesh{};
+    };
+
+    ExtractedMesh large = extract(1000, 96);
+    ASSERT_GT(large.mesh.triangleCount(), 1000u);
+    ASSERT_TRUE(large.preview);
+    EXPECT_EQ(large.previewResolution, 64u);
+    // Triangles go with the square of the resolution: (64 / 96)^2 of them, give or take.
+    const double ratio = double(large.preview->triangleCount()) / large.mesh.triangleCount();
+    EXPECT_NEAR(ratio, 4.0 / 9.0, 0.1);
+    const test::MeshProperties full = test::measureMesh(large.mesh),
+                               coarse = test::measureMesh(*large.preview);
+    EXPECT_TRUE(coarse.closedManifold()) << coarse.str();
+    EXPECT_NEAR(coarse.volume, full.volume, 0.03 * full.volume);
+    EXPECT_NEAR(coarse.area, full.area, 0.03 * full.area);
+
+    ExtractedMesh small = extract(kPreviewMeshTriangles, 96);
+    EXPECT_GT(small.mesh.triangleCount(), 1000u);
+    EXPECT_FALSE(small.preview);
+    EXPECT_EQ(small.previewResolution, 0u);
 }

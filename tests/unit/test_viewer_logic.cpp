@@ -931,6 +931,19 @@ TEST(ViewerResolution, PreviewScaleAimsAtTheTargetTime) {
     EXPECT_FLOAT_EQ(previewScale(0.0, 0, 1000000, 0.1), 0.5f);
 }
 
+TEST(ViewerResolution, PreviewMeshHasAboutAnEighthOfTheTriangles) {
+    // mesh_b at 512 cells has 2.9 million triangles: its preview at 170 has about 330 thousand.
+    EXPECT_EQ(previewMeshResolution(512, 2900000), 170u);
+    EXPECT_EQ(previewMeshResolution(300, 400000), 100u);
+    // Small meshes draw quickly enough as they are.
+    EXPECT_EQ(previewMeshResolution(512, kPreviewMeshTriangles), 0u);
+    EXPECT_EQ(previewMeshResolution(128, 1000), 0u);
+    // Never below 64 cells, and never as many cells as the mesh itself.
+    EXPECT_EQ(previewMeshResolution(150, 500000), 64u);
+    EXPECT_EQ(previewMeshResolution(64, 500000), 0u);
+    EXPECT_EQ(previewMeshResolution(96, 5000, 1000), 64u);
+}
+
 TEST(ViewerScript, MeshCommands) {
     auto script = parseScript("mesh extract 64\nview mesh\nwireframe on\nmesh export out.obj\n"
                               "view march\n",
