@@ -1013,8 +1013,9 @@ bool runScript(Viewer& v) {
             v.boxes = arg == "none"  ? BoxOverlay::None
                       : arg == "all" ? BoxOverlay::All
                                      : BoxOverlay::Selected;
-        } else if (c.verb == "orbit") {
+        } else if (c.verb == "orbit" || c.verb == "drag") {
             orbit(v.camera, glm::radians(c.numbers[0]), glm::radians(c.numbers[1]));
+            if (c.verb == "drag") v.lastInteraction = now();
         } else if (c.verb == "zoom") {
             zoom(v.camera, c.numbers[0]);
         } else if (c.verb == "frame") {

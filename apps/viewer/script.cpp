@@ -41,6 +41,7 @@ const std::vector<Verb>& verbs() {
         {"grid", 1, 1, false, {"on", "off"}},
         {"boxes", 1, 1, false, {"none", "all", "selected"}},
         {"orbit", 2, 2, true, {}},
+        {"drag", 2, 2, true, {}},
         {"zoom", 1, 1, true, {}},
         {"frame", 0, 0, false, {}},
         {"reset", 0, 0, false, {}},

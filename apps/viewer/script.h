@@ -6,6 +6,8 @@
 //   mode shaded|normals|depth|steps
 //   shadows on|off    ao on|off    grid on|off    boxes none|all|selected
 //   orbit DYAW DPITCH        turn the camera, in degrees
+//   drag DYAW DPITCH         the same as a mouse drag: the view counts as moving for a moment,
+//                            so previews are drawn until it settles
 //   zoom FACTOR              multiply the distance to the target
 //   frame    reset           frame the selection (or scene), or go back to the scene's camera
 //   undo    redo

@@ -772,7 +772,7 @@ TEST(ViewerScript, ReportsEveryProblem) {
     EXPECT_EQ(script.error().str(),
               "s.txt:1:1: mode: expected one of shaded, normals, depth, steps, got \"shiny\"\n"
               "s.txt:2:1: unknown command \"fly\" (known: select, set, mode, shadows, ao, grid, "
-              "boxes, orbit, zoom, frame, reset, undo, redo, save, screenshot, generate, "
+              "boxes, orbit, drag, zoom, frame, reset, undo, redo, save, screenshot, generate, "
               "edit-scene, add, remove, kind, op, move, parent, open, pick, wait-reload, ui, "
               "expect-error, expect-selected, print-bounds, mesh, view, wireframe)\n"
               "s.txt:3:1: set: expected a finite number, got \"big\"\n"

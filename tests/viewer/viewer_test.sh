@@ -248,6 +248,18 @@ run "$scene" --script mesh.txt --size 320x240 --no-ui || fail "scripted mesh ses
 "$diff" m1-mesh.png m4-grid.png differ 0.005 || fail "the mesh view shows no grid"
 "$diff" m3-march.png m0-march.png same 0 0 || fail "the ray-marched view did not come back"
 grep -q "^f " mesh.obj || fail "the exported mesh has no faces"
+# A large mesh is drawn coarse while the view moves (under the validation layer), and whole
+# again once it settles.
+cat > preview.txt <<'SCRIPT'
+mesh extract 256
+screenshot p0-full.png
+drag 10 0
+drag -10 0
+screenshot p1-settled.png
+SCRIPT
+run "$src/assets/scenes/mesh_b.json" --script preview.txt --size 320x240 --no-ui ||
+    fail "scripted mesh preview session"
+"$diff" p0-full.png p1-settled.png same 0 0 || fail "the full mesh did not come back after a drag"
 printf 'view mesh\n' > no-mesh.txt
 if run "$scene" --script no-mesh.txt --size 320x240 --no-ui 2> no-mesh.err; then
     fail "showing a mesh before extracting one was accepted"
