@@ -1,5 +1,5 @@
 #version 450
-// Sphere tracing of the generated scene in three passes over a band of rows (kPass):
+// Sphere tracing of the generated scene in passes over a band of rows (kPass):
 //   march:   one invocation per sample (aa x aa per pixel) traces its ray to the first hit and
 //            writes the colour of misses and of the depth and steps modes; hits that need
 //            shading are appended to a list, which also counts the shade pass's workgroups.

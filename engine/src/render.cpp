@@ -47,6 +47,7 @@ struct FrameUniform {
 static_assert(sizeof(FrameUniform) ==
               13 * 16 + SDFCSG_MAX_LIGHTS * 48 + SDFCSG_MAX_CLIP_BOXES * 32);
 static_assert(SDFCSG_MAX_LIGHTS == 4, "raymarch.comp reads the lights into four locals");
+static_assert(GroundGrid{}.halfLines == SDFCSG_GRID_HALF_LINES);
 
 constexpr detail::Binding kBindings[] = {
     {SDFCSG_BINDING_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
@@ -94,7 +95,8 @@ struct Renderer::Impl {
     VkShaderModule module = VK_NULL_HANDLE;
     VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
     VkPipelineLayout pipelineLayout = VK_NULL_HANDLE;
-    // [pass][bounds skipping], made on first use; the resolve pass does not evaluate the scene.
+    // [pass][bounds skipping], made on first use; the resolve and overlay passes do not evaluate
+    // the scene.
     VkPipeline pipelines[4][2] = {};
     VkDescriptorPool pool = VK_NULL_HANDLE;
     VkDescriptorSet set = VK_NULL_HANDLE;
@@ -353,7 +355,6 @@ GroundGrid groundGrid(const Evaluator& evaluator) {
     g.centreX = std::round(0.5f * (box.min.x + box.max.x) / g.spacing) * g.spacing;
     g.centreZ = std::round(0.5f * (box.min.z + box.max.z) / g.spacing) * g.spacing;
     g.height = box.min.y;
-    g.halfLines = SDFCSG_GRID_HALF_LINES;
     return g;
 }
 

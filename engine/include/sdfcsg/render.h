@@ -27,7 +27,7 @@ struct GroundGrid {
     float centreX = 0.0f, centreZ = 0.0f; // where the middle lines cross
     float height = 0.0f;                  // y of the plane: the bottom of the bounds
     float spacing = 1.0f; // a power of ten, from a twentieth to a half of the bounds' width
-    int halfLines = 0;    // lines on each side of the middle ones
+    int halfLines = 10;   // lines on each side of the middle ones
 };
 GroundGrid groundGrid(const Evaluator& evaluator);
 
