@@ -206,26 +206,35 @@ void destroySceneImage(Presenter& p) {
     p.sceneMemory = VK_NULL_HANDLE;
 }
 
-void createSceneImage(Presenter& p, uint32_t width, uint32_t height) {
-    destroySceneImage(p);
+// A 2D image in device-local memory, in the undefined layout.
+void createImage(Presenter& p, VkExtent2D extent, VkFormat format, VkImageUsageFlags usage,
+                 VkImage& image, VkDeviceMemory& memory) {
     VkImageCreateInfo info = {VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
     info.imageType = VK_IMAGE_TYPE_2D;
-    info.format = VK_FORMAT_R8G8B8A8_UNORM; // the bytes as the engine wrote them, no conversion
-    info.extent = {width, height, 1};
+    info.format = format;
+    info.extent = {extent.width, extent.height, 1};
     info.mipLevels = 1;
     info.arrayLayers = 1;
     info.samples = VK_SAMPLE_COUNT_1_BIT;
     info.tiling = VK_IMAGE_TILING_OPTIMAL;
-    info.usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    info.usage = usage;
     info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    VK_CHECK(vkCreateImage(p.device, &info, nullptr, &p.sceneImage));
+    VK_CHECK(vkCreateImage(p.device, &info, nullptr, &image));
     VkMemoryRequirements req;
-    vkGetImageMemoryRequirements(p.device, p.sceneImage, &req);
+    vkGetImageMemoryRequirements(p.device, image, &req);
     VkMemoryAllocateInfo alloc = {VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
     alloc.allocationSize = req.size;
     alloc.memoryTypeIndex = memoryType(p, req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-    VK_CHECK(vkAllocateMemory(p.device, &alloc, nullptr, &p.sceneMemory));
-    VK_CHECK(vkBindImageMemory(p.device, p.sceneImage, p.sceneMemory, 0));
+    VK_CHECK(vkAllocateMemory(p.device, &alloc, nullptr, &memory));
+    VK_CHECK(vkBindImageMemory(p.device, image, memory, 0));
+}
+
+void createSceneImage(Presenter& p, uint32_t width, uint32_t height) {
+    destroySceneImage(p);
+    // The bytes as the engine wrote them, no conversion.
+    createImage(p, {width, height}, VK_FORMAT_R8G8B8A8_UNORM,
+                VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, p.sceneImage,
+                p.sceneMemory);
     p.sceneWidth = width;
     p.sceneHeight = height;
 }
@@ -250,24 +259,7 @@ void destroyTarget(Presenter& p, Target& t) {
 Target createTarget(Presenter& p, VkExtent2D extent, VkFormat format, VkImageUsageFlags usage,
                     VkImageAspectFlags aspect) {
     Target t;
-    VkImageCreateInfo info = {VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
-    info.imageType = VK_IMAGE_TYPE_2D;
-    info.format = format;
-    info.extent = {extent.width, extent.height, 1};
-    info.mipLevels = 1;
-    info.arrayLayers = 1;
-    info.samples = VK_SAMPLE_COUNT_1_BIT;
-    info.tiling = VK_IMAGE_TILING_OPTIMAL;
-    info.usage = usage;
-    info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    VK_CHECK(vkCreateImage(p.device, &info, nullptr, &t.image));
-    VkMemoryRequirements req;
-    vkGetImageMemoryRequirements(p.device, t.image, &req);
-    VkMemoryAllocateInfo alloc = {VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-    alloc.allocationSize = req.size;
-    alloc.memoryTypeIndex = memoryType(p, req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-    VK_CHECK(vkAllocateMemory(p.device, &alloc, nullptr, &t.memory));
-    VK_CHECK(vkBindImageMemory(p.device, t.image, t.memory, 0));
+    createImage(p, extent, format, usage, t.image, t.memory);
     VkImageViewCreateInfo view = {VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
     view.image = t.image;
     view.viewType = VK_IMAGE_VIEW_TYPE_2D;
