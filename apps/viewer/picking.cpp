@@ -30,7 +30,7 @@ std::optional<glm::vec3> castRay(const Evaluator& evaluator, const Camera& camer
     const detail::ClipVolume clip = detail::makeClipVolume(evaluator, rc.eye);
     float t, tFar;
     if (!detail::rayInterval(clip, rc.eye, dir, t, tFar)) return std::nullopt;
-    // The loop of march() in shaders/raymarch.comp.
+    // The loop of march() in shaders/march.comp.
     for (uint32_t i = 0; i < SDFCSG_MAX_STEPS && t <= tFar; ++i) {
         float d = evaluator.distance(rc.eye + t * dir);
         if (d < detail::hitEpsilon(rc, t)) return rc.eye + t * dir;

@@ -1,6 +1,6 @@
 // Ray generation and ray clipping shared by the renderer (which uploads these values) and the CPU
-// tests (which trace the same rays). shaders/raymarch.comp implements the same formulas; keep the
-// two in step.
+// tests (which trace the same rays). shaders/raymarch.glsl and march.comp implement the same
+// formulas; keep the two in step.
 #pragma once
 
 #include "sdfcsg/eval.h"
@@ -168,7 +168,7 @@ inline bool clipRay(const Aabb& box, glm::vec3 origin, glm::vec3 dir, float& tNe
     return tNear <= tFar;
 }
 
-// Entry and exit of a ray in a surface part, as partInterval() in shaders/raymarch.comp.
+// Entry and exit of a ray in a surface part, as partInterval() in shaders/raymarch.glsl.
 inline bool partInterval(const SurfacePart& part, glm::vec3 origin, glm::vec3 dir, float& tIn,
                          float& tOut) {
     if (!part.halfSpace) return clipRay(part.box, origin, dir, tIn, tOut);
@@ -182,7 +182,7 @@ inline bool partInterval(const SurfacePart& part, glm::vec3 origin, glm::vec3 di
     return tIn <= tOut;
 }
 
-// The interval of a ray that is traced, as trace() in shaders/raymarch.comp computes it: inside
+// The interval of a ray that is traced, as march() in shaders/march.comp computes it: inside
 // the clip box, from the first entry into a surface box to the last exit. False when empty.
 inline bool rayInterval(const ClipVolume& clip, glm::vec3 origin, glm::vec3 dir, float& tNear,
                         float& tFar) {

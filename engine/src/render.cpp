@@ -1,5 +1,6 @@
 // The ray march: per band of rows, a march, a shade and (with several samples per pixel) a
-// resolve pass (shaders/raymarch.comp), read back to RGBA8 and per-pixel info.
+// resolve pass (shaders/march.comp, shade.comp and finish.comp, around raymarch.glsl), read back
+// to RGBA8 and per-pixel info.
 #include "sdfcsg/render.h"
 
 #include "camera.h"
@@ -17,6 +18,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -31,7 +33,7 @@ struct FrameLight {
     glm::vec4 color;
 };
 
-// Mirrors the Frame uniform block in shaders/raymarch.comp (std140: every member is 16 bytes).
+// Mirrors the Frame uniform block in shaders/raymarch.glsl (std140: every member is 16 bytes).
 struct FrameUniform {
     glm::vec4 eye, right, up, forward;
     glm::vec4 clipMin, clipMax;
@@ -41,12 +43,12 @@ struct FrameUniform {
     glm::uvec4 counts;   // aa, lights, nodes, selected
     FrameLight lights[SDFCSG_MAX_LIGHTS];
     glm::uvec4 surfaceBoxCount; // x
-    glm::vec4 surfaceBoxes[2 * SDFCSG_MAX_CLIP_BOXES]; // surface parts, as in raymarch.comp
+    glm::vec4 surfaceBoxes[2 * SDFCSG_MAX_CLIP_BOXES]; // surface parts, as in raymarch.glsl
     glm::vec4 grid; // centre x, z; plane height; spacing
 };
 static_assert(sizeof(FrameUniform) ==
               13 * 16 + SDFCSG_MAX_LIGHTS * 48 + SDFCSG_MAX_CLIP_BOXES * 32);
-static_assert(SDFCSG_MAX_LIGHTS == 4, "raymarch.comp reads the lights into four locals");
+static_assert(SDFCSG_MAX_LIGHTS == 4, "shade.comp reads the lights into four locals");
 static_assert(GroundGrid{}.halfLines == SDFCSG_GRID_HALF_LINES);
 
 constexpr detail::Binding kBindings[] = {
@@ -59,7 +61,7 @@ constexpr detail::Binding kBindings[] = {
     {SDFCSG_BINDING_TILES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
 };
 
-// Mirrors the Band push constants of shaders/raymarch.comp.
+// Mirrors the Band push constants of shaders/raymarch.glsl.
 struct BandConstants {
     uint32_t firstRow;
     uint32_t colorOffset;
@@ -92,11 +94,14 @@ struct Renderer::Impl {
     std::unique_ptr<Evaluator> evaluator;
     uint32_t nodeCount = 0;
 
-    VkShaderModule module = VK_NULL_HANDLE;
+    // The scene's kernels, march.comp and shade.comp, and finish.comp (the resolve and overlay
+    // passes), which does not depend on the scene.
+    VkShaderModule marchModule = VK_NULL_HANDLE, shadeModule = VK_NULL_HANDLE;
+    VkShaderModule finishModule = VK_NULL_HANDLE;
     VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
     VkPipelineLayout pipelineLayout = VK_NULL_HANDLE;
-    // [pass][bounds skipping], made on first use; the resolve and overlay passes do not evaluate
-    // the scene.
+    // [pass][bounds skipping], made on first use (buildKernels() makes the default march and
+    // shade ones); the resolve and overlay passes do not evaluate the scene.
     VkPipeline pipelines[4][2] = {};
     VkDescriptorPool pool = VK_NULL_HANDLE;
     VkDescriptorSet set = VK_NULL_HANDLE;
@@ -119,38 +124,79 @@ struct Renderer::Impl {
              {&frame, &nodes, &pixels, &info, &pixelsStaging, &infoStaging, &samples, &hits, &tiles})
             detail::destroyBuffer(ctx, *b);
         destroyKernel();
+        for (int pass : {SDFCSG_RAYMARCH_PASS_RESOLVE, SDFCSG_RAYMARCH_PASS_OVERLAY})
+            if (pipelines[pass][0]) vkDestroyPipeline(device, pipelines[pass][0], nullptr);
+        if (finishModule) vkDestroyShaderModule(device, finishModule, nullptr);
         if (pool) vkDestroyDescriptorPool(device, pool, nullptr);
         if (pipelineLayout) vkDestroyPipelineLayout(device, pipelineLayout, nullptr);
         if (setLayout) vkDestroyDescriptorSetLayout(device, setLayout, nullptr);
     }
 
-    // Generates and compiles the kernel for `scene`, replacing any previous one. Pipelines are
-    // made on first use.
-    Status buildKernel() {
+    // Generates and compiles the scene's kernels, replacing the previous ones, and makes the
+    // march and shade pipelines that render() uses by default, ready to run. The two kernels
+    // are compiled side by side, and on drivers that compile to machine code at the first
+    // dispatch (llvmpipe) the march kernel's compile runs while the shade kernel is still being
+    // translated on the other thread. On failure the previous kernels stay.
+    Status buildKernels() {
         CodegenOptions codegen;
         codegen.inlineParams = options.inlineValues;
-        auto spirv = compileKernel("raymarch.comp", generateSceneGlsl(scene, codegen));
-        if (!spirv) return spirv.error();
+        const std::string glsl = generateSceneGlsl(scene, codegen);
+        const bool skipping = defaultSkipping();
+        struct Built {
+            std::optional<Error> error;
+            VkShaderModule module = VK_NULL_HANDLE;
+            VkPipeline pipeline = VK_NULL_HANDLE;
+        };
+        auto build = [&](const char* kernel, uint32_t pass) {
+            Built b;
+            auto spirv = compileKernel(kernel, glsl);
+            if (!spirv) {
+                b.error = spirv.error();
+                return b;
+            }
+            b.module = detail::createShaderModule(ctx, *spirv);
+            b.pipeline = createPipeline(b.module, pass, skipping);
+            return b;
+        };
+        Built shade;
+        std::thread other([&] { shade = build("shade.comp", SDFCSG_RAYMARCH_PASS_SHADE); });
+        Built march = build("march.comp", SDFCSG_RAYMARCH_PASS_MARCH);
+        if (!march.error) warmUp(march.pipeline);
+        other.join();
+        if (march.error || shade.error) {
+            for (Built* b : {&march, &shade}) {
+                if (b->pipeline) vkDestroyPipeline(ctx.device, b->pipeline, nullptr);
+                if (b->module) vkDestroyShaderModule(ctx.device, b->module, nullptr);
+            }
+            return march.error ? *march.error : *shade.error;
+        }
         destroyKernel();
-        module = detail::createShaderModule(ctx, *spirv);
+        marchModule = march.module;
+        shadeModule = shade.module;
+        pipelines[SDFCSG_RAYMARCH_PASS_MARCH][skipping ? 1 : 0] = march.pipeline;
+        pipelines[SDFCSG_RAYMARCH_PASS_SHADE][skipping ? 1 : 0] = shade.pipeline;
+        warmUp(shade.pipeline);
         return Ok{};
     }
 
+    // The scene's kernels and their pipelines.
     void destroyKernel() {
-        for (auto& pass : pipelines)
-            for (VkPipeline& p : pass) {
+        for (int pass : {SDFCSG_RAYMARCH_PASS_MARCH, SDFCSG_RAYMARCH_PASS_SHADE})
+            for (VkPipeline& p : pipelines[pass]) {
                 if (p) vkDestroyPipeline(ctx.device, p, nullptr);
                 p = VK_NULL_HANDLE;
             }
-        if (module) vkDestroyShaderModule(ctx.device, module, nullptr);
-        module = VK_NULL_HANDLE;
+        for (VkShaderModule* m : {&marchModule, &shadeModule}) {
+            if (*m) vkDestroyShaderModule(ctx.device, *m, nullptr);
+            *m = VK_NULL_HANDLE;
+        }
     }
 
     bool defaultSkipping() const {
         return ctx.properties.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU;
     }
 
-    VkPipeline createPass(uint32_t pass, bool skipping) const {
+    VkPipeline createPipeline(VkShaderModule module, uint32_t pass, bool skipping) const {
         detail::SpecConstant spec[] = {{SDFCSG_SPEC_BOUNDS_SKIPPING, skipping ? 1u : 0u},
                                        {SDFCSG_SPEC_RAYMARCH_PASS, pass}};
         return detail::createComputePipeline(ctx, module, pipelineLayout, spec);
@@ -158,27 +204,18 @@ struct Renderer::Impl {
 
     // The pipeline of a pass and skipping choice, created and warmed up on first use.
     VkPipeline pipeline(uint32_t pass, bool skipping) {
-        if (pass == SDFCSG_RAYMARCH_PASS_RESOLVE || pass == SDFCSG_RAYMARCH_PASS_OVERLAY)
-            skipping = false; // no scene evaluation
+        const bool finishing =
+            pass == SDFCSG_RAYMARCH_PASS_RESOLVE || pass == SDFCSG_RAYMARCH_PASS_OVERLAY;
+        if (finishing) skipping = false; // no scene evaluation
         VkPipeline& p = pipelines[pass][skipping ? 1 : 0];
         if (!p) {
-            p = createPass(pass, skipping);
+            VkShaderModule module = finishing                          ? finishModule
+                                    : pass == SDFCSG_RAYMARCH_PASS_MARCH ? marchModule
+                                                                         : shadeModule;
+            p = createPipeline(module, pass, skipping);
             warmUp(p);
         }
         return p;
-    }
-
-    // The march and shade pipelines that render() uses by default, built side by side.
-    void createDefaultPipelines() {
-        const bool skipping = defaultSkipping();
-        VkPipeline made[2] = {};
-        std::thread shade([&] { made[1] = createPass(SDFCSG_RAYMARCH_PASS_SHADE, skipping); });
-        made[0] = createPass(SDFCSG_RAYMARCH_PASS_MARCH, skipping);
-        shade.join();
-        for (uint32_t pass = 0; pass < 2; ++pass) {
-            pipelines[pass][skipping ? 1 : 0] = made[pass];
-            warmUp(made[pass]);
-        }
     }
 
     // Some drivers (llvmpipe among them) compile a compute pipeline to machine code only at its
@@ -379,7 +416,9 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene
     r.evaluator = std::make_unique<Evaluator>(scene);
     r.nodeCount = uint32_t(scene.nodes.size());
 
-    if (auto built = r.buildKernel(); !built) return built.error();
+    auto finish = compileKernel("finish.comp", "");
+    if (!finish) return finish.error();
+    r.finishModule = detail::createShaderModule(r.ctx, *finish);
     r.setLayout = detail::createDescriptorSetLayout(r.ctx, kBindings);
     r.pipelineLayout = detail::createPipelineLayout(r.ctx, r.setLayout, sizeof(BandConstants));
     r.pool = detail::createDescriptorPool(r.ctx, kBindings);
@@ -397,7 +436,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene
     r.uploadNodes();
     if (auto reserved = r.reserve(64 * 64); !reserved) return reserved.error();
     if (auto reserved = r.reserveSamples(64 * 64, 64); !reserved) return reserved.error();
-    r.createDefaultPipelines();
+    if (auto built = r.buildKernels(); !built) return built.error();
     return std::unique_ptr<Renderer>(new Renderer(std::move(impl)));
 }
 
@@ -409,11 +448,10 @@ Status Renderer::updateValues(const Scene& scene) {
     Scene previous = std::move(r.scene);
     r.scene = scene;
     if (r.options.inlineValues) {
-        if (auto built = r.buildKernel(); !built) {
+        if (auto built = r.buildKernels(); !built) {
             r.scene = std::move(previous);
             return built.error();
         }
-        r.createDefaultPipelines();
     }
     r.evaluator = std::make_unique<Evaluator>(scene);
     r.uploadNodes(); // no render is in flight: render() waits for its fence

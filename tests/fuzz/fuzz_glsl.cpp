@@ -2,8 +2,8 @@
 // validates compiles, in each way the library compiles scenes: values read from the node buffer
 // or inlined as literals (the renderer), and inlined with primitive lists (the mesher). The
 // input's hash picks one of the three, so a crash reproduces from its file alone. The kernels are
-// the library's own; probe.comp includes exactly what raymarch.comp includes around the scene
-// (shared.h, sdf.glsl, nodes.glsl) and is much quicker to compile.
+// the library's own; probe.comp includes exactly what march.comp and shade.comp give the scene to
+// build on (shared.h, sdf.glsl, nodes.glsl) and is much quicker to compile.
 //
 // Almost every random change to a scene breaks it, and fuzz_parse covers broken input, so the
 // mutator retries until the scene still loads: most executions then compile a scene. The SPIR-V

@@ -158,7 +158,7 @@ TEST(Codegen, BundledScenesCompile) {
             CodegenOptions options;
             options.inlineParams = inlineParams;
             std::string glsl = generateSceneGlsl(*scene, options);
-            for (const char* kernel : {"probe.comp", "raymarch.comp"}) {
+            for (const char* kernel : {"probe.comp", "march.comp", "shade.comp"}) {
                 detail::clearShaderMemoryCache();
                 auto start = std::chrono::steady_clock::now();
                 auto spirv = compileKernel(kernel, glsl);
@@ -174,7 +174,7 @@ TEST(Codegen, BundledScenesCompile) {
 
 TEST(Codegen, EveryKernelCompilesAgainstGeneratedCode) {
     std::string glsl = generateSceneGlsl(primitiveGallery());
-    for (const char* kernel : {"probe.comp", "raymarch.comp"}) {
+    for (const char* kernel : {"probe.comp", "march.comp", "shade.comp"}) {
         if (shaderSource(kernel).empty()) continue; // not written yet
         auto spirv = compileKernel(kernel, glsl);
         EXPECT_TRUE(spirv) << kernel << ": " << (spirv ? "" : spirv.error().str());

@@ -1,6 +1,6 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// As gridCoverage() in shaders/raymarch.comp: the middle lines darker, and every line fading out
+// As gridCoverage() in shaders/raymarch.glsl: the middle lines darker, and every line fading out
 // where a pixel spans so much of the spacing that the lines would alias.
 #include "mesh_draw.glsl"
 

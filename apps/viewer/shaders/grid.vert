@@ -1,6 +1,6 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// The ground grid of the ray marcher (sdfcsg::groundGrid, shaders/raymarch.comp) as a line list
+// The ground grid of the ray marcher (sdfcsg::groundGrid, shaders/raymarch.glsl) as a line list
 // made from gl_VertexIndex alone: lines pc.grid.w apart on the plane y = pc.grid.z, pc.up.w on
 // each side of the middle lines through (pc.grid.x, pc.grid.y), each reaching half a spacing
 // past the outermost ones, first those along z, then those along x.

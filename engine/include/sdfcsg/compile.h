@@ -34,7 +34,7 @@ struct CodegenOptions {
 
 std::string generateSceneGlsl(const Scene& scene, const CodegenOptions& options = {});
 
-// Source of an embedded shader file (e.g. "sdf.glsl", "raymarch.comp"); empty if unknown.
+// Source of an embedded shader file (e.g. "sdf.glsl", "march.comp"); empty if unknown.
 std::string_view shaderSource(std::string_view name);
 
 // Compiles an embedded kernel with `scene.glsl` resolving to `sceneGlsl`. SPIR-V is cached by a
