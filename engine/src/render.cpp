@@ -209,7 +209,7 @@ struct Renderer::Impl {
         if (finishing) skipping = false; // no scene evaluation
         VkPipeline& p = pipelines[pass][skipping ? 1 : 0];
         if (!p) {
-            VkShaderModule module = finishing                          ? finishModule
+            VkShaderModule module = finishing                            ? finishModule
                                     : pass == SDFCSG_RAYMARCH_PASS_MARCH ? marchModule
                                                                          : shadeModule;
             p = createPipeline(module, pass, skipping);
