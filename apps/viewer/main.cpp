@@ -1292,9 +1292,11 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "%s\n", v.renderError->str().c_str());
         v.exitCode = 1;
     }
-    // Under the tests' validation layer, any message fails an automated run.
+    // Under the tests' validation layer, any message fails an automated run: the window's
+    // device, the renderer's and the live renderer's own.
     if (automated && v.exitCode == 0 &&
-        (presenterValidationMessages(*v.presenter) || v.context->validationMessageCount())) {
+        (presenterValidationMessages(*v.presenter) || v.context->validationMessageCount() ||
+         (v.liveContext && v.liveContext->validationMessageCount()))) {
         std::fprintf(stderr, "sdfcsg-viewer: the validation layer reported problems\n");
         v.exitCode = 1;
     }
