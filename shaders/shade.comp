@@ -14,7 +14,6 @@
 const int kShadowSteps = 24;
 const float kShadowSharpness = 10.0;
 
-
 // The shade pass: normal, occlusion and shadows at the hit r.t. All scene evaluations go
 // through one call of sceneDistance in one loop, driven by a small state machine: four normal
 // taps, five occlusion taps and one shadow ray per light, each evaluating the scene at

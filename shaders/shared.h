@@ -13,9 +13,9 @@
 #define SDFCSG_BINDING_NODES 1  // readonly buffer of Node (see nodes.glsl), index-aligned with the scene
 #define SDFCSG_BINDING_PIXELS 2 // buffer of packed RGBA8, row-major, top row first
 #define SDFCSG_BINDING_INFO 3   // buffer of vec2 per pixel: (hit depth or -1, step count)
-#define SDFCSG_BINDING_SAMPLES 6 // raymarch.comp: packed RGBA8 per sample of a band
-#define SDFCSG_BINDING_HITS 7    // raymarch.comp: hits to shade, after an indirect dispatch
-#define SDFCSG_BINDING_TILES 8   // raymarch.comp: workgroups of a band that the march pass runs
+#define SDFCSG_BINDING_SAMPLES 6 // raymarch.glsl: packed RGBA8 per sample of a band
+#define SDFCSG_BINDING_HITS 7    // raymarch.glsl: hits to shade, after an indirect dispatch
+#define SDFCSG_BINDING_TILES 8   // raymarch.glsl: workgroups of a band that the march pass runs
 #define SDFCSG_BINDING_PROBE_IN 4  // probe.comp: readonly buffer of vec4 points (xyz used)
 #define SDFCSG_BINDING_PROBE_OUT 5 // probe.comp: buffer of vec4 sceneSample() results
 
@@ -75,7 +75,7 @@
 #define SDFCSG_SPEC_BOUNDS_SKIPPING 0
 #define SDFCSG_SPEC_MESH_PASS 1  // mesh_field.comp: which pass (SDFCSG_MESH_PASS_*)
 #define SDFCSG_SPEC_MESH_GROUP 2 // mesh_field.comp: workgroup size of that pass
-#define SDFCSG_SPEC_RAYMARCH_PASS 3 // raymarch.comp: which pass (SDFCSG_RAYMARCH_PASS_*)
+#define SDFCSG_SPEC_RAYMARCH_PASS 3 // finish.comp: which pass (SDFCSG_RAYMARCH_PASS_*)
 
 #define SDFCSG_RAYMARCH_PASS_MARCH 0
 #define SDFCSG_RAYMARCH_PASS_SHADE 1
