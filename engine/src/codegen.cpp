@@ -215,13 +215,13 @@ class Emitter {
                     std::string(kindInfo(list.kind).name) + " operands, those near the region\n";
             indent(depth + 2);
             var(op);
-            out_ += " = opUnion(";
+            out_ += " = sharpUnion(";
             var(op);
             out_ += ", ";
             const std::string call = std::string(kCalls[int(list.kind)].helper) +
                                      "(sceneList[" + k + "], p)";
             out_ += sample_ ? "withColor(sceneList[" + k + "], " + call + ")" : call;
-            out_ += ", 0.0);\n";
+            out_ += ");\n";
             indent(depth + 1);
             out_ += "}\n";
         }
@@ -341,16 +341,21 @@ class Emitter {
     void fold(uint32_t op, uint32_t child, uint32_t depth) {
         const NodeKind kind = scene_.nodes[op].kind;
         const bool guarded = kind != NodeKind::Intersection;
+        // A literal blend radius of 0 takes the sharp form: the same bits, much less code.
+        const bool sharp = lit_ && (*lit_)[op].bmin.w == 0.0f;
         indent(depth + (guarded ? 1 : 0));
         var(op);
-        out_ += kind == NodeKind::Union          ? " = opUnion("
-                : kind == NodeKind::Intersection ? " = opIntersection("
-                                                 : " = opDifference(";
+        out_ += sharp ? " = sharp" : " = op";
+        out_ += kind == NodeKind::Union          ? "Union("
+                : kind == NodeKind::Intersection ? "Intersection("
+                                                 : "Difference(";
         var(op);
         out_ += ", ";
         var(child);
-        out_ += ", ";
-        smooth(op);
+        if (!sharp) {
+            out_ += ", ";
+            smooth(op);
+        }
         out_ += ");\n";
         if (guarded) {
             indent(depth);

@@ -119,6 +119,15 @@ inline vec4 opDifference(vec4 a, vec4 b, float k) {
     return opIntersection(a, vec4(vec3(b), -b.w), k);
 }
 
+// The operators at k = 0 (sdf.glsl's sharp*, which generated code with literal values uses):
+// bit for bit opUnion(a, b, 0) and the others, in one comparison.
+inline float sharpUnion(float a, float b) { return a <= b ? a : b; }
+inline float sharpIntersection(float a, float b) { return a >= b ? a : b; }
+inline float sharpDifference(float a, float b) { return a >= -b ? a : -b; }
+inline vec4 sharpUnion(vec4 a, vec4 b) { return a.w <= b.w ? a : b; }
+inline vec4 sharpIntersection(vec4 a, vec4 b) { return a.w >= b.w ? a : b; }
+inline vec4 sharpDifference(vec4 a, vec4 b) { return a.w >= -b.w ? a : vec4(vec3(b), -b.w); }
+
 // ---- Kernel parameters ----
 // What a primitive's kernel takes, derived once from the table's values (Node::params) so that
 // the shader does no arithmetic on them. packNodes() copies these into the node buffer

@@ -231,6 +231,23 @@ TEST(Codegen, SizeAndCompileTimeAreLinear) {
     EXPECT_TRUE(compileKernel("probe.comp", nested));
 }
 
+// With literal values, an operation whose blend radius is 0 takes the sharp form (one
+// comparison, same bits); a smooth one keeps the blend. Buffer-mode code reads every radius.
+TEST(Codegen, LiteralSharpOperationsTakeTheShortForm) {
+    Scene scene = makeScene(
+        subtract({unite({sphere(1), sphere(0.5f).at(1, 0, 0)}, 0.25f), sphere(0.3f)}));
+    CodegenOptions inl;
+    inl.inlineParams = true;
+    const std::string literal = generateSceneGlsl(scene, inl);
+    EXPECT_NE(literal.find("d0 = sharpDifference(d0, d4);"), std::string::npos) << literal;
+    EXPECT_NE(literal.find("s0 = sharpDifference(s0, s4);"), std::string::npos) << literal;
+    EXPECT_NE(literal.find("d1 = opUnion(d1, d3, 0.25);"), std::string::npos) << literal;
+    const std::string buffer = generateSceneGlsl(scene);
+    EXPECT_EQ(buffer.find("sharp"), std::string::npos) << buffer;
+    EXPECT_NE(buffer.find("d0 = opDifference(d0, d4, nodeSmooth(0u));"), std::string::npos)
+        << buffer;
+}
+
 // Past 1024 nodes inlining would make glslang quadratic; such scenes read the buffer.
 TEST(Codegen, HugeScenesAreNotInlined) {
     CodegenOptions inl;

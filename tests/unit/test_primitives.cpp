@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <random>
 #include <string>
@@ -352,6 +353,26 @@ TEST(Primitives, OperatorsBlendAndEndExactly) {
     // Equal operands blend halfway and dip by k/4.
     EXPECT_FLOAT_EQ(opUnion(1.0f, 1.0f, 0.4f), 0.9f);
     EXPECT_FLOAT_EQ(opIntersection(1.0f, 1.0f, 0.4f), 1.1f);
+}
+
+// The sharp forms that generated code uses for a literal k = 0 give opX(a, b, 0)'s bits, ties
+// (to the first operand) and signed zeros included.
+TEST(Primitives, SharpOperatorsMatchTheSmoothOnesAtZero) {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(-2, 2);
+    auto same = [](float x, float y) { return std::memcmp(&x, &y, sizeof x) == 0; };
+    auto sameVec = [](glm::vec4 x, glm::vec4 y) { return std::memcmp(&x, &y, sizeof x) == 0; };
+    for (int i = 0; i < 10000; ++i) {
+        float a = u(rng), b = i % 3 == 0 ? a : i % 3 == 1 ? -a : u(rng);
+        if (i % 100 == 0) a = i % 200 == 0 ? 0.0f : -0.0f, b = -a;
+        EXPECT_TRUE(same(sdf::sharpUnion(a, b), sdf::opUnion(a, b, 0.0f))) << a << " " << b;
+        EXPECT_TRUE(same(sdf::sharpIntersection(a, b), sdf::opIntersection(a, b, 0.0f)));
+        EXPECT_TRUE(same(sdf::sharpDifference(a, b), sdf::opDifference(a, b, 0.0f)));
+        glm::vec4 ca(1, 0, 0, a), cb(0, 0, 1, b);
+        EXPECT_TRUE(sameVec(sdf::sharpUnion(ca, cb), sdf::opUnion(ca, cb, 0.0f)));
+        EXPECT_TRUE(sameVec(sdf::sharpIntersection(ca, cb), sdf::opIntersection(ca, cb, 0.0f)));
+        EXPECT_TRUE(sameVec(sdf::sharpDifference(ca, cb), sdf::opDifference(ca, cb, 0.0f)));
+    }
 }
 
 } // namespace
