@@ -7,15 +7,18 @@
 //            shading are appended to a list, which also counts the shade pass's workgroups.
 //            It runs only the workgroups whose rays can meet a surface (the host lists them);
 //            the host fills the rest of the band with the colour of a miss;
-//   shade:   one invocation per listed hit (an indirect dispatch): normal, occlusion, shadows
-//            and lighting;
-//   overlay: with the ground grid or the box overlay on, one invocation per listed hit draws
-//            them over its shaded colour (the march pass draws them over the samples it colours);
-//   resolve: with several samples per pixel, one invocation per pixel averages them.
+//   shade:   one invocation per listed hit (an indirect dispatch): colour, normal, occlusion,
+//            shadows and lighting;
+//   resolve: with several samples per pixel, one invocation per pixel averages them;
+//   overlay: with the ground grid or the box overlay on, one invocation per pixel draws them
+//            over its colour, in front of its first sample's hit.
 // CPU drivers such as lavapipe run invocations in SIMD lanes and execute every branch that any
 // lane takes; split this way, misses never pay for shading and every shading lane has a hit.
 // Each pass is its own module and pipeline: a kernel holds only the code its pass reaches, and
-// the overlays and the resolve, which do not depend on the scene, are compiled once per renderer.
+// the resolve and the overlays, which do not depend on the scene, are compiled once per
+// renderer. Whatever a scene kernel holds, each new scene pays for in its compile (drawing the
+// overlays in the march pass took a third of its compile for a one-sphere scene), so the scene
+// kernels hold nothing that can live elsewhere.
 //
 // Rays are generated and clipped exactly as engine/src/camera.h does on the CPU (the tests trace
 // the same rays with the reference evaluator). Normals use the four-tap tetrahedral difference
@@ -30,7 +33,8 @@ struct FrameLight {
     vec4 color;     // rgb: colour times intensity
 };
 
-// Mirrors FrameUniform in engine/src/render.cpp (std140).
+// Mirrors FrameUniform in engine/src/render.cpp (std140): the frame's values. No branch or loop
+// may depend on these alone (see Control).
 layout(std140, set = 0, binding = SDFCSG_BINDING_FRAME) uniform Frame {
     vec4 eye;        // xyz; w: tan(fov / 2)
     vec4 right;      // xyz; w: aspect (width / height)
@@ -41,14 +45,26 @@ layout(std140, set = 0, binding = SDFCSG_BINDING_FRAME) uniform Frame {
     vec4 background; // rgb as given (output space)
     vec4 sky;        // rgb: background in linear space, for the ambient term
     vec4 distances;  // x: depth-mode near, y: depth-mode far, z: occlusion scale, w: shadow reach
-    uvec4 size;      // width, height, mode, flags
-    uvec4 counts;    // aa, light count, node count, selected node
     FrameLight lights[SDFCSG_MAX_LIGHTS];
-    uvec4 surfaceBoxCount; // x: regions that hold every surface (0: use the clip box alone)
-    // Pairs: a box (min, w = 0; max), or a half-space dot(p, n) < offset (n, w = 1; offset, ...).
+    // The parts that hold every surface (control.parts.x of them), pairs: a box (min, w = 0;
+    // max), or a half-space dot(p, n) < offset (n, w = 1; offset, ...).
     vec4 surfaceBoxes[2 * SDFCSG_MAX_CLIP_BOXES];
     vec4 grid; // ground grid: xy: centre (x, z); z: height of its plane; w: line spacing
 } frame;
+
+// Mirrors FrameControl in engine/src/render.cpp: the frame's values that branches and loops
+// read. A storage buffer, not a uniform block: lavapipe (Mesa 22.3) may specialise a kernel on
+// the uniform-block values that decide its branches, and then compiles it again whenever the
+// block or the push constants change, which they do at every band's dispatch. Whether it does
+// depends on its heuristics and on the code, the scene's included: with these values in Frame,
+// the march kernel did for smooth_blend, a third of its frame in depth mode.
+// Render.OtherValuesCompileNothing checks that no kernel recompiles. Only these few values
+// are in a storage buffer, whose every load costs CPU drivers a bounds check.
+layout(std430, set = 0, binding = SDFCSG_BINDING_CONTROL) readonly buffer Control {
+    uvec4 size;   // width, height, mode, flags
+    uvec4 counts; // aa, light count, node count, selected node
+    uvec4 parts;  // x: surface parts in Frame.surfaceBoxes (0: the clip box alone)
+} control;
 
 // The band this dispatch computes (engine/src/render.cpp): its first pixel row, and where its
 // first sample's colour goes in Colors.
@@ -57,12 +73,12 @@ layout(push_constant) uniform Band {
     uint colorOffset;
 } band;
 
-layout(std430, set = 0, binding = SDFCSG_BINDING_PIXELS) writeonly buffer Pixels {
+layout(std430, set = 0, binding = SDFCSG_BINDING_PIXELS) buffer Pixels {
     uint pixels[];
 };
 
 // Per pixel, from its first sample: x: ray parameter of the hit (negative: a miss), y: steps.
-layout(std430, set = 0, binding = SDFCSG_BINDING_INFO) writeonly buffer Info {
+layout(std430, set = 0, binding = SDFCSG_BINDING_INFO) buffer Info {
     vec2 info[];
 };
 
@@ -94,7 +110,7 @@ float hitEpsilon(float t) {
 }
 
 vec3 rayDirection(vec2 xy) {
-    vec2 size = vec2(frame.size.xy);
+    vec2 size = vec2(control.size.xy);
     float u = (2.0 * xy.x / size.x - 1.0) * frame.eye.w * frame.right.w;
     float v = (1.0 - 2.0 * xy.y / size.y) * frame.eye.w;
     return normalize(frame.forward.xyz + u * frame.right.xyz + v * frame.up.xyz);
@@ -146,70 +162,18 @@ float pow48(float x) {
 
 // Whether a sample's colour needs the shade pass: hits in the shaded and normals modes.
 bool needsShading(Trace r) {
-    uint mode = frame.size.z;
+    uint mode = control.size.z;
     return r.t >= 0.0 && (mode == SDFCSG_MODE_SHADED || mode == SDFCSG_MODE_NORMALS);
 }
 
 // The colour of a sample that needs no shading (see needsShading).
 vec3 plainColor(Trace r) {
-    uint mode = frame.size.z;
+    uint mode = control.size.z;
     // Steps on a log scale: a handful already shows, and 256 is red.
     if (mode == SDFCSG_MODE_STEPS) return heat(log2(1.0 + float(r.steps)) / log2(1.0 + float(SDFCSG_MAX_STEPS)));
     if (r.t < 0.0) return mode == SDFCSG_MODE_SHADED ? frame.background.rgb : vec3(0.0);
     float x = (r.t - frame.distances.x) / max(frame.distances.y - frame.distances.x, 1e-6);
     return vec3(1.0 - 0.85 * clamp(x, 0.0, 1.0)); // depth
-}
-
-// Thin edges of node boxes in front of the hit: where the ray enters or leaves a box close to
-// one of its edges (the second-smallest distance to a face plane is within a pixel or so).
-vec4 boxOverlay(vec3 ro, vec3 rd, float tHit) {
-    uint flags = frame.size.w;
-    uint first = 0u, last = frame.counts.z;
-    if ((flags & SDFCSG_FLAG_BOXES_SELECTED) != 0u) {
-        first = frame.counts.w;
-        last = min(first + 1u, frame.counts.z);
-    }
-    float tLimit = tHit < 0.0 ? frame.clipMin.w : tHit;
-    vec4 result = vec4(0.0);
-    for (uint i = first; i < last; ++i) {
-        vec3 bmin = nodes[i].bmin.xyz, bmax = nodes[i].bmax.xyz;
-        if (any(greaterThan(bmax - bmin, vec3(1.0e29))) || any(greaterThan(bmin, bmax))) continue;
-        vec2 range = clipRay(bmin, bmax, ro, rd);
-        if (range.x > range.y) continue;
-        for (int e = 0; e < 2; ++e) {
-            float t = e == 0 ? range.x : range.y;
-            if (t <= 0.0 || t > tLimit) continue;
-            vec3 p = ro + rd * t;
-            vec3 d = min(abs(p - bmin), abs(p - bmax));
-            // Second smallest component: distance to the nearest edge on this face.
-            float edge = max(min(d.x, d.y), min(max(d.x, d.y), d.z));
-            float width = 1.2 * t * frame.up.w;
-            if (edge < width) {
-                float a = 1.0 - edge / width;
-                result = max(result, vec4(1.0, 0.85, 0.2, 0.9 * a));
-            }
-        }
-    }
-    return result;
-}
-
-// How much of the sample the ground grid covers where the ray meets the grid's plane in front
-// of the hit (tHit < 0: a miss): lines frame.grid.w apart, 2 SDFCSG_GRID_HALF_LINES + 1 each
-// way, about a pixel wide, fading out where a pixel spans so much of the spacing that they
-// would alias.
-float gridCoverage(vec3 ro, vec3 rd, float tHit) {
-    float spacing = frame.grid.w;
-    float tPlane = (frame.grid.z - ro.y) / (abs(rd.y) < 1.0e-20 ? 1.0e-20 : rd.y);
-    if (tPlane <= 0.0 || (tHit >= 0.0 && tPlane > tHit) || tPlane > frame.clipMin.w) return 0.0;
-    vec2 q = (ro.xz + rd.xz * tPlane - frame.grid.xy) / spacing; // in spacings from the centre
-    if (any(greaterThan(abs(q), vec2(float(SDFCSG_GRID_HALF_LINES) + 0.5)))) return 0.0;
-    vec2 toLine = abs(q - round(q));
-    float width = tPlane * frame.up.w / spacing; // a pixel, in spacings, across the ray
-    float along = width / max(abs(rd.y), 0.05);  // ... and along it, where the plane tilts away
-    float line = 1.0 - smoothstep(0.5 * width, 1.5 * width, min(toLine.x, toLine.y));
-    bool axis = (abs(round(q.x)) < 0.5 && toLine.x <= toLine.y) ||
-                (abs(round(q.y)) < 0.5 && toLine.y <= toLine.x);
-    return line * (axis ? 0.7 : 0.4) * (1.0 - smoothstep(0.1, 0.3, along));
 }
 
 uint packColor(vec3 c) {
@@ -221,22 +185,23 @@ vec3 unpackColor(uint c) {
     return vec3(uvec3(c, c >> 8, c >> 16) & 255u) / 255.0;
 }
 
-// The sample's final colour: the ground grid and the box edges drawn over it.
-uint finish(vec3 c, vec3 ro, vec3 rd, float t) {
-    if ((frame.size.w & SDFCSG_FLAG_GRID) != 0u) c = mix(c, vec3(0.12), gridCoverage(ro, rd, t));
-    if ((frame.size.w & (SDFCSG_FLAG_BOXES_ALL | SDFCSG_FLAG_BOXES_SELECTED)) != 0u) {
-        vec4 o = boxOverlay(ro, rd, t);
-        c = mix(c, o.rgb, o.a);
-    }
-    return packColor(c);
+// The pixel and the ray of sample s of the band (column, row in its width * aa x rows * aa grid).
+void sampleRay(uvec2 s, out uvec2 pixel, out vec3 rd) {
+    uint aa = max(control.counts.x, 1u);
+    // s / aa through floats, exact here (s < 2^24, aa <= 8): integer division by a value the
+    // compiler cannot see is a loop of scalar divisions on CPU drivers.
+    uvec2 p = uvec2((vec2(s) + 0.5) / float(aa));
+    pixel = p + uvec2(0u, band.firstRow);
+    rd = rayDirection(vec2(pixel) + (vec2(s - p * aa) + 0.5) / float(aa));
 }
 
-// Sample `sampleIndex` of the band (row-major over its width * aa columns): its pixel and its ray.
-void sampleRay(uint sampleIndex, out uvec2 pixel, out vec3 rd) {
-    uint aa = max(frame.counts.x, 1u);
-    uvec2 s = uvec2(sampleIndex % (frame.size.x * aa), sampleIndex / (frame.size.x * aa));
-    pixel = s / aa + uvec2(0u, band.firstRow);
-    vec2 offset = (vec2(s % aa) + 0.5) / float(aa);
-    rd = rayDirection(vec2(pixel) + offset);
+// Sample index i of the band (row-major) as column and row: i / n through floats, corrected
+// by one where rounding missed (n = width * aa; i / n stays below 2^16, so the float quotient
+// is within one of it).
+uvec2 sampleCoords(uint i) {
+    uint n = control.size.x * max(control.counts.x, 1u);
+    int row = int(float(i) / float(n));
+    int column = int(i) - row * int(n);
+    row += column < 0 ? -1 : column >= int(n) ? 1 : 0;
+    return uvec2(uint(int(i) - row * int(n)), uint(row));
 }
-

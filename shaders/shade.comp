@@ -14,14 +14,15 @@
 const int kShadowSteps = 24;
 const float kShadowSharpness = 10.0;
 
-// The shade pass: normal, occlusion and shadows at the hit r.t. All scene evaluations go
-// through one call of sceneDistance in one loop, driven by a small state machine: four normal
-// taps, five occlusion taps and one shadow ray per light, each evaluating the scene at
-// origin + dir * t. Two reasons, both about lavapipe: its compiler inlines every call site, so
-// one site keeps the JIT compile short; and a lane that has finished its occlusion taps
-// evaluates its shadow steps in the same instructions as its neighbours' taps instead of
-// idling through them.
-const uint kNormal = 1u, kOcclusion = 2u, kShadow = 3u, kDone = 4u;
+// The shade pass: colour, normal, occlusion and shadows at the hit r.t. All scene evaluations
+// go through one call of sceneSample in one loop, driven by a small state machine: the colour
+// at the hit (shaded mode), four normal taps, five occlusion taps and one shadow ray per light,
+// each evaluating the scene at origin + dir * t. Two reasons, both about lavapipe: its compiler
+// inlines every call site, so one site keeps the JIT compile short (the colour's own call cost
+// the house about 50 ms of compile); and a lane that has finished its occlusion taps evaluates
+// its shadow steps in the same instructions as its neighbours' taps instead of idling through
+// them.
+const uint kColor = 0u, kNormal = 1u, kOcclusion = 2u, kShadow = 3u, kDone = 4u;
 
 // The tetrahedron k = (1, -1): k.xyy, k.yyx, k.yxy, k.xxx.
 vec3 tetraTap(int i) {
@@ -31,12 +32,13 @@ vec3 tetraTap(int i) {
                   : vec3(1.0);
 }
 
-void surface(vec3 ro, vec3 rd, inout Trace r) {
-    uint mode = frame.size.z;
-    uint flags = frame.size.w;
-    uint lightCount = (flags & SDFCSG_FLAG_SHADOWS) != 0u ? frame.counts.y : 0u;
+void surface(vec3 ro, vec3 rd, inout Trace r, out vec3 albedo) {
+    uint mode = control.size.z;
+    uint flags = control.size.w;
+    uint lightCount = (flags & SDFCSG_FLAG_SHADOWS) != 0u ? control.counts.y : 0u;
     float aoScale = frame.distances.z;
     float shadowReach = frame.distances.w;
+    uint partCount = control.parts.x; // read before the loops (see march.comp)
 
     vec3 light0 = frame.lights[0].direction.xyz, inverse0 = frame.lights[0].inverse.xyz;
     vec3 light1 = frame.lights[1].direction.xyz, inverse1 = frame.lights[1].inverse.xyz;
@@ -57,9 +59,9 @@ void surface(vec3 ro, vec3 rd, inout Trace r) {
         vec3 t0 = (frame.clipMin.xyz - p) * inv, t1 = (frame.clipMax.xyz - p) * inv;
         vec3 far = max(t0, t1);
         float end = min(min(far.x, far.y), min(far.z, shadowReach));
-        if (frame.surfaceBoxCount.x > 0u) {
+        if (partCount > 0u) {
             float lastExit = 0.0;
-            for (uint b = 0u; b < frame.surfaceBoxCount.x; ++b) {
+            for (uint b = 0u; b < partCount; ++b) {
                 vec2 range = partInterval(b, p, l);
                 if (range.x <= range.y) lastExit = max(lastExit, range.y);
             }
@@ -67,19 +69,25 @@ void surface(vec3 ro, vec3 rd, inout Trace r) {
         }
         ends = mix(ends, vec4(end), equal(uvec4(0u, 1u, 2u, 3u), uvec4(i)));
     }
-    uint phase = kNormal;
+    uint phase = mode == SDFCSG_MODE_SHADED ? kColor : kNormal;
     vec3 origin = p, dir = tetraTap(0);
-    float t = eps;
+    float t = phase == kColor ? 0.0 : eps; // the colour is taken at the hit itself
+    albedo = vec3(0.0);
     int tap = 0;
     float weight = 1.0;
     uint light = 0u;
     float res = 1.0, ph = 1.0e20, shadowEnd = 0.0; // shadow ray (IQ's improved soft shadow)
 
     while (phase != kDone) {
-        float d = sceneDistance(origin + dir * t);
+        vec4 s = sceneSample(origin + dir * t);
+        float d = s.w;
         bool nextLight = false;
 
-        if (phase == kNormal) {
+        if (phase == kColor) {
+            albedo = s.rgb;
+            phase = kNormal;
+            t = eps;
+        } else if (phase == kNormal) {
             r.n += dir * d;
             tap += 1;
             dir = tetraTap(tap);
@@ -146,20 +154,20 @@ void surface(vec3 ro, vec3 rd, inout Trace r) {
 // Scene colours are treated as gamma 2 (sRGB, close enough): squared to shade, square-rooted
 // back; pow() is slow on CPU drivers. Lambert and Blinn-Phong per light, an ambient term from the
 // background, occlusion and shadows from surface().
-vec3 shade(vec3 ro, vec3 rd, Trace r) {
-    uint mode = frame.size.z;
+vec3 shade(vec3 ro, vec3 rd, Trace r, vec3 albedo) {
+    uint mode = control.size.z;
     vec3 n = r.n;
     if (mode == SDFCSG_MODE_NORMALS) return n * 0.5 + 0.5;
 
-    vec3 albedo = sceneSample(ro + rd * r.t).rgb;
     albedo *= albedo;
     vec3 col = albedo * (0.10 + 0.15 * frame.sky.rgb * (0.5 + 0.5 * n.y)) * r.ao;
+    uint lightCount = control.counts.y;
     // Unrolled with constant indices: a per-lane index into r.shadow would keep it in memory.
     for (int i = 0; i < SDFCSG_MAX_LIGHTS; ++i) {
         vec3 l = frame.lights[i].direction.xyz;
         float lambert = max(dot(n, l), 0.0);
         float spec = pow48(max(dot(n, normalize(l - rd)), 0.0)) * 0.25;
-        float lit = uint(i) < frame.counts.y ? r.shadow[i] * lambert : 0.0;
+        float lit = uint(i) < lightCount ? r.shadow[i] * lambert : 0.0;
         col += frame.lights[i].color.rgb * lit * (albedo + spec);
     }
     col = sqrt(col);
@@ -175,11 +183,12 @@ void shadePass() {
     uvec2 hit = hits[slot];
     uvec2 pixel;
     vec3 rd;
-    sampleRay(hit.x, pixel, rd);
+    sampleRay(sampleCoords(hit.x), pixel, rd);
     vec3 ro = frame.eye.xyz;
     Trace r = Trace(uintBitsToFloat(hit.y), 0u, vec3(0.0), 1.0, vec4(1.0));
-    surface(ro, rd, r);
-    colors[band.colorOffset + hit.x] = packColor(shade(ro, rd, r));
+    vec3 albedo;
+    surface(ro, rd, r, albedo);
+    colors[band.colorOffset + hit.x] = packColor(shade(ro, rd, r, albedo));
 }
 
 void main() { shadePass(); }

@@ -16,6 +16,7 @@
 #define SDFCSG_BINDING_SAMPLES 6 // raymarch.glsl: packed RGBA8 per sample of a band
 #define SDFCSG_BINDING_HITS 7    // raymarch.glsl: hits to shade, after an indirect dispatch
 #define SDFCSG_BINDING_TILES 8   // raymarch.glsl: workgroups of a band that the march pass runs
+#define SDFCSG_BINDING_CONTROL 9 // raymarch.glsl: buffer Control: the values that branches read
 #define SDFCSG_BINDING_PROBE_IN 4  // probe.comp: readonly buffer of vec4 points (xyz used)
 #define SDFCSG_BINDING_PROBE_OUT 5 // probe.comp: buffer of vec4 sceneSample() results
 

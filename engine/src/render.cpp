@@ -39,15 +39,19 @@ struct FrameUniform {
     glm::vec4 clipMin, clipMax;
     glm::vec4 background, sky;
     glm::vec4 distances; // depth near, depth far, occlusion scale, shadow reach
-    glm::uvec4 size;     // width, height, mode, flags
-    glm::uvec4 counts;   // aa, lights, nodes, selected
     FrameLight lights[SDFCSG_MAX_LIGHTS];
-    glm::uvec4 surfaceBoxCount; // x
     glm::vec4 surfaceBoxes[2 * SDFCSG_MAX_CLIP_BOXES]; // surface parts, as in raymarch.glsl
     glm::vec4 grid; // centre x, z; plane height; spacing
 };
 static_assert(sizeof(FrameUniform) ==
-              13 * 16 + SDFCSG_MAX_LIGHTS * 48 + SDFCSG_MAX_CLIP_BOXES * 32);
+              10 * 16 + SDFCSG_MAX_LIGHTS * 48 + SDFCSG_MAX_CLIP_BOXES * 32);
+
+// Mirrors the Control buffer in shaders/raymarch.glsl: the values that branches read.
+struct FrameControl {
+    glm::uvec4 size;   // width, height, mode, flags
+    glm::uvec4 counts; // aa, lights, nodes, selected
+    glm::uvec4 parts;  // x: surface parts in FrameUniform::surfaceBoxes
+};
 static_assert(SDFCSG_MAX_LIGHTS == 4, "shade.comp reads the lights into four locals");
 static_assert(GroundGrid{}.halfLines == SDFCSG_GRID_HALF_LINES);
 
@@ -59,6 +63,7 @@ constexpr detail::Binding kBindings[] = {
     {SDFCSG_BINDING_SAMPLES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
     {SDFCSG_BINDING_HITS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
     {SDFCSG_BINDING_TILES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+    {SDFCSG_BINDING_CONTROL, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
 };
 
 // Mirrors the Band push constants of shaders/raymarch.glsl.
@@ -108,7 +113,7 @@ struct Renderer::Impl {
 
     // The image (pixels, info), and per band: the samples' colours (with several per pixel),
     // the workgroups to march and the hits to shade.
-    Buffer frame, nodes, pixels, info, pixelsStaging, infoStaging, samples, hits, tiles;
+    Buffer frame, control, nodes, pixels, info, pixelsStaging, infoStaging, samples, hits, tiles;
     uint32_t capacity = 0;       // pixels the image buffers hold
     uint32_t sampleCapacity = 0; // samples the band buffers hold
     uint32_t tileCapacity = 0;   // workgroups the tile list holds
@@ -121,7 +126,8 @@ struct Renderer::Impl {
     ~Impl() {
         VkDevice device = ctx.device;
         for (Buffer* b :
-             {&frame, &nodes, &pixels, &info, &pixelsStaging, &infoStaging, &samples, &hits, &tiles})
+             {&frame, &control, &nodes, &pixels, &info, &pixelsStaging, &infoStaging, &samples, &hits,
+              &tiles})
             detail::destroyBuffer(ctx, *b);
         destroyKernel();
         for (int pass : {SDFCSG_RAYMARCH_PASS_RESOLVE, SDFCSG_RAYMARCH_PASS_OVERLAY})
@@ -223,8 +229,8 @@ struct Renderer::Impl {
     // once) moves that cost here, so a created pipeline is ready and the first frame costs what
     // later ones do.
     void warmUp(VkPipeline p) {
-        FrameUniform empty = {};
-        detail::uploadBuffer(ctx, frame, &empty, sizeof(empty));
+        FrameControl empty = {};
+        detail::uploadBuffer(ctx, control, &empty, sizeof(empty));
         VkCommandBuffer cmd = detail::beginCommands(ctx);
         vkCmdFillBuffer(cmd, hits.buffer, 0, kHitsHeader, 0);
         detail::recordComputeBarrier(cmd);
@@ -246,7 +252,7 @@ struct Renderer::Impl {
     void writeDescriptors() {
         if (!pixels.buffer || !samples.buffer) return;
         const Buffer* buffers[] = {&frame, &nodes, &pixels, &info,
-                                   samplesArePixels ? &pixels : &samples, &hits, &tiles};
+                                   samplesArePixels ? &pixels : &samples, &hits, &tiles, &control};
         detail::writeDescriptorSet(ctx, set, kBindings, buffers);
     }
 
@@ -324,11 +330,13 @@ struct Renderer::Impl {
         return Ok{};
     }
 
-    FrameUniform frameUniform(const RenderOptions& render, const detail::RayCamera& rc,
-                              const detail::ClipVolume& clip) const {
+    // The frame's values (f) and what its branches read (c).
+    void frameValues(const RenderOptions& render, const detail::RayCamera& rc,
+                     const detail::ClipVolume& clip, FrameUniform& f, FrameControl& c) const {
         Aabb finite = detail::finitePrimitiveBounds(*evaluator);
 
-        FrameUniform f = {};
+        f = {};
+        c = {};
         f.eye = glm::vec4(rc.eye, rc.tanHalfFov);
         f.right = glm::vec4(rc.right, rc.aspect);
         f.up = glm::vec4(rc.up, rc.footprint);
@@ -336,7 +344,7 @@ struct Renderer::Impl {
         f.clipMin = glm::vec4(clip.box.min, clip.far);
         // Supersampling resolves detail finer than a pixel: the hit epsilon follows the sample.
         f.clipMax = glm::vec4(clip.box.max, rc.footprint / float(std::max(render.aa, 1u)));
-        f.surfaceBoxCount.x = uint32_t(clip.parts.size());
+        c.parts.x = uint32_t(clip.parts.size());
         for (size_t i = 0; i < clip.parts.size(); ++i) {
             const detail::SurfacePart& part = clip.parts[i];
             f.surfaceBoxes[2 * i] = part.halfSpace ? glm::vec4(part.normal, 1.0f)
@@ -366,7 +374,7 @@ struct Renderer::Impl {
             const GroundGrid g = groundGrid(*evaluator);
             f.grid = glm::vec4(g.centreX, g.centreZ, g.height, g.spacing);
         }
-        f.size = glm::uvec4(render.width, render.height, uint32_t(render.mode), flags);
+        c.size = glm::uvec4(render.width, render.height, uint32_t(render.mode), flags);
 
         std::vector<Light> lights = scene.lights.empty() ? defaultLights() : scene.lights;
         uint32_t lightCount = uint32_t(std::min<size_t>(lights.size(), SDFCSG_MAX_LIGHTS));
@@ -379,8 +387,7 @@ struct Renderer::Impl {
             f.lights[i].color = glm::vec4(lights[i].color * lights[i].intensity, 0.0f);
         }
         uint32_t selected = render.selectedNode >= 0 ? uint32_t(render.selectedNode) : nodeCount;
-        f.counts = glm::uvec4(render.aa, lightCount, nodeCount, selected);
-        return f;
+        c.counts = glm::uvec4(render.aa, lightCount, nodeCount, selected);
     }
 };
 
@@ -428,6 +435,10 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene
         r.ctx, sizeof(FrameUniform), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, detail::MemoryUse::Upload);
     if (!frame) return frame.error();
     r.frame = *frame;
+    auto control = detail::createBuffer(
+        r.ctx, sizeof(FrameControl), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, detail::MemoryUse::Upload);
+    if (!control) return control.error();
+    r.control = *control;
     auto nodes =
         detail::createBuffer(r.ctx, r.nodeCount * sizeof(detail::GpuNode),
                              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, detail::MemoryUse::Upload);
@@ -511,19 +522,20 @@ Result<Image> Renderer::render(const RenderOptions& options) {
     VkPipeline shade = shading ? r.pipeline(SDFCSG_RAYMARCH_PASS_SHADE, skipping) : VK_NULL_HANDLE;
     VkPipeline resolve = aa > 1 ? r.pipeline(SDFCSG_RAYMARCH_PASS_RESOLVE, false) : VK_NULL_HANDLE;
     const bool overlays = options.grid || options.boxes != BoxOverlay::None;
-    VkPipeline overlay = shading && overlays ? r.pipeline(SDFCSG_RAYMARCH_PASS_OVERLAY, false)
-                                             : VK_NULL_HANDLE;
+    VkPipeline overlay = overlays ? r.pipeline(SDFCSG_RAYMARCH_PASS_OVERLAY, false) : VK_NULL_HANDLE;
     const detail::RayCamera rc = detail::makeRayCamera(camera, options.width, options.height);
     const detail::ClipVolume clip = detail::makeClipVolume(*r.evaluator, rc.eye);
-    FrameUniform f = r.frameUniform(options, rc, clip);
+    FrameUniform f;
+    FrameControl control;
+    r.frameValues(options, rc, clip, f, control);
     detail::uploadBuffer(r.ctx, r.frame, &f, sizeof(f));
+    detail::uploadBuffer(r.ctx, r.control, &control, sizeof(control));
 
     // Workgroups whose rays cannot meet a surface are not marched; the band is filled with the
-    // colour and info of a miss first (t = -1; the steps word too, read back as 0). The
-    // overlays draw outside the surfaces and the steps mode colours misses by their steps, so
-    // those trace every ray.
+    // colour and info of a miss first (t = -1; the steps word too, read back as 0). The steps
+    // mode colours misses by their steps, so it traces every ray.
     std::vector<detail::ScreenRect> rects;
-    const bool culling = !overlays && options.mode != RenderMode::Steps &&
+    const bool culling = options.mode != RenderMode::Steps &&
                          detail::surfaceRects(rc, clip, options.width, options.height, rects);
     auto packed = [](glm::vec3 c) {
         glm::uvec3 u(glm::clamp(c, 0.0f, 1.0f) * 255.0f + 0.5f);
@@ -576,16 +588,15 @@ Result<Image> Renderer::render(const RenderOptions& options) {
                            &band);
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, march);
         if (!tiles.empty()) vkCmdDispatch(cmd, uint32_t(tiles.size()), 1, 1);
-        // One invocation per listed hit each.
-        for (VkPipeline perHit : {shade, overlay}) {
-            if (!perHit) continue;
+        if (shade) { // one invocation per listed hit
             detail::recordComputeBarrier(cmd);
-            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, perHit);
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, shade);
             vkCmdDispatchIndirect(cmd, r.hits.buffer, 4);
         }
-        if (resolve) {
+        for (VkPipeline perPixel : {resolve, overlay}) {
+            if (!perPixel) continue;
             detail::recordComputeBarrier(cmd);
-            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, resolve);
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, perPixel);
             vkCmdDispatch(cmd, detail::groupCount(options.width, SDFCSG_RAYMARCH_GROUP_X), groups,
                           1);
         }

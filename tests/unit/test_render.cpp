@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <random>
 
 namespace sdfcsg::test {
@@ -521,6 +522,90 @@ INSTANTIATE_TEST_SUITE_P(Render, UpdateValues, ::testing::Values(true, false),
                              return param.param ? std::string("InlineValues")
                                                 : std::string("BufferValues");
                          });
+
+// Sets an environment variable for its lifetime.
+class ScopedEnv {
+  public:
+    ScopedEnv(const char* name, const char* value) : name_(name) {
+        if (const char* old = std::getenv(name)) old_ = old;
+        if (value)
+            ::setenv(name, value, 1);
+        else
+            ::unsetenv(name);
+    }
+    ~ScopedEnv() {
+        if (old_)
+            ::setenv(name_, old_->c_str(), 1);
+        else
+            ::unsetenv(name_);
+    }
+
+  private:
+    const char* name_;
+    std::optional<std::string> old_;
+};
+
+// lavapipe may specialise a kernel on values that it reads from a uniform block or from push
+// constants to decide branches, and then compiles it again whenever they change, which would
+// be at every band of every frame. Whether it does depends on the kernel's code, the scene's
+// included. Its disk cache shows such compiles: with the cache in a folder of the test's own,
+// renders with other values (camera, size and so bands, mode, samples, overlays, lights) after
+// renders that used the same pipelines must add nothing to it.
+TEST_F(Render, OtherValuesCompileNothing) {
+    if (context().deviceName().find("llvmpipe") == std::string::npos)
+        GTEST_SKIP() << "a property of lavapipe's compiler; " << context().deviceName();
+    const fs::path dir =
+        fs::temp_directory_path() / ("sdfcsg-mesa-cache-" + std::to_string(::getpid()));
+    ScopedEnv cacheDir("MESA_SHADER_CACHE_DIR", dir.string().c_str());
+    ScopedEnv cacheOn("MESA_SHADER_CACHE_DISABLE", nullptr);
+    auto cachedKernels = [&] {
+        size_t n = 0;
+        for (const auto& entry : fs::recursive_directory_iterator(dir))
+            n += entry.is_regular_file() && entry.path().filename() != "index";
+        return n;
+    };
+    // Each list uses the same pipelines: march, shade, resolve and overlay.
+    auto renderAll = [&](const Scene& scene, const std::vector<RenderOptions>& renders) {
+        ContextOptions contextOptions;
+        contextOptions.validation = 1;
+        auto ctx = Context::create(contextOptions);
+        ASSERT_TRUE(ctx) << ctx.error().str();
+        {
+            auto renderer = Renderer::create(**ctx, scene);
+            ASSERT_TRUE(renderer) << renderer.error().str();
+            for (const RenderOptions& options : renders)
+                ASSERT_TRUE((*renderer)->render(options));
+        }
+        EXPECT_EQ((*ctx)->validationMessageCount(), 0u);
+        // Destroying the device finishes the cache's writes.
+    };
+    RenderOptions first;
+    first.width = 64, first.height = 48, first.aa = 2, first.grid = true;
+    RenderOptions depth = first;
+    depth.mode = RenderMode::Depth, depth.aa = 1;
+
+    RenderOptions other = first;
+    other.width = 320, other.height = 240; // two bands
+    other.aa = 3, other.grid = false, other.boxes = BoxOverlay::All;
+    other.camera = Camera{glm::vec3(3.0f, 2.0f, 4.0f), glm::vec3(0.0f)};
+    other.ambientOcclusion = false;
+    RenderOptions normals = other;
+    normals.mode = RenderMode::Normals, normals.shadows = false;
+    RenderOptions otherDepth = other;
+    otherDepth.mode = RenderMode::Depth, otherDepth.aa = 1, otherDepth.width = 200;
+
+    for (const fs::path& path : bundledScenes()) {
+        SCOPED_TRACE(path.filename().string());
+        const Scene scene = loadOrDie(path);
+        fs::remove_all(dir);
+        renderAll(scene, {first, depth});
+        const size_t before = cachedKernels();
+        ASSERT_GT(before, 0u) << "the driver cached nothing in " << dir;
+        renderAll(scene, {normals, other, otherDepth});
+        EXPECT_EQ(cachedKernels(), before) << "kernels were compiled again for other values";
+    }
+    fs::remove_all(dir);
+}
 
 TEST_F(Render, UpdateValuesRefusesStructuralChanges) {
     Scene scene = loadOrDie(scenePath("csg_part.json"));
