@@ -153,9 +153,8 @@ struct Renderer::Impl {
             VkShaderModule module = VK_NULL_HANDLE;
             VkPipeline pipeline = VK_NULL_HANDLE;
         };
-        auto build = [&](const char* kernel, uint32_t pass) {
+        auto build = [&](Result<std::vector<uint32_t>> spirv, uint32_t pass) {
             Built b;
-            auto spirv = compileKernel(kernel, glsl);
             if (!spirv) {
                 b.error = spirv.error();
                 return b;
@@ -164,9 +163,15 @@ struct Renderer::Impl {
             b.pipeline = createPipeline(b.module, pass, skipping);
             return b;
         };
+        // glslang compiles one kernel at a time: the march kernel first, whose pipeline starts
+        // the longer chain of compiles (the shade kernel's SPIR-V and pipeline are ready well
+        // before the march kernel's machine code).
+        auto marchSpirv = compileKernel("march.comp", glsl);
         Built shade;
-        std::thread other([&] { shade = build("shade.comp", SDFCSG_RAYMARCH_PASS_SHADE); });
-        Built march = build("march.comp", SDFCSG_RAYMARCH_PASS_MARCH);
+        std::thread other([&] {
+            shade = build(compileKernel("shade.comp", glsl), SDFCSG_RAYMARCH_PASS_SHADE);
+        });
+        Built march = build(std::move(marchSpirv), SDFCSG_RAYMARCH_PASS_MARCH);
         if (!march.error) warmUp(march.pipeline);
         other.join();
         if (march.error || shade.error) {
@@ -330,13 +335,13 @@ struct Renderer::Impl {
         return Ok{};
     }
 
-    // The frame's values (f) and what its branches read (c).
+    // The frame's values (f) and those that its branches read (fc).
     void frameValues(const RenderOptions& render, const detail::RayCamera& rc,
-                     const detail::ClipVolume& clip, FrameUniform& f, FrameControl& c) const {
+                     const detail::ClipVolume& clip, FrameUniform& f, FrameControl& fc) const {
         Aabb finite = detail::finitePrimitiveBounds(*evaluator);
 
         f = {};
-        c = {};
+        fc = {};
         f.eye = glm::vec4(rc.eye, rc.tanHalfFov);
         f.right = glm::vec4(rc.right, rc.aspect);
         f.up = glm::vec4(rc.up, rc.footprint);
@@ -344,7 +349,7 @@ struct Renderer::Impl {
         f.clipMin = glm::vec4(clip.box.min, clip.far);
         // Supersampling resolves detail finer than a pixel: the hit epsilon follows the sample.
         f.clipMax = glm::vec4(clip.box.max, rc.footprint / float(std::max(render.aa, 1u)));
-        c.parts.x = uint32_t(clip.parts.size());
+        fc.parts.x = uint32_t(clip.parts.size());
         for (size_t i = 0; i < clip.parts.size(); ++i) {
             const detail::SurfacePart& part = clip.parts[i];
             f.surfaceBoxes[2 * i] = part.halfSpace ? glm::vec4(part.normal, 1.0f)
@@ -374,7 +379,7 @@ struct Renderer::Impl {
             const GroundGrid g = groundGrid(*evaluator);
             f.grid = glm::vec4(g.centreX, g.centreZ, g.height, g.spacing);
         }
-        c.size = glm::uvec4(render.width, render.height, uint32_t(render.mode), flags);
+        fc.size = glm::uvec4(render.width, render.height, uint32_t(render.mode), flags);
 
         std::vector<Light> lights = scene.lights.empty() ? defaultLights() : scene.lights;
         uint32_t lightCount = uint32_t(std::min<size_t>(lights.size(), SDFCSG_MAX_LIGHTS));
@@ -387,7 +392,7 @@ struct Renderer::Impl {
             f.lights[i].color = glm::vec4(lights[i].color * lights[i].intensity, 0.0f);
         }
         uint32_t selected = render.selectedNode >= 0 ? uint32_t(render.selectedNode) : nodeCount;
-        c.counts = glm::uvec4(render.aa, lightCount, nodeCount, selected);
+        fc.counts = glm::uvec4(render.aa, lightCount, nodeCount, selected);
     }
 };
 
