@@ -1,6 +1,7 @@
 #version 450
 // The shade pass of the ray march (shaders/raymarch.glsl): one invocation per listed hit.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_KHR_shader_subgroup_ballot : require
 
 #include "shared.h"
 #include "sdf.glsl"
@@ -22,6 +23,12 @@ const float kShadowSharpness = 10.0;
 // the house about 50 ms of compile); and a lane that has finished its occlusion taps evaluates
 // its shadow steps in the same instructions as its neighbours' taps instead of idling through
 // them.
+// A loop index over the lights, the same in every invocation, said so: CPU drivers such as
+// lavapipe cannot tell, and read what it indexes lane by lane, eight loads per component;
+// from subgroupBroadcastFirst they read once. One loop body instead of one per light cuts
+// the kernel's compile.
+uint uniformIndex(uint i) { return subgroupBroadcastFirst(i); }
+
 const uint kColor = 0u, kNormal = 1u, kOcclusion = 2u, kShadow = 3u, kDone = 4u;
 
 // The tetrahedron k = (1, -1): k.xyy, k.yyx, k.yxy, k.xxx.
@@ -40,10 +47,9 @@ void surface(vec3 ro, vec3 rd, inout Trace r, out vec3 albedo) {
     float shadowReach = frame.distances.w;
     uint partCount = control.parts.x; // read before the loops (see march.comp)
 
-    vec3 light0 = frame.lights[0].direction.xyz, inverse0 = frame.lights[0].inverse.xyz;
-    vec3 light1 = frame.lights[1].direction.xyz, inverse1 = frame.lights[1].inverse.xyz;
-    vec3 light2 = frame.lights[2].direction.xyz, inverse2 = frame.lights[2].inverse.xyz;
-    vec3 light3 = frame.lights[3].direction.xyz, inverse3 = frame.lights[3].inverse.xyz;
+    // For the loop below, whose lanes may be on different lights (see nextLight).
+    vec3 light0 = frame.lights[0].direction.xyz, light1 = frame.lights[1].direction.xyz;
+    vec3 light2 = frame.lights[2].direction.xyz, light3 = frame.lights[3].direction.xyz;
 
     float eps = hitEpsilon(r.t);
     vec3 p = ro + rd * r.t; // the hit, then the hit lifted off the surface
@@ -53,9 +59,9 @@ void surface(vec3 ro, vec3 rd, inout Trace r, out vec3 albedo) {
     // surfaces, so a ray ends where it leaves them. From the hit; the ray starts from the
     // hit lifted by 2 eps, hence the margin.
     vec4 ends = vec4(0.0);
-    for (uint i = 0u; i < lightCount; ++i) {
-        vec3 l = i == 0u ? light0 : i == 1u ? light1 : i == 2u ? light2 : light3;
-        vec3 inv = i == 0u ? inverse0 : i == 1u ? inverse1 : i == 2u ? inverse2 : inverse3;
+    for (uint k = 0u; k < lightCount; ++k) {
+        uint i = uniformIndex(k);
+        vec3 l = frame.lights[i].direction.xyz, inv = frame.lights[i].inverse.xyz;
         vec3 t0 = (frame.clipMin.xyz - p) * inv, t1 = (frame.clipMax.xyz - p) * inv;
         vec3 far = max(t0, t1);
         float end = min(min(far.x, far.y), min(far.z, shadowReach));
@@ -162,13 +168,14 @@ vec3 shade(vec3 ro, vec3 rd, Trace r, vec3 albedo) {
     albedo *= albedo;
     vec3 col = albedo * (0.10 + 0.15 * frame.sky.rgb * (0.5 + 0.5 * n.y)) * r.ao;
     uint lightCount = control.counts.y;
-    // Unrolled with constant indices: a per-lane index into r.shadow would keep it in memory.
-    for (int i = 0; i < SDFCSG_MAX_LIGHTS; ++i) {
+    for (uint k = 0u; k < lightCount; ++k) {
+        uint i = uniformIndex(k);
         vec3 l = frame.lights[i].direction.xyz;
+        // r.shadow through selects: a per-lane index would keep it in memory.
+        float shadow = i == 0u ? r.shadow.x : i == 1u ? r.shadow.y : i == 2u ? r.shadow.z : r.shadow.w;
         float lambert = max(dot(n, l), 0.0);
         float spec = pow48(max(dot(n, normalize(l - rd)), 0.0)) * 0.25;
-        float lit = uint(i) < lightCount ? r.shadow[i] * lambert : 0.0;
-        col += frame.lights[i].color.rgb * lit * (albedo + spec);
+        col += frame.lights[i].color.rgb * (shadow * lambert) * (albedo + spec);
     }
     col = sqrt(col);
     // Fade into the background towards the far limit so a ground plane has no hard edge.

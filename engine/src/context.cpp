@@ -89,6 +89,18 @@ std::string lower(std::string_view s) {
     return out;
 }
 
+// The kernels use subgroupBroadcastFirst (shade.comp says why): optional in Vulkan 1.1, though
+// lavapipe and the desktop GPU drivers offer it.
+bool ballotInCompute(VkPhysicalDevice device) {
+    VkPhysicalDeviceSubgroupProperties subgroup = {
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+    VkPhysicalDeviceProperties2 props = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+    props.pNext = &subgroup;
+    vkGetPhysicalDeviceProperties2(device, &props);
+    return (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
+           (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_BALLOT_BIT);
+}
+
 // A compute-capable queue family, preferring one without graphics (a dedicated compute queue).
 int computeFamily(VkPhysicalDevice device) {
     uint32_t count = 0;
@@ -219,9 +231,11 @@ Result<std::unique_ptr<Context>> Context::create(const ContextOptions& options) 
         VkPhysicalDeviceProperties props;
         vkGetPhysicalDeviceProperties(devices[i], &props);
         int family = computeFamily(devices[i]);
+        const bool usable = props.apiVersion >= VK_API_VERSION_1_1 && ballotInCompute(devices[i]);
         list += "\n  " + std::to_string(i) + ": " + props.deviceName +
-                (family < 0 ? " (no compute queue)" : "");
-        if (family < 0 || props.apiVersion < VK_API_VERSION_1_1) continue;
+                (family < 0 ? " (no compute queue)" : "") +
+                (family >= 0 && !usable ? " (no Vulkan 1.1 subgroup ballot in compute)" : "");
+        if (family < 0 || !usable) continue;
         bool match;
         if (!wanted.empty()) {
             bool numeric = std::all_of(wanted.begin(), wanted.end(),
@@ -244,9 +258,11 @@ Result<std::unique_ptr<Context>> Context::create(const ContextOptions& options) 
     if (chosen < 0) {
         if (!wanted.empty())
             return vulkanError(
-                "no Vulkan 1.1 device with a compute queue matches SDFCSG_DEVICE=\"" + wanted +
+                "no Vulkan 1.1 device with a compute queue and subgroup ballot matches "
+                "SDFCSG_DEVICE=\"" + wanted +
                 "\"; devices:" + list);
-        return vulkanError("no Vulkan 1.1 device with a compute queue; devices:" + list);
+        return vulkanError(
+            "no Vulkan 1.1 device with a compute queue and subgroup ballot; devices:" + list);
     }
     impl->physicalDevice = devices[chosen];
     impl->queueFamily = uint32_t(chosenFamily);
