@@ -42,7 +42,7 @@ vec4 boxOverlay(vec3 ro, vec3 rd, float tHit) {
     return result;
 }
 
-// How much of the sample the ground grid covers where the ray meets the grid's plane in front
+// How much of the pixel the ground grid covers where the ray meets the grid's plane in front
 // of the hit (tHit < 0: a miss): lines frame.grid.w apart, 2 SDFCSG_GRID_HALF_LINES + 1 each
 // way, about a pixel wide, fading out where a pixel spans so much of the spacing that they
 // would alias.
@@ -61,7 +61,7 @@ float gridCoverage(vec3 ro, vec3 rd, float tHit) {
     return line * (axis ? 0.7 : 0.4) * (1.0 - smoothstep(0.1, 0.3, along));
 }
 
-// The sample's final colour: the ground grid and the box edges drawn over it.
+// The pixel's final colour: the ground grid and the box edges drawn over it.
 uint finish(vec3 c, vec3 ro, vec3 rd, float t) {
     if ((control.size.w & SDFCSG_FLAG_GRID) != 0u) c = mix(c, vec3(0.12), gridCoverage(ro, rd, t));
     if ((control.size.w & (SDFCSG_FLAG_BOXES_ALL | SDFCSG_FLAG_BOXES_SELECTED)) != 0u) {
@@ -70,7 +70,6 @@ uint finish(vec3 c, vec3 ro, vec3 rd, float t) {
     }
     return packColor(c);
 }
-
 
 void resolvePass() {
     uvec2 pixel = gl_GlobalInvocationID.xy + uvec2(0u, band.firstRow);

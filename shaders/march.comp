@@ -53,7 +53,8 @@ void marchPass() {
     sampleRay(s, pixel, rd);
     vec3 ro = frame.eye.xyz;
     Trace r = march(ro, rd);
-    if (all(equal(s, (pixel - uvec2(0u, band.firstRow)) * aa))) info[pixel.y * control.size.x + pixel.x] = vec2(r.t, float(r.steps));
+    if (all(equal(s, (pixel - uvec2(0u, band.firstRow)) * aa))) // the pixel's first sample
+        info[pixel.y * control.size.x + pixel.x] = vec2(r.t, float(r.steps));
     if (needsShading(r)) {
         uint slot = atomicAdd(count, 1u);
         if (slot % (SDFCSG_RAYMARCH_GROUP_X * SDFCSG_RAYMARCH_GROUP_Y) == 0u) atomicAdd(groups, 1u);

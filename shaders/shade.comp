@@ -9,6 +9,12 @@
 #include "raymarch.glsl"
 #include "scene.glsl"
 
+// A loop index over the lights, the same in every invocation, said so: CPU drivers such as
+// lavapipe cannot tell, and read what it indexes lane by lane, eight loads per component;
+// from subgroupBroadcastFirst they read once. One loop body instead of one per light cuts
+// the kernel's compile.
+uint uniformIndex(uint i) { return subgroupBroadcastFirst(i); }
+
 // Steps per shadow ray, each a full scene evaluation. A ray that grazes a surface crawls along
 // it in short steps; one that runs out of them before passing it ends too lit, and with 16 a
 // patch of the snowman's drift showed the edge where that began. 24 cost about 1% of a frame.
@@ -23,12 +29,6 @@ const float kShadowSharpness = 10.0;
 // the house about 50 ms of compile); and a lane that has finished its occlusion taps evaluates
 // its shadow steps in the same instructions as its neighbours' taps instead of idling through
 // them.
-// A loop index over the lights, the same in every invocation, said so: CPU drivers such as
-// lavapipe cannot tell, and read what it indexes lane by lane, eight loads per component;
-// from subgroupBroadcastFirst they read once. One loop body instead of one per light cuts
-// the kernel's compile.
-uint uniformIndex(uint i) { return subgroupBroadcastFirst(i); }
-
 const uint kColor = 0u, kNormal = 1u, kOcclusion = 2u, kShadow = 3u, kDone = 4u;
 
 // The tetrahedron k = (1, -1): k.xyy, k.yyx, k.yxy, k.xxx.
@@ -172,7 +172,10 @@ vec3 shade(vec3 ro, vec3 rd, Trace r, vec3 albedo) {
         uint i = uniformIndex(k);
         vec3 l = frame.lights[i].direction.xyz;
         // r.shadow through selects: a per-lane index would keep it in memory.
-        float shadow = i == 0u ? r.shadow.x : i == 1u ? r.shadow.y : i == 2u ? r.shadow.z : r.shadow.w;
+        float shadow = i == 0u   ? r.shadow.x
+                       : i == 1u ? r.shadow.y
+                       : i == 2u ? r.shadow.z
+                                 : r.shadow.w;
         float lambert = max(dot(n, l), 0.0);
         float spec = pow48(max(dot(n, normalize(l - rd)), 0.0)) * 0.25;
         col += frame.lights[i].color.rgb * (shadow * lambert) * (albedo + spec);

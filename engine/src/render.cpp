@@ -125,9 +125,8 @@ struct Renderer::Impl {
     // device may be busy with other threads' work: nothing to wait for.
     ~Impl() {
         VkDevice device = ctx.device;
-        for (Buffer* b :
-             {&frame, &control, &nodes, &pixels, &info, &pixelsStaging, &infoStaging, &samples, &hits,
-              &tiles})
+        for (Buffer* b : {&frame, &control, &nodes, &pixels, &info, &pixelsStaging, &infoStaging,
+                          &samples, &hits, &tiles})
             detail::destroyBuffer(ctx, *b);
         destroyKernel();
         for (int pass : {SDFCSG_RAYMARCH_PASS_RESOLVE, SDFCSG_RAYMARCH_PASS_OVERLAY})
@@ -527,7 +526,8 @@ Result<Image> Renderer::render(const RenderOptions& options) {
     VkPipeline shade = shading ? r.pipeline(SDFCSG_RAYMARCH_PASS_SHADE, skipping) : VK_NULL_HANDLE;
     VkPipeline resolve = aa > 1 ? r.pipeline(SDFCSG_RAYMARCH_PASS_RESOLVE, false) : VK_NULL_HANDLE;
     const bool overlays = options.grid || options.boxes != BoxOverlay::None;
-    VkPipeline overlay = overlays ? r.pipeline(SDFCSG_RAYMARCH_PASS_OVERLAY, false) : VK_NULL_HANDLE;
+    VkPipeline overlay =
+        overlays ? r.pipeline(SDFCSG_RAYMARCH_PASS_OVERLAY, false) : VK_NULL_HANDLE;
     const detail::RayCamera rc = detail::makeRayCamera(camera, options.width, options.height);
     const detail::ClipVolume clip = detail::makeClipVolume(*r.evaluator, rc.eye);
     FrameUniform f;
