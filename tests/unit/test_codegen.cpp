@@ -2,6 +2,7 @@
 // pasted twice, linear size), that it compiles in both modes through compileKernel, compile
 // errors as values, and the SPIR-V cache in memory and on disk.
 #include "scene_build_util.h"
+#include "scoped_env.h"
 #include "shader_compile.h"
 
 #include <sdfcsg/compile.h>
@@ -50,24 +51,6 @@ size_t count(const std::string& text, const std::regex& pattern) {
     return size_t(std::distance(std::sregex_iterator(text.begin(), text.end(), pattern),
                                 std::sregex_iterator()));
 }
-
-// Sets SDFCSG_CACHE_DIR for one test and restores it afterwards.
-class CacheDir {
-  public:
-    explicit CacheDir(const std::string& value) {
-        if (const char* old = std::getenv("SDFCSG_CACHE_DIR")) old_ = old;
-        setenv("SDFCSG_CACHE_DIR", value.c_str(), 1);
-    }
-    ~CacheDir() {
-        if (old_)
-            setenv("SDFCSG_CACHE_DIR", old_->c_str(), 1);
-        else
-            unsetenv("SDFCSG_CACHE_DIR");
-    }
-
-  private:
-    std::optional<std::string> old_;
-};
 
 std::vector<Scene> testScenes() {
     std::vector<Scene> scenes = {primitiveGallery()};
@@ -150,7 +133,7 @@ TEST(Codegen, GeneratedCodeCompilesInBothModes) {
 TEST(Codegen, BundledScenesCompile) {
     std::vector<fs::path> paths = bundledScenePaths();
     ASSERT_GE(paths.size(), 6u);
-    CacheDir off("off");
+    ScopedEnv off("SDFCSG_CACHE_DIR", "off");
     for (const fs::path& path : paths) {
         auto scene = loadScene(path);
         ASSERT_TRUE(scene) << scene.error().str();
@@ -219,7 +202,7 @@ TEST(Codegen, SizeAndCompileTimeAreLinear) {
         text += line.size() - std::min(line.size(), line.find_first_not_of(' '));
     EXPECT_LT(text, 2u * 127 * 300);
 
-    CacheDir off("off");
+    ScopedEnv off("SDFCSG_CACHE_DIR", "off");
     detail::clearShaderMemoryCache();
     auto start = std::chrono::steady_clock::now();
     auto spirv = compileKernel("probe.comp", large);
@@ -277,7 +260,7 @@ TEST(Codegen, CompileErrorsComeBackWithTheLog) {
 TEST(Codegen, SpirvIsCachedInMemoryAndOnDisk) {
     fs::path dir = fs::path(SDFCSG_TEST_OUTPUT_DIR) / "codegen-cache";
     fs::remove_all(dir);
-    CacheDir cacheDir(dir.string());
+    ScopedEnv cacheDir("SDFCSG_CACHE_DIR", dir.string());
     // A scene no other test (or earlier run) compiles.
     std::string glsl = generateSceneGlsl(randomScene(99, 30));
     glsl +=
@@ -334,7 +317,7 @@ TEST(Codegen, SpirvIsCachedInMemoryAndOnDisk) {
     // "off" disables the disk cache.
     {
         fs::remove_all(dir);
-        CacheDir off("off");
+        ScopedEnv off("SDFCSG_CACHE_DIR", "off");
         detail::clearShaderMemoryCache();
         EXPECT_TRUE(compileKernel("probe.comp", glsl));
         EXPECT_FALSE(fs::exists(dir));

@@ -2,6 +2,7 @@
 // same clipping, same epsilon rule. Plus modes, bounds skipping, value updates and PNG output.
 #include "camera.h"
 #include "gpu_test.h"
+#include "scoped_env.h"
 #include "shader_compile.h"
 #include "shared.h"
 
@@ -11,7 +12,6 @@
 
 #include <cmath>
 #include <fstream>
-#include <optional>
 #include <random>
 
 namespace sdfcsg::test {
@@ -522,28 +522,6 @@ INSTANTIATE_TEST_SUITE_P(Render, UpdateValues, ::testing::Values(true, false),
                              return param.param ? std::string("InlineValues")
                                                 : std::string("BufferValues");
                          });
-
-// Sets an environment variable for its lifetime.
-class ScopedEnv {
-  public:
-    ScopedEnv(const char* name, const char* value) : name_(name) {
-        if (const char* old = std::getenv(name)) old_ = old;
-        if (value)
-            ::setenv(name, value, 1);
-        else
-            ::unsetenv(name);
-    }
-    ~ScopedEnv() {
-        if (old_)
-            ::setenv(name_, old_->c_str(), 1);
-        else
-            ::unsetenv(name_);
-    }
-
-  private:
-    const char* name_;
-    std::optional<std::string> old_;
-};
 
 // lavapipe may specialise a kernel on values that it reads from a uniform block or from push
 // constants to decide branches, and then compiles it again whenever they change, which would
