@@ -3,6 +3,7 @@
 // times per stage at several resolutions instead.
 #include "bench.h"
 
+#include "scoped_env.h"
 #include "shader_compile.h"
 
 #include <sdfcsg/sdfcsg.h>
@@ -23,6 +24,7 @@ namespace sdfcsg::app {
 namespace {
 
 namespace fs = std::filesystem;
+using detail::ScopedEnv;
 
 // The scenes (*.json) in `dir`, sorted; empty, with a message, when there are none.
 std::vector<fs::path> findScenes(const fs::path& dir) {
@@ -84,28 +86,6 @@ bool parseCount(const char* s, uint32_t lo, uint32_t hi, uint32_t& out) {
     out = uint32_t(v);
     return true;
 }
-
-// Sets an environment variable for the lifetime of this object, then restores it.
-class ScopedEnv {
-  public:
-    ScopedEnv(const char* name, const std::string& value) : name_(name) {
-        if (const char* old = std::getenv(name)) old_ = old, had_ = true;
-        ::setenv(name, value.c_str(), 1);
-    }
-    ~ScopedEnv() {
-        if (had_)
-            ::setenv(name_, old_.c_str(), 1);
-        else
-            ::unsetenv(name_);
-    }
-    ScopedEnv(const ScopedEnv&) = delete;
-    ScopedEnv& operator=(const ScopedEnv&) = delete;
-
-  private:
-    const char* name_;
-    std::string old_;
-    bool had_ = false;
-};
 
 // JSON text to a renderer with its pipeline built.
 Result<std::unique_ptr<Renderer>> buildFromJson(Context& context, const std::string& json,

@@ -25,6 +25,7 @@ namespace sdfcsg {
 namespace {
 
 using namespace sdfcsg::test;
+using sdfcsg::detail::ScopedEnv;
 namespace fs = std::filesystem;
 
 double seconds(std::chrono::steady_clock::time_point since) {

@@ -18,6 +18,7 @@ namespace sdfcsg::test {
 namespace {
 
 namespace fs = std::filesystem;
+using detail::ScopedEnv;
 
 constexpr uint32_t kSize = 128;
 

@@ -1,11 +1,12 @@
-// Sets or clears an environment variable for a test's scope, then restores it.
+// Sets or clears an environment variable for a scope, then restores it: for the benchmark and
+// the tests, which steer the caches and the driver through the environment.
 #pragma once
 
 #include <cstdlib>
 #include <optional>
 #include <string>
 
-namespace sdfcsg::test {
+namespace sdfcsg::detail {
 
 class ScopedEnv {
   public:
@@ -32,4 +33,4 @@ class ScopedEnv {
     std::optional<std::string> old_;
 };
 
-} // namespace sdfcsg::test
+} // namespace sdfcsg::detail
