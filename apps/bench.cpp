@@ -47,7 +47,8 @@ For every scene (*.json) in DIR (default assets/scenes), prints the median milli
 frame in shaded mode with and without bounding-box skipping (after two warm-up frames; a frame
 includes the read-back), and the median milliseconds from JSON text to a ready pipeline (parse,
 code generation, GLSL compilation, pipeline creation including the driver's compile): cold,
-with nothing cached (no SPIR-V cache, Mesa's shader cache disabled), and warm, with the SPIR-V
+with nothing cached (no SPIR-V cache, an empty folder for Mesa's shader cache), also without
+the compile helper (one device; see ContextOptions::compileHelper), and warm, with the SPIR-V
 and driver disk caches filled but the in-process cache cleared.
 
 Options:
@@ -109,7 +110,7 @@ Result<double> medianFrameMs(Renderer& renderer, const RenderOptions& options, u
 struct Row {
     std::string name;
     size_t nodes = 0;
-    double skip = 0, noSkip = 0, cold = 0, warm = 0;
+    double skip = 0, noSkip = 0, cold = 0, coldOneDevice = 0, warm = 0;
     double buffer = 0, bufferBuild = 0; // with --buffer
 };
 
@@ -316,17 +317,8 @@ int runBench(int argc, char** argv) {
         std::fprintf(stderr, "%s\n", context.error().str().c_str());
         return 4;
     }
-    // For the cold column a second context whose driver keeps no disk cache of compiled
-    // pipelines (Mesa reads this when the device is created; other drivers ignore it).
-    auto coldContext = [] {
-        ScopedEnv noDriverCache("MESA_SHADER_CACHE_DISABLE", "true");
-        return Context::create();
-    }();
-    if (!coldContext) {
-        std::fprintf(stderr, "%s\n", coldContext.error().str().c_str());
-        return 4;
-    }
-    // A private disk cache, so "warm" means exactly this run's compiles.
+    // A private disk cache, so "warm" means exactly this run's compiles; below it, an empty
+    // folder for Mesa's disk cache for every cold build.
     std::string cacheTemplate = (fs::temp_directory_path() / "sdfcsg-bench-XXXXXX").string();
     if (!::mkdtemp(cacheTemplate.data())) {
         std::fprintf(stderr, "sdfcsg bench: cannot create a temporary cache folder\n");
@@ -334,6 +326,21 @@ int runBench(int argc, char** argv) {
     }
     const fs::path cacheDir = cacheTemplate;
     constexpr int kPipelineRuns = 3;
+    int coldRuns = 0;
+    // Runs `work` on a new context whose driver disk cache starts empty, with no SPIR-V cache.
+    // Mesa reads its folder when a device is made (the compile helper's too, after each use), so
+    // the variable stays set throughout.
+    auto withColdContext = [&](bool helper, auto&& work) -> Status {
+        const fs::path mesa = cacheDir / ("mesa-" + std::to_string(coldRuns++));
+        ScopedEnv driverCache("MESA_SHADER_CACHE_DIR", mesa.string());
+        ScopedEnv noSpirvCache("SDFCSG_CACHE_DIR", "off");
+        ContextOptions contextOptions;
+        contextOptions.compileHelper = helper;
+        auto coldContext = Context::create(contextOptions);
+        if (!coldContext) return coldContext.error();
+        detail::clearShaderMemoryCache();
+        return work(**coldContext);
+    };
 
     std::printf("device: %s, %u x %u shaded, median of %u frames (2 warm-up)\n",
                 (*context)->deviceName().c_str(), width, height, frames);
@@ -351,19 +358,17 @@ int runBench(int argc, char** argv) {
             std::fprintf(stderr, "%s: %s\n", file.c_str(), e.str().c_str());
             status = 4;
         };
-        std::vector<double> cold, warm;
+        std::vector<double> cold[2], warm; // [one device, with the helper]
         std::unique_ptr<Renderer> renderer;
-        {
-            ScopedEnv off("SDFCSG_CACHE_DIR", "off");
-            for (int i = 0; i < kPipelineRuns && status == 0; ++i) {
-                detail::clearShaderMemoryCache();
+        for (int i = 0; i < 2 * kPipelineRuns && status == 0; ++i) {
+            auto ok = withColdContext(i % 2, [&](Context& coldContext) -> Status {
                 auto start = Clock::now();
-                auto built = buildFromJson(**coldContext, json, file);
-                if (!built)
-                    fail(built.error());
-                else
-                    cold.push_back(msSince(start));
-            }
+                auto built = buildFromJson(coldContext, json, file);
+                if (!built) return built.error();
+                cold[i % 2].push_back(msSince(start));
+                return Ok{};
+            });
+            if (!ok) fail(ok.error());
         }
         {
             ScopedEnv disk("SDFCSG_CACHE_DIR", cacheDir.string());
@@ -379,7 +384,8 @@ int runBench(int argc, char** argv) {
             }
         }
         if (status != 0) break;
-        row.cold = median(cold);
+        row.cold = median(cold[1]);
+        row.coldOneDevice = median(cold[0]);
         row.warm = median(warm);
         if (auto scene = parseScene(json, file)) row.nodes = scene->nodes.size();
 
@@ -397,45 +403,46 @@ int runBench(int argc, char** argv) {
         row.skip = *skip;
         row.noSkip = *noSkip;
         if (buffer) {
-            ScopedEnv off("SDFCSG_CACHE_DIR", "off");
-            detail::clearShaderMemoryCache();
-            auto scene = parseScene(json, file);
-            RendererOptions values;
-            values.inlineValues = false;
-            auto start = Clock::now();
-            auto built = scene ? Renderer::create(**coldContext, *scene, values)
-                               : Result<std::unique_ptr<Renderer>>(scene.error());
-            if (!built) {
-                fail(built.error());
+            auto ok = withColdContext(true, [&](Context& coldContext) -> Status {
+                auto scene = parseScene(json, file);
+                if (!scene) return scene.error();
+                RendererOptions values;
+                values.inlineValues = false;
+                auto start = Clock::now();
+                auto built = Renderer::create(coldContext, *scene, values);
+                if (!built) return built.error();
+                row.bufferBuild = msSince(start);
+                options.boundsSkipping.reset();
+                auto frame = medianFrameMs(**built, options, frames);
+                if (!frame) return frame.error();
+                row.buffer = *frame;
+                return Ok{};
+            });
+            if (!ok) {
+                fail(ok.error());
                 break;
             }
-            row.bufferBuild = msSince(start);
-            options.boundsSkipping.reset();
-            auto frame = medianFrameMs(**built, options, frames);
-            if (!frame) {
-                fail(frame.error());
-                break;
-            }
-            row.buffer = *frame;
         }
         std::fprintf(stderr, "  %s done\n", row.name.c_str());
         rows.push_back(row);
     }
     fs::remove_all(cacheDir, ec);
 
-    std::printf("\n%-16s %6s %14s %14s %8s %16s %16s", "scene", "nodes", "skip ms", "no-skip ms",
-                "speedup", "json->pipe cold", "json->pipe warm");
+    std::printf("\n%-16s %6s %12s %12s %8s %16s %12s %16s", "scene", "nodes", "skip ms",
+                "no-skip ms", "speedup", "json->pipe cold", "one device", "json->pipe warm");
     if (buffer) std::printf(" %10s %16s", "buffer ms", "buffer build ms");
     std::printf("\n");
     for (const Row& r : rows) {
-        std::printf("%-16s %6zu %14.1f %14.1f %7.2fx %16.1f %16.1f", r.name.c_str(), r.nodes,
-                    r.skip, r.noSkip, r.noSkip / std::max(r.skip, 1e-9), r.cold, r.warm);
+        std::printf("%-16s %6zu %12.1f %12.1f %7.2fx %16.1f %12.1f %16.1f", r.name.c_str(), r.nodes,
+                    r.skip, r.noSkip, r.noSkip / std::max(r.skip, 1e-9), r.cold, r.coldOneDevice,
+                    r.warm);
         if (buffer) std::printf(" %10.1f %16.1f", r.buffer, r.bufferBuild);
         std::printf("\n");
     }
     std::printf(
         "\njson->pipe: parse + codegen + GLSL compile + pipeline ready to run. cold: nothing "
-        "cached; warm: SPIR-V and driver disk caches filled, in-process cache cleared.\n"
+        "cached; one device: cold without the compile helper; warm: SPIR-V and driver disk "
+        "caches filled, in-process cache cleared.\n"
         "Renders use bounds skipping by default on GPUs and not on CPU devices (lavapipe runs both "
         "sides of every branch, so there the bounds tests only add work).\n");
     return status;

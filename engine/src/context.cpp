@@ -117,9 +117,31 @@ int computeFamily(VkPhysicalDevice device) {
     return best;
 }
 
+// llvmpipe makes machine code at a pipeline's first dispatch, not when it is created.
+bool compilesAtDispatch(const Context::Impl& impl) {
+    if (impl.properties.apiVersion < VK_API_VERSION_1_2) return false;
+    VkPhysicalDeviceDriverProperties driver = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
+    VkPhysicalDeviceProperties2 props = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+    props.pNext = &driver;
+    vkGetPhysicalDeviceProperties2(impl.physicalDevice, &props);
+    return driver.driverID == VK_DRIVER_ID_MESA_LLVMPIPE;
+}
+
+// Mesa's disk cache of machine code, which the compile helper hands its work over with, is on
+// unless one of these says otherwise (as Mesa parses them).
+bool mesaCacheDisabled() {
+    for (const char* name : {"MESA_SHADER_CACHE_DISABLE", "MESA_GLSL_CACHE_DISABLE"}) {
+        const char* value = std::getenv(name);
+        const std::string v = lower(value ? value : "");
+        if (v == "1" || v == "y" || v == "yes" || v == "t" || v == "true") return true;
+    }
+    return false;
+}
+
 } // namespace
 
 Context::Impl::~Impl() {
+    helper.reset();
     if (compilerWarmUp.joinable()) compilerWarmUp.join();
     if (device) {
         vkDeviceWaitIdle(device);
@@ -151,10 +173,8 @@ uint32_t Context::validationMessageCount() const {
     return impl_->validationMessages.load(std::memory_order_relaxed);
 }
 
-Result<std::unique_ptr<Context>> Context::create(const ContextOptions& options) {
-    auto impl = std::make_unique<Impl>();
-    impl->compilerWarmUp = std::thread(detail::warmUpCompiler);
-
+Status detail::setUpContext(Context::Impl& impl, const ContextOptions& options,
+                            Context::Impl& report) {
     uint32_t loaderVersion = VK_API_VERSION_1_0;
     auto enumerateVersion = reinterpret_cast<PFN_vkEnumerateInstanceVersion>(
         vkGetInstanceProcAddr(nullptr, "vkEnumerateInstanceVersion"));
@@ -171,7 +191,7 @@ Result<std::unique_ptr<Context>> Context::create(const ContextOptions& options) 
             return vulkanError(
                 std::string(kValidationLayer) +
                 " was requested but is not installed (Debian: vulkan-validationlayers)");
-        impl->validation = available;
+        impl.validation = available;
     }
 
     VkApplicationInfo app = {VK_STRUCTURE_TYPE_APPLICATION_INFO};
@@ -190,33 +210,33 @@ Result<std::unique_ptr<Context>> Context::create(const ContextOptions& options) 
                                 VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
                                 VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
     messengerInfo.pfnUserCallback = debugCallback;
-    messengerInfo.pUserData = impl.get();
+    messengerInfo.pUserData = &report;
 
     VkInstanceCreateInfo info = {VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
     info.pApplicationInfo = &app;
-    if (impl->validation) {
+    if (impl.validation) {
         info.enabledLayerCount = 1;
         info.ppEnabledLayerNames = layers;
         info.enabledExtensionCount = 1;
         info.ppEnabledExtensionNames = extensions;
         info.pNext = &messengerInfo; // also reports problems in vkCreate/DestroyInstance
     }
-    VkResult result = vkCreateInstance(&info, nullptr, &impl->instance);
+    VkResult result = vkCreateInstance(&info, nullptr, &impl.instance);
     if (result == VK_ERROR_INCOMPATIBLE_DRIVER)
         return vulkanError("no Vulkan driver is installed (Debian: mesa-vulkan-drivers)", result);
     if (result != VK_SUCCESS) return vulkanError("cannot create a Vulkan instance", result);
 
-    if (impl->validation) {
+    if (impl.validation) {
         auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
-            vkGetInstanceProcAddr(impl->instance, "vkCreateDebugUtilsMessengerEXT"));
-        VK_CHECK(create(impl->instance, &messengerInfo, nullptr, &impl->messenger));
+            vkGetInstanceProcAddr(impl.instance, "vkCreateDebugUtilsMessengerEXT"));
+        VK_CHECK(create(impl.instance, &messengerInfo, nullptr, &impl.messenger));
     }
 
     // Device selection.
     uint32_t count = 0;
-    VK_CHECK(vkEnumeratePhysicalDevices(impl->instance, &count, nullptr));
+    VK_CHECK(vkEnumeratePhysicalDevices(impl.instance, &count, nullptr));
     std::vector<VkPhysicalDevice> devices(count);
-    VK_CHECK(vkEnumeratePhysicalDevices(impl->instance, &count, devices.data()));
+    VK_CHECK(vkEnumeratePhysicalDevices(impl.instance, &count, devices.data()));
     if (devices.empty())
         return vulkanError("no Vulkan device found (install mesa-vulkan-drivers for the CPU "
                            "driver lavapipe)");
@@ -264,39 +284,54 @@ Result<std::unique_ptr<Context>> Context::create(const ContextOptions& options) 
         return vulkanError(
             "no Vulkan 1.1 device with a compute queue and subgroup ballot; devices:" + list);
     }
-    impl->physicalDevice = devices[chosen];
-    impl->queueFamily = uint32_t(chosenFamily);
-    vkGetPhysicalDeviceProperties(impl->physicalDevice, &impl->properties);
-    vkGetPhysicalDeviceMemoryProperties(impl->physicalDevice, &impl->memoryProperties);
+    impl.physicalDevice = devices[chosen];
+    impl.deviceIndex = uint32_t(chosen);
+    impl.queueFamily = uint32_t(chosenFamily);
+    vkGetPhysicalDeviceProperties(impl.physicalDevice, &impl.properties);
+    vkGetPhysicalDeviceMemoryProperties(impl.physicalDevice, &impl.memoryProperties);
 
     float priority = 1.0f;
     VkDeviceQueueCreateInfo queueInfo = {VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
-    queueInfo.queueFamilyIndex = impl->queueFamily;
+    queueInfo.queueFamilyIndex = impl.queueFamily;
     queueInfo.queueCount = 1;
     queueInfo.pQueuePriorities = &priority;
     VkDeviceCreateInfo deviceInfo = {VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
     deviceInfo.queueCreateInfoCount = 1;
     deviceInfo.pQueueCreateInfos = &queueInfo;
-    result = vkCreateDevice(impl->physicalDevice, &deviceInfo, nullptr, &impl->device);
+    result = vkCreateDevice(impl.physicalDevice, &deviceInfo, nullptr, &impl.device);
     if (result != VK_SUCCESS)
-        return vulkanError(std::string("cannot create a device on ") + impl->properties.deviceName,
+        return vulkanError(std::string("cannot create a device on ") + impl.properties.deviceName,
                            result);
-    vkGetDeviceQueue(impl->device, impl->queueFamily, 0, &impl->queue);
+    vkGetDeviceQueue(impl.device, impl.queueFamily, 0, &impl.queue);
 
     VkCommandPoolCreateInfo poolInfo = {VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
     poolInfo.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
-    poolInfo.queueFamilyIndex = impl->queueFamily;
-    VK_CHECK(vkCreateCommandPool(impl->device, &poolInfo, nullptr, &impl->commandPool));
+    poolInfo.queueFamilyIndex = impl.queueFamily;
+    VK_CHECK(vkCreateCommandPool(impl.device, &poolInfo, nullptr, &impl.commandPool));
 
     VkCommandBufferAllocateInfo allocInfo = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-    allocInfo.commandPool = impl->commandPool;
+    allocInfo.commandPool = impl.commandPool;
     allocInfo.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
     allocInfo.commandBufferCount = 1;
-    VK_CHECK(vkAllocateCommandBuffers(impl->device, &allocInfo, &impl->commandBuffer));
+    VK_CHECK(vkAllocateCommandBuffers(impl.device, &allocInfo, &impl.commandBuffer));
 
     VkFenceCreateInfo fenceInfo = {VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-    VK_CHECK(vkCreateFence(impl->device, &fenceInfo, nullptr, &impl->fence));
+    VK_CHECK(vkCreateFence(impl.device, &fenceInfo, nullptr, &impl.fence));
 
+    return Ok{};
+}
+
+Result<std::unique_ptr<Context>> Context::create(const ContextOptions& options) {
+    auto impl = std::make_unique<Impl>();
+    impl->compilerWarmUp = std::thread(detail::warmUpCompiler);
+    if (auto ok = detail::setUpContext(*impl, options, *impl); !ok) return ok.error();
+    if (options.compileHelper && compilesAtDispatch(*impl) && !mesaCacheDisabled()) {
+        impl->helperOptions = options;
+        impl->helperOptions.device = std::to_string(impl->deviceIndex);
+        impl->helperOptions.validation = impl->validation ? 1 : 0;
+        impl->helperWanted = true;
+        detail::makeCompileHelper(*impl);
+    }
     return std::unique_ptr<Context>(new Context(std::move(impl)));
 }
 

@@ -5,6 +5,7 @@
 
 #include "camera.h"
 #include "gpu_nodes.h"
+#include "shader_compile.h"
 #include "vk.h"
 
 #include "sdfcsg/compile.h"
@@ -138,10 +139,11 @@ struct Renderer::Impl {
     }
 
     // Generates and compiles the scene's kernels, replacing the previous ones, and makes the
-    // march and shade pipelines that render() uses by default, ready to run. The two kernels
-    // are compiled side by side, and on drivers that compile to machine code at the first
-    // dispatch (llvmpipe) the march kernel's compile runs while the shade kernel is still being
-    // translated on the other thread. On failure the previous kernels stay.
+    // march and shade pipelines that render() uses by default, ready to run. The two kernels are
+    // compiled side by side. On llvmpipe, which makes machine code at a pipeline's first dispatch
+    // and one pipeline at a time, a new march kernel is compiled on the context's helper device
+    // (precompileElsewhere()) while this device compiles the shade kernel, the longer of the two.
+    // On failure the previous kernels stay.
     Status buildKernels() {
         CodegenOptions codegen;
         codegen.inlineParams = options.inlineValues;
@@ -152,7 +154,7 @@ struct Renderer::Impl {
             VkShaderModule module = VK_NULL_HANDLE;
             VkPipeline pipeline = VK_NULL_HANDLE;
         };
-        auto build = [&](Result<std::vector<uint32_t>> spirv, uint32_t pass) {
+        auto build = [&](const Result<std::vector<uint32_t>>& spirv, uint32_t pass) {
             Built b;
             if (!spirv) {
                 b.error = spirv.error();
@@ -162,30 +164,36 @@ struct Renderer::Impl {
             b.pipeline = createPipeline(b.module, pass, skipping);
             return b;
         };
-        // glslang compiles one kernel at a time: the march kernel first, whose pipeline starts
-        // the longer chain of compiles (the shade kernel's SPIR-V and pipeline are ready well
-        // before the march kernel's machine code).
-        auto marchSpirv = compileKernel("march.comp", glsl);
-        Built shade;
+        // glslang compiles one kernel at a time: the shade kernel first, which starts the longer
+        // chain (its translation, then its machine code on this device's queue).
+        bool fresh = false;
+        auto shadeSpirv = detail::compileKernel("shade.comp", glsl, fresh);
+        const bool newKernels = fresh && shadeSpirv;
+        Built march;
         std::thread other([&] {
-            shade = build(compileKernel("shade.comp", glsl), SDFCSG_RAYMARCH_PASS_SHADE);
+            auto spirv = compileKernel("march.comp", glsl);
+            if (spirv && newKernels) {
+                const auto spec = specConstants(SDFCSG_RAYMARCH_PASS_MARCH, skipping);
+                detail::precompileElsewhere(ctx, *spirv, kBindings, sizeof(BandConstants), spec);
+            }
+            march = build(spirv, SDFCSG_RAYMARCH_PASS_MARCH);
         });
-        Built march = build(std::move(marchSpirv), SDFCSG_RAYMARCH_PASS_MARCH);
-        if (!march.error) warmUp(march.pipeline);
+        Built shade = build(shadeSpirv, SDFCSG_RAYMARCH_PASS_SHADE);
+        if (!shade.error) warmUp(shade.pipeline);
         other.join();
         if (march.error || shade.error) {
             for (Built* b : {&march, &shade}) {
                 if (b->pipeline) vkDestroyPipeline(ctx.device, b->pipeline, nullptr);
                 if (b->module) vkDestroyShaderModule(ctx.device, b->module, nullptr);
             }
-            return march.error ? *march.error : *shade.error;
+            return shade.error ? *shade.error : *march.error;
         }
         destroyKernel();
         marchModule = march.module;
         shadeModule = shade.module;
         pipelines[SDFCSG_RAYMARCH_PASS_MARCH][skipping ? 1 : 0] = march.pipeline;
         pipelines[SDFCSG_RAYMARCH_PASS_SHADE][skipping ? 1 : 0] = shade.pipeline;
-        warmUp(shade.pipeline);
+        warmUp(march.pipeline);
         return Ok{};
     }
 
@@ -206,10 +214,14 @@ struct Renderer::Impl {
         return ctx.properties.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU;
     }
 
+    static std::array<detail::SpecConstant, 2> specConstants(uint32_t pass, bool skipping) {
+        return {{{SDFCSG_SPEC_BOUNDS_SKIPPING, skipping ? 1u : 0u},
+                 {SDFCSG_SPEC_RAYMARCH_PASS, pass}}};
+    }
+
     VkPipeline createPipeline(VkShaderModule module, uint32_t pass, bool skipping) const {
-        detail::SpecConstant spec[] = {{SDFCSG_SPEC_BOUNDS_SKIPPING, skipping ? 1u : 0u},
-                                       {SDFCSG_SPEC_RAYMARCH_PASS, pass}};
-        return detail::createComputePipeline(ctx, module, pipelineLayout, spec);
+        return detail::createComputePipeline(ctx, module, pipelineLayout,
+                                             specConstants(pass, skipping));
     }
 
     // The pipeline of a pass and skipping choice, created and warmed up on first use.

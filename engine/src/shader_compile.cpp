@@ -229,6 +229,13 @@ std::string_view shaderSource(std::string_view name) {
 }
 
 Result<std::vector<uint32_t>> compileKernel(std::string_view kernel, std::string_view sceneGlsl) {
+    bool compiled;
+    return detail::compileKernel(kernel, sceneGlsl, compiled);
+}
+
+Result<std::vector<uint32_t>> detail::compileKernel(std::string_view kernel,
+                                                    std::string_view sceneGlsl, bool& ranGlslang) {
+    ranGlslang = false;
     std::string_view source = shaderSource(kernel);
     if (source.empty())
         return Error::message(ErrorKind::Shader, std::string(kernel),
@@ -264,6 +271,7 @@ Result<std::vector<uint32_t>> compileKernel(std::string_view kernel, std::string
     }
 
     auto compiled = runGlslang(kernel, source, sceneGlsl);
+    ranGlslang = true;
     {
         std::lock_guard lock(c.mutex);
         ++c.stats.compiles;

@@ -1,7 +1,11 @@
 // Internals of compileKernel (sdfcsg/compile.h) that tests and the benchmark look at.
 #pragma once
 
+#include "sdfcsg/error.h"
+
 #include <cstdint>
+#include <string_view>
+#include <vector>
 
 namespace sdfcsg::detail {
 
@@ -12,6 +16,12 @@ struct ShaderCacheStats {
 };
 
 ShaderCacheStats shaderCacheStats();
+
+// compileKernel() (sdfcsg/compile.h), telling whether glslang ran: the SPIR-V was in neither
+// cache, so the kernel is new to this machine and the driver has most likely not cached its
+// machine code either.
+Result<std::vector<uint32_t>> compileKernel(std::string_view kernel, std::string_view sceneGlsl,
+                                            bool& ranGlslang);
 
 // Sets glslang up for compute shaders, once per process: its first parse builds the tables of
 // built-in symbols (about 0.1 s on lavapipe's machines). Context::create starts it on a thread

@@ -14,6 +14,7 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <mutex>
 #include <span>
 #include <string>
@@ -53,11 +54,25 @@ struct Context::Impl {
     bool validation = false;
     std::atomic<uint32_t> validationMessages{0};
     std::thread compilerWarmUp; // detail::warmUpCompiler(), while the device is set up
+    uint32_t deviceIndex = 0;   // in vkEnumeratePhysicalDevices' order
+
+    // llvmpipe only: a second instance and device on the same driver, whose queue compiles a
+    // kernel to machine code while this one's compiles another (see precompileElsewhere()).
+    // Made with the context and again at the first use after each use, under helperMutex.
+    bool helperWanted = false;    // set before the context is shared, then read only
+    ContextOptions helperOptions; // this device, this validation setting
+    std::mutex helperMutex;
+    std::unique_ptr<Impl> helper;
+    std::atomic<uint32_t> helperCompiles{0}; // kernels it compiled (tests look)
 
     ~Impl();
 };
 
 namespace detail {
+
+// The instance (its validation messages counted in `report`), the chosen device, its queue,
+// command pool and fence: Context::create, and the compile helper.
+Status setUpContext(Context::Impl& impl, const ContextOptions& options, Context::Impl& report);
 
 enum class MemoryUse {
     Upload,   // written by the host every frame, read by shaders (uniforms, node data)
@@ -125,6 +140,23 @@ void recordComputeBarrier(VkCommandBuffer cmd);
 void recordReadback(VkCommandBuffer cmd, const Buffer& buffer, const Buffer* staging);
 // The mapped bytes of whichever buffer holds the result, invalidated.
 const void* readback(Context::Impl& ctx, const Buffer& buffer, const Buffer* staging);
+
+// llvmpipe makes a compute pipeline's machine code at its first dispatch, on the thread of the
+// device's one queue, so the kernels of one renderer would compile one after the other. A second
+// instance and device on the same driver compile on a queue thread of their own, and Mesa's disk
+// cache of machine code hands the result over: a pipeline made from the same SPIR-V, layout and
+// constants on this context loads it at its first dispatch instead of compiling.
+//
+// Compiles such a pipeline on the helper device and returns once its machine code is in the
+// disk cache (destroying the helper's instance waits for the cache's writes; the next call makes
+// a new one). Returns false, having done nothing, where there is no helper (other drivers, Mesa's
+// disk cache turned off, ContextOptions::compileHelper false) or it is busy with another kernel.
+bool precompileElsewhere(Context::Impl& ctx, std::span<const uint32_t> spirv,
+                         std::span<const Binding> bindings, uint32_t pushConstantBytes,
+                         std::span<const SpecConstant> spec);
+// Makes the helper device now, so that the first precompileElsewhere() need not wait for it (and
+// it reads the environment that the context was made in); turns the helper off if that fails.
+void makeCompileHelper(Context::Impl& ctx);
 
 // Dispatch with group counts derived from a local size.
 inline uint32_t groupCount(uint32_t threads, uint32_t localSize) {

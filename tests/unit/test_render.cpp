@@ -5,6 +5,7 @@
 #include "scoped_env.h"
 #include "shader_compile.h"
 #include "shared.h"
+#include "vk.h"
 
 #include <glm/common.hpp>
 #include <glm/exponential.hpp>
@@ -584,6 +585,62 @@ TEST_F(Render, OtherValuesCompileNothing) {
         EXPECT_EQ(cachedKernels(), before) << "kernels were compiled again for other values";
     }
     fs::remove_all(dir);
+}
+
+// On lavapipe a second device compiles the march kernel while the context's own compiles the
+// shade kernel, and hands the machine code over through Mesa's disk cache. The hand-over works
+// only if the helper's pipeline is the one this device looks up (same SPIR-V, layout and
+// constants): otherwise this device compiles the kernel again and caches one kernel more.
+TEST_F(Render, CompileHelperHandsMachineCodeOver) {
+    if (context().deviceName().find("llvmpipe") == std::string::npos)
+        GTEST_SKIP() << "lavapipe only; " << context().deviceName();
+    const fs::path dir =
+        fs::temp_directory_path() / ("sdfcsg-helper-cache-" + std::to_string(::getpid()));
+    ScopedEnv cacheDir("MESA_SHADER_CACHE_DIR", dir.string().c_str());
+    ScopedEnv cacheOn("MESA_SHADER_CACHE_DISABLE", nullptr);
+    ScopedEnv noSpirvCache("SDFCSG_CACHE_DIR", "off"); // new kernels, as for a new scene
+    const Scene scene = loadOrDie(scenePath("robot.json"));
+    RenderOptions options;
+    options.width = 64, options.height = 48;
+
+    std::optional<Image> images[2];
+    size_t cached[2] = {};
+    for (int helper : {0, 1}) {
+        SCOPED_TRACE(helper ? "with the helper" : "without the helper");
+        fs::remove_all(dir);
+        detail::clearShaderMemoryCache();
+        {
+            ContextOptions contextOptions;
+            contextOptions.validation = 1;
+            contextOptions.compileHelper = helper;
+            auto ctx = Context::create(contextOptions);
+            ASSERT_TRUE(ctx) << ctx.error().str();
+            ASSERT_EQ((*ctx)->impl().helperWanted, bool(helper));
+            {
+                auto renderer = Renderer::create(**ctx, scene);
+                ASSERT_TRUE(renderer) << renderer.error().str();
+                EXPECT_EQ((*ctx)->impl().helperCompiles.load(), uint32_t(helper));
+                auto image = (*renderer)->render(options);
+                ASSERT_TRUE(image) << image.error().str();
+                images[helper] = *image;
+            }
+            EXPECT_EQ((*ctx)->validationMessageCount(), 0u);
+        } // destroying the device finishes the cache's writes
+        for (const auto& entry : fs::recursive_directory_iterator(dir))
+            cached[helper] += entry.is_regular_file() && entry.path().filename() != "index";
+    }
+    EXPECT_GE(cached[0], 2u) << "the driver cached nothing in " << dir;
+    EXPECT_EQ(cached[1], cached[0]) << "this device compiled the helper's kernel again";
+    EXPECT_EQ(images[1]->rgba, images[0]->rgba);
+    fs::remove_all(dir);
+
+    // Without Mesa's disk cache there is nothing to hand the machine code over with.
+    ScopedEnv cacheOff("MESA_SHADER_CACHE_DISABLE", "true");
+    ContextOptions contextOptions;
+    contextOptions.validation = 1;
+    auto ctx = Context::create(contextOptions);
+    ASSERT_TRUE(ctx) << ctx.error().str();
+    EXPECT_FALSE((*ctx)->impl().helperWanted);
 }
 
 TEST_F(Render, UpdateValuesRefusesStructuralChanges) {

@@ -24,6 +24,11 @@ struct ContextOptions {
     // and when SDFCSG_VALIDATION=1; SDFCSG_VALIDATION=0 forces it off.
     int validation = -1; // -1: default, 0: off, 1: on (an error if the layer is missing)
     std::string device;  // overrides SDFCSG_DEVICE when not empty
+    // On lavapipe, which compiles kernels to machine code one after the other on its one queue,
+    // compile a renderer's new kernels side by side on a second device of the same driver, which
+    // hands the machine code over through Mesa's shader cache on disk (so only while that cache
+    // is on, as it is by default). Other drivers compile in parallel threads anyway.
+    bool compileHelper = true;
 };
 
 class Context {

@@ -1,0 +1,71 @@
+// The compile helper of lavapipe contexts: see precompileElsewhere() in vk.h.
+#include "vk.h"
+
+#include <vector>
+
+namespace sdfcsg::detail {
+namespace {
+
+// Uniform blocks are at most this large on every device (Vulkan's minimum limit).
+constexpr VkDeviceSize kBindingBytes = 16384;
+
+} // namespace
+
+void makeCompileHelper(Context::Impl& ctx) {
+    auto helper = std::make_unique<Context::Impl>();
+    if (setUpContext(*helper, ctx.helperOptions, ctx))
+        ctx.helper = std::move(helper);
+    else
+        ctx.helperWanted = false;
+}
+
+bool precompileElsewhere(Context::Impl& ctx, std::span<const uint32_t> spirv,
+                         std::span<const Binding> bindings, uint32_t pushConstantBytes,
+                         std::span<const SpecConstant> spec) {
+    if (!ctx.helperWanted) return false;
+    std::unique_lock lock(ctx.helperMutex, std::try_to_lock);
+    if (!lock) return false;
+    if (!ctx.helper) {
+        auto helper = std::make_unique<Context::Impl>();
+        if (!setUpContext(*helper, ctx.helperOptions, ctx)) return false;
+        ctx.helper = std::move(helper);
+    }
+    Context::Impl& h = *ctx.helper;
+    // Every binding of the set must point at a buffer, though a dispatch of no workgroups, which
+    // makes llvmpipe compile, runs no invocation to read one.
+    auto buffer = createBuffer(
+        h, kBindingBytes, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+        MemoryUse::Device);
+    if (!buffer) return false;
+    VkDescriptorSetLayout setLayout = createDescriptorSetLayout(h, bindings);
+    VkPipelineLayout layout = createPipelineLayout(h, setLayout, pushConstantBytes);
+    VkDescriptorPool pool = createDescriptorPool(h, bindings);
+    VkDescriptorSet set = allocateDescriptorSet(h, pool, setLayout);
+    const std::vector<const Buffer*> buffers(bindings.size(), &*buffer);
+    writeDescriptorSet(h, set, bindings, buffers);
+    VkShaderModule module = createShaderModule(h, spirv);
+    VkPipeline pipeline = createComputePipeline(h, module, layout, spec);
+
+    VkCommandBuffer cmd = beginCommands(h);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &set, 0, nullptr);
+    if (pushConstantBytes) {
+        const std::vector<uint8_t> zeros(pushConstantBytes);
+        vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, pushConstantBytes,
+                           zeros.data());
+    }
+    vkCmdDispatch(cmd, 0, 0, 0);
+    submitAndWait(h);
+
+    vkDestroyPipeline(h.device, pipeline, nullptr);
+    vkDestroyShaderModule(h.device, module, nullptr);
+    vkDestroyDescriptorPool(h.device, pool, nullptr);
+    vkDestroyPipelineLayout(h.device, layout, nullptr);
+    vkDestroyDescriptorSetLayout(h.device, setLayout, nullptr);
+    destroyBuffer(h, *buffer);
+    ctx.helper.reset(); // the instance's end waits for the disk cache's writes
+    ctx.helperCompiles.fetch_add(1, std::memory_order_relaxed);
+    return true;
+}
+
+} // namespace sdfcsg::detail
