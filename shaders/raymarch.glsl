@@ -7,18 +7,21 @@
 //            shading are appended to a list, which also counts the shade pass's workgroups.
 //            It runs only the workgroups whose rays can meet a surface (the host lists them);
 //            the host fills the rest of the band with the colour of a miss;
-//   shade:   one invocation per listed hit (an indirect dispatch): colour, normal, occlusion,
-//            shadows and lighting;
+//   ends:    one invocation per listed hit (an indirect dispatch): where the shadow ray towards
+//            each light can end, leaving the clip box and the boxes that hold surfaces;
+//   shade:   one invocation per listed hit: colour, normal, occlusion and shadows;
+//   light:   one invocation per listed hit: lighting, from what the shade pass found;
 //   resolve: with several samples per pixel, one invocation per pixel averages them;
 //   overlay: with the ground grid or the box overlay on, one invocation per pixel draws them
 //            over its colour, in front of its first sample's hit.
 // CPU drivers such as lavapipe run invocations in SIMD lanes and execute every branch that any
 // lane takes; split this way, misses never pay for shading and every shading lane has a hit.
-// Each pass is its own module and pipeline: a kernel holds only the code its pass reaches, and
-// the resolve and the overlays, which do not depend on the scene, are compiled once per
-// renderer. Whatever a scene kernel holds, each new scene pays for in its compile (drawing the
-// overlays in the march pass took a third of its compile for a one-sphere scene), so the scene
-// kernels hold nothing that can live elsewhere.
+// Each pass is its own pipeline: a kernel holds only the code its pass reaches, and the passes
+// that do not depend on the scene (finish.comp, light.comp) are compiled once per context.
+// Whatever a scene kernel holds, each new scene pays for in its compile (drawing the overlays in
+// the march pass took a third of its compile for a one-sphere scene; the shadow-ray ends and the
+// lighting a quarter of the shade kernel's), so the scene kernels hold nothing that can live
+// elsewhere.
 //
 // Rays are generated and clipped exactly as engine/src/camera.h does on the CPU (the tests trace
 // the same rays with the reference evaluator). Normals use the four-tap tetrahedral difference
@@ -95,8 +98,8 @@ layout(std430, set = 0, binding = SDFCSG_BINDING_TILES) readonly buffer Tiles {
 };
 
 // Hits of the band that need shading: x: sample index in the band, y: ray parameter (bits).
-// count and groups are cleared before the march pass; groups, 1, 1 are the shade pass's
-// indirect dispatch.
+// count and groups are cleared before the march pass; groups, 1, 1 are the indirect dispatch of
+// the ends, shade and light passes.
 layout(std430, set = 0, binding = SDFCSG_BINDING_HITS) buffer Hits {
     uint count;
     uint groups;
@@ -104,6 +107,18 @@ layout(std430, set = 0, binding = SDFCSG_BINDING_HITS) buffer Hits {
     uint groupsZ;
     uvec2 hits[];
 };
+
+// Per listed hit (the index into hits), four vec4s: 0: where each light's shadow ray can end
+// (ends pass); from the shade pass, 1: normal and occlusion, 2: shadow per light, 3: albedo.
+layout(std430, set = 0, binding = SDFCSG_BINDING_SURFACES) buffer Surfaces {
+    vec4 surfaces[];
+};
+
+// The index into hits of this invocation of the ends, shade and light passes.
+uint hitSlot() {
+    return gl_WorkGroupID.x * (SDFCSG_RAYMARCH_GROUP_X * SDFCSG_RAYMARCH_GROUP_Y) +
+           gl_LocalInvocationIndex;
+}
 
 float hitEpsilon(float t) {
     return max(frame.forward.w, 0.5 * t * frame.clipMax.w);

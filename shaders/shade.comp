@@ -1,19 +1,13 @@
 #version 450
-// The shade pass of the ray march (shaders/raymarch.glsl): one invocation per listed hit.
+// The shade pass of the ray march (shaders/raymarch.glsl): one invocation per listed hit, whose
+// findings the light pass (light.comp) turns into a colour.
 #extension GL_GOOGLE_include_directive : require
-#extension GL_KHR_shader_subgroup_ballot : require
 
 #include "shared.h"
 #include "sdf.glsl"
 #include "nodes.glsl"
 #include "raymarch.glsl"
 #include "scene.glsl"
-
-// A loop index over the lights, the same in every invocation, said so: CPU drivers such as
-// lavapipe cannot tell, and read what it indexes lane by lane, eight loads per component;
-// from subgroupBroadcastFirst they read once. One loop body instead of one per light cuts
-// the kernel's compile.
-uint uniformIndex(uint i) { return subgroupBroadcastFirst(i); }
 
 // Steps per shadow ray, each a full scene evaluation. A ray that grazes a surface crawls along
 // it in short steps; one that runs out of them before passing it ends too lit, and with 16 a
@@ -39,13 +33,11 @@ vec3 tetraTap(int i) {
                   : vec3(1.0);
 }
 
-void surface(vec3 ro, vec3 rd, inout Trace r, out vec3 albedo) {
+void surface(vec3 ro, vec3 rd, vec4 ends, inout Trace r, out vec3 albedo) {
     uint mode = control.size.z;
     uint flags = control.size.w;
     uint lightCount = (flags & SDFCSG_FLAG_SHADOWS) != 0u ? control.counts.y : 0u;
     float aoScale = frame.distances.z;
-    float shadowReach = frame.distances.w;
-    uint partCount = control.parts.x; // read before the loops (see march.comp)
 
     // For the loop below, whose lanes may be on different lights (see nextLight).
     vec3 light0 = frame.lights[0].direction.xyz, light1 = frame.lights[1].direction.xyz;
@@ -54,27 +46,6 @@ void surface(vec3 ro, vec3 rd, inout Trace r, out vec3 albedo) {
     float eps = hitEpsilon(r.t);
     vec3 p = ro + rd * r.t; // the hit, then the hit lifted off the surface
 
-    // Where each shadow ray can end, worked out here rather than in the loop (whose every
-    // iteration would run it): occluders lie inside the clip box and the boxes that hold
-    // surfaces, so a ray ends where it leaves them. From the hit; the ray starts from the
-    // hit lifted by 2 eps, hence the margin.
-    vec4 ends = vec4(0.0);
-    for (uint k = 0u; k < lightCount; ++k) {
-        uint i = uniformIndex(k);
-        vec3 l = frame.lights[i].direction.xyz, inv = frame.lights[i].inverse.xyz;
-        vec3 t0 = (frame.clipMin.xyz - p) * inv, t1 = (frame.clipMax.xyz - p) * inv;
-        vec3 far = max(t0, t1);
-        float end = min(min(far.x, far.y), min(far.z, shadowReach));
-        if (partCount > 0u) {
-            float lastExit = 0.0;
-            for (uint b = 0u; b < partCount; ++b) {
-                vec2 range = partInterval(b, p, l);
-                if (range.x <= range.y) lastExit = max(lastExit, range.y);
-            }
-            end = min(end, lastExit);
-        }
-        ends = mix(ends, vec4(end), equal(uvec4(0u, 1u, 2u, 3u), uvec4(i)));
-    }
     uint phase = mode == SDFCSG_MODE_SHADED ? kColor : kNormal;
     vec3 origin = p, dir = tetraTap(0);
     float t = phase == kColor ? 0.0 : eps; // the colour is taken at the hit itself
@@ -157,38 +128,8 @@ void surface(vec3 ro, vec3 rd, inout Trace r, out vec3 albedo) {
     }
 }
 
-// Scene colours are treated as gamma 2 (sRGB, close enough): squared to shade, square-rooted
-// back; pow() is slow on CPU drivers. Lambert and Blinn-Phong per light, an ambient term from the
-// background, occlusion and shadows from surface().
-vec3 shade(vec3 ro, vec3 rd, Trace r, vec3 albedo) {
-    uint mode = control.size.z;
-    vec3 n = r.n;
-    if (mode == SDFCSG_MODE_NORMALS) return n * 0.5 + 0.5;
-
-    albedo *= albedo;
-    vec3 col = albedo * (0.10 + 0.15 * frame.sky.rgb * (0.5 + 0.5 * n.y)) * r.ao;
-    uint lightCount = control.counts.y;
-    for (uint k = 0u; k < lightCount; ++k) {
-        uint i = uniformIndex(k);
-        vec3 l = frame.lights[i].direction.xyz;
-        // r.shadow through selects: a per-lane index would keep it in memory.
-        float shadow = i == 0u   ? r.shadow.x
-                       : i == 1u ? r.shadow.y
-                       : i == 2u ? r.shadow.z
-                                 : r.shadow.w;
-        float lambert = max(dot(n, l), 0.0);
-        float spec = pow48(max(dot(n, normalize(l - rd)), 0.0)) * 0.25;
-        col += frame.lights[i].color.rgb * (shadow * lambert) * (albedo + spec);
-    }
-    col = sqrt(col);
-    // Fade into the background towards the far limit so a ground plane has no hard edge.
-    float fog = smoothstep(0.6, 1.0, r.t / frame.clipMin.w);
-    return mix(col, frame.background.rgb, fog);
-}
-
 void shadePass() {
-    uint slot = gl_WorkGroupID.x * (SDFCSG_RAYMARCH_GROUP_X * SDFCSG_RAYMARCH_GROUP_Y) +
-                gl_LocalInvocationIndex;
+    uint slot = hitSlot();
     if (slot >= count) return;
     uvec2 hit = hits[slot];
     uvec2 pixel;
@@ -197,8 +138,10 @@ void shadePass() {
     vec3 ro = frame.eye.xyz;
     Trace r = Trace(uintBitsToFloat(hit.y), 0u, vec3(0.0), 1.0, vec4(1.0));
     vec3 albedo;
-    surface(ro, rd, r, albedo);
-    colors[band.colorOffset + hit.x] = packColor(shade(ro, rd, r, albedo));
+    surface(ro, rd, surfaces[4u * slot], r, albedo);
+    surfaces[4u * slot + 1u] = vec4(r.n, r.ao);
+    surfaces[4u * slot + 2u] = r.shadow;
+    surfaces[4u * slot + 3u] = vec4(albedo, 0.0);
 }
 
 void main() { shadePass(); }

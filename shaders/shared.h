@@ -17,6 +17,7 @@
 #define SDFCSG_BINDING_HITS 7    // raymarch.glsl: hits to shade, after an indirect dispatch
 #define SDFCSG_BINDING_TILES 8   // raymarch.glsl: workgroups of a band that the march pass runs
 #define SDFCSG_BINDING_CONTROL 9 // raymarch.glsl: buffer Control: the values that branches read
+#define SDFCSG_BINDING_SURFACES 10 // raymarch.glsl: per listed hit, what the shade pass hands over
 #define SDFCSG_BINDING_PROBE_IN 4  // probe.comp: readonly buffer of vec4 points (xyz used)
 #define SDFCSG_BINDING_PROBE_OUT 5 // probe.comp: buffer of vec4 sceneSample() results
 
@@ -76,12 +77,15 @@
 #define SDFCSG_SPEC_BOUNDS_SKIPPING 0
 #define SDFCSG_SPEC_MESH_PASS 1  // mesh_field.comp: which pass (SDFCSG_MESH_PASS_*)
 #define SDFCSG_SPEC_MESH_GROUP 2 // mesh_field.comp: workgroup size of that pass
-#define SDFCSG_SPEC_RAYMARCH_PASS 3 // finish.comp: which pass (SDFCSG_RAYMARCH_PASS_*)
+#define SDFCSG_SPEC_RAYMARCH_PASS 3 // finish.comp, light.comp: which pass (SDFCSG_RAYMARCH_PASS_*)
 
 #define SDFCSG_RAYMARCH_PASS_MARCH 0
 #define SDFCSG_RAYMARCH_PASS_SHADE 1
 #define SDFCSG_RAYMARCH_PASS_RESOLVE 2
 #define SDFCSG_RAYMARCH_PASS_OVERLAY 3
+#define SDFCSG_RAYMARCH_PASS_ENDS 4
+#define SDFCSG_RAYMARCH_PASS_LIGHT 5
+#define SDFCSG_RAYMARCH_PASSES 6
 
 #define SDFCSG_MESH_PASS_CULL 0
 #define SDFCSG_MESH_PASS_CLASSIFY 1

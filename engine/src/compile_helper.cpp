@@ -9,14 +9,24 @@ namespace {
 // Uniform blocks are at most this large on every device (Vulkan's minimum limit).
 constexpr VkDeviceSize kBindingBytes = 16384;
 
+// Under ctx.helperMutex.
+bool haveHelper(Context::Impl& ctx) {
+    if (!ctx.helper && !ctx.helperFailed) {
+        auto helper = std::make_unique<Context::Impl>();
+        if (setUpContext(*helper, ctx.helperOptions, ctx))
+            ctx.helper = std::move(helper);
+        else
+            ctx.helperFailed = true;
+    }
+    return ctx.helper != nullptr;
+}
+
 } // namespace
 
 void makeCompileHelper(Context::Impl& ctx) {
-    auto helper = std::make_unique<Context::Impl>();
-    if (setUpContext(*helper, ctx.helperOptions, ctx))
-        ctx.helper = std::move(helper);
-    else
-        ctx.helperWanted = false;
+    if (!ctx.helperWanted) return;
+    std::unique_lock lock(ctx.helperMutex, std::try_to_lock);
+    if (lock) haveHelper(ctx);
 }
 
 bool precompileElsewhere(Context::Impl& ctx, std::span<const uint32_t> spirv,
@@ -24,12 +34,7 @@ bool precompileElsewhere(Context::Impl& ctx, std::span<const uint32_t> spirv,
                          std::span<const SpecConstant> spec) {
     if (!ctx.helperWanted) return false;
     std::unique_lock lock(ctx.helperMutex, std::try_to_lock);
-    if (!lock) return false;
-    if (!ctx.helper) {
-        auto helper = std::make_unique<Context::Impl>();
-        if (!setUpContext(*helper, ctx.helperOptions, ctx)) return false;
-        ctx.helper = std::move(helper);
-    }
+    if (!lock || !haveHelper(ctx)) return false;
     Context::Impl& h = *ctx.helper;
     // Every binding of the set must point at a buffer, though a dispatch of no workgroups, which
     // makes llvmpipe compile, runs no invocation to read one.

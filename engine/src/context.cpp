@@ -141,6 +141,7 @@ bool mesaCacheDisabled() {
 } // namespace
 
 Context::Impl::~Impl() {
+    rendererShared.reset(); // holds objects of the device
     helper.reset();
     if (compilerWarmUp.joinable()) compilerWarmUp.join();
     if (device) {

@@ -19,6 +19,8 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
@@ -65,6 +67,29 @@ constexpr detail::Binding kBindings[] = {
     {SDFCSG_BINDING_HITS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
     {SDFCSG_BINDING_TILES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
     {SDFCSG_BINDING_CONTROL, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+    {SDFCSG_BINDING_SURFACES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+};
+
+// What the renderers of a context share: the layout of the kernels' bindings, and the pipelines
+// of the passes that do not evaluate the scene (finish.comp, light.comp), each made once per
+// context, at its first use. A new scene compiles only its own kernels.
+struct SharedPasses {
+    Context::Impl& ctx;
+    VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+    VkShaderModule finish = VK_NULL_HANDLE, light = VK_NULL_HANDLE;
+    std::mutex mutex; // guards pipelines
+    VkPipeline pipelines[SDFCSG_RAYMARCH_PASSES] = {};
+
+    explicit SharedPasses(Context::Impl& c) : ctx(c) {}
+    ~SharedPasses() {
+        for (VkPipeline p : pipelines)
+            if (p) vkDestroyPipeline(ctx.device, p, nullptr);
+        for (VkShaderModule m : {finish, light})
+            if (m) vkDestroyShaderModule(ctx.device, m, nullptr);
+        if (layout) vkDestroyPipelineLayout(ctx.device, layout, nullptr);
+        if (setLayout) vkDestroyDescriptorSetLayout(ctx.device, setLayout, nullptr);
+    }
 };
 
 // Mirrors the Band push constants of shaders/raymarch.glsl.
@@ -75,6 +100,7 @@ struct BandConstants {
 
 constexpr uint32_t kGroupSize = SDFCSG_RAYMARCH_GROUP_X * SDFCSG_RAYMARCH_GROUP_Y;
 constexpr VkDeviceSize kHitsHeader = 16; // count, then the shade pass's dispatch
+constexpr VkDeviceSize kSurfaceBytes = 64; // per listed hit: four vec4 (raymarch.glsl)
 
 Error usage(std::string text) {
     return Error::message(ErrorKind::Usage, "<render>", std::move(text));
@@ -82,6 +108,22 @@ Error usage(std::string text) {
 
 // Samples per submission (see Renderer::render).
 constexpr uint32_t kBandSamples = 1u << 16;
+
+Result<std::shared_ptr<SharedPasses>> sharedPasses(Context::Impl& ctx) {
+    std::lock_guard lock(ctx.rendererSharedMutex);
+    if (ctx.rendererShared) return std::static_pointer_cast<SharedPasses>(ctx.rendererShared);
+    auto finish = compileKernel("finish.comp", "");
+    if (!finish) return finish.error();
+    auto light = compileKernel("light.comp", "");
+    if (!light) return light.error();
+    auto shared = std::make_shared<SharedPasses>(ctx);
+    shared->setLayout = detail::createDescriptorSetLayout(ctx, kBindings);
+    shared->layout = detail::createPipelineLayout(ctx, shared->setLayout, sizeof(BandConstants));
+    shared->finish = detail::createShaderModule(ctx, *finish);
+    shared->light = detail::createShaderModule(ctx, *light);
+    ctx.rendererShared = shared;
+    return shared;
+}
 
 } // namespace
 
@@ -100,21 +142,20 @@ struct Renderer::Impl {
     std::unique_ptr<Evaluator> evaluator;
     uint32_t nodeCount = 0;
 
-    // The scene's kernels, march.comp and shade.comp, and finish.comp (the resolve and overlay
-    // passes), which does not depend on the scene.
+    std::shared_ptr<SharedPasses> shared;
+    VkPipelineLayout pipelineLayout = VK_NULL_HANDLE; // shared->layout
+    // The scene's kernels, march.comp and shade.comp, and their pipelines: [pass][bounds
+    // skipping], made on first use (buildKernels() makes the default ones).
     VkShaderModule marchModule = VK_NULL_HANDLE, shadeModule = VK_NULL_HANDLE;
-    VkShaderModule finishModule = VK_NULL_HANDLE;
-    VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
-    VkPipelineLayout pipelineLayout = VK_NULL_HANDLE;
-    // [pass][bounds skipping], made on first use (buildKernels() makes the default march and
-    // shade ones); the resolve and overlay passes do not evaluate the scene.
-    VkPipeline pipelines[4][2] = {};
+    VkPipeline pipelines[2][2] = {};
+    static_assert(SDFCSG_RAYMARCH_PASS_MARCH == 0 && SDFCSG_RAYMARCH_PASS_SHADE == 1);
     VkDescriptorPool pool = VK_NULL_HANDLE;
     VkDescriptorSet set = VK_NULL_HANDLE;
 
     // The image (pixels, info), and per band: the samples' colours (with several per pixel),
     // the workgroups to march and the hits to shade.
-    Buffer frame, control, nodes, pixels, info, pixelsStaging, infoStaging, samples, hits, tiles;
+    Buffer frame, control, nodes, pixels, info, pixelsStaging, infoStaging, samples, hits, tiles,
+        surfaces;
     uint32_t capacity = 0;       // pixels the image buffers hold
     uint32_t sampleCapacity = 0; // samples the band buffers hold
     uint32_t tileCapacity = 0;   // workgroups the tile list holds
@@ -127,23 +168,18 @@ struct Renderer::Impl {
     ~Impl() {
         VkDevice device = ctx.device;
         for (Buffer* b : {&frame, &control, &nodes, &pixels, &info, &pixelsStaging, &infoStaging,
-                          &samples, &hits, &tiles})
+                          &samples, &hits, &tiles, &surfaces})
             detail::destroyBuffer(ctx, *b);
         destroyKernel();
-        for (int pass : {SDFCSG_RAYMARCH_PASS_RESOLVE, SDFCSG_RAYMARCH_PASS_OVERLAY})
-            if (pipelines[pass][0]) vkDestroyPipeline(device, pipelines[pass][0], nullptr);
-        if (finishModule) vkDestroyShaderModule(device, finishModule, nullptr);
         if (pool) vkDestroyDescriptorPool(device, pool, nullptr);
-        if (pipelineLayout) vkDestroyPipelineLayout(device, pipelineLayout, nullptr);
-        if (setLayout) vkDestroyDescriptorSetLayout(device, setLayout, nullptr);
     }
 
     // Generates and compiles the scene's kernels, replacing the previous ones, and makes the
     // march and shade pipelines that render() uses by default, ready to run. The two kernels are
     // compiled side by side. On llvmpipe, which makes machine code at a pipeline's first dispatch
     // and one pipeline at a time, a new march kernel is compiled on the context's helper device
-    // (precompileElsewhere()) while this device compiles the shade kernel, the longer of the two.
-    // On failure the previous kernels stay.
+    // (precompileElsewhere()) while this device compiles the shade kernel. On failure the
+    // previous kernels stay.
     Status buildKernels() {
         CodegenOptions codegen;
         codegen.inlineParams = options.inlineValues;
@@ -164,21 +200,22 @@ struct Renderer::Impl {
             b.pipeline = createPipeline(b.module, pass, skipping);
             return b;
         };
-        // glslang compiles one kernel at a time: the shade kernel first, which starts the longer
-        // chain (its translation, then its machine code on this device's queue).
-        bool fresh = false;
-        auto shadeSpirv = detail::compileKernel("shade.comp", glsl, fresh);
-        const bool newKernels = fresh && shadeSpirv;
+        // While this device compiles the shade kernel, the other thread makes the march kernel:
+        // on llvmpipe, its machine code on the helper device (if it is a new kernel), and this
+        // device's pipeline beside that, which at its first dispatch loads the helper's work.
         Built march;
         std::thread other([&] {
-            auto spirv = compileKernel("march.comp", glsl);
-            if (spirv && newKernels) {
+            detail::makeCompileHelper(ctx); // the last build used it up
+            bool fresh = false;
+            auto spirv = detail::compileKernel("march.comp", glsl, fresh);
+            std::thread translate([&] { march = build(spirv, SDFCSG_RAYMARCH_PASS_MARCH); });
+            if (spirv && fresh) {
                 const auto spec = specConstants(SDFCSG_RAYMARCH_PASS_MARCH, skipping);
                 detail::precompileElsewhere(ctx, *spirv, kBindings, sizeof(BandConstants), spec);
             }
-            march = build(spirv, SDFCSG_RAYMARCH_PASS_MARCH);
+            translate.join();
         });
-        Built shade = build(shadeSpirv, SDFCSG_RAYMARCH_PASS_SHADE);
+        Built shade = build(compileKernel("shade.comp", glsl), SDFCSG_RAYMARCH_PASS_SHADE);
         if (!shade.error) warmUp(shade.pipeline);
         other.join();
         if (march.error || shade.error) {
@@ -226,15 +263,21 @@ struct Renderer::Impl {
 
     // The pipeline of a pass and skipping choice, created and warmed up on first use.
     VkPipeline pipeline(uint32_t pass, bool skipping) {
-        const bool finishing =
-            pass == SDFCSG_RAYMARCH_PASS_RESOLVE || pass == SDFCSG_RAYMARCH_PASS_OVERLAY;
-        if (finishing) skipping = false; // no scene evaluation
+        if (pass != SDFCSG_RAYMARCH_PASS_MARCH && pass != SDFCSG_RAYMARCH_PASS_SHADE) {
+            std::lock_guard lock(shared->mutex);
+            VkPipeline& p = shared->pipelines[pass];
+            if (!p) {
+                const bool finishing =
+                    pass == SDFCSG_RAYMARCH_PASS_RESOLVE || pass == SDFCSG_RAYMARCH_PASS_OVERLAY;
+                p = createPipeline(finishing ? shared->finish : shared->light, pass, false);
+                warmUp(p);
+            }
+            return p;
+        }
         VkPipeline& p = pipelines[pass][skipping ? 1 : 0];
         if (!p) {
-            VkShaderModule module = finishing                            ? finishModule
-                                    : pass == SDFCSG_RAYMARCH_PASS_MARCH ? marchModule
-                                                                         : shadeModule;
-            p = createPipeline(module, pass, skipping);
+            p = createPipeline(pass == SDFCSG_RAYMARCH_PASS_MARCH ? marchModule : shadeModule, pass,
+                               skipping);
             warmUp(p);
         }
         return p;
@@ -267,8 +310,9 @@ struct Renderer::Impl {
     // Once the image and band buffers exist (create() reserves both).
     void writeDescriptors() {
         if (!pixels.buffer || !samples.buffer) return;
-        const Buffer* buffers[] = {&frame, &nodes, &pixels, &info,
-                                   samplesArePixels ? &pixels : &samples, &hits, &tiles, &control};
+        const Buffer* colors = samplesArePixels ? &pixels : &samples;
+        const Buffer* buffers[] = {&frame, &nodes, &pixels,  &info,    colors,
+                                   &hits,  &tiles, &control, &surfaces};
         detail::writeDescriptorSet(ctx, set, kBindings, buffers);
     }
 
@@ -280,15 +324,16 @@ struct Renderer::Impl {
         tileCount = std::max(tileCount, tileCapacity);
         constexpr VkBufferUsageFlags kStorage =
             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-        const VkDeviceSize sizes[] = {VkDeviceSize(count) * 4, kHitsHeader + VkDeviceSize(count) * 8,
-                                      VkDeviceSize(tileCount) * 4};
-        const VkBufferUsageFlags usages[] = {kStorage,
-                                             kStorage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT,
-                                             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT};
+        const VkDeviceSize sizes[] = {
+            VkDeviceSize(count) * 4, kHitsHeader + VkDeviceSize(count) * 8,
+            VkDeviceSize(tileCount) * 4, VkDeviceSize(count) * kSurfaceBytes};
+        const VkBufferUsageFlags usages[] = {
+            kStorage, kStorage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT,
+            VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT};
         const detail::MemoryUse uses[] = {detail::MemoryUse::Device, detail::MemoryUse::Device,
-                                          detail::MemoryUse::Upload};
-        Buffer made[3];
-        for (int i = 0; i < 3; ++i) {
+                                          detail::MemoryUse::Upload, detail::MemoryUse::Device};
+        Buffer made[4];
+        for (int i = 0; i < 4; ++i) {
             auto buffer = detail::createBuffer(ctx, sizes[i], usages[i], uses[i]);
             if (!buffer) {
                 for (Buffer& b : made)
@@ -297,8 +342,8 @@ struct Renderer::Impl {
             }
             made[i] = *buffer;
         }
-        Buffer* current[] = {&samples, &hits, &tiles};
-        for (int i = 0; i < 3; ++i) {
+        Buffer* current[] = {&samples, &hits, &tiles, &surfaces};
+        for (int i = 0; i < 4; ++i) {
             detail::destroyBuffer(ctx, *current[i]);
             *current[i] = made[i];
         }
@@ -439,13 +484,12 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene
     r.evaluator = std::make_unique<Evaluator>(scene);
     r.nodeCount = uint32_t(scene.nodes.size());
 
-    auto finish = compileKernel("finish.comp", "");
-    if (!finish) return finish.error();
-    r.finishModule = detail::createShaderModule(r.ctx, *finish);
-    r.setLayout = detail::createDescriptorSetLayout(r.ctx, kBindings);
-    r.pipelineLayout = detail::createPipelineLayout(r.ctx, r.setLayout, sizeof(BandConstants));
+    auto shared = sharedPasses(r.ctx);
+    if (!shared) return shared.error();
+    r.shared = *shared;
+    r.pipelineLayout = r.shared->layout;
     r.pool = detail::createDescriptorPool(r.ctx, kBindings);
-    r.set = detail::allocateDescriptorSet(r.ctx, r.pool, r.setLayout);
+    r.set = detail::allocateDescriptorSet(r.ctx, r.pool, r.shared->setLayout);
 
     auto frame = detail::createBuffer(
         r.ctx, sizeof(FrameUniform), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, detail::MemoryUse::Upload);
@@ -464,6 +508,10 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene
     if (auto reserved = r.reserve(64 * 64); !reserved) return reserved.error();
     if (auto reserved = r.reserveSamples(64 * 64, 64); !reserved) return reserved.error();
     if (auto built = r.buildKernels(); !built) return built.error();
+    // The passes around the shade pass run in every shaded frame (the first renderer of the
+    // context makes them).
+    r.pipeline(SDFCSG_RAYMARCH_PASS_ENDS, false);
+    r.pipeline(SDFCSG_RAYMARCH_PASS_LIGHT, false);
     return std::unique_ptr<Renderer>(new Renderer(std::move(impl)));
 }
 
@@ -536,6 +584,10 @@ Result<Image> Renderer::render(const RenderOptions& options) {
     const bool shading = options.mode == RenderMode::Shaded || options.mode == RenderMode::Normals;
     VkPipeline march = r.pipeline(SDFCSG_RAYMARCH_PASS_MARCH, skipping);
     VkPipeline shade = shading ? r.pipeline(SDFCSG_RAYMARCH_PASS_SHADE, skipping) : VK_NULL_HANDLE;
+    VkPipeline light = shading ? r.pipeline(SDFCSG_RAYMARCH_PASS_LIGHT, false) : VK_NULL_HANDLE;
+    VkPipeline ends = shading && options.mode == RenderMode::Shaded && options.shadows
+                          ? r.pipeline(SDFCSG_RAYMARCH_PASS_ENDS, false)
+                          : VK_NULL_HANDLE;
     VkPipeline resolve = aa > 1 ? r.pipeline(SDFCSG_RAYMARCH_PASS_RESOLVE, false) : VK_NULL_HANDLE;
     const bool overlays = options.grid || options.boxes != BoxOverlay::None;
     VkPipeline overlay =
@@ -605,9 +657,10 @@ Result<Image> Renderer::render(const RenderOptions& options) {
                            &band);
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, march);
         if (!tiles.empty()) vkCmdDispatch(cmd, uint32_t(tiles.size()), 1, 1);
-        if (shade) { // one invocation per listed hit
+        for (VkPipeline perHit : {ends, shade, light}) { // one invocation per listed hit
+            if (!perHit) continue;
             detail::recordComputeBarrier(cmd);
-            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, shade);
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, perHit);
             vkCmdDispatchIndirect(cmd, r.hits.buffer, 4);
         }
         for (VkPipeline perPixel : {resolve, overlay}) {

@@ -58,12 +58,17 @@ struct Context::Impl {
 
     // llvmpipe only: a second instance and device on the same driver, whose queue compiles a
     // kernel to machine code while this one's compiles another (see precompileElsewhere()).
-    // Made with the context and again at the first use after each use, under helperMutex.
+    // Made with the context, and again after each use (makeCompileHelper()).
     bool helperWanted = false;    // set before the context is shared, then read only
     ContextOptions helperOptions; // this device, this validation setting
-    std::mutex helperMutex;
+    std::mutex helperMutex;       // guards what follows
     std::unique_ptr<Impl> helper;
+    bool helperFailed = false;               // its setup failed once: not tried again
     std::atomic<uint32_t> helperCompiles{0}; // kernels it compiled (tests look)
+
+    // What the renderers of this context share (render.cpp), made by the first.
+    std::mutex rendererSharedMutex;
+    std::shared_ptr<void> rendererShared;
 
     ~Impl();
 };
@@ -154,8 +159,9 @@ const void* readback(Context::Impl& ctx, const Buffer& buffer, const Buffer* sta
 bool precompileElsewhere(Context::Impl& ctx, std::span<const uint32_t> spirv,
                          std::span<const Binding> bindings, uint32_t pushConstantBytes,
                          std::span<const SpecConstant> spec);
-// Makes the helper device now, so that the first precompileElsewhere() need not wait for it (and
-// it reads the environment that the context was made in); turns the helper off if that fails.
+// Makes the helper device where there is none (at first, and after each use), so that
+// precompileElsewhere() need not wait for it. Does nothing where the helper does not apply or is
+// busy.
 void makeCompileHelper(Context::Impl& ctx);
 
 // Dispatch with group counts derived from a local size.
