@@ -1,11 +1,15 @@
 // Declarations and helpers of the ray-march kernels, none of which evaluates the scene: the
-// scene's march.comp and shade.comp, and finish.comp, which does not depend on it.
+// scene's march.comp and shade.comp, and clip.comp, light.comp and finish.comp, which do not
+// depend on it.
 //
 // Sphere tracing of the generated scene in passes over a band of rows:
-//   march:   one invocation per sample (aa x aa per pixel) traces its ray to the first hit and
+//   clip:    one invocation per sample (aa x aa per pixel) finds the part of its ray to march:
+//            inside the clip box, from the first entry into a region that holds surfaces to
+//            the last exit;
+//   march:   one invocation per sample traces that part of its ray to the first hit and
 //            writes the colour of misses and of the depth and steps modes; hits that need
 //            shading are appended to a list, which also counts the shade pass's workgroups.
-//            It runs only the workgroups whose rays can meet a surface (the host lists them);
+//            Both run only the workgroups whose rays can meet a surface (the host lists them);
 //            the host fills the rest of the band with the colour of a miss;
 //   ends:    one invocation per listed hit (an indirect dispatch): where the shadow ray towards
 //            each light can end, leaving the clip box and the boxes that hold surfaces;
@@ -17,11 +21,12 @@
 // CPU drivers such as lavapipe run invocations in SIMD lanes and execute every branch that any
 // lane takes; split this way, misses never pay for shading and every shading lane has a hit.
 // Each pass is its own pipeline: a kernel holds only the code its pass reaches, and the passes
-// that do not depend on the scene (finish.comp, light.comp) are compiled once per context.
+// that do not depend on the scene (clip.comp, light.comp, finish.comp) are compiled once per
+// context.
 // Whatever a scene kernel holds, each new scene pays for in its compile (drawing the overlays in
-// the march pass took a third of its compile for a one-sphere scene; the shadow-ray ends and the
-// lighting a quarter of the shade kernel's), so the scene kernels hold nothing that can live
-// elsewhere.
+// the march pass took a third of its compile for a one-sphere scene, clipping the rays a fifth of
+// the house's; the shadow-ray ends and the lighting a quarter of the shade kernel's), so the
+// scene kernels hold nothing that can live elsewhere.
 //
 // Rays are generated and clipped exactly as engine/src/camera.h does on the CPU (the tests trace
 // the same rays with the reference evaluator). Normals use the four-tap tetrahedral difference
@@ -112,6 +117,12 @@ layout(std430, set = 0, binding = SDFCSG_BINDING_HITS) buffer Hits {
 // (ends pass); from the shade pass, 1: normal and occlusion, 2: shadow per light, 3: albedo.
 layout(std430, set = 0, binding = SDFCSG_BINDING_SURFACES) buffer Surfaces {
     vec4 surfaces[];
+};
+
+// Per sample of the band (row-major), the part of its ray to march (clip pass): from x to y,
+// nothing where x > y.
+layout(std430, set = 0, binding = SDFCSG_BINDING_RANGES) buffer Ranges {
+    vec2 ranges[];
 };
 
 // The index into hits of this invocation of the ends, shade and light passes.
@@ -219,4 +230,14 @@ uvec2 sampleCoords(uint i) {
     int column = int(i) - row * int(n);
     row += column < 0 ? -1 : column >= int(n) ? 1 : 0;
     return uvec2(uint(int(i) - row * int(n)), uint(row));
+}
+
+// The sample of this invocation of the clip and march passes (column and row in the band's
+// sample grid) and its index; false outside the image.
+bool tileSample(out uvec2 s, out uint sampleIndex) {
+    uint aa = max(control.counts.x, 1u);
+    uint tile = tiles[gl_WorkGroupID.x];
+    s = uvec2(tile & 0xffffu, tile >> 16) * gl_WorkGroupSize.xy + gl_LocalInvocationID.xy;
+    sampleIndex = s.y * control.size.x * aa + s.x;
+    return s.x < control.size.x * aa && s.y < (control.size.y - band.firstRow) * aa;
 }

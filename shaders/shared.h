@@ -15,9 +15,10 @@
 #define SDFCSG_BINDING_INFO 3   // buffer of vec2 per pixel: (hit depth or -1, step count)
 #define SDFCSG_BINDING_SAMPLES 6 // raymarch.glsl: packed RGBA8 per sample of a band
 #define SDFCSG_BINDING_HITS 7    // raymarch.glsl: hits to shade, after an indirect dispatch
-#define SDFCSG_BINDING_TILES 8   // raymarch.glsl: workgroups of a band that the march pass runs
+#define SDFCSG_BINDING_TILES 8   // raymarch.glsl: workgroups of a band that the clip and march passes run
 #define SDFCSG_BINDING_CONTROL 9 // raymarch.glsl: buffer Control: the values that branches read
 #define SDFCSG_BINDING_SURFACES 10 // raymarch.glsl: per listed hit, what the shade pass hands over
+#define SDFCSG_BINDING_RANGES 11   // raymarch.glsl: per sample, the part of its ray to march
 #define SDFCSG_BINDING_PROBE_IN 4  // probe.comp: readonly buffer of vec4 points (xyz used)
 #define SDFCSG_BINDING_PROBE_OUT 5 // probe.comp: buffer of vec4 sceneSample() results
 
@@ -85,7 +86,8 @@
 #define SDFCSG_RAYMARCH_PASS_OVERLAY 3
 #define SDFCSG_RAYMARCH_PASS_ENDS 4
 #define SDFCSG_RAYMARCH_PASS_LIGHT 5
-#define SDFCSG_RAYMARCH_PASSES 6
+#define SDFCSG_RAYMARCH_PASS_CLIP 6
+#define SDFCSG_RAYMARCH_PASSES 7
 
 #define SDFCSG_MESH_PASS_CULL 0
 #define SDFCSG_MESH_PASS_CLASSIFY 1

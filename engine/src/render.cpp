@@ -1,6 +1,7 @@
-// The ray march: per band of rows, a march, a shade and (with several samples per pixel) a
-// resolve pass (shaders/march.comp, shade.comp and finish.comp, around raymarch.glsl), read back
-// to RGBA8 and per-pixel info.
+// The ray march: per band of rows, the clip, march, ends, shade and light passes and, with several
+// samples per pixel or overlays, the resolve and overlay passes (shaders/clip.comp, march.comp,
+// light.comp, shade.comp and finish.comp, around raymarch.glsl), read back to RGBA8 and
+// per-pixel info.
 #include "sdfcsg/render.h"
 
 #include "camera.h"
@@ -68,16 +69,17 @@ constexpr detail::Binding kBindings[] = {
     {SDFCSG_BINDING_TILES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
     {SDFCSG_BINDING_CONTROL, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
     {SDFCSG_BINDING_SURFACES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+    {SDFCSG_BINDING_RANGES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
 };
 
 // What the renderers of a context share: the layout of the kernels' bindings, and the pipelines
-// of the passes that do not evaluate the scene (finish.comp, light.comp), each made once per
-// context, at its first use. A new scene compiles only its own kernels.
+// of the passes that do not evaluate the scene (clip.comp, light.comp, finish.comp), each made
+// once per context, at its first use. A new scene compiles only its own kernels.
 struct SharedPasses {
     Context::Impl& ctx;
     VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
     VkPipelineLayout layout = VK_NULL_HANDLE;
-    VkShaderModule finish = VK_NULL_HANDLE, light = VK_NULL_HANDLE;
+    VkShaderModule clip = VK_NULL_HANDLE, light = VK_NULL_HANDLE, finish = VK_NULL_HANDLE;
     std::mutex mutex; // guards pipelines
     VkPipeline pipelines[SDFCSG_RAYMARCH_PASSES] = {};
 
@@ -85,7 +87,7 @@ struct SharedPasses {
     ~SharedPasses() {
         for (VkPipeline p : pipelines)
             if (p) vkDestroyPipeline(ctx.device, p, nullptr);
-        for (VkShaderModule m : {finish, light})
+        for (VkShaderModule m : {clip, light, finish})
             if (m) vkDestroyShaderModule(ctx.device, m, nullptr);
         if (layout) vkDestroyPipelineLayout(ctx.device, layout, nullptr);
         if (setLayout) vkDestroyDescriptorSetLayout(ctx.device, setLayout, nullptr);
@@ -101,6 +103,7 @@ struct BandConstants {
 constexpr uint32_t kGroupSize = SDFCSG_RAYMARCH_GROUP_X * SDFCSG_RAYMARCH_GROUP_Y;
 constexpr VkDeviceSize kHitsHeader = 16; // count, then the shade pass's dispatch
 constexpr VkDeviceSize kSurfaceBytes = 64; // per listed hit: four vec4 (raymarch.glsl)
+constexpr VkDeviceSize kRangeBytes = 8;    // per sample: a vec2
 
 Error usage(std::string text) {
     return Error::message(ErrorKind::Usage, "<render>", std::move(text));
@@ -112,15 +115,16 @@ constexpr uint32_t kBandSamples = 1u << 16;
 Result<std::shared_ptr<SharedPasses>> sharedPasses(Context::Impl& ctx) {
     std::lock_guard lock(ctx.rendererSharedMutex);
     if (ctx.rendererShared) return std::static_pointer_cast<SharedPasses>(ctx.rendererShared);
-    auto finish = compileKernel("finish.comp", "");
-    if (!finish) return finish.error();
-    auto light = compileKernel("light.comp", "");
-    if (!light) return light.error();
     auto shared = std::make_shared<SharedPasses>(ctx);
+    const char* kernels[] = {"clip.comp", "light.comp", "finish.comp"};
+    VkShaderModule* modules[] = {&shared->clip, &shared->light, &shared->finish};
+    for (int i = 0; i < 3; ++i) {
+        auto spirv = compileKernel(kernels[i], "");
+        if (!spirv) return spirv.error();
+        *modules[i] = detail::createShaderModule(ctx, *spirv);
+    }
     shared->setLayout = detail::createDescriptorSetLayout(ctx, kBindings);
     shared->layout = detail::createPipelineLayout(ctx, shared->setLayout, sizeof(BandConstants));
-    shared->finish = detail::createShaderModule(ctx, *finish);
-    shared->light = detail::createShaderModule(ctx, *light);
     ctx.rendererShared = shared;
     return shared;
 }
@@ -155,7 +159,7 @@ struct Renderer::Impl {
     // The image (pixels, info), and per band: the samples' colours (with several per pixel),
     // the workgroups to march and the hits to shade.
     Buffer frame, control, nodes, pixels, info, pixelsStaging, infoStaging, samples, hits, tiles,
-        surfaces;
+        surfaces, ranges;
     uint32_t capacity = 0;       // pixels the image buffers hold
     uint32_t sampleCapacity = 0; // samples the band buffers hold
     uint32_t tileCapacity = 0;   // workgroups the tile list holds
@@ -168,7 +172,7 @@ struct Renderer::Impl {
     ~Impl() {
         VkDevice device = ctx.device;
         for (Buffer* b : {&frame, &control, &nodes, &pixels, &info, &pixelsStaging, &infoStaging,
-                          &samples, &hits, &tiles, &surfaces})
+                          &samples, &hits, &tiles, &surfaces, &ranges})
             detail::destroyBuffer(ctx, *b);
         destroyKernel();
         if (pool) vkDestroyDescriptorPool(device, pool, nullptr);
@@ -267,9 +271,12 @@ struct Renderer::Impl {
             std::lock_guard lock(shared->mutex);
             VkPipeline& p = shared->pipelines[pass];
             if (!p) {
-                const bool finishing =
-                    pass == SDFCSG_RAYMARCH_PASS_RESOLVE || pass == SDFCSG_RAYMARCH_PASS_OVERLAY;
-                p = createPipeline(finishing ? shared->finish : shared->light, pass, false);
+                const bool lighting =
+                    pass == SDFCSG_RAYMARCH_PASS_ENDS || pass == SDFCSG_RAYMARCH_PASS_LIGHT;
+                VkShaderModule module = pass == SDFCSG_RAYMARCH_PASS_CLIP ? shared->clip
+                                        : lighting                        ? shared->light
+                                                                          : shared->finish;
+                p = createPipeline(module, pass, false);
                 warmUp(p);
             }
             return p;
@@ -311,8 +318,8 @@ struct Renderer::Impl {
     void writeDescriptors() {
         if (!pixels.buffer || !samples.buffer) return;
         const Buffer* colors = samplesArePixels ? &pixels : &samples;
-        const Buffer* buffers[] = {&frame, &nodes, &pixels,  &info,    colors,
-                                   &hits,  &tiles, &control, &surfaces};
+        const Buffer* buffers[] = {&frame, &nodes, &pixels,  &info,     colors,
+                                   &hits,  &tiles, &control, &surfaces, &ranges};
         detail::writeDescriptorSet(ctx, set, kBindings, buffers);
     }
 
@@ -324,16 +331,20 @@ struct Renderer::Impl {
         tileCount = std::max(tileCount, tileCapacity);
         constexpr VkBufferUsageFlags kStorage =
             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-        const VkDeviceSize sizes[] = {
+        constexpr int kBuffers = 5;
+        const VkDeviceSize sizes[kBuffers] = {
             VkDeviceSize(count) * 4, kHitsHeader + VkDeviceSize(count) * 8,
-            VkDeviceSize(tileCount) * 4, VkDeviceSize(count) * kSurfaceBytes};
-        const VkBufferUsageFlags usages[] = {
+            VkDeviceSize(tileCount) * 4, VkDeviceSize(count) * kSurfaceBytes,
+            VkDeviceSize(count) * kRangeBytes};
+        const VkBufferUsageFlags usages[kBuffers] = {
             kStorage, kStorage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT,
-            VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT};
-        const detail::MemoryUse uses[] = {detail::MemoryUse::Device, detail::MemoryUse::Device,
-                                          detail::MemoryUse::Upload, detail::MemoryUse::Device};
-        Buffer made[4];
-        for (int i = 0; i < 4; ++i) {
+            VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+            VK_BUFFER_USAGE_STORAGE_BUFFER_BIT};
+        const detail::MemoryUse uses[kBuffers] = {
+            detail::MemoryUse::Device, detail::MemoryUse::Device, detail::MemoryUse::Upload,
+            detail::MemoryUse::Device, detail::MemoryUse::Device};
+        Buffer made[kBuffers];
+        for (int i = 0; i < kBuffers; ++i) {
             auto buffer = detail::createBuffer(ctx, sizes[i], usages[i], uses[i]);
             if (!buffer) {
                 for (Buffer& b : made)
@@ -342,8 +353,8 @@ struct Renderer::Impl {
             }
             made[i] = *buffer;
         }
-        Buffer* current[] = {&samples, &hits, &tiles, &surfaces};
-        for (int i = 0; i < 4; ++i) {
+        Buffer* current[kBuffers] = {&samples, &hits, &tiles, &surfaces, &ranges};
+        for (int i = 0; i < kBuffers; ++i) {
             detail::destroyBuffer(ctx, *current[i]);
             *current[i] = made[i];
         }
@@ -508,8 +519,9 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene
     if (auto reserved = r.reserve(64 * 64); !reserved) return reserved.error();
     if (auto reserved = r.reserveSamples(64 * 64, 64); !reserved) return reserved.error();
     if (auto built = r.buildKernels(); !built) return built.error();
-    // The passes around the shade pass run in every shaded frame (the first renderer of the
-    // context makes them).
+    // The passes around the march and shade passes run in every shaded frame (the first
+    // renderer of the context makes them).
+    r.pipeline(SDFCSG_RAYMARCH_PASS_CLIP, false);
     r.pipeline(SDFCSG_RAYMARCH_PASS_ENDS, false);
     r.pipeline(SDFCSG_RAYMARCH_PASS_LIGHT, false);
     return std::unique_ptr<Renderer>(new Renderer(std::move(impl)));
@@ -558,7 +570,7 @@ Result<Image> Renderer::render(const RenderOptions& options) {
     if (count * 8 > limits.maxStorageBufferRange ||
         kHitsHeader + bandSamples * 8 > limits.maxStorageBufferRange ||
         groupsX > limits.maxComputeWorkGroupCount[0] || groupsX > 0xffff ||
-        uint64_t(bandGroups) * aa > 0xffff || // the march pass's tile list packs x | y << 16
+        uint64_t(bandGroups) * aa > 0xffff || // the tile list packs x | y << 16
         uint64_t(bandGroups) * aa > limits.maxComputeWorkGroupCount[1] ||
         bandSamples / kGroupSize > limits.maxComputeWorkGroupCount[0])
         return Error::message(ErrorKind::Limit, "<render>",
@@ -582,6 +594,7 @@ Result<Image> Renderer::render(const RenderOptions& options) {
                                      : frameCamera(*r.evaluator, aspect);
     const bool skipping = options.boundsSkipping.value_or(r.defaultSkipping());
     const bool shading = options.mode == RenderMode::Shaded || options.mode == RenderMode::Normals;
+    VkPipeline clipRays = r.pipeline(SDFCSG_RAYMARCH_PASS_CLIP, false);
     VkPipeline march = r.pipeline(SDFCSG_RAYMARCH_PASS_MARCH, skipping);
     VkPipeline shade = shading ? r.pipeline(SDFCSG_RAYMARCH_PASS_SHADE, skipping) : VK_NULL_HANDLE;
     VkPipeline light = shading ? r.pipeline(SDFCSG_RAYMARCH_PASS_LIGHT, false) : VK_NULL_HANDLE;
@@ -655,8 +668,13 @@ Result<Image> Renderer::render(const RenderOptions& options) {
                                 &r.set, 0, nullptr);
         vkCmdPushConstants(cmd, r.pipelineLayout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof band,
                            &band);
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, march);
-        if (!tiles.empty()) vkCmdDispatch(cmd, uint32_t(tiles.size()), 1, 1);
+        if (!tiles.empty()) { // the listed workgroups' samples
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, clipRays);
+            vkCmdDispatch(cmd, uint32_t(tiles.size()), 1, 1);
+            detail::recordComputeBarrier(cmd);
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, march);
+            vkCmdDispatch(cmd, uint32_t(tiles.size()), 1, 1);
+        }
         for (VkPipeline perHit : {ends, shade, light}) { // one invocation per listed hit
             if (!perHit) continue;
             detail::recordComputeBarrier(cmd);

@@ -1,0 +1,37 @@
+#version 450
+// The clip pass of the ray march (shaders/raymarch.glsl): one invocation per sample of the
+// listed workgroups finds the part of its ray that the march pass traces. It does not depend on
+// the scene, so out of the march kernel, which every new scene compiles, it is compiled once
+// per context.
+#extension GL_GOOGLE_include_directive : require
+#extension GL_KHR_shader_subgroup_ballot : require
+
+#include "shared.h"
+#include "raymarch.glsl"
+
+// A loop index, the same in every invocation, said so (see light.comp).
+uint uniformIndex(uint i) { return subgroupBroadcastFirst(i); }
+
+void main() {
+    uvec2 s;
+    uint sampleIndex;
+    if (!tileSample(s, sampleIndex)) return;
+    uvec2 pixel;
+    vec3 rd;
+    sampleRay(s, pixel, rd);
+    vec3 ro = frame.eye.xyz;
+    vec2 range = clipRay(frame.clipMin.xyz, frame.clipMax.xyz, ro, rd);
+    // Control values that loops use are read before them: on CPU drivers a storage buffer load
+    // in a loop stays there, a bounds check and a load in every iteration.
+    uint partCount = control.parts.x;
+    if (partCount > 0u) {
+        // Start at the first entry into a box that holds surfaces, end at the last exit.
+        vec2 parts = vec2(1.0e30, -1.0e30);
+        for (uint i = 0u; i < partCount; ++i) {
+            vec2 b = partInterval(uniformIndex(i), ro, rd);
+            if (b.x <= b.y) parts = vec2(min(parts.x, b.x), max(parts.y, b.y));
+        }
+        range = vec2(max(range.x, parts.x), min(range.y, parts.y));
+    }
+    ranges[sampleIndex] = vec2(range.x, min(range.y, frame.clipMin.w));
+}
