@@ -4,13 +4,9 @@
 // the scene, so out of the march kernel, which every new scene compiles, it is compiled once
 // per context.
 #extension GL_GOOGLE_include_directive : require
-#extension GL_KHR_shader_subgroup_ballot : require
 
 #include "shared.h"
 #include "raymarch.glsl"
-
-// A loop index, the same in every invocation, said so (see light.comp).
-uint uniformIndex(uint i) { return subgroupBroadcastFirst(i); }
 
 void main() {
     uvec2 s;
@@ -20,7 +16,8 @@ void main() {
     vec3 rd;
     sampleRay(s, pixel, rd);
     vec3 ro = frame.eye.xyz;
-    vec2 range = clipRay(frame.clipMin.xyz, frame.clipMax.xyz, ro, rd);
+    vec3 inv = safeInverse(rd);
+    vec2 range = clipRayInverse(frame.clipMin.xyz, frame.clipMax.xyz, ro, inv);
     // Control values that loops use are read before them: on CPU drivers a storage buffer load
     // in a loop stays there, a bounds check and a load in every iteration.
     uint partCount = control.parts.x;
@@ -28,7 +25,7 @@ void main() {
         // Start at the first entry into a box that holds surfaces, end at the last exit.
         vec2 parts = vec2(1.0e30, -1.0e30);
         for (uint i = 0u; i < partCount; ++i) {
-            vec2 b = partInterval(uniformIndex(i), ro, rd);
+            vec2 b = partInterval(i, ro, rd, inv);
             if (b.x <= b.y) parts = vec2(min(parts.x, b.x), max(parts.y, b.y));
         }
         range = vec2(max(range.x, parts.x), min(range.y, parts.y));

@@ -47,7 +47,7 @@ void endsPass() {
         if (partCount > 0u) {
             float lastExit = 0.0;
             for (uint b = 0u; b < partCount; ++b) {
-                vec2 range = partInterval(b, p, l);
+                vec2 range = partInterval(b, p, l, inv);
                 if (range.x <= range.y) lastExit = max(lastExit, range.y);
             }
             end = min(end, lastExit);

@@ -147,19 +147,24 @@ vec3 safeInverse(vec3 d) {
     return 1.0 / mix(d, s, lessThan(abs(d), vec3(1.0e-20)));
 }
 
-// Slab test against a box; x: entry (clamped to 0), y: exit. Misses when x > y.
-vec2 clipRay(vec3 bmin, vec3 bmax, vec3 ro, vec3 rd) {
-    vec3 inv = safeInverse(rd);
+// Slab test against a box, given inv = safeInverse(rd); x: entry (clamped to 0), y: exit.
+// Misses when x > y.
+vec2 clipRayInverse(vec3 bmin, vec3 bmax, vec3 ro, vec3 inv) {
     vec3 t0 = (bmin - ro) * inv;
     vec3 t1 = (bmax - ro) * inv;
     vec3 lo = min(t0, t1), hi = max(t0, t1);
     return vec2(max(max(lo.x, lo.y), max(lo.z, 0.0)), min(min(hi.x, hi.y), hi.z));
 }
 
-// Entry and exit of a ray in surface part i (see Frame); misses when x > y.
-vec2 partInterval(uint i, vec3 ro, vec3 rd) {
+vec2 clipRay(vec3 bmin, vec3 bmax, vec3 ro, vec3 rd) {
+    return clipRayInverse(bmin, bmax, ro, safeInverse(rd));
+}
+
+// Entry and exit of a ray in surface part i (see Frame), given inv = safeInverse(rd), which
+// the caller works out once for all parts (three divisions); misses when x > y.
+vec2 partInterval(uint i, vec3 ro, vec3 rd, vec3 inv) {
     vec4 a = frame.surfaceBoxes[2u * i], b = frame.surfaceBoxes[2u * i + 1u];
-    if (a.w == 0.0) return clipRay(a.xyz, b.xyz, ro, rd);
+    if (a.w == 0.0) return clipRayInverse(a.xyz, b.xyz, ro, inv);
     float dn = dot(rd, a.xyz), on = dot(ro, a.xyz);
     float tPlane = (b.x - on) / (abs(dn) < 1.0e-20 ? 1.0e-20 : dn);
     if (on < b.x) return vec2(0.0, dn > 0.0 ? tPlane : 1.0e30);
