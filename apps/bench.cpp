@@ -47,13 +47,14 @@ For every scene (*.json) in DIR (default assets/scenes), prints the median milli
 frame in shaded mode with and without bounding-box skipping (after two warm-up frames; a frame
 includes the read-back), and the median milliseconds from JSON text to a ready pipeline (parse,
 code generation, GLSL compilation, pipeline creation including the driver's compile):
-  cold        a new scene: none of its kernels cached (no SPIR-V cache, Mesa's shader cache in
-              an empty folder), in a new context that has built one other scene first, and so
-              made the passes that do not depend on the scene, as the viewer has and as the
-              driver's disk cache holds after any earlier run;
+  cold        a new scene, none of its kernels cached (SPIR-V and driver disk caches in folders
+              of their own), in a context that has built one other scene, and so has made the
+              passes that do not depend on the scene: as in the viewer;
   one device  the same without the compile helper (see ContextOptions::compileHelper);
-  first       the first build of a new context with nothing cached at all, those passes
-              included;
+  new process the same in a new context, whose disk caches hold what the other scene's build
+              in an earlier context left there: a new process on a machine that has run
+              sdfcsg before;
+  first       the first build of a new context with nothing cached at all;
   warm        with the SPIR-V and driver disk caches filled but the in-process cache cleared.
 
 Options:
@@ -115,7 +116,7 @@ Result<double> medianFrameMs(Renderer& renderer, const RenderOptions& options, u
 struct Row {
     std::string name;
     size_t nodes = 0;
-    double skip = 0, noSkip = 0, cold = 0, coldOneDevice = 0, first = 0, warm = 0;
+    double skip = 0, noSkip = 0, cold = 0, coldOneDevice = 0, newProcess = 0, first = 0, warm = 0;
     double buffer = 0, bufferBuild = 0; // with --buffer
 };
 
@@ -334,17 +335,37 @@ int runBench(int argc, char** argv) {
     int coldRuns = 0;
     // The other scene of the cold column's contexts.
     const std::string kOtherScene = R"({"version": 1, "root": {"type": "sphere", "radius": 1}})";
-    // Runs `work` on a new context whose driver disk cache starts empty, with no SPIR-V cache.
+    // Runs `work` on a new context whose SPIR-V and driver disk caches are folders of their own:
+    // empty (Seed::None); or holding what building the other scene left there, in an earlier
+    // context (Seed::Earlier: as a new process finds them on a machine that has run sdfcsg
+    // before) or in this one (Seed::Same: as the viewer has them when it opens another scene).
     // Mesa reads its folder when a device is made (the compile helper's too, after each use), so
-    // the variable stays set throughout.
-    auto withColdContext = [&](bool helper, auto&& work) -> Status {
-        const fs::path mesa = cacheDir / ("mesa-" + std::to_string(coldRuns++));
-        ScopedEnv driverCache("MESA_SHADER_CACHE_DIR", mesa.string());
-        ScopedEnv noSpirvCache("SDFCSG_CACHE_DIR", "off");
+    // the variables stay set throughout.
+    enum class Seed { None, Earlier, Same };
+    auto withColdContext = [&](bool helper, Seed seed, auto&& work) -> Status {
+        const fs::path runDir = cacheDir / ("cold-" + std::to_string(coldRuns++));
+        std::error_code made;
+        fs::create_directories(runDir, made); // Mesa makes only the last folder of its path
+        ScopedEnv driverCache("MESA_SHADER_CACHE_DIR", (runDir / "mesa").string());
+        ScopedEnv spirvCache("SDFCSG_CACHE_DIR", (runDir / "spirv").string());
         ContextOptions contextOptions;
         contextOptions.compileHelper = helper;
+        auto buildOther = [&](Context& c) -> Status {
+            detail::clearShaderMemoryCache();
+            auto other = buildFromJson(c, kOtherScene, "<other scene>");
+            if (!other) return other.error();
+            detail::clearShaderMemoryCache();
+            return Ok{};
+        };
+        if (seed == Seed::Earlier) {
+            auto seeding = Context::create(contextOptions);
+            if (!seeding) return seeding.error();
+            if (auto ok = buildOther(**seeding); !ok) return ok;
+        } // the context's end finishes the driver cache's writes
         auto coldContext = Context::create(contextOptions);
         if (!coldContext) return coldContext.error();
+        if (seed == Seed::Same)
+            if (auto ok = buildOther(**coldContext); !ok) return ok;
         detail::clearShaderMemoryCache();
         return work(**coldContext);
     };
@@ -365,23 +386,21 @@ int runBench(int argc, char** argv) {
             std::fprintf(stderr, "%s: %s\n", file.c_str(), e.str().c_str());
             status = 4;
         };
-        // [one device, with the helper, first], alternated.
-        std::vector<double> cold[3], warm;
+        // Alternated: cold, one device, new process, first.
+        constexpr int kColdColumns = 4;
+        const Seed seeds[kColdColumns] = {Seed::Same, Seed::Same, Seed::Earlier, Seed::None};
+        std::vector<double> cold[kColdColumns], warm;
         std::unique_ptr<Renderer> renderer;
-        for (int i = 0; i < 3 * kPipelineRuns && status == 0; ++i) {
-            const int column = i % 3;
-            auto ok = withColdContext(column > 0, [&](Context& coldContext) -> Status {
-                if (column < 2) {
-                    auto other = buildFromJson(coldContext, kOtherScene, "<other scene>");
-                    if (!other) return other.error();
-                    detail::clearShaderMemoryCache();
-                }
+        for (int i = 0; i < kColdColumns * kPipelineRuns && status == 0; ++i) {
+            const int column = i % kColdColumns;
+            auto build = [&](Context& coldContext) -> Status {
                 auto start = Clock::now();
                 auto built = buildFromJson(coldContext, json, file);
                 if (!built) return built.error();
                 cold[column].push_back(msSince(start));
                 return Ok{};
-            });
+            };
+            auto ok = withColdContext(column != 1, seeds[column], build);
             if (!ok) fail(ok.error());
         }
         {
@@ -398,9 +417,10 @@ int runBench(int argc, char** argv) {
             }
         }
         if (status != 0) break;
-        row.cold = median(cold[1]);
-        row.coldOneDevice = median(cold[0]);
-        row.first = median(cold[2]);
+        row.cold = median(cold[0]);
+        row.coldOneDevice = median(cold[1]);
+        row.newProcess = median(cold[2]);
+        row.first = median(cold[3]);
         row.warm = median(warm);
         if (auto scene = parseScene(json, file)) row.nodes = scene->nodes.size();
 
@@ -418,7 +438,7 @@ int runBench(int argc, char** argv) {
         row.skip = *skip;
         row.noSkip = *noSkip;
         if (buffer) {
-            auto ok = withColdContext(true, [&](Context& coldContext) -> Status {
+            auto ok = withColdContext(true, Seed::None, [&](Context& coldContext) -> Status {
                 auto scene = parseScene(json, file);
                 if (!scene) return scene.error();
                 RendererOptions values;
@@ -443,22 +463,24 @@ int runBench(int argc, char** argv) {
     }
     fs::remove_all(cacheDir, ec);
 
-    std::printf("\n%-14s %5s %9s %11s %8s %15s %10s %7s %7s", "scene", "nodes", "skip ms",
-                "no-skip ms", "speedup", "json->pipe cold", "one device", "first", "warm");
+    std::printf("\n%-13s %5s %8s %10s %7s %15s %10s %11s %6s %5s", "scene", "nodes", "skip ms",
+                "no-skip ms", "speedup", "json->pipe cold", "one device", "new process", "first",
+                "warm");
     if (buffer) std::printf(" %10s %16s", "buffer ms", "buffer build ms");
     std::printf("\n");
     for (const Row& r : rows) {
-        std::printf("%-14s %5zu %9.1f %11.1f %7.2fx %15.1f %10.1f %7.1f %7.1f", r.name.c_str(),
-                    r.nodes, r.skip, r.noSkip, r.noSkip / std::max(r.skip, 1e-9), r.cold,
-                    r.coldOneDevice, r.first, r.warm);
+        std::printf("%-13s %5zu %8.1f %10.1f %6.2fx %15.1f %10.1f %11.1f %6.1f %5.1f",
+                    r.name.c_str(), r.nodes, r.skip, r.noSkip, r.noSkip / std::max(r.skip, 1e-9),
+                    r.cold, r.coldOneDevice, r.newProcess, r.first, r.warm);
         if (buffer) std::printf(" %10.1f %16.1f", r.buffer, r.bufferBuild);
         std::printf("\n");
     }
     std::printf(
         "\njson->pipe ms: parse + codegen + GLSL compile + pipelines ready to run. cold: a new "
-        "scene (its kernels cached nowhere) in a context that has built another; one device: "
-        "the same without the compile helper; first: a new context's first build, nothing "
-        "cached; warm: SPIR-V and driver disk caches filled, in-process cache cleared.\n"
+        "scene, its kernels cached nowhere, in a context that has built another; one device: "
+        "the same without the compile helper; new process: the same in a new context (the disk "
+        "caches hold the other scene's build); first: a new context, nothing cached at all; "
+        "warm: SPIR-V and driver disk caches filled, in-process cache cleared.\n"
         "Renders use bounds skipping by default on GPUs and not on CPU devices (lavapipe runs both "
         "sides of every branch, so there the bounds tests only add work).\n");
     return status;

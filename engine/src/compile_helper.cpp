@@ -1,6 +1,8 @@
 // The compile helper of lavapipe contexts: see precompileElsewhere() in vk.h.
 #include "vk.h"
 
+#include <algorithm>
+#include <chrono>
 #include <vector>
 
 namespace sdfcsg::detail {
@@ -29,19 +31,19 @@ void makeCompileHelper(Context::Impl& ctx) {
     if (lock) haveHelper(ctx);
 }
 
-bool precompileElsewhere(Context::Impl& ctx, std::span<const uint32_t> spirv,
-                         std::span<const Binding> bindings, uint32_t pushConstantBytes,
-                         std::span<const SpecConstant> spec) {
-    if (!ctx.helperWanted) return false;
+double precompileElsewhere(Context::Impl& ctx, std::span<const uint32_t> spirv,
+                           std::span<const Binding> bindings, uint32_t pushConstantBytes,
+                           std::span<const SpecConstant> spec) {
+    if (!ctx.helperWanted) return 0.0;
     std::unique_lock lock(ctx.helperMutex, std::try_to_lock);
-    if (!lock || !haveHelper(ctx)) return false;
+    if (!lock || !haveHelper(ctx)) return 0.0;
     Context::Impl& h = *ctx.helper;
     // Every binding of the set must point at a buffer, though a dispatch of no workgroups, which
     // makes llvmpipe compile, runs no invocation to read one.
     auto buffer = createBuffer(
         h, kBindingBytes, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
         MemoryUse::Device);
-    if (!buffer) return false;
+    if (!buffer) return 0.0;
     VkDescriptorSetLayout setLayout = createDescriptorSetLayout(h, bindings);
     VkPipelineLayout layout = createPipelineLayout(h, setLayout, pushConstantBytes);
     VkDescriptorPool pool = createDescriptorPool(h, bindings);
@@ -60,7 +62,10 @@ bool precompileElsewhere(Context::Impl& ctx, std::span<const uint32_t> spirv,
                            zeros.data());
     }
     vkCmdDispatch(cmd, 0, 0, 0);
+    const auto start = std::chrono::steady_clock::now();
     submitAndWait(h);
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 
     vkDestroyPipeline(h.device, pipeline, nullptr);
     vkDestroyShaderModule(h.device, module, nullptr);
@@ -70,7 +75,13 @@ bool precompileElsewhere(Context::Impl& ctx, std::span<const uint32_t> spirv,
     destroyBuffer(h, *buffer);
     ctx.helper.reset(); // the instance's end waits for the disk cache's writes
     ctx.helperCompiles.fetch_add(1, std::memory_order_relaxed);
-    return true;
+    return std::max(ms, 1e-3);
+}
+
+void compileHelperMissed(Context::Impl& ctx) {
+    std::lock_guard lock(ctx.helperMutex);
+    ctx.helperFailed = true;
+    ctx.helper.reset();
 }
 
 } // namespace sdfcsg::detail

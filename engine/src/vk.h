@@ -63,7 +63,7 @@ struct Context::Impl {
     ContextOptions helperOptions; // this device, this validation setting
     std::mutex helperMutex;       // guards what follows
     std::unique_ptr<Impl> helper;
-    bool helperFailed = false;               // its setup failed once: not tried again
+    bool helperFailed = false; // its setup or a hand-over failed once: not tried again
     std::atomic<uint32_t> helperCompiles{0}; // kernels it compiled (tests look)
 
     // What the renderers of this context share (render.cpp), made by the first.
@@ -154,11 +154,16 @@ const void* readback(Context::Impl& ctx, const Buffer& buffer, const Buffer* sta
 //
 // Compiles such a pipeline on the helper device and returns once its machine code is in the
 // disk cache (destroying the helper's instance waits for the cache's writes; the next call makes
-// a new one). Returns false, having done nothing, where there is no helper (other drivers, Mesa's
-// disk cache turned off, ContextOptions::compileHelper false) or it is busy with another kernel.
-bool precompileElsewhere(Context::Impl& ctx, std::span<const uint32_t> spirv,
-                         std::span<const Binding> bindings, uint32_t pushConstantBytes,
-                         std::span<const SpecConstant> spec);
+// a new one), with the milliseconds the compile took. Returns 0, having done nothing, where there
+// is no helper (other drivers, Mesa's disk cache turned off, ContextOptions::compileHelper false)
+// or it is busy with another kernel.
+double precompileElsewhere(Context::Impl& ctx, std::span<const uint32_t> spirv,
+                           std::span<const Binding> bindings, uint32_t pushConstantBytes,
+                           std::span<const SpecConstant> spec);
+// Says that this device compiled a kernel that the helper had compiled (its first dispatch took
+// about as long as the helper's compile): Mesa's disk cache did not hand it over, though the
+// environment did not turn it off (an unwritable folder, say). Turns the helper off.
+void compileHelperMissed(Context::Impl& ctx);
 // Makes the helper device where there is none (at first, and after each use), so that
 // precompileElsewhere() need not wait for it. Does nothing where the helper does not apply or is
 // busy.

@@ -620,6 +620,8 @@ TEST_F(Render, CompileHelperHandsMachineCodeOver) {
                 auto renderer = Renderer::create(**ctx, scene);
                 ASSERT_TRUE(renderer) << renderer.error().str();
                 EXPECT_EQ((*ctx)->impl().helperCompiles.load(), uint32_t(helper));
+                std::lock_guard lock((*ctx)->impl().helperMutex);
+                EXPECT_FALSE((*ctx)->impl().helperFailed) << "the hand-over was taken to fail";
                 auto image = (*renderer)->render(options);
                 ASSERT_TRUE(image) << image.error().str();
                 images[helper] = *image;
@@ -641,6 +643,36 @@ TEST_F(Render, CompileHelperHandsMachineCodeOver) {
     auto ctx = Context::create(contextOptions);
     ASSERT_TRUE(ctx) << ctx.error().str();
     EXPECT_FALSE((*ctx)->impl().helperWanted);
+}
+
+// Mesa turns its disk cache off where it cannot make its folder, which the environment does not
+// tell. The context then sees this device compile what the helper compiled, and stops using it.
+TEST_F(Render, CompileHelperStopsWhereTheCacheHandsNothingOver) {
+    if (context().deviceName().find("llvmpipe") == std::string::npos)
+        GTEST_SKIP() << "lavapipe only; " << context().deviceName();
+    const fs::path missing =
+        fs::temp_directory_path() / ("sdfcsg-no-folder-" + std::to_string(::getpid())) / "mesa";
+    ScopedEnv cacheDir("MESA_SHADER_CACHE_DIR", missing.string().c_str());
+    ScopedEnv cacheOn("MESA_SHADER_CACHE_DISABLE", nullptr);
+    ScopedEnv noSpirvCache("SDFCSG_CACHE_DIR", "off");
+    ContextOptions contextOptions;
+    contextOptions.validation = 1;
+    auto ctx = Context::create(contextOptions);
+    ASSERT_TRUE(ctx) << ctx.error().str();
+    Context::Impl& impl = (*ctx)->impl();
+    ASSERT_TRUE(impl.helperWanted);
+    for (const char* name : {"robot.json", "snowman.json"}) {
+        SCOPED_TRACE(name);
+        detail::clearShaderMemoryCache();
+        auto renderer = Renderer::create(**ctx, loadOrDie(scenePath(name)));
+        ASSERT_TRUE(renderer) << renderer.error().str();
+        EXPECT_EQ(impl.helperCompiles.load(), 1u) << "the helper compiled after it missed";
+        std::lock_guard lock(impl.helperMutex);
+        EXPECT_TRUE(impl.helperFailed);
+        EXPECT_EQ(impl.helper, nullptr);
+    }
+    EXPECT_EQ((*ctx)->validationMessageCount(), 0u);
+    EXPECT_FALSE(fs::exists(missing));
 }
 
 TEST_F(Render, UpdateValuesRefusesStructuralChanges) {
