@@ -525,6 +525,40 @@ INSTANTIATE_TEST_SUITE_P(Render, UpdateValues, ::testing::Values(true, false),
                                                 : std::string("BufferValues");
                          });
 
+bool onLavapipe(Context& context) {
+    return context.deviceName().find("llvmpipe") != std::string::npos;
+}
+
+// Mesa's disk cache of machine code in a folder of the test's own, which Mesa makes (only the
+// last folder of the path), and the kernels it holds.
+class DriverCacheFolder {
+  public:
+    explicit DriverCacheFolder(fs::path dir)
+        : dir_(std::move(dir)), folder_("MESA_SHADER_CACHE_DIR", dir_.string()),
+          on_("MESA_SHADER_CACHE_DISABLE", nullptr) {}
+    ~DriverCacheFolder() { clear(); }
+    const fs::path& dir() const { return dir_; }
+    void clear() const {
+        std::error_code ec;
+        fs::remove_all(dir_, ec);
+    }
+    size_t kernels() const {
+        size_t n = 0;
+        std::error_code ec;
+        for (const auto& entry : fs::recursive_directory_iterator(dir_, ec))
+            n += entry.is_regular_file() && entry.path().filename() != "index";
+        return n;
+    }
+
+  private:
+    fs::path dir_;
+    ScopedEnv folder_, on_;
+};
+
+fs::path testFolder(const std::string& name) {
+    return fs::temp_directory_path() / (name + "-" + std::to_string(::getpid()));
+}
+
 // lavapipe may specialise a kernel on values that it reads from a uniform block or from push
 // constants to decide branches, and then compiles it again whenever they change, which would
 // be at every band of every frame. Whether it does depends on the kernel's code, the scene's
@@ -532,18 +566,9 @@ INSTANTIATE_TEST_SUITE_P(Render, UpdateValues, ::testing::Values(true, false),
 // renders with other values (camera, size and so bands, mode, samples, overlays, lights) after
 // renders that used the same pipelines must add nothing to it.
 TEST_F(Render, OtherValuesCompileNothing) {
-    if (context().deviceName().find("llvmpipe") == std::string::npos)
+    if (!onLavapipe(context()))
         GTEST_SKIP() << "a property of lavapipe's compiler; " << context().deviceName();
-    const fs::path dir =
-        fs::temp_directory_path() / ("sdfcsg-mesa-cache-" + std::to_string(::getpid()));
-    ScopedEnv cacheDir("MESA_SHADER_CACHE_DIR", dir.string().c_str());
-    ScopedEnv cacheOn("MESA_SHADER_CACHE_DISABLE", nullptr);
-    auto cachedKernels = [&] {
-        size_t n = 0;
-        for (const auto& entry : fs::recursive_directory_iterator(dir))
-            n += entry.is_regular_file() && entry.path().filename() != "index";
-        return n;
-    };
+    const DriverCacheFolder cache(testFolder("sdfcsg-mesa-cache"));
     // Each list uses the same pipelines: march, shade, resolve and overlay.
     auto renderAll = [&](const Scene& scene, const std::vector<RenderOptions>& renders) {
         ContextOptions contextOptions;
@@ -577,14 +602,13 @@ TEST_F(Render, OtherValuesCompileNothing) {
     for (const fs::path& path : bundledScenes()) {
         SCOPED_TRACE(path.filename().string());
         const Scene scene = loadOrDie(path);
-        fs::remove_all(dir);
+        cache.clear();
         renderAll(scene, {first, depth});
-        const size_t before = cachedKernels();
-        ASSERT_GT(before, 0u) << "the driver cached nothing in " << dir;
+        const size_t before = cache.kernels();
+        ASSERT_GT(before, 0u) << "the driver cached nothing in " << cache.dir();
         renderAll(scene, {normals, other, otherDepth});
-        EXPECT_EQ(cachedKernels(), before) << "kernels were compiled again for other values";
+        EXPECT_EQ(cache.kernels(), before) << "kernels were compiled again for other values";
     }
-    fs::remove_all(dir);
 }
 
 // On lavapipe a second device compiles the march kernel while the context's own compiles the
@@ -592,12 +616,8 @@ TEST_F(Render, OtherValuesCompileNothing) {
 // only if the helper's pipeline is the one this device looks up (same SPIR-V, layout and
 // constants): otherwise this device compiles the kernel again and caches one kernel more.
 TEST_F(Render, CompileHelperHandsMachineCodeOver) {
-    if (context().deviceName().find("llvmpipe") == std::string::npos)
-        GTEST_SKIP() << "lavapipe only; " << context().deviceName();
-    const fs::path dir =
-        fs::temp_directory_path() / ("sdfcsg-helper-cache-" + std::to_string(::getpid()));
-    ScopedEnv cacheDir("MESA_SHADER_CACHE_DIR", dir.string().c_str());
-    ScopedEnv cacheOn("MESA_SHADER_CACHE_DISABLE", nullptr);
+    if (!onLavapipe(context())) GTEST_SKIP() << "lavapipe only; " << context().deviceName();
+    const DriverCacheFolder cache(testFolder("sdfcsg-helper-cache"));
     ScopedEnv noSpirvCache("SDFCSG_CACHE_DIR", "off"); // new kernels, as for a new scene
     const Scene scene = loadOrDie(scenePath("robot.json"));
     RenderOptions options;
@@ -607,7 +627,7 @@ TEST_F(Render, CompileHelperHandsMachineCodeOver) {
     size_t cached[2] = {};
     for (int helper : {0, 1}) {
         SCOPED_TRACE(helper ? "with the helper" : "without the helper");
-        fs::remove_all(dir);
+        cache.clear();
         detail::clearShaderMemoryCache();
         {
             ContextOptions contextOptions;
@@ -628,13 +648,11 @@ TEST_F(Render, CompileHelperHandsMachineCodeOver) {
             }
             EXPECT_EQ((*ctx)->validationMessageCount(), 0u);
         } // destroying the device finishes the cache's writes
-        for (const auto& entry : fs::recursive_directory_iterator(dir))
-            cached[helper] += entry.is_regular_file() && entry.path().filename() != "index";
+        cached[helper] = cache.kernels();
     }
-    EXPECT_GE(cached[0], 2u) << "the driver cached nothing in " << dir;
+    EXPECT_GE(cached[0], 2u) << "the driver cached nothing in " << cache.dir();
     EXPECT_EQ(cached[1], cached[0]) << "this device compiled the helper's kernel again";
     EXPECT_EQ(images[1]->rgba, images[0]->rgba);
-    fs::remove_all(dir);
 
     // Without Mesa's disk cache there is nothing to hand the machine code over with.
     ScopedEnv cacheOff("MESA_SHADER_CACHE_DISABLE", "true");
@@ -648,12 +666,8 @@ TEST_F(Render, CompileHelperHandsMachineCodeOver) {
 // Mesa turns its disk cache off where it cannot make its folder, which the environment does not
 // tell. The context then sees this device compile what the helper compiled, and stops using it.
 TEST_F(Render, CompileHelperStopsWhereTheCacheHandsNothingOver) {
-    if (context().deviceName().find("llvmpipe") == std::string::npos)
-        GTEST_SKIP() << "lavapipe only; " << context().deviceName();
-    const fs::path missing =
-        fs::temp_directory_path() / ("sdfcsg-no-folder-" + std::to_string(::getpid())) / "mesa";
-    ScopedEnv cacheDir("MESA_SHADER_CACHE_DIR", missing.string().c_str());
-    ScopedEnv cacheOn("MESA_SHADER_CACHE_DISABLE", nullptr);
+    if (!onLavapipe(context())) GTEST_SKIP() << "lavapipe only; " << context().deviceName();
+    const DriverCacheFolder cache(testFolder("sdfcsg-no-folder") / "mesa");
     ScopedEnv noSpirvCache("SDFCSG_CACHE_DIR", "off");
     ContextOptions contextOptions;
     contextOptions.validation = 1;
@@ -672,7 +686,7 @@ TEST_F(Render, CompileHelperStopsWhereTheCacheHandsNothingOver) {
         EXPECT_EQ(impl.helper, nullptr);
     }
     EXPECT_EQ((*ctx)->validationMessageCount(), 0u);
-    EXPECT_FALSE(fs::exists(missing));
+    EXPECT_FALSE(fs::exists(cache.dir()));
 }
 
 TEST_F(Render, UpdateValuesRefusesStructuralChanges) {
