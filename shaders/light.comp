@@ -17,13 +17,6 @@ layout(constant_id = SDFCSG_SPEC_RAYMARCH_PASS) const uint kPass = SDFCSG_RAYMAR
 // the kernel's compile.
 uint uniformIndex(uint i) { return subgroupBroadcastFirst(i); }
 
-// The listed hit's ray and ray parameter.
-void hitRay(uvec2 hit, out vec3 rd, out float t) {
-    uvec2 pixel;
-    sampleRay(sampleCoords(hit.x), pixel, rd);
-    t = uintBitsToFloat(hit.y);
-}
-
 // Where each shadow ray can end: occluders lie inside the clip box and the boxes that hold
 // surfaces, so a ray ends where it leaves them. From the hit; the shade pass starts the ray
 // from the hit lifted by 2 eps, hence the margin.

@@ -237,6 +237,13 @@ uvec2 sampleCoords(uint i) {
     return uvec2(uint(int(i) - row * int(n)), uint(row));
 }
 
+// A listed hit's ray direction and ray parameter (the ends, shade and light passes).
+void hitRay(uvec2 hit, out vec3 rd, out float t) {
+    uvec2 pixel;
+    sampleRay(sampleCoords(hit.x), pixel, rd);
+    t = uintBitsToFloat(hit.y);
+}
+
 // The sample of this invocation of the clip and march passes (column and row in the band's
 // sample grid) and its index; false outside the image.
 bool tileSample(out uvec2 s, out uint sampleIndex) {

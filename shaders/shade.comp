@@ -131,12 +131,11 @@ void surface(vec3 ro, vec3 rd, vec4 ends, inout Trace r, out vec3 albedo) {
 void shadePass() {
     uint slot = hitSlot();
     if (slot >= count) return;
-    uvec2 hit = hits[slot];
-    uvec2 pixel;
     vec3 rd;
-    sampleRay(sampleCoords(hit.x), pixel, rd);
+    float t;
+    hitRay(hits[slot], rd, t);
     vec3 ro = frame.eye.xyz;
-    Trace r = Trace(uintBitsToFloat(hit.y), 0u, vec3(0.0), 1.0, vec4(1.0));
+    Trace r = Trace(t, 0u, vec3(0.0), 1.0, vec4(1.0));
     vec3 albedo;
     surface(ro, rd, surfaces[4u * slot], r, albedo);
     surfaces[4u * slot + 1u] = vec4(r.n, r.ao);
