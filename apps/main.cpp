@@ -430,15 +430,18 @@ int emit(const std::string& text, const std::string& out) {
     return kOk;
 }
 
-const char* kGlslHelp = R"(Usage: sdfcsg glsl SCENE [-o FILE] [--inline]
+const char* kGlslHelp = R"(Usage: sdfcsg glsl SCENE [-o FILE] [--inline] [--no-bounds-tests]
 
 Prints the GLSL that SCENE compiles to: sceneDistance() and sceneSample(), one line per node.
   -o, --output FILE  write to FILE (atomically) instead of standard output
   --inline           bake parameters in as literals instead of reading the node buffer
+  --no-bounds-tests  leave out the tests that skip operands by their bounds, as the renderer
+                     does where it does not skip (by default on CPU devices such as lavapipe)
 )";
 
 int cmdGlsl(int argc, char** argv) {
-    Args args("glsl", argc, argv, {"-o", "--output"}, {"--inline", "--help", "-h"});
+    Args args("glsl", argc, argv, {"-o", "--output"},
+              {"--inline", "--no-bounds-tests", "--help", "-h"});
     if (args.has("--help") || args.has("-h")) return std::fputs(kGlslHelp, stdout), kOk;
     if (!args.error.empty()) return usageError("glsl", args.error);
     if (args.positional.size() != 1) return usageError("glsl", "expected one SCENE file");
@@ -446,6 +449,7 @@ int cmdGlsl(int argc, char** argv) {
     if (!scene) return fail(scene.error());
     sdfcsg::CodegenOptions options;
     options.inlineParams = args.has("--inline");
+    options.boundsTests = !args.has("--no-bounds-tests");
     return emit(sdfcsg::generateSceneGlsl(*scene, options), args.get("-o", args.get("--output")));
 }
 

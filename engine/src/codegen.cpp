@@ -88,9 +88,9 @@ void appendVector(std::string& out, const float* v, int count) {
 class Emitter {
   public:
     Emitter(const Scene& scene, std::string& out, const std::vector<detail::GpuNode>* literals,
-            std::vector<detail::PrimitiveList> lists)
+            std::vector<detail::PrimitiveList> lists, bool boundsTests)
         : scene_(scene), out_(out), lit_(literals), lists_(std::move(lists)),
-          operands_(scene.nodes.size()) {
+          operands_(scene.nodes.size()), tests_(boundsTests) {
         std::vector<bool> listed(scene.nodes.size(), false);
         for (const detail::PrimitiveList& list : lists_)
             for (uint32_t m : list.members)
@@ -316,9 +316,13 @@ class Emitter {
     }
 
     // Opens the block of operand `child` of union/difference `op`, entered only when the
-    // operand can change the running value.
+    // operand can change the running value (without bounds tests, a plain block).
     void guard(uint32_t op, uint32_t child, uint32_t depth) {
         indent(depth);
+        if (!tests_) {
+            out_ += "{\n";
+            return;
+        }
         out_ +=
             scene_.nodes[op].kind == NodeKind::Union ? "if (unionNeeds(" : "if (differenceNeeds(";
         if (lit_) {
@@ -368,6 +372,7 @@ class Emitter {
     const std::vector<detail::GpuNode>* lit_; // null: values come from the node buffer
     std::vector<detail::PrimitiveList> lists_;
     std::vector<std::vector<uint32_t>> operands_; // per operation, those not in a list
+    bool tests_;                                  // CodegenOptions::boundsTests
     bool sample_ = false;
 };
 
@@ -393,7 +398,8 @@ std::string generateSceneGlsl(const Scene& scene, const CodegenOptions& options)
     out.reserve(out.size() + scene.nodes.size() * (inlined ? 500 : 200));
     Emitter emitter(scene, out, inlined ? &literals : nullptr,
                     options.primitiveLists ? detail::primitiveLists(scene, evaluator)
-                                           : std::vector<detail::PrimitiveList>{});
+                                           : std::vector<detail::PrimitiveList>{},
+                    options.boundsTests);
     emitter.helpers();
     emitter.function(false);
     out += '\n';

@@ -379,9 +379,12 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
     m.evaluator = std::make_unique<Evaluator>(scene);
 
     m.lists = detail::primitiveLists(scene, *m.evaluator);
+    // Bounds tests pay off only where branches are real (see RenderOptions::boundsSkipping).
+    const uint32_t skipping = m.ctx.properties.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU;
     CodegenOptions codegen;
     codegen.inlineParams = true;
     codegen.primitiveLists = true;
+    codegen.boundsTests = skipping != 0;
     const std::string sceneGlsl = generateSceneGlsl(scene, codegen);
     const char* kernels[] = {"mesh_field.comp", "mesh_triangles.comp"};
     for (int i = 0; i < 2; ++i) {
@@ -394,8 +397,6 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
     m.pool = detail::createDescriptorPool(m.ctx, kBindings);
     m.set = detail::allocateDescriptorSet(m.ctx, m.pool, m.setLayout);
 
-    // Bounds tests pay off only where branches are real (see RenderOptions::boundsSkipping).
-    const uint32_t skipping = m.ctx.properties.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU;
     auto field = [&](uint32_t pass, uint32_t group) {
         detail::SpecConstant spec[] = {{SDFCSG_SPEC_BOUNDS_SKIPPING, skipping},
                                        {SDFCSG_SPEC_MESH_PASS, pass},

@@ -150,8 +150,9 @@ struct Renderer::Impl {
     std::shared_ptr<SharedPasses> shared;
     VkPipelineLayout pipelineLayout = VK_NULL_HANDLE; // shared->layout
     // The scene's kernels, march.comp and shade.comp, and their pipelines: [pass][bounds
-    // skipping], made on first use (buildKernels() makes the default ones).
-    VkShaderModule marchModule = VK_NULL_HANDLE, shadeModule = VK_NULL_HANDLE;
+    // skipping]. The generated code differs with skipping (CodegenOptions::boundsTests).
+    // buildKernels() makes the default ones, kernels() and pipeline() the others on first use.
+    VkShaderModule modules[2][2] = {};
     VkPipeline pipelines[2][2] = {};
     static_assert(SDFCSG_RAYMARCH_PASS_MARCH == 0 && SDFCSG_RAYMARCH_PASS_SHADE == 1);
     VkDescriptorPool pool = VK_NULL_HANDLE;
@@ -186,10 +187,8 @@ struct Renderer::Impl {
     // (precompileElsewhere()) while this device compiles the shade kernel. On failure the
     // previous kernels stay.
     Status buildKernels() {
-        CodegenOptions codegen;
-        codegen.inlineParams = options.inlineValues;
-        const std::string glsl = generateSceneGlsl(scene, codegen);
         const bool skipping = defaultSkipping();
+        const std::string glsl = sceneGlsl(skipping);
         struct Built {
             std::optional<Error> error;
             VkShaderModule module = VK_NULL_HANDLE;
@@ -233,8 +232,8 @@ struct Renderer::Impl {
             return shade.error ? *shade.error : *march.error;
         }
         destroyKernel();
-        marchModule = march.module;
-        shadeModule = shade.module;
+        modules[SDFCSG_RAYMARCH_PASS_MARCH][skipping ? 1 : 0] = march.module;
+        modules[SDFCSG_RAYMARCH_PASS_SHADE][skipping ? 1 : 0] = shade.module;
         pipelines[SDFCSG_RAYMARCH_PASS_MARCH][skipping ? 1 : 0] = march.pipeline;
         pipelines[SDFCSG_RAYMARCH_PASS_SHADE][skipping ? 1 : 0] = shade.pipeline;
         const auto start = std::chrono::steady_clock::now();
@@ -250,14 +249,37 @@ struct Renderer::Impl {
     // The scene's kernels and their pipelines.
     void destroyKernel() {
         for (int pass : {SDFCSG_RAYMARCH_PASS_MARCH, SDFCSG_RAYMARCH_PASS_SHADE})
-            for (VkPipeline& p : pipelines[pass]) {
+            for (int skipping : {0, 1}) {
+                VkPipeline& p = pipelines[pass][skipping];
                 if (p) vkDestroyPipeline(ctx.device, p, nullptr);
                 p = VK_NULL_HANDLE;
+                VkShaderModule& m = modules[pass][skipping];
+                if (m) vkDestroyShaderModule(ctx.device, m, nullptr);
+                m = VK_NULL_HANDLE;
             }
-        for (VkShaderModule* m : {&marchModule, &shadeModule}) {
-            if (*m) vkDestroyShaderModule(ctx.device, *m, nullptr);
-            *m = VK_NULL_HANDLE;
+    }
+
+    std::string sceneGlsl(bool skipping) const {
+        CodegenOptions codegen;
+        codegen.inlineParams = options.inlineValues;
+        codegen.boundsTests = skipping;
+        return generateSceneGlsl(scene, codegen);
+    }
+
+    // The scene's kernels for a skipping choice, compiled on first use.
+    Status kernels(bool skipping) {
+        VkShaderModule* made[] = {&modules[SDFCSG_RAYMARCH_PASS_MARCH][skipping ? 1 : 0],
+                                  &modules[SDFCSG_RAYMARCH_PASS_SHADE][skipping ? 1 : 0]};
+        if (*made[0] && *made[1]) return Ok{};
+        const std::string glsl = sceneGlsl(skipping);
+        const char* names[] = {"march.comp", "shade.comp"};
+        for (int i = 0; i < 2; ++i) {
+            if (*made[i]) continue;
+            auto spirv = compileKernel(names[i], glsl);
+            if (!spirv) return spirv.error();
+            *made[i] = detail::createShaderModule(ctx, *spirv);
         }
+        return Ok{};
     }
 
     bool defaultSkipping() const {
@@ -292,8 +314,7 @@ struct Renderer::Impl {
         }
         VkPipeline& p = pipelines[pass][skipping ? 1 : 0];
         if (!p) {
-            p = createPipeline(pass == SDFCSG_RAYMARCH_PASS_MARCH ? marchModule : shadeModule, pass,
-                               skipping);
+            p = createPipeline(modules[pass][skipping ? 1 : 0], pass, skipping); // see kernels()
             warmUp(p);
         }
         return p;
@@ -602,6 +623,7 @@ Result<Image> Renderer::render(const RenderOptions& options) {
                     : r.scene.camera ? *r.scene.camera
                                      : frameCamera(*r.evaluator, aspect);
     const bool skipping = options.boundsSkipping.value_or(r.defaultSkipping());
+    if (auto made = r.kernels(skipping); !made) return made.error();
     const bool shading = options.mode == RenderMode::Shaded || options.mode == RenderMode::Normals;
     VkPipeline clipRays = r.pipeline(SDFCSG_RAYMARCH_PASS_CLIP, false);
     VkPipeline march = r.pipeline(SDFCSG_RAYMARCH_PASS_MARCH, skipping);

@@ -102,6 +102,10 @@ ls | grep -q '\.tmp-' && { echo "FAIL mesh left a temporary file behind"; failur
 check "glsl" 0 "$bin" glsl "$src/assets/scenes/csg_part.json"
 grep -q "float sceneDistance(vec3 p)" out.txt || { echo "FAIL glsl has no sceneDistance"; failures=$((failures + 1)); }
 grep -q "hole x" out.txt || { echo "FAIL glsl does not name the nodes"; failures=$((failures + 1)); }
+grep -q "Needs(" out.txt || { echo "FAIL glsl has no bounds tests"; failures=$((failures + 1)); }
+check "glsl without bounds tests" 0 "$bin" glsl "$src/assets/scenes/csg_part.json" --no-bounds-tests
+grep -q "Needs(" out.txt && { echo "FAIL glsl --no-bounds-tests has bounds tests"; failures=$((failures + 1)); }
+grep -q "hole x" out.txt || { echo "FAIL glsl --no-bounds-tests does not name the nodes"; failures=$((failures + 1)); }
 
 check "convert legacy" 0 "$bin" convert "$src/tests/data/legacy/csg.json" -o converted.json
 check "converted validates" 0 "$bin" validate converted.json

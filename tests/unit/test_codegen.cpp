@@ -100,6 +100,31 @@ TEST(Codegen, NamesCannotBreakTheCode) {
     EXPECT_TRUE(spirv) << spirv.error().str();
 }
 
+TEST(Codegen, BoundsTestsCanBeLeftOut) {
+    Scene scene =
+        makeScene(unite({sphere(1), subtract({box(1, 1, 1), sphere(0.6f)}), box(2, 1, 1)}));
+    for (bool inlineParams : {false, true}) {
+        CodegenOptions options;
+        options.inlineParams = inlineParams;
+        const std::string with = generateSceneGlsl(scene, options);
+        options.boundsTests = false;
+        const std::string without = generateSceneGlsl(scene, options);
+        EXPECT_NE(with.find("if (unionNeeds("), std::string::npos) << with;
+        EXPECT_NE(with.find("if (differenceNeeds("), std::string::npos) << with;
+        EXPECT_EQ(without.find("Needs("), std::string::npos) << without;
+        // The same lines otherwise: each guard becomes a plain block.
+        std::vector<std::string> a = lines(with), b = lines(without);
+        ASSERT_EQ(a.size(), b.size()) << without;
+        for (size_t i = 0; i < a.size(); ++i)
+            if (a[i].find("Needs(") != std::string::npos)
+                EXPECT_EQ(b[i], a[i].substr(0, a[i].find("if (")) + "{");
+            else
+                EXPECT_EQ(b[i], a[i]);
+        auto spirv = compileKernel("march.comp", without);
+        EXPECT_TRUE(spirv) << spirv.error().str();
+    }
+}
+
 TEST(Codegen, IndentationFollowsDepth) {
     Scene scene = makeScene(unite({sphere(1), subtract({box(1, 1, 1), sphere(0.6f)})}));
     std::string body = function(generateSceneGlsl(scene), "float sceneDistance");

@@ -1,6 +1,6 @@
 // The generated GLSL against the CPU reference evaluator: shaders/probe.comp evaluates
 // sceneSample at thousands of points, for every primitive kind, the operations, and every bundled
-// scene, with bounds skipping on and off.
+// scene, with bounds skipping on and off, and with the bounds tests left out of the code.
 #include "gpu_nodes.h"
 #include "gpu_test.h"
 #include "shared.h"
@@ -18,14 +18,33 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// How probeGpu() compiles and runs the scene.
+struct Probe {
+    const char* name;
+    bool boundsTests; // CodegenOptions::boundsTests
+    bool skipping;    // kBoundsSkipping
+    // The result is read back through a staging copy, as on GPUs whose storage memory is not
+    // mappable (lavapipe's always is), so that path runs under validation too.
+    bool viaStaging;
+};
+
+constexpr Probe kProbes[] = {
+    {"bounds skipping on", true, true, false},
+    {"bounds skipping off, staging read-back", true, false, true},
+    {"bounds tests left out", false, false, false},
+};
+
 // Runs probe.comp over `points`; returns (rgb colour, distance) per point.
-// With `viaStaging`, the result is read back through a staging copy, as on GPUs whose storage
-// memory is not mappable (lavapipe's always is), so that path runs under validation too.
 std::vector<glm::vec4> probeGpu(Context& context, const Scene& scene,
-                                const std::vector<glm::vec4>& points, bool skipping,
-                                bool viaStaging) {
+                                const std::vector<glm::vec4>& points, const Probe& probe) {
     Context::Impl& ctx = context.impl();
-    auto spirv = compileKernel("probe.comp", generateSceneGlsl(scene));
+    CodegenOptions codegen;
+    codegen.boundsTests = probe.boundsTests;
+    const std::string glsl = generateSceneGlsl(scene, codegen);
+    if (!probe.boundsTests) {
+        EXPECT_EQ(glsl.find("Needs("), std::string::npos) << glsl;
+    }
+    auto spirv = compileKernel("probe.comp", glsl);
     if (!spirv) {
         ADD_FAILURE() << spirv.error().str();
         return {};
@@ -38,7 +57,7 @@ std::vector<glm::vec4> probeGpu(Context& context, const Scene& scene,
     VkShaderModule module = detail::createShaderModule(ctx, *spirv);
     VkDescriptorSetLayout setLayout = detail::createDescriptorSetLayout(ctx, bindings);
     VkPipelineLayout layout = detail::createPipelineLayout(ctx, setLayout, sizeof(uint32_t));
-    detail::SpecConstant spec[] = {{SDFCSG_SPEC_BOUNDS_SKIPPING, skipping ? 1u : 0u}};
+    detail::SpecConstant spec[] = {{SDFCSG_SPEC_BOUNDS_SKIPPING, probe.skipping ? 1u : 0u}};
     VkPipeline pipeline = detail::createComputePipeline(ctx, module, layout, spec);
     VkDescriptorPool pool = detail::createDescriptorPool(ctx, bindings);
     VkDescriptorSet set = detail::allocateDescriptorSet(ctx, pool, setLayout);
@@ -56,7 +75,7 @@ std::vector<glm::vec4> probeGpu(Context& context, const Scene& scene,
         detail::MemoryUse::Readback);
     detail::Buffer staging;
     detail::Buffer source = out; // what recordReadback() sees
-    if (viaStaging) source.data = nullptr;
+    if (probe.viaStaging) source.data = nullptr;
     if (!source.data)
         staging = *detail::createBuffer(ctx, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                         detail::MemoryUse::Staging);
@@ -123,9 +142,9 @@ std::vector<glm::vec4> samplePoints(const Evaluator& ev, size_t count, uint32_t 
 void expectGpuMatchesCpu(Context& context, const Scene& scene, size_t count = 2048) {
     Evaluator ev(scene);
     std::vector<glm::vec4> points = samplePoints(ev, count, 12345);
-    for (bool skipping : {true, false}) {
-        SCOPED_TRACE(skipping ? "bounds skipping on" : "bounds skipping off, staging read-back");
-        std::vector<glm::vec4> gpu = probeGpu(context, scene, points, skipping, !skipping);
+    for (const Probe& probe : kProbes) {
+        SCOPED_TRACE(probe.name);
+        std::vector<glm::vec4> gpu = probeGpu(context, scene, points, probe);
         ASSERT_EQ(gpu.size(), points.size());
         size_t badDistance = 0, badColour = 0;
         std::string first;
