@@ -26,6 +26,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <utility>
 
 namespace sdfcsg {
 namespace {
@@ -81,6 +82,9 @@ struct SharedPasses {
     VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
     VkPipelineLayout layout = VK_NULL_HANDLE;
     VkShaderModule clip = VK_NULL_HANDLE, light = VK_NULL_HANDLE, finish = VK_NULL_HANDLE;
+    // The SPIR-V of clip.comp and light.comp where glslang made it (none was cached): then the
+    // driver has most likely not compiled them either, and the compile helper may.
+    std::vector<uint32_t> freshClip, freshLight;
     std::mutex mutex; // guards pipelines
     VkPipeline pipelines[SDFCSG_RAYMARCH_PASSES] = {};
 
@@ -119,10 +123,13 @@ Result<std::shared_ptr<SharedPasses>> sharedPasses(Context::Impl& ctx) {
     auto shared = std::make_shared<SharedPasses>(ctx);
     const char* kernels[] = {"clip.comp", "light.comp", "finish.comp"};
     VkShaderModule* modules[] = {&shared->clip, &shared->light, &shared->finish};
+    std::vector<uint32_t>* fresh[] = {&shared->freshClip, &shared->freshLight, nullptr};
     for (int i = 0; i < 3; ++i) {
-        auto spirv = compileKernel(kernels[i], "");
+        bool ranGlslang = false;
+        auto spirv = detail::compileKernel(kernels[i], "", ranGlslang);
         if (!spirv) return spirv.error();
         *modules[i] = detail::createShaderModule(ctx, *spirv);
+        if (ranGlslang && fresh[i]) *fresh[i] = std::move(*spirv);
     }
     shared->setLayout = detail::createDescriptorSetLayout(ctx, kBindings);
     shared->layout = detail::createPipelineLayout(ctx, shared->setLayout, sizeof(BandConstants));
@@ -207,6 +214,17 @@ struct Renderer::Impl {
         // While this device compiles the shade kernel, the other thread makes the march kernel:
         // on llvmpipe, its machine code on the helper device (if it is a new kernel), and this
         // device's pipeline beside that, which at its first dispatch loads the helper's work.
+        // In a context's first build the passes that do not depend on the scene are most likely
+        // new too: the helper then compiles the clip and ends passes after the march kernel, and
+        // this device the light pass after the shade kernel (about as long on either side).
+        std::vector<uint32_t> clipSpirv, endsSpirv;
+        {
+            std::lock_guard lock(shared->mutex);
+            if (!shared->pipelines[SDFCSG_RAYMARCH_PASS_CLIP])
+                clipSpirv = std::exchange(shared->freshClip, {});
+            if (!shared->pipelines[SDFCSG_RAYMARCH_PASS_ENDS])
+                endsSpirv = std::exchange(shared->freshLight, {});
+        }
         Built march;
         double helperMs = 0.0; // the helper's compile of the march kernel
         std::thread other([&] {
@@ -214,15 +232,23 @@ struct Renderer::Impl {
             bool fresh = false;
             auto spirv = detail::compileKernel("march.comp", glsl, fresh);
             std::thread translate([&] { march = build(spirv, SDFCSG_RAYMARCH_PASS_MARCH); });
-            if (spirv && fresh) {
-                const auto spec = specConstants(SDFCSG_RAYMARCH_PASS_MARCH, skipping);
-                helperMs = detail::precompileElsewhere(ctx, *spirv, kBindings,
-                                                       sizeof(BandConstants), spec);
-            }
+            const auto marchSpec = specConstants(SDFCSG_RAYMARCH_PASS_MARCH, skipping);
+            const auto clipSpec = specConstants(SDFCSG_RAYMARCH_PASS_CLIP, false);
+            const auto endsSpec = specConstants(SDFCSG_RAYMARCH_PASS_ENDS, false);
+            std::vector<detail::Precompile> jobs;
+            if (spirv && fresh) jobs.push_back({*spirv, marchSpec});
+            if (!clipSpirv.empty()) jobs.push_back({clipSpirv, clipSpec});
+            if (!endsSpirv.empty()) jobs.push_back({endsSpirv, endsSpec});
+            const double ms =
+                detail::precompileElsewhere(ctx, jobs, kBindings, sizeof(BandConstants));
+            if (spirv && fresh) helperMs = ms;
             translate.join();
         });
         Built shade = build(compileKernel("shade.comp", glsl), SDFCSG_RAYMARCH_PASS_SHADE);
-        if (!shade.error) warmUp(shade.pipeline);
+        if (!shade.error) {
+            warmUp(shade.pipeline);
+            pipeline(SDFCSG_RAYMARCH_PASS_LIGHT, false); // made once per context
+        }
         other.join();
         if (march.error || shade.error) {
             for (Built* b : {&march, &shade}) {
@@ -550,7 +576,8 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene
     if (auto reserved = r.reserveSamples(64 * 64, 64); !reserved) return reserved.error();
     if (auto built = r.buildKernels(); !built) return built.error();
     // The passes around the march and shade passes run in every shaded frame (the first
-    // renderer of the context makes them).
+    // renderer of the context makes them; buildKernels() has made the light pass, and on
+    // lavapipe compiled the others on the helper).
     r.pipeline(SDFCSG_RAYMARCH_PASS_CLIP, false);
     r.pipeline(SDFCSG_RAYMARCH_PASS_ENDS, false);
     r.pipeline(SDFCSG_RAYMARCH_PASS_LIGHT, false);

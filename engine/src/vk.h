@@ -64,7 +64,7 @@ struct Context::Impl {
     std::mutex helperMutex;       // guards what follows
     std::unique_ptr<Impl> helper;
     bool helperFailed = false; // its setup or a hand-over failed once: not tried again
-    std::atomic<uint32_t> helperCompiles{0}; // kernels it compiled (tests look)
+    std::atomic<uint32_t> helperCompiles{0}; // pipelines it compiled (tests look)
 
     // What the renderers of this context share (render.cpp), made by the first.
     std::mutex rendererSharedMutex;
@@ -152,14 +152,18 @@ const void* readback(Context::Impl& ctx, const Buffer& buffer, const Buffer* sta
 // cache of machine code hands the result over: a pipeline made from the same SPIR-V, layout and
 // constants on this context loads it at its first dispatch instead of compiling.
 //
-// Compiles such a pipeline on the helper device and returns once its machine code is in the
-// disk cache (destroying the helper's instance waits for the cache's writes; the next call makes
-// a new one), with the milliseconds the compile took. Returns 0, having done nothing, where there
-// is no helper (other drivers, Mesa's disk cache turned off, ContextOptions::compileHelper false)
-// or it is busy with another kernel.
-double precompileElsewhere(Context::Impl& ctx, std::span<const uint32_t> spirv,
-                           std::span<const Binding> bindings, uint32_t pushConstantBytes,
-                           std::span<const SpecConstant> spec);
+// A pipeline for precompileElsewhere(): its SPIR-V and specialisation constants.
+struct Precompile {
+    std::span<const uint32_t> spirv;
+    std::span<const SpecConstant> spec;
+};
+// Compiles such pipelines, one after the other, on the helper device, all with the same layout,
+// and returns once their machine code is in the disk cache (destroying the helper's instance
+// waits for the cache's writes; the next call makes a new one), with the milliseconds the first
+// one's compile took. Returns 0, having done nothing, where there is no helper (other drivers,
+// Mesa's disk cache turned off, ContextOptions::compileHelper false) or it is busy.
+double precompileElsewhere(Context::Impl& ctx, std::span<const Precompile> pipelines,
+                           std::span<const Binding> bindings, uint32_t pushConstantBytes);
 // Says that this device compiled a kernel that the helper had compiled (its first dispatch took
 // about as long as the helper's compile): Mesa's disk cache did not hand it over, though the
 // environment did not turn it off (an unwritable folder, say). Turns the helper off.
