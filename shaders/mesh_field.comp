@@ -154,14 +154,6 @@ void classify() {
     if (plane == 0u) counts[slot] = uvec2(total & 0xffffu, total >> 16);
 }
 
-vec3 normalAt(vec3 p, vec3 edgeDirection) {
-    const vec2 k = vec2(1.0, -1.0);
-    float e = 0.05 * grid.origin.w;
-    vec3 g = k.xyy * sceneDistance(p + k.xyy * e) + k.yyx * sceneDistance(p + k.yyx * e) +
-             k.yxy * sceneDistance(p + k.yxy * e) + k.xxx * sceneDistance(p + k.xxx * e);
-    return length(g) > 1e-20 ? normalize(g) : edgeDirection;
-}
-
 void placeVertices() {
     uint batchSlot = gl_WorkGroupID.x;
     if (batchSlot >= push.count) return;
@@ -182,21 +174,34 @@ void placeVertices() {
         vec3 pa = samplePosition(b + l);
         vec3 pb = samplePosition(b + l + step);
 
+        // Regula falsi on the field (grid.cells.w steps from the linear estimate), then the
+        // normal's four tetrahedral taps around the vertex, all through one call of the scene
+        // in one loop: lavapipe's compiler inlines every call site, each a copy of the scene to
+        // compile (six of them took the house's kernel three times as long).
+        const uint steps = grid.cells.w;
+        const float e = 0.05 * grid.origin.w;
         float t = da / (da - db);
         float lo = 0.0, hi = 1.0, dlo = da, dhi = db;
-        for (uint k = 0u; k < grid.cells.w; ++k) {
-            float d = sceneDistance(pa + (pb - pa) * t);
-            if ((d < 0.0) == (dlo < 0.0)) {
-                lo = t;
-                dlo = d;
-            } else {
-                hi = t;
-                dhi = d;
-            }
-            t = lo + (hi - lo) * (dlo / (dlo - dhi));
-        }
         vec3 p = pa + (pb - pa) * t;
-        vec3 n = normalAt(p, vec3(step) * (db > da ? 1.0 : -1.0));
+        vec3 g = vec3(0.0);
+        for (uint k = 0u; k < steps + 4u; ++k) {
+            vec3 tap = k < steps ? vec3(0.0) : tetraTap(int(k - steps));
+            float d = sceneDistance(p + tap * e);
+            if (k < steps) {
+                if ((d < 0.0) == (dlo < 0.0)) {
+                    lo = t;
+                    dlo = d;
+                } else {
+                    hi = t;
+                    dhi = d;
+                }
+                t = lo + (hi - lo) * (dlo / (dlo - dhi));
+                p = pa + (pb - pa) * t;
+            } else {
+                g += tap * d;
+            }
+        }
+        vec3 n = length(g) > 1e-20 ? normalize(g) : vec3(step) * (db > da ? 1.0 : -1.0);
         vec3 c = sceneSample(p).rgb;
 
         uint o = (first + v) * 9u;

@@ -116,3 +116,12 @@ float sharpDifference(float a, float b) { return a >= -b ? a : -b; }
 vec4 sharpUnion(vec4 a, vec4 b) { return a.w <= b.w ? a : b; }
 vec4 sharpIntersection(vec4 a, vec4 b) { return a.w >= b.w ? a : b; }
 vec4 sharpDifference(vec4 a, vec4 b) { return a.w >= -b.w ? a : vec4(b.rgb, -b.w); }
+
+// Tap i (0..3) of the four-tap tetrahedral difference, the tetrahedron k = (1, -1): k.xyy,
+// k.yyx, k.yxy, k.xxx. The normal at p is normalize(sum of tap(i) * f(p + tap(i) * e)).
+vec3 tetraTap(int i) {
+    return i == 0 ? vec3(1.0, -1.0, -1.0)
+         : i == 1 ? vec3(-1.0, -1.0, 1.0)
+         : i == 2 ? vec3(-1.0, 1.0, -1.0)
+                  : vec3(1.0);
+}

@@ -25,14 +25,6 @@ const float kShadowSharpness = 10.0;
 // them.
 const uint kColor = 0u, kNormal = 1u, kOcclusion = 2u, kShadow = 3u, kDone = 4u;
 
-// The tetrahedron k = (1, -1): k.xyy, k.yyx, k.yxy, k.xxx.
-vec3 tetraTap(int i) {
-    return i == 0 ? vec3(1.0, -1.0, -1.0)
-         : i == 1 ? vec3(-1.0, -1.0, 1.0)
-         : i == 2 ? vec3(-1.0, 1.0, -1.0)
-                  : vec3(1.0);
-}
-
 void surface(vec3 ro, vec3 rd, vec4 ends, inout Trace r, out vec3 albedo) {
     uint mode = control.size.z;
     uint flags = control.size.w;

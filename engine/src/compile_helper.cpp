@@ -38,11 +38,20 @@ double precompileElsewhere(Context::Impl& ctx, std::span<const Precompile> pipel
     if (!lock || !haveHelper(ctx)) return 0.0;
     Context::Impl& h = *ctx.helper;
     // Every binding of the set must point at a buffer, though a dispatch of no workgroups, which
-    // makes llvmpipe compile, runs no invocation to read one.
-    auto buffer = createBuffer(
-        h, kBindingBytes, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-        MemoryUse::Device);
+    // makes llvmpipe compile, runs no invocation to read one. Its zeros are what the pipelines'
+    // warm-ups on the context's device bind: at a pipeline's first dispatch, lavapipe may inline
+    // the values of its uniform blocks into the code, and keeps doing so if that shrank it
+    // enough, so the two devices compile the same code only for the same values.
+    auto buffer =
+        createBuffer(h, kBindingBytes,
+                     VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                         VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                     MemoryUse::Device);
     if (!buffer) return 0.0;
+    VkCommandBuffer fill = beginCommands(h);
+    vkCmdFillBuffer(fill, buffer->buffer, 0, VK_WHOLE_SIZE, 0);
+    recordComputeBarrier(fill);
+    submitAndWait(h);
     VkDescriptorSetLayout setLayout = createDescriptorSetLayout(h, bindings);
     VkPipelineLayout layout = createPipelineLayout(h, setLayout, pushConstantBytes);
     VkDescriptorPool pool = createDescriptorPool(h, bindings);

@@ -16,6 +16,7 @@
 #include "gpu_nodes.h"
 #include "mc_tables.h"
 #include "primitive_lists.h"
+#include "shader_compile.h"
 #include "vk.h"
 
 #include "sdfcsg/compile.h"
@@ -25,10 +26,13 @@
 #include <glm/vec4.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <thread>
+#include <vector>
 
 namespace sdfcsg {
 namespace {
@@ -320,14 +324,11 @@ struct Mesher::Impl {
         return static_cast<const T*>(b.data);
     }
 
-    // Every pipeline runs once on an empty batch, so drivers that compile on first use (llvmpipe)
-    // have done so before the first extraction is timed.
-    void warmUp() {
-        for (VkPipeline p : {cull, classify, vertices, triangles}) {
-            VkCommandBuffer cmd = begin(p);
-            dispatch(cmd, MeshPush{}, 1);
-            detail::submitAndWait(ctx);
-        }
+    // Runs a pipeline on an empty batch: drivers that compile at first use (llvmpipe) do so here.
+    void warmUp(VkPipeline p) {
+        VkCommandBuffer cmd = begin(p);
+        dispatch(cmd, MeshPush{}, 1);
+        detail::submitAndWait(ctx);
     }
 
     // Set by run() when a triangle needed a vertex of a skipped brick: the field falls faster
@@ -387,25 +388,32 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
     codegen.boundsTests = skipping != 0;
     const std::string sceneGlsl = generateSceneGlsl(scene, codegen);
     const char* kernels[] = {"mesh_field.comp", "mesh_triangles.comp"};
+    std::vector<uint32_t> spirv[2];
+    bool fresh[2] = {}; // glslang made the SPIR-V: the driver has most likely not compiled it
     for (int i = 0; i < 2; ++i) {
-        auto spirv = compileKernel(kernels[i], i == 0 ? std::string_view(sceneGlsl) : "");
-        if (!spirv) return spirv.error();
-        m.modules[i] = detail::createShaderModule(m.ctx, *spirv);
+        auto made =
+            detail::compileKernel(kernels[i], i == 0 ? std::string_view(sceneGlsl) : "", fresh[i]);
+        if (!made) return made.error();
+        spirv[i] = std::move(*made);
+        m.modules[i] = detail::createShaderModule(m.ctx, spirv[i]);
     }
     m.setLayout = detail::createDescriptorSetLayout(m.ctx, kBindings);
     m.pipelineLayout = detail::createPipelineLayout(m.ctx, m.setLayout, sizeof(MeshPush));
     m.pool = detail::createDescriptorPool(m.ctx, kBindings);
     m.set = detail::allocateDescriptorSet(m.ctx, m.pool, m.setLayout);
 
-    auto field = [&](uint32_t pass, uint32_t group) {
-        detail::SpecConstant spec[] = {{SDFCSG_SPEC_BOUNDS_SKIPPING, skipping},
-                                       {SDFCSG_SPEC_MESH_PASS, pass},
-                                       {SDFCSG_SPEC_MESH_GROUP, group}};
-        return detail::createComputePipeline(m.ctx, m.modules[0], m.pipelineLayout, spec);
+    using FieldSpec = std::array<detail::SpecConstant, 3>;
+    auto fieldSpec = [&](uint32_t pass, uint32_t group) {
+        return FieldSpec{{{SDFCSG_SPEC_BOUNDS_SKIPPING, skipping},
+                          {SDFCSG_SPEC_MESH_PASS, pass},
+                          {SDFCSG_SPEC_MESH_GROUP, group}}};
     };
-    m.cull = field(SDFCSG_MESH_PASS_CULL, SDFCSG_MESH_GROUP_X);
-    m.classify = field(SDFCSG_MESH_PASS_CLASSIFY, SDFCSG_MESH_BRICK);
-    m.vertices = field(SDFCSG_MESH_PASS_VERTICES, SDFCSG_MESH_GROUP_X);
+    const FieldSpec cullSpec = fieldSpec(SDFCSG_MESH_PASS_CULL, SDFCSG_MESH_GROUP_X);
+    const FieldSpec classifySpec = fieldSpec(SDFCSG_MESH_PASS_CLASSIFY, SDFCSG_MESH_BRICK);
+    const FieldSpec verticesSpec = fieldSpec(SDFCSG_MESH_PASS_VERTICES, SDFCSG_MESH_GROUP_X);
+    m.cull = detail::createComputePipeline(m.ctx, m.modules[0], m.pipelineLayout, cullSpec);
+    m.classify = detail::createComputePipeline(m.ctx, m.modules[0], m.pipelineLayout, classifySpec);
+    m.vertices = detail::createComputePipeline(m.ctx, m.modules[0], m.pipelineLayout, verticesSpec);
     m.triangles = detail::createComputePipeline(m.ctx, m.modules[1], m.pipelineLayout, {});
 
     std::vector<detail::GpuNode> nodes = detail::packNodes(*m.evaluator);
@@ -431,7 +439,27 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
     MeshGrid empty = {};
     detail::uploadBuffer(m.ctx, m.buffer(SDFCSG_BINDING_MESH_GRID), &empty, sizeof empty);
     m.writeDescriptors();
-    m.warmUp();
+
+    // Every pipeline runs once on an empty batch, so drivers that compile at first use (llvmpipe)
+    // have done so before the first extraction is timed. On lavapipe the compile helper makes the
+    // vertices pass (and a new triangle pass) meanwhile, as buildKernels() in render.cpp does.
+    double helperMs = 0.0; // its compile of the vertices pass
+    std::thread other([&] {
+        std::vector<detail::Precompile> jobs;
+        if (fresh[0]) jobs.push_back({spirv[0], verticesSpec});
+        if (fresh[1]) jobs.push_back({spirv[1], {}});
+        const double ms = detail::precompileElsewhere(m.ctx, jobs, kBindings, sizeof(MeshPush));
+        if (fresh[0]) helperMs = ms;
+    });
+    m.warmUp(m.cull);
+    m.warmUp(m.classify);
+    other.join();
+    const auto start = std::chrono::steady_clock::now();
+    m.warmUp(m.vertices);
+    const std::chrono::duration<double, std::milli> verticesMs =
+        std::chrono::steady_clock::now() - start;
+    if (helperMs > 0.0 && verticesMs.count() > 0.25 * helperMs) detail::compileHelperMissed(m.ctx);
+    m.warmUp(m.triangles);
     return std::unique_ptr<Mesher>(new Mesher(std::move(impl)));
 }
 

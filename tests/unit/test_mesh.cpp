@@ -1,9 +1,12 @@
 // The GPU mesher (engine/src/mesh.cpp) by the properties of its meshes: analytic volume and area,
 // topology, vertices on the surface, outward normals, closed and manifold meshes of the bundled
 // scenes, equality with the CPU reference (mesh_reference.h), repeatability, and its errors.
+#include "driver_cache.h"
 #include "gpu_test.h"
 #include "mesh_checks.h"
 #include "mesh_reference.h"
+#include "shader_compile.h"
+#include "vk.h"
 
 #include <numbers>
 
@@ -229,6 +232,89 @@ TEST_F(MeshTest, RepeatedExtractionsAreIdentical) {
         ASSERT_EQ(mesh->indices, first->indices) << "run " << run;
         EXPECT_EQ(stats.vertices, first->vertexCount());
     }
+}
+
+// Mesher::create() compiles every kernel that extractions run, whatever their options: lavapipe
+// may specialise a kernel on the values it reads from a uniform block or push constants to
+// bound its loops, and then compiles it again for other values (the number of refinement steps
+// did). Its disk cache shows such compiles: with the cache in a folder of the test's own,
+// extractions must add nothing to what creating the mesher compiled.
+TEST_F(MeshTest, ExtractionsCompileNothing) {
+    if (!onLavapipe(context()))
+        GTEST_SKIP() << "a property of lavapipe's compiler; " << context().deviceName();
+    const DriverCacheFolder cache(testFolder("sdfcsg-mesh-cache"));
+    const Scene scene =
+        loadOrDie(std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes/house.json");
+    auto run = [&](const std::vector<MeshOptions>& extractions) {
+        ContextOptions contextOptions;
+        contextOptions.validation = 1;
+        auto ctx = Context::create(contextOptions);
+        ASSERT_TRUE(ctx) << ctx.error().str();
+        {
+            auto mesher = Mesher::create(**ctx, scene);
+            ASSERT_TRUE(mesher) << mesher.error().str();
+            for (const MeshOptions& options : extractions) {
+                auto mesh = (*mesher)->extract(options);
+                ASSERT_TRUE(mesh) << mesh.error().str();
+                EXPECT_GT(mesh->triangleCount(), 0u);
+            }
+        }
+        EXPECT_EQ((*ctx)->validationMessageCount(), 0u);
+        // Destroying the device finishes the cache's writes.
+    };
+    run({});
+    const size_t created = cache.kernels();
+    ASSERT_GE(created, 4u) << "the driver cached too little in " << cache.dir();
+    MeshOptions coarse, fine, other;
+    coarse.resolution = 24;
+    fine.resolution = 72;
+    other.resolution = 40, other.refineSteps = 5;
+    run({coarse, fine, other});
+    EXPECT_EQ(cache.kernels(), created) << "extractions compiled kernels again";
+}
+
+// On lavapipe the compile helper compiles the vertices and triangle passes while the context's
+// device compiles the cull and classify passes, and hands the machine code over through Mesa's
+// disk cache (see Render.CompileHelperHandsMachineCodeOver): the same kernels must be cached
+// with and without it, and the same mesh made.
+TEST_F(MeshTest, CompileHelperHandsMachineCodeOver) {
+    if (!onLavapipe(context())) GTEST_SKIP() << "lavapipe only; " << context().deviceName();
+    const DriverCacheFolder cache(testFolder("sdfcsg-mesh-helper-cache"));
+    detail::ScopedEnv noSpirvCache("SDFCSG_CACHE_DIR", "off"); // new kernels
+    const Scene scene =
+        loadOrDie(std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes/robot.json");
+    MeshOptions options;
+    options.resolution = 32;
+    std::optional<Mesh> meshes[2];
+    size_t cached[2] = {};
+    for (int helper : {0, 1}) {
+        SCOPED_TRACE(helper ? "with the helper" : "without the helper");
+        cache.clear();
+        detail::clearShaderMemoryCache();
+        {
+            ContextOptions contextOptions;
+            contextOptions.validation = 1;
+            contextOptions.compileHelper = helper;
+            auto ctx = Context::create(contextOptions);
+            ASSERT_TRUE(ctx) << ctx.error().str();
+            {
+                auto mesher = Mesher::create(**ctx, scene);
+                ASSERT_TRUE(mesher) << mesher.error().str();
+                EXPECT_EQ((*ctx)->impl().helperCompiles.load(), helper ? 2u : 0u);
+                std::lock_guard lock((*ctx)->impl().helperMutex);
+                EXPECT_FALSE((*ctx)->impl().helperFailed) << "the hand-over was taken to fail";
+                auto mesh = (*mesher)->extract(options);
+                ASSERT_TRUE(mesh) << mesh.error().str();
+                meshes[helper] = std::move(*mesh);
+            }
+            EXPECT_EQ((*ctx)->validationMessageCount(), 0u);
+        } // destroying the device finishes the cache's writes
+        cached[helper] = cache.kernels();
+    }
+    EXPECT_GE(cached[0], 4u) << "the driver cached too little in " << cache.dir();
+    EXPECT_EQ(cached[1], cached[0]) << "this device compiled the helper's kernels again";
+    EXPECT_EQ(meshes[1]->positions, meshes[0]->positions);
+    EXPECT_EQ(meshes[1]->indices, meshes[0]->indices);
 }
 
 // Progress climbs to 1; a callback that returns false stops the extraction, which can then run

@@ -1,6 +1,7 @@
 // The GPU ray march against CPU sphere tracing with the reference evaluator: same rays (camera.h),
 // same clipping, same epsilon rule. Plus modes, bounds skipping, value updates and PNG output.
 #include "camera.h"
+#include "driver_cache.h"
 #include "gpu_test.h"
 #include "scoped_env.h"
 #include "shader_compile.h"
@@ -524,40 +525,6 @@ INSTANTIATE_TEST_SUITE_P(Render, UpdateValues, ::testing::Values(true, false),
                              return param.param ? std::string("InlineValues")
                                                 : std::string("BufferValues");
                          });
-
-bool onLavapipe(Context& context) {
-    return context.deviceName().find("llvmpipe") != std::string::npos;
-}
-
-// Mesa's disk cache of machine code in a folder of the test's own, which Mesa makes (only the
-// last folder of the path), and the kernels it holds.
-class DriverCacheFolder {
-  public:
-    explicit DriverCacheFolder(fs::path dir)
-        : dir_(std::move(dir)), folder_("MESA_SHADER_CACHE_DIR", dir_.string()),
-          on_("MESA_SHADER_CACHE_DISABLE", nullptr) {}
-    ~DriverCacheFolder() { clear(); }
-    const fs::path& dir() const { return dir_; }
-    void clear() const {
-        std::error_code ec;
-        fs::remove_all(dir_, ec);
-    }
-    size_t kernels() const {
-        size_t n = 0;
-        std::error_code ec;
-        for (const auto& entry : fs::recursive_directory_iterator(dir_, ec))
-            n += entry.is_regular_file() && entry.path().filename() != "index";
-        return n;
-    }
-
-  private:
-    fs::path dir_;
-    ScopedEnv folder_, on_;
-};
-
-fs::path testFolder(const std::string& name) {
-    return fs::temp_directory_path() / (name + "-" + std::to_string(::getpid()));
-}
 
 // lavapipe may specialise a kernel on values that it reads from a uniform block or from push
 // constants to decide branches, and then compiles it again whenever they change, which would
