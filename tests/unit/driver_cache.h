@@ -2,12 +2,18 @@
 #pragma once
 
 #include "scoped_env.h"
+#include "shader_compile.h"
+#include "vk.h"
 
 #include <sdfcsg/sdfcsg.h>
 
+#include <gtest/gtest.h>
+
 #include <unistd.h>
 
+#include <cstdint>
 #include <filesystem>
+#include <mutex>
 #include <string>
 #include <system_error>
 #include <utility>
@@ -46,6 +52,49 @@ class DriverCacheFolder {
 
 inline std::filesystem::path testFolder(const std::string& name) {
     return std::filesystem::temp_directory_path() / (name + "-" + std::to_string(::getpid()));
+}
+
+// Runs `use(context)` on a new context with the validation layer on (and the compile helper as
+// given), expects no message from the layer, and destroys the context, which finishes the
+// driver cache's writes.
+template <class Use> void onNewContext(bool helper, Use&& use) {
+    ContextOptions contextOptions;
+    contextOptions.validation = 1;
+    contextOptions.compileHelper = helper;
+    auto ctx = Context::create(contextOptions);
+    ASSERT_TRUE(ctx) << ctx.error().str();
+    use(**ctx);
+    EXPECT_EQ((*ctx)->validationMessageCount(), 0u);
+}
+
+// On lavapipe the compile helper compiles some pipelines while the context's device compiles
+// others, and Mesa's disk cache hands the machine code over, which works only if the helper's
+// pipelines are the ones this device looks up (same SPIR-V, layout, constants and the values
+// bound at the first dispatch): otherwise this device compiles them again and caches more
+// kernels. Runs `use(context, helper)`, which builds and runs what is tested, on a new context
+// without and then with the helper, each time with `cache` empty and no SPIR-V cached, and
+// checks that both cached the same kernels, that the helper compiled `helperPipelines`, and that
+// the context did not take its hand-over to have failed.
+template <class Use>
+void expectHelperHandsOver(const DriverCacheFolder& cache, uint32_t helperPipelines, Use&& use) {
+    detail::ScopedEnv noSpirvCache("SDFCSG_CACHE_DIR", "off");
+    size_t cached[2] = {};
+    for (int helper : {0, 1}) {
+        SCOPED_TRACE(helper ? "with the helper" : "without the helper");
+        cache.clear();
+        detail::clearShaderMemoryCache();
+        onNewContext(helper, [&](Context& ctx) {
+            Context::Impl& impl = ctx.impl();
+            ASSERT_EQ(impl.helperWanted, bool(helper));
+            use(ctx, helper);
+            EXPECT_EQ(impl.helperCompiles.load(), helper ? helperPipelines : 0u);
+            std::lock_guard lock(impl.helperMutex);
+            EXPECT_FALSE(impl.helperFailed) << "the hand-over was taken to fail";
+        });
+        cached[helper] = cache.kernels();
+    }
+    EXPECT_GE(cached[0], 2u) << "the driver cached too little in " << cache.dir();
+    EXPECT_EQ(cached[1], cached[0]) << "this device compiled the helper's kernels again";
 }
 
 } // namespace sdfcsg::test

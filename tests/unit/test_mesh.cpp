@@ -5,8 +5,6 @@
 #include "gpu_test.h"
 #include "mesh_checks.h"
 #include "mesh_reference.h"
-#include "shader_compile.h"
-#include "vk.h"
 
 #include <numbers>
 
@@ -246,21 +244,15 @@ TEST_F(MeshTest, ExtractionsCompileNothing) {
     const Scene scene =
         loadOrDie(std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes/house.json");
     auto run = [&](const std::vector<MeshOptions>& extractions) {
-        ContextOptions contextOptions;
-        contextOptions.validation = 1;
-        auto ctx = Context::create(contextOptions);
-        ASSERT_TRUE(ctx) << ctx.error().str();
-        {
-            auto mesher = Mesher::create(**ctx, scene);
+        onNewContext(true, [&](Context& ctx) {
+            auto mesher = Mesher::create(ctx, scene);
             ASSERT_TRUE(mesher) << mesher.error().str();
             for (const MeshOptions& options : extractions) {
                 auto mesh = (*mesher)->extract(options);
                 ASSERT_TRUE(mesh) << mesh.error().str();
                 EXPECT_GT(mesh->triangleCount(), 0u);
             }
-        }
-        EXPECT_EQ((*ctx)->validationMessageCount(), 0u);
-        // Destroying the device finishes the cache's writes.
+        });
     };
     run({});
     const size_t created = cache.kernels();
@@ -275,44 +267,24 @@ TEST_F(MeshTest, ExtractionsCompileNothing) {
 
 // On lavapipe the compile helper compiles the vertices and triangle passes while the context's
 // device compiles the cull and classify passes, and hands the machine code over through Mesa's
-// disk cache (see Render.CompileHelperHandsMachineCodeOver): the same kernels must be cached
-// with and without it, and the same mesh made.
+// disk cache (expectHelperHandsOver() in driver_cache.h). The mesh is the same either way.
 TEST_F(MeshTest, CompileHelperHandsMachineCodeOver) {
     if (!onLavapipe(context())) GTEST_SKIP() << "lavapipe only; " << context().deviceName();
     const DriverCacheFolder cache(testFolder("sdfcsg-mesh-helper-cache"));
-    detail::ScopedEnv noSpirvCache("SDFCSG_CACHE_DIR", "off"); // new kernels
     const Scene scene =
         loadOrDie(std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes/robot.json");
     MeshOptions options;
     options.resolution = 32;
     std::optional<Mesh> meshes[2];
-    size_t cached[2] = {};
-    for (int helper : {0, 1}) {
-        SCOPED_TRACE(helper ? "with the helper" : "without the helper");
-        cache.clear();
-        detail::clearShaderMemoryCache();
-        {
-            ContextOptions contextOptions;
-            contextOptions.validation = 1;
-            contextOptions.compileHelper = helper;
-            auto ctx = Context::create(contextOptions);
-            ASSERT_TRUE(ctx) << ctx.error().str();
-            {
-                auto mesher = Mesher::create(**ctx, scene);
-                ASSERT_TRUE(mesher) << mesher.error().str();
-                EXPECT_EQ((*ctx)->impl().helperCompiles.load(), helper ? 2u : 0u);
-                std::lock_guard lock((*ctx)->impl().helperMutex);
-                EXPECT_FALSE((*ctx)->impl().helperFailed) << "the hand-over was taken to fail";
-                auto mesh = (*mesher)->extract(options);
-                ASSERT_TRUE(mesh) << mesh.error().str();
-                meshes[helper] = std::move(*mesh);
-            }
-            EXPECT_EQ((*ctx)->validationMessageCount(), 0u);
-        } // destroying the device finishes the cache's writes
-        cached[helper] = cache.kernels();
-    }
-    EXPECT_GE(cached[0], 4u) << "the driver cached too little in " << cache.dir();
-    EXPECT_EQ(cached[1], cached[0]) << "this device compiled the helper's kernels again";
+    // The vertices and triangle passes.
+    expectHelperHandsOver(cache, 2, [&](Context& ctx, int helper) {
+        auto mesher = Mesher::create(ctx, scene);
+        ASSERT_TRUE(mesher) << mesher.error().str();
+        auto mesh = (*mesher)->extract(options);
+        ASSERT_TRUE(mesh) << mesh.error().str();
+        meshes[helper] = std::move(*mesh);
+    });
+    ASSERT_TRUE(meshes[0] && meshes[1]);
     EXPECT_EQ(meshes[1]->positions, meshes[0]->positions);
     EXPECT_EQ(meshes[1]->indices, meshes[0]->indices);
 }
