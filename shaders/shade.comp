@@ -25,7 +25,7 @@ const float kShadowSharpness = 10.0;
 // them.
 const uint kColor = 0u, kNormal = 1u, kOcclusion = 2u, kShadow = 3u, kDone = 4u;
 
-void surface(uint slot, vec3 ro, vec3 rd, inout Trace r, out vec3 albedo) {
+void surface(vec3 ro, vec3 rd, vec4 ends, inout Trace r, out vec3 albedo) {
     uint mode = control.size.z;
     uint flags = control.size.w;
     uint lightCount = (flags & SDFCSG_FLAG_SHADOWS) != 0u ? control.counts.y : 0u;
@@ -102,12 +102,12 @@ void surface(uint slot, vec3 ro, vec3 rd, inout Trace r, out vec3 albedo) {
         }
 
         if (nextLight) {
-            // Lanes may be on different lights: on CPU drivers these loads gather, in every
-            // iteration. Keeping the four directions and ends in locals instead, to select from,
-            // cost about a fifth of the kernel's compile (sixteen more values live through the
-            // loop) and saved no measurable time per frame.
+            // Lanes may be on different lights: on CPU drivers this load gathers, in every
+            // iteration. Keeping the four directions in locals instead, to select from, cost
+            // about a sixth of the kernel's compile (twelve more values live through the loop
+            // and its inlined scene) and saved no measurable time per frame.
             dir = frame.lights[min(light, 3u)].direction.xyz;
-            shadowEnd = surfaces[4u * slot][min(light, 3u)]; // the ends pass's
+            shadowEnd = light == 0u ? ends.x : light == 1u ? ends.y : light == 2u ? ends.z : ends.w;
             phase = light < lightCount ? kShadow : kDone;
             t = 2.0 * eps;
             // A light behind the surface needs no shadow (Lambert is zero): end it at once.
@@ -127,7 +127,7 @@ void shadePass() {
     vec3 ro = frame.eye.xyz;
     Trace r = Trace(t, 0u, vec3(0.0), 1.0, vec4(1.0));
     vec3 albedo;
-    surface(slot, ro, rd, r, albedo);
+    surface(ro, rd, surfaces[4u * slot], r, albedo);
     surfaces[4u * slot + 1u] = vec4(r.n, r.ao);
     surfaces[4u * slot + 2u] = r.shadow;
     surfaces[4u * slot + 3u] = vec4(albedo, 0.0);
