@@ -232,7 +232,6 @@ struct Renderer::Impl {
             detail::makeCompileHelper(ctx); // the last build used it up
             bool fresh = false;
             auto spirv = detail::compileKernel("march.comp", glsl, fresh);
-            std::thread translate([&] { march = build(spirv, SDFCSG_RAYMARCH_PASS_MARCH); });
             const auto marchSpec = specConstants(SDFCSG_RAYMARCH_PASS_MARCH, skipping);
             const auto clipSpec = specConstants(SDFCSG_RAYMARCH_PASS_CLIP, false);
             const auto sortSpec = specConstants(SDFCSG_RAYMARCH_PASS_SORT, false);
@@ -244,10 +243,20 @@ struct Renderer::Impl {
                 jobs.push_back({clipSpirv, sortSpec});
             }
             if (!endsSpirv.empty()) jobs.push_back({endsSpirv, endsSpec});
+            // This device's pipeline translates the kernel (SPIR-V to the driver's IR, a tenth of
+            // the compile). Beside the helper's compile of the march kernel alone, which ends
+            // before the shade kernel's, that would take the shade kernel's core from it: after
+            // it. Beside a first build's longer list, which ends later.
+            auto translate = [&] { march = build(spirv, SDFCSG_RAYMARCH_PASS_MARCH); };
+            std::thread beside;
+            if (jobs.size() > 1) beside = std::thread(translate);
             const double ms =
                 detail::precompileElsewhere(ctx, jobs, kBindings, sizeof(BandConstants));
             if (spirv && fresh) helperMs = ms;
-            translate.join();
+            if (beside.joinable())
+                beside.join();
+            else
+                translate();
         });
         Built shade = build(compileKernel("shade.comp", glsl), SDFCSG_RAYMARCH_PASS_SHADE);
         if (!shade.error) {
