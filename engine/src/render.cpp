@@ -85,10 +85,15 @@ struct SharedPasses {
     // The SPIR-V of clip.comp and light.comp where glslang made it (none was cached): then the
     // driver has most likely not compiled them either, and the compile helper may.
     std::vector<uint32_t> freshClip, freshLight;
-    std::mutex mutex; // guards pipelines
+    std::mutex mutex; // guards pipelines and warm
     VkPipeline pipelines[SDFCSG_RAYMARCH_PASSES] = {};
+    bool warm[SDFCSG_RAYMARCH_PASSES] = {}; // the pipeline has run (Renderer::Impl::warmUp)
 
     explicit SharedPasses(Context::Impl& c) : ctx(c) {}
+
+    // The pipeline of a pass, created on first use. Under mutex.
+    VkPipeline created(uint32_t pass);
+
     ~SharedPasses() {
         for (VkPipeline p : pipelines)
             if (p) vkDestroyPipeline(ctx.device, p, nullptr);
@@ -257,6 +262,14 @@ struct Renderer::Impl {
                 beside.join();
             else
                 translate();
+            // The first renderer of a context makes the passes that do not depend on the scene
+            // (their machine code, in a first build, from the helper): their translations too,
+            // beside the shade kernel's compile. Their warm-ups follow (pipeline()).
+            for (uint32_t pass : {SDFCSG_RAYMARCH_PASS_CLIP, SDFCSG_RAYMARCH_PASS_SORT,
+                                  SDFCSG_RAYMARCH_PASS_ENDS}) {
+                std::lock_guard lock(shared->mutex);
+                shared->created(pass);
+            }
         });
         Built shade = build(compileKernel("shade.comp", glsl), SDFCSG_RAYMARCH_PASS_SHADE);
         if (!shade.error) {
@@ -340,18 +353,9 @@ struct Renderer::Impl {
     VkPipeline pipeline(uint32_t pass, bool skipping) {
         if (pass != SDFCSG_RAYMARCH_PASS_MARCH && pass != SDFCSG_RAYMARCH_PASS_SHADE) {
             std::lock_guard lock(shared->mutex);
-            VkPipeline& p = shared->pipelines[pass];
-            if (!p) {
-                const bool lighting =
-                    pass == SDFCSG_RAYMARCH_PASS_ENDS || pass == SDFCSG_RAYMARCH_PASS_LIGHT;
-                const bool perSample =
-                    pass == SDFCSG_RAYMARCH_PASS_CLIP || pass == SDFCSG_RAYMARCH_PASS_SORT;
-                VkShaderModule module = perSample  ? shared->clip
-                                        : lighting ? shared->light
-                                                   : shared->finish;
-                p = createPipeline(module, pass, false);
-                warmUp(p);
-            }
+            VkPipeline p = shared->created(pass);
+            if (!shared->warm[pass]) warmUp(p);
+            shared->warm[pass] = true;
             return p;
         }
         VkPipeline& p = pipelines[pass][skipping ? 1 : 0];
@@ -556,6 +560,17 @@ std::optional<RenderMode> parseRenderMode(std::string_view name) {
 
 Renderer::Renderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 Renderer::~Renderer() = default;
+
+VkPipeline SharedPasses::created(uint32_t pass) {
+    VkPipeline& p = pipelines[pass];
+    if (p) return p;
+    const bool perSample = pass == SDFCSG_RAYMARCH_PASS_CLIP || pass == SDFCSG_RAYMARCH_PASS_SORT;
+    const bool perHit = pass == SDFCSG_RAYMARCH_PASS_ENDS || pass == SDFCSG_RAYMARCH_PASS_LIGHT;
+    VkShaderModule module = perSample ? clip : perHit ? light : finish;
+    p = detail::createComputePipeline(ctx, module, layout,
+                                      Renderer::Impl::specConstants(pass, false));
+    return p;
+}
 
 Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene& scene,
                                                    const RendererOptions& options) {
