@@ -36,8 +36,8 @@ void clipPass() {
 }
 
 // The march pass left the ray parameter of the hit (negative: a miss) and its steps in the
-// sample's range: the pixel's info from its first sample, then a hit to shade goes on the list,
-// any other sample gets its colour.
+// sample's range: the pixel's info from its first sample, then a hit to shade goes on the list
+// with its ray, any other sample gets its colour.
 void sortPass() {
     uvec2 s;
     uint sampleIndex;
@@ -45,13 +45,16 @@ void sortPass() {
     uint aa = max(control.counts.x, 1u);
     vec2 marched = ranges[sampleIndex];
     Trace r = Trace(marched.x, uint(marched.y), vec3(0.0), 1.0, vec4(1.0));
-    uvec2 pixel = uvec2((vec2(s) + 0.5) / float(aa)); // as sampleRay()
-    if (all(equal(s, pixel * aa))) // the pixel's first sample
-        info[(pixel.y + band.firstRow) * control.size.x + pixel.x] = marched;
+    uvec2 pixel;
+    vec3 rd;
+    sampleRay(s, pixel, rd);
+    if (all(equal(s, (pixel - uvec2(0u, band.firstRow)) * aa))) // the pixel's first sample
+        info[pixel.y * control.size.x + pixel.x] = marched;
     if (needsShading(r)) {
         uint slot = atomicAdd(count, 1u);
         if (slot % (SDFCSG_RAYMARCH_GROUP_X * SDFCSG_RAYMARCH_GROUP_Y) == 0u) atomicAdd(groups, 1u);
         hits[slot] = uvec2(sampleIndex, floatBitsToUint(r.t));
+        surfaces[4u * slot + 1u] = vec4(rd, r.t);
     } else {
         colors[band.colorOffset + sampleIndex] = packColor(plainColor(r));
     }

@@ -23,10 +23,8 @@ uint uniformIndex(uint i) { return subgroupBroadcastFirst(i); }
 void endsPass() {
     uint slot = hitSlot();
     if (slot >= count) return;
-    vec3 rd;
-    float t;
-    hitRay(hits[slot], rd, t);
-    vec3 p = frame.eye.xyz + rd * t;
+    vec4 ray = surfaces[4u * slot + 1u]; // from the sort pass
+    vec3 p = frame.eye.xyz + ray.xyz * ray.w;
     uint lightCount = control.counts.y;
     float shadowReach = frame.distances.w;
     uint partCount = control.parts.x;

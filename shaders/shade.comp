@@ -121,9 +121,9 @@ void surface(vec3 ro, vec3 rd, vec4 ends, inout Trace r, out vec3 albedo) {
 void shadePass() {
     uint slot = hitSlot();
     if (slot >= count) return;
-    vec3 rd;
-    float t;
-    hitRay(hits[slot], rd, t);
+    vec4 ray = surfaces[4u * slot + 1u]; // from the sort pass
+    vec3 rd = ray.xyz;
+    float t = ray.w;
     vec3 ro = frame.eye.xyz;
     Trace r = Trace(t, 0u, vec3(0.0), 1.0, vec4(1.0));
     vec3 albedo;
