@@ -32,7 +32,8 @@ void clipPass() {
         }
         range = vec2(max(range.x, parts.x), min(range.y, parts.y));
     }
-    ranges[sampleIndex] = vec2(range.x, min(range.y, frame.clipMin.w));
+    ranges[2u * sampleIndex] = vec4(rd, range.x);
+    ranges[2u * sampleIndex + 1u].x = min(range.y, frame.clipMin.w);
 }
 
 // The march pass left the ray parameter of the hit (negative: a miss) and its steps in the
@@ -43,13 +44,12 @@ void sortPass() {
     uint sampleIndex;
     if (!tileSample(s, sampleIndex)) return;
     uint aa = max(control.counts.x, 1u);
-    vec2 marched = ranges[sampleIndex];
+    vec3 rd = ranges[2u * sampleIndex].xyz;
+    vec2 marched = ranges[2u * sampleIndex + 1u].xy;
     Trace r = Trace(marched.x, uint(marched.y), vec3(0.0), 1.0, vec4(1.0));
-    uvec2 pixel;
-    vec3 rd;
-    sampleRay(s, pixel, rd);
-    if (all(equal(s, (pixel - uvec2(0u, band.firstRow)) * aa))) // the pixel's first sample
-        info[pixel.y * control.size.x + pixel.x] = marched;
+    uvec2 pixel = uvec2((vec2(s) + 0.5) / float(aa)); // in the band, as sampleRay() finds it
+    if (all(equal(s, pixel * aa))) // the pixel's first sample
+        info[(pixel.y + band.firstRow) * control.size.x + pixel.x] = marched;
     if (needsShading(r)) {
         uint slot = atomicAdd(count, 1u);
         if (slot % (SDFCSG_RAYMARCH_GROUP_X * SDFCSG_RAYMARCH_GROUP_Y) == 0u) atomicAdd(groups, 1u);

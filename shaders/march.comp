@@ -35,12 +35,9 @@ void marchPass() {
     uvec2 s;
     uint sampleIndex;
     if (!tileSample(s, sampleIndex)) return;
-    uvec2 pixel;
-    vec3 rd;
-    sampleRay(s, pixel, rd);
-    vec2 range = ranges[sampleIndex];
-    Trace r = march(frame.eye.xyz, rd, range.x, range.y);
-    ranges[sampleIndex] = vec2(r.t, float(r.steps));
+    vec4 ray = ranges[2u * sampleIndex]; // from the clip pass
+    Trace r = march(frame.eye.xyz, ray.xyz, ray.w, ranges[2u * sampleIndex + 1u].x);
+    ranges[2u * sampleIndex + 1u].xy = vec2(r.t, float(r.steps));
 }
 
 void main() { marchPass(); }

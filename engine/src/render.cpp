@@ -113,7 +113,7 @@ struct BandConstants {
 constexpr uint32_t kGroupSize = SDFCSG_RAYMARCH_GROUP_X * SDFCSG_RAYMARCH_GROUP_Y;
 constexpr VkDeviceSize kHitsHeader = 16; // count, then the shade pass's dispatch
 constexpr VkDeviceSize kSurfaceBytes = 64; // per listed hit: four vec4 (raymarch.glsl)
-constexpr VkDeviceSize kRangeBytes = 8;    // per sample: a vec2
+constexpr VkDeviceSize kRangeBytes = 32;   // per sample: two vec4 (raymarch.glsl)
 
 Error usage(std::string text) {
     return Error::message(ErrorKind::Usage, "<render>", std::move(text));
