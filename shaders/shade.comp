@@ -31,6 +31,10 @@ void surface(vec3 ro, vec3 rd, vec4 ends, inout Trace r, out vec3 albedo) {
     uint lightCount = (flags & SDFCSG_FLAG_SHADOWS) != 0u ? control.counts.y : 0u;
     float aoScale = frame.distances.z;
 
+    // For the loop below, whose lanes may be on different lights (see nextLight).
+    vec3 light0 = frame.lights[0].direction.xyz, light1 = frame.lights[1].direction.xyz;
+    vec3 light2 = frame.lights[2].direction.xyz, light3 = frame.lights[3].direction.xyz;
+
     float eps = hitEpsilon(r.t);
     vec3 p = ro + rd * r.t; // the hit, then the hit lifted off the surface
 
@@ -102,11 +106,11 @@ void surface(vec3 ro, vec3 rd, vec4 ends, inout Trace r, out vec3 albedo) {
         }
 
         if (nextLight) {
-            // Lanes may be on different lights: on CPU drivers this load gathers, in every
-            // iteration. Keeping the four directions in locals instead, to select from, cost
-            // about a sixth of the kernel's compile (twelve more values live through the loop
-            // and its inlined scene) and saved no measurable time per frame.
-            dir = frame.lights[min(light, 3u)].direction.xyz;
+            // Light directions come from locals with selects. Indexing the uniform array by the
+            // lane's light instead compiles about a tenth faster on lavapipe, but that load
+            // gathers in every iteration of this loop on CPU drivers: a fifth more time per
+            // frame for the small scenes (csg_part, mesh_a).
+            dir = light == 0u ? light0 : light == 1u ? light1 : light == 2u ? light2 : light3;
             shadowEnd = light == 0u ? ends.x : light == 1u ? ends.y : light == 2u ? ends.z : ends.w;
             phase = light < lightCount ? kShadow : kDone;
             t = 2.0 * eps;
