@@ -23,7 +23,7 @@ uint uniformIndex(uint i) { return subgroupBroadcastFirst(i); }
 void endsPass() {
     uint slot = hitSlot();
     if (slot >= count) return;
-    vec4 ray = surfaces[4u * slot + 1u]; // from the sort pass
+    vec4 ray = surfaces[4u * slot + 1u]; // from the march pass
     vec3 p = frame.eye.xyz + ray.xyz * ray.w;
     uint lightCount = control.counts.y;
     float shadowReach = frame.distances.w;

@@ -27,17 +27,24 @@ Trace march(vec3 ro, vec3 rd, float t, float tFar) {
     return r;
 }
 
-// The sort pass (clip.comp) reads the result from the sample's range and does the rest: the
-// pixel's info, the hit list, the colour of the samples that need no shading. Out of this
-// kernel, which every new scene compiles, that work cost the house's march kernel about a fifth
-// of its compile on lavapipe.
 void marchPass() {
     uvec2 s;
     uint sampleIndex;
     if (!tileSample(s, sampleIndex)) return;
     vec4 ray = ranges[2u * sampleIndex]; // from the clip pass
     Trace r = march(frame.eye.xyz, ray.xyz, ray.w, ranges[2u * sampleIndex + 1u].x);
-    ranges[2u * sampleIndex + 1u].xy = vec2(r.t, float(r.steps));
+    uint aa = max(control.counts.x, 1u);
+    uvec2 pixel = uvec2((vec2(s) + 0.5) / float(aa)); // in the band, as sampleRay() finds it
+    if (all(equal(s, pixel * aa))) // the pixel's first sample
+        info[(pixel.y + band.firstRow) * control.size.x + pixel.x] = vec2(r.t, float(r.steps));
+    if (needsShading(r)) {
+        uint slot = atomicAdd(count, 1u);
+        if (slot % (SDFCSG_RAYMARCH_GROUP_X * SDFCSG_RAYMARCH_GROUP_Y) == 0u) atomicAdd(groups, 1u);
+        hits[slot] = uvec2(sampleIndex, floatBitsToUint(r.t));
+        surfaces[4u * slot + 1u] = vec4(ray.xyz, r.t);
+    } else {
+        colors[band.colorOffset + sampleIndex] = packColor(plainColor(r));
+    }
 }
 
 void main() { marchPass(); }

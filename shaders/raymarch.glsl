@@ -6,12 +6,11 @@
 //   clip:    one invocation per sample (aa x aa per pixel) finds the part of its ray to march:
 //            inside the clip box, from the first entry into a region that holds surfaces to
 //            the last exit;
-//   march:   one invocation per sample traces that part of its ray to the first hit;
-//   sort:    one invocation per sample writes the colour of misses and of the depth and steps
-//            modes; hits that need shading are appended to a list, which also counts the
-//            workgroups of the passes per hit.
-//            These three run only the workgroups whose rays can meet a surface (the host lists
-//            them); the host fills the rest of the band with the colour of a miss;
+//   march:   one invocation per sample traces that part of its ray to the first hit and
+//            writes the colour of misses and of the depth and steps modes; hits that need
+//            shading are appended to a list, which also counts the shade pass's workgroups.
+//            Both run only the workgroups whose rays can meet a surface (the host lists them);
+//            the host fills the rest of the band with the colour of a miss;
 //   ends:    one invocation per listed hit (an indirect dispatch): where the shadow ray towards
 //            each light can end, leaving the clip box and the boxes that hold surfaces;
 //   shade:   one invocation per listed hit: colour, normal, occlusion and shadows;
@@ -22,12 +21,12 @@
 // CPU drivers such as lavapipe run invocations in SIMD lanes and execute every branch that any
 // lane takes; split this way, misses never pay for shading and every shading lane has a hit.
 // Each pass is its own pipeline: a kernel holds only the code its pass reaches, and the passes
-// that do not depend on the scene (clip.comp: clip and sort, light.comp: ends and light,
-// finish.comp: resolve and overlay) are compiled once per context.
+// that do not depend on the scene (clip.comp, light.comp, finish.comp) are compiled once per
+// context.
 // Whatever a scene kernel holds, each new scene pays for in its compile (drawing the overlays in
 // the march pass took a third of its compile for a one-sphere scene, clipping the rays a fifth of
-// the house's and sorting the results another fifth; the shadow-ray ends and the lighting a
-// quarter of the shade kernel's), so the scene kernels hold nothing that can live elsewhere.
+// the house's; the shadow-ray ends and the lighting a quarter of the shade kernel's), so the
+// scene kernels hold nothing that can live elsewhere.
 //
 // Rays are generated and clipped exactly as engine/src/camera.h does on the CPU (the tests trace
 // the same rays with the reference evaluator). Normals use the four-tap tetrahedral difference
@@ -115,19 +114,18 @@ layout(std430, set = 0, binding = SDFCSG_BINDING_HITS) buffer Hits {
 };
 
 // Per listed hit (the index into hits), four vec4s: 0: where each light's shadow ray can end
-// (ends pass); 1: the ray (direction, ray parameter of the hit) from the sort pass, which the
+// (ends pass); 1: the ray (direction, ray parameter of the hit) from the march pass, which the
 // shade pass reads and replaces with normal and occlusion; from the shade pass, 2: shadow per
-// light, 3: albedo. The scene kernels take their rays from here: working them out from the
-// sample index (hitRay) took a fifth of the shade kernel's compile on lavapipe.
+// light, 3: albedo. The shade kernel takes its ray from here: working it out from the sample
+// index (hitRay) took a fifth of its compile on lavapipe.
 layout(std430, set = 0, binding = SDFCSG_BINDING_SURFACES) buffer Surfaces {
     vec4 surfaces[];
 };
 
-// Per sample of the band (row-major), two vec4s. From the clip pass, its ray and the part of it
-// to march: 0: the direction, and where the march begins; 1: x: where it ends (nothing where it
-// begins later). Then 1.xy: what the march pass found (x: the hit's ray parameter, negative for a
-// miss; y: steps), for the sort pass. The march kernel takes its ray from here: working it out
-// from the sample (sampleRay) took about a sixth of its compile on lavapipe.
+// Per sample of the band (row-major), two vec4s from the clip pass: its ray and the part of it
+// to march. 0: the direction, and where the march begins; 1: x: where it ends (nothing where it
+// begins later). The march kernel takes its ray from here: working it out from the sample
+// (sampleRay) took about a third of its compile on lavapipe.
 layout(std430, set = 0, binding = SDFCSG_BINDING_RANGES) buffer Ranges {
     vec4 ranges[];
 };
@@ -251,7 +249,7 @@ void hitRay(uvec2 hit, out vec3 rd, out float t) {
     t = uintBitsToFloat(hit.y);
 }
 
-// The sample of this invocation of the clip, march and sort passes (column and row in the band's
+// The sample of this invocation of the clip and march passes (column and row in the band's
 // sample grid) and its index; false outside the image.
 bool tileSample(out uvec2 s, out uint sampleIndex) {
     uint aa = max(control.counts.x, 1u);

@@ -125,7 +125,7 @@ void surface(vec3 ro, vec3 rd, vec4 ends, inout Trace r, out vec3 albedo) {
 void shadePass() {
     uint slot = hitSlot();
     if (slot >= count) return;
-    vec4 ray = surfaces[4u * slot + 1u]; // from the sort pass
+    vec4 ray = surfaces[4u * slot + 1u]; // from the march pass
     vec3 rd = ray.xyz;
     float t = ray.w;
     vec3 ro = frame.eye.xyz;

@@ -78,7 +78,7 @@
 #define SDFCSG_SPEC_BOUNDS_SKIPPING 0
 #define SDFCSG_SPEC_MESH_PASS 1  // mesh_field.comp: which pass (SDFCSG_MESH_PASS_*)
 #define SDFCSG_SPEC_MESH_GROUP 2 // mesh_field.comp: workgroup size of that pass
-#define SDFCSG_SPEC_RAYMARCH_PASS 3 // clip.comp, finish.comp, light.comp: which pass (SDFCSG_RAYMARCH_PASS_*)
+#define SDFCSG_SPEC_RAYMARCH_PASS 3 // finish.comp, light.comp: which pass (SDFCSG_RAYMARCH_PASS_*)
 
 #define SDFCSG_RAYMARCH_PASS_MARCH 0
 #define SDFCSG_RAYMARCH_PASS_SHADE 1
@@ -87,8 +87,7 @@
 #define SDFCSG_RAYMARCH_PASS_ENDS 4
 #define SDFCSG_RAYMARCH_PASS_LIGHT 5
 #define SDFCSG_RAYMARCH_PASS_CLIP 6
-#define SDFCSG_RAYMARCH_PASS_SORT 7
-#define SDFCSG_RAYMARCH_PASSES 8
+#define SDFCSG_RAYMARCH_PASSES 7
 
 #define SDFCSG_MESH_PASS_CULL 0
 #define SDFCSG_MESH_PASS_CLASSIFY 1

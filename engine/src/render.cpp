@@ -1,7 +1,7 @@
-// The ray march: per band of rows, the clip, march, sort, ends, shade and light passes and, with
-// several samples per pixel or overlays, the resolve and overlay passes (shaders/clip.comp,
-// march.comp, light.comp, shade.comp and finish.comp, around raymarch.glsl), read back to RGBA8
-// and per-pixel info.
+// The ray march: per band of rows, the clip, march, ends, shade and light passes and, with several
+// samples per pixel or overlays, the resolve and overlay passes (shaders/clip.comp, march.comp,
+// light.comp, shade.comp and finish.comp, around raymarch.glsl), read back to RGBA8 and
+// per-pixel info.
 #include "sdfcsg/render.h"
 
 #include "camera.h"
@@ -220,9 +220,8 @@ struct Renderer::Impl {
         // on llvmpipe, its machine code on the helper device (if it is a new kernel), and this
         // device's pipeline beside that, which at its first dispatch loads the helper's work.
         // In a context's first build the passes that do not depend on the scene are most likely
-        // new too: the helper then compiles the clip, sort and ends passes after the march
-        // kernel, and this device the light pass after the shade kernel (about as long on either
-        // side).
+        // new too: the helper then compiles the clip and ends passes after the march kernel, and
+        // this device the light pass after the shade kernel (about as long on either side).
         std::vector<uint32_t> clipSpirv, endsSpirv;
         {
             std::lock_guard lock(shared->mutex);
@@ -239,14 +238,10 @@ struct Renderer::Impl {
             auto spirv = detail::compileKernel("march.comp", glsl, fresh);
             const auto marchSpec = specConstants(SDFCSG_RAYMARCH_PASS_MARCH, skipping);
             const auto clipSpec = specConstants(SDFCSG_RAYMARCH_PASS_CLIP, false);
-            const auto sortSpec = specConstants(SDFCSG_RAYMARCH_PASS_SORT, false);
             const auto endsSpec = specConstants(SDFCSG_RAYMARCH_PASS_ENDS, false);
             std::vector<detail::Precompile> jobs;
             if (spirv && fresh) jobs.push_back({*spirv, marchSpec});
-            if (!clipSpirv.empty()) {
-                jobs.push_back({clipSpirv, clipSpec});
-                jobs.push_back({clipSpirv, sortSpec});
-            }
+            if (!clipSpirv.empty()) jobs.push_back({clipSpirv, clipSpec});
             if (!endsSpirv.empty()) jobs.push_back({endsSpirv, endsSpec});
             // This device's pipeline translates the kernel (SPIR-V to the driver's IR, a tenth of
             // the compile). Beside the helper's compile of the march kernel alone, which ends
@@ -265,8 +260,7 @@ struct Renderer::Impl {
             // The first renderer of a context makes the passes that do not depend on the scene
             // (their machine code, in a first build, from the helper): their translations too,
             // beside the shade kernel's compile. Their warm-ups follow (pipeline()).
-            for (uint32_t pass : {SDFCSG_RAYMARCH_PASS_CLIP, SDFCSG_RAYMARCH_PASS_SORT,
-                                  SDFCSG_RAYMARCH_PASS_ENDS}) {
+            for (uint32_t pass : {SDFCSG_RAYMARCH_PASS_CLIP, SDFCSG_RAYMARCH_PASS_ENDS}) {
                 std::lock_guard lock(shared->mutex);
                 shared->created(pass);
             }
@@ -564,9 +558,8 @@ Renderer::~Renderer() = default;
 VkPipeline SharedPasses::created(uint32_t pass) {
     VkPipeline& p = pipelines[pass];
     if (p) return p;
-    const bool perSample = pass == SDFCSG_RAYMARCH_PASS_CLIP || pass == SDFCSG_RAYMARCH_PASS_SORT;
     const bool perHit = pass == SDFCSG_RAYMARCH_PASS_ENDS || pass == SDFCSG_RAYMARCH_PASS_LIGHT;
-    VkShaderModule module = perSample ? clip : perHit ? light : finish;
+    VkShaderModule module = pass == SDFCSG_RAYMARCH_PASS_CLIP ? clip : perHit ? light : finish;
     p = detail::createComputePipeline(ctx, module, layout,
                                       Renderer::Impl::specConstants(pass, false));
     return p;
@@ -610,7 +603,6 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene
     // renderer of the context makes them; buildKernels() has made the light pass, and on
     // lavapipe compiled the others on the helper).
     r.pipeline(SDFCSG_RAYMARCH_PASS_CLIP, false);
-    r.pipeline(SDFCSG_RAYMARCH_PASS_SORT, false);
     r.pipeline(SDFCSG_RAYMARCH_PASS_ENDS, false);
     r.pipeline(SDFCSG_RAYMARCH_PASS_LIGHT, false);
     return std::unique_ptr<Renderer>(new Renderer(std::move(impl)));
@@ -686,7 +678,6 @@ Result<Image> Renderer::render(const RenderOptions& options) {
     const bool shading = options.mode == RenderMode::Shaded || options.mode == RenderMode::Normals;
     VkPipeline clipRays = r.pipeline(SDFCSG_RAYMARCH_PASS_CLIP, false);
     VkPipeline march = r.pipeline(SDFCSG_RAYMARCH_PASS_MARCH, skipping);
-    VkPipeline sort = r.pipeline(SDFCSG_RAYMARCH_PASS_SORT, false);
     VkPipeline shade = shading ? r.pipeline(SDFCSG_RAYMARCH_PASS_SHADE, skipping) : VK_NULL_HANDLE;
     VkPipeline light = shading ? r.pipeline(SDFCSG_RAYMARCH_PASS_LIGHT, false) : VK_NULL_HANDLE;
     VkPipeline ends = shading && options.mode == RenderMode::Shaded && options.shadows
@@ -764,9 +755,6 @@ Result<Image> Renderer::render(const RenderOptions& options) {
             vkCmdDispatch(cmd, uint32_t(tiles.size()), 1, 1);
             detail::recordComputeBarrier(cmd);
             vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, march);
-            vkCmdDispatch(cmd, uint32_t(tiles.size()), 1, 1);
-            detail::recordComputeBarrier(cmd);
-            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, sort);
             vkCmdDispatch(cmd, uint32_t(tiles.size()), 1, 1);
         }
         for (VkPipeline perHit : {ends, shade, light}) { // one invocation per listed hit

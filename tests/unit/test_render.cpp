@@ -574,8 +574,8 @@ TEST_F(Render, OtherValuesCompileNothing) {
 
 // On lavapipe a second device compiles the march kernel while the context's own compiles the
 // shade kernel, and hands the machine code over through Mesa's disk cache (expectHelperHandsOver()
-// in driver_cache.h); in a context's first build, also the clip, sort and ends passes. The image is
-// the same either way.
+// in driver_cache.h); in a context's first build, also the clip and ends passes. The image is the
+// same either way.
 TEST_F(Render, CompileHelperHandsMachineCodeOver) {
     if (!onLavapipe(context())) GTEST_SKIP() << "lavapipe only; " << context().deviceName();
     const DriverCacheFolder cache(testFolder("sdfcsg-helper-cache"));
@@ -583,8 +583,8 @@ TEST_F(Render, CompileHelperHandsMachineCodeOver) {
     RenderOptions options;
     options.width = 64, options.height = 48;
     std::optional<Image> images[2];
-    // The first build of a context: the march kernel, the clip, sort and ends passes.
-    expectHelperHandsOver(cache, 4, [&](Context& ctx, int helper) {
+    // The first build of a context: the march kernel, the clip and ends passes.
+    expectHelperHandsOver(cache, 3, [&](Context& ctx, int helper) {
         auto renderer = Renderer::create(ctx, scene);
         ASSERT_TRUE(renderer) << renderer.error().str();
         auto image = (*renderer)->render(options);
@@ -620,8 +620,8 @@ TEST_F(Render, CompileHelperStopsWhereTheCacheHandsNothingOver) {
         detail::clearShaderMemoryCache();
         auto renderer = Renderer::create(**ctx, loadOrDie(scenePath(name)));
         ASSERT_TRUE(renderer) << renderer.error().str();
-        // The first build's march kernel, clip, sort and ends passes.
-        EXPECT_EQ(impl.helperCompiles.load(), 4u) << "the helper compiled after it missed";
+        // The first build's march kernel, clip and ends passes.
+        EXPECT_EQ(impl.helperCompiles.load(), 3u) << "the helper compiled after it missed";
         std::lock_guard lock(impl.helperMutex);
         EXPECT_TRUE(impl.helperFailed);
         EXPECT_EQ(impl.helper, nullptr);
