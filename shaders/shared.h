@@ -19,6 +19,7 @@
 #define SDFCSG_BINDING_CONTROL 9 // raymarch.glsl: buffer Control: the values that branches read
 #define SDFCSG_BINDING_SURFACES 10 // raymarch.glsl: per listed hit, what the shade pass hands over
 #define SDFCSG_BINDING_RANGES 11   // raymarch.glsl: per sample, the part of its ray to march
+#define SDFCSG_BINDING_FIELD 15   // tape.glsl: per-region pruned tapes (engine/src/prune.h)
 #define SDFCSG_BINDING_PROBE_IN 4  // probe.comp: readonly buffer of vec4 points (xyz used)
 #define SDFCSG_BINDING_PROBE_OUT 5 // probe.comp: buffer of vec4 sceneSample() results
 

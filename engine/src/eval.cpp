@@ -4,6 +4,7 @@
 // generates, so the CPU and GPU fields agree to rounding.
 #include "sdfcsg/eval.h"
 
+#include "prune.h"
 #include "sdf.h"
 
 #include <glm/geometric.hpp>
@@ -165,6 +166,14 @@ V evaluate(const std::vector<FlatNode>& nodes, uint32_t root, glm::vec3 p, bool 
 
 } // namespace
 
+namespace detail {
+
+float primitiveValue(const FlatNode& node, glm::vec3 p) {
+    return leaf<float>(node, p);
+}
+
+} // namespace detail
+
 Evaluator::Evaluator(const Scene& scene) {
     const size_t count = scene.nodes.size();
     nodes_.resize(count);
@@ -233,9 +242,11 @@ Evaluator::Evaluator(const Scene& scene) {
                 box.min = glm::min(box.min, nodes_[c].bounds.min);
                 box.max = glm::max(box.max, nodes_[c].bounds.max);
             }
-            // Each smooth fold lowers the value by at most k/4 below the sharp minimum.
+            // However many operands, the fold never goes more than k below their minimum: the
+            // smooth minimum grows with each operand, and smin(m - k, m) = m - k, so from
+            // operands >= m every fold stays >= m - k. Boxes widened by k then bound it.
             if (n.smooth > 0.0f) {
-                float grow = float(n.children.size() - 1) * n.smooth * 0.25f * (1.0f + 1e-5f);
+                float grow = n.smooth * (1.0f + 1e-5f);
                 box.min -= grow;
                 box.max += grow;
             }

@@ -1,5 +1,6 @@
 #include "gpu_nodes.h"
 
+#include "prune.h"
 #include "shared.h"
 
 #include <algorithm>
@@ -34,6 +35,24 @@ std::vector<GpuNode> packNodes(const Evaluator& evaluator) {
         out.push_back(g);
     }
     return out;
+}
+
+Result<bool> uploadField(Context::Impl& ctx, Buffer& buffer, const Scene& scene,
+                         const Evaluator& evaluator, Evaluation evaluation) {
+    std::vector<uint32_t> words = usesTapes(scene, evaluation)
+                                      ? packField(pruneField(evaluator))
+                                      : std::vector<uint32_t>(kFieldHeaderWords, 0u);
+    const VkDeviceSize bytes = words.size() * sizeof(uint32_t);
+    bool made = false;
+    if (!buffer.buffer || buffer.size < bytes) {
+        auto grown = createBuffer(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::Upload);
+        if (!grown) return grown.error();
+        destroyBuffer(ctx, buffer);
+        buffer = *grown;
+        made = true;
+    }
+    uploadBuffer(ctx, buffer, words.data(), size_t(bytes));
+    return made;
 }
 
 } // namespace sdfcsg::detail

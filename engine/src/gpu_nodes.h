@@ -1,7 +1,9 @@
 // The node buffer: one GpuNode per scene node, index-aligned, read by the generated scene code.
 #pragma once
 
+#include "sdfcsg/compile.h"
 #include "sdfcsg/eval.h"
+#include "vk.h"
 
 #include <glm/vec4.hpp>
 
@@ -21,5 +23,12 @@ static_assert(sizeof(GpuNode) == 128, "GpuNode must match the std430 Node in nod
 
 // Everything numeric the shaders need, so that changing values needs only a re-upload.
 std::vector<GpuNode> packNodes(const Evaluator& evaluator);
+
+// The buffer that shaders/tape.glsl reads (binding SDFCSG_BINDING_FIELD): the scene's pruned
+// field where its kernels run tapes, a header alone otherwise (the binding must still hold a
+// buffer). Grows `buffer` when the field no longer fits; returns true when it made a new one,
+// whose descriptors the caller then writes again. On failure the old buffer stays.
+Result<bool> uploadField(Context::Impl& ctx, Buffer& buffer, const Scene& scene,
+                         const Evaluator& evaluator, Evaluation evaluation);
 
 } // namespace sdfcsg::detail

@@ -82,6 +82,7 @@ constexpr detail::Binding kBindings[] = {
     {SDFCSG_BINDING_MESH_STATUS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
     {SDFCSG_BINDING_MESH_LIST_RANGES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
     {SDFCSG_BINDING_MESH_LIST_ITEMS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+    {SDFCSG_BINDING_FIELD, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
 };
 constexpr size_t kBindingCount = std::size(kBindings);
 
@@ -238,7 +239,8 @@ struct Mesher::Impl {
         case SDFCSG_BINDING_MESH_ACTIVE:
         case SDFCSG_BINDING_MESH_BASES:
         case SDFCSG_BINDING_MESH_LIST_RANGES:
-        case SDFCSG_BINDING_MESH_LIST_ITEMS: return MemoryUse::Upload;
+        case SDFCSG_BINDING_MESH_LIST_ITEMS:
+        case SDFCSG_BINDING_FIELD: return MemoryUse::Upload;
         case SDFCSG_BINDING_MESH_MAP: // written by the cull pass, read and rewritten by the host
         case SDFCSG_BINDING_MESH_COUNTS:
         case SDFCSG_BINDING_MESH_VERTICES:
@@ -373,18 +375,21 @@ struct Mesher::Impl {
 Mesher::Mesher(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 Mesher::~Mesher() = default;
 
-Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& scene) {
+Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& scene,
+                                               Evaluation evaluation) {
     if (scene.nodes.empty()) return usage("the scene has no nodes");
     auto impl = std::make_unique<Impl>(context.impl());
     Impl& m = *impl;
     m.evaluator = std::make_unique<Evaluator>(scene);
 
-    m.lists = detail::primitiveLists(scene, *m.evaluator);
+    const bool tapes = usesTapes(scene, evaluation);
+    if (!tapes) m.lists = detail::primitiveLists(scene, *m.evaluator);
     // Bounds tests pay off only where branches are real (see RenderOptions::boundsSkipping).
     const uint32_t skipping = m.ctx.properties.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU;
     CodegenOptions codegen;
     codegen.inlineParams = true;
     codegen.primitiveLists = true;
+    codegen.evaluation = evaluation;
     codegen.boundsTests = skipping != 0;
     const std::string sceneGlsl = generateSceneGlsl(scene, codegen);
     const char* kernels[] = {"mesh_field.comp", "mesh_triangles.comp"};
@@ -423,7 +428,9 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
                          : b.binding == SDFCSG_BINDING_NODES       ? nodes.size() * sizeof nodes[0]
                          : b.binding == SDFCSG_BINDING_MESH_TABLES ? tables.size() * 4
                          : b.binding == SDFCSG_BINDING_MESH_STATUS ? 8
+                         : b.binding == SDFCSG_BINDING_FIELD       ? 0 // uploadField() makes it
                                                                    : 4;
+        if (b.binding == SDFCSG_BINDING_FIELD) continue;
         auto made = detail::createBuffer(
             m.ctx, bytes,
             b.type == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER ? VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT
@@ -436,6 +443,10 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
                          nodes.size() * sizeof nodes[0]);
     detail::uploadBuffer(m.ctx, m.buffer(SDFCSG_BINDING_MESH_TABLES), tables.data(),
                          tables.size() * 4);
+    if (auto made = detail::uploadField(m.ctx, m.buffer(SDFCSG_BINDING_FIELD), scene, *m.evaluator,
+                                        evaluation);
+        !made)
+        return made.error();
     MeshGrid empty = {};
     detail::uploadBuffer(m.ctx, m.buffer(SDFCSG_BINDING_MESH_GRID), &empty, sizeof empty);
     m.writeDescriptors();

@@ -72,6 +72,7 @@ constexpr detail::Binding kBindings[] = {
     {SDFCSG_BINDING_CONTROL, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
     {SDFCSG_BINDING_SURFACES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
     {SDFCSG_BINDING_RANGES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+    {SDFCSG_BINDING_FIELD, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
 };
 
 // What the renderers of a context share: the layout of the kernels' bindings, and the pipelines
@@ -173,7 +174,7 @@ struct Renderer::Impl {
     // The image (pixels, info), and per band: the samples' colours (with several per pixel),
     // the workgroups to march and the hits to shade.
     Buffer frame, control, nodes, pixels, info, pixelsStaging, infoStaging, samples, hits, tiles,
-        surfaces, ranges;
+        surfaces, ranges, field;
     uint32_t capacity = 0;       // pixels the image buffers hold
     uint32_t sampleCapacity = 0; // samples the band buffers hold
     uint32_t tileCapacity = 0;   // workgroups the tile list holds
@@ -186,7 +187,7 @@ struct Renderer::Impl {
     ~Impl() {
         VkDevice device = ctx.device;
         for (Buffer* b : {&frame, &control, &nodes, &pixels, &info, &pixelsStaging, &infoStaging,
-                          &samples, &hits, &tiles, &surfaces, &ranges})
+                          &samples, &hits, &tiles, &surfaces, &ranges, &field})
             detail::destroyBuffer(ctx, *b);
         destroyKernel();
         if (pool) vkDestroyDescriptorPool(device, pool, nullptr);
@@ -309,6 +310,7 @@ struct Renderer::Impl {
     std::string sceneGlsl(bool skipping) const {
         CodegenOptions codegen;
         codegen.inlineParams = options.inlineValues;
+        codegen.evaluation = options.evaluation;
         codegen.boundsTests = skipping;
         return generateSceneGlsl(scene, codegen);
     }
@@ -379,17 +381,22 @@ struct Renderer::Impl {
         detail::submitAndWait(ctx);
     }
 
-    void uploadNodes() {
+    // The node buffer, and the pruned field where the kernels run tapes.
+    Status uploadNodes() {
         std::vector<detail::GpuNode> packed = detail::packNodes(*evaluator);
         detail::uploadBuffer(ctx, nodes, packed.data(), packed.size() * sizeof(detail::GpuNode));
+        auto made = detail::uploadField(ctx, field, scene, *evaluator, options.evaluation);
+        if (!made) return made.error();
+        if (*made) writeDescriptors();
+        return Ok{};
     }
 
     // Once the image and band buffers exist (create() reserves both).
     void writeDescriptors() {
         if (!pixels.buffer || !samples.buffer) return;
         const Buffer* colors = samplesArePixels ? &pixels : &samples;
-        const Buffer* buffers[] = {&frame, &nodes, &pixels,  &info,     colors,
-                                   &hits,  &tiles, &control, &surfaces, &ranges};
+        const Buffer* buffers[] = {&frame, &nodes,   &pixels,   &info,   colors, &hits,
+                                   &tiles, &control, &surfaces, &ranges, &field};
         detail::writeDescriptorSet(ctx, set, kBindings, buffers);
     }
 
@@ -595,7 +602,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene
                              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, detail::MemoryUse::Upload);
     if (!nodes) return nodes.error();
     r.nodes = *nodes;
-    r.uploadNodes();
+    if (auto uploaded = r.uploadNodes(); !uploaded) return uploaded.error();
     if (auto reserved = r.reserve(64 * 64); !reserved) return reserved.error();
     if (auto reserved = r.reserveSamples(64 * 64, 64); !reserved) return reserved.error();
     if (auto built = r.buildKernels(); !built) return built.error();
@@ -615,15 +622,14 @@ Status Renderer::updateValues(const Scene& scene) {
     Impl& r = *impl_;
     Scene previous = std::move(r.scene);
     r.scene = scene;
-    if (r.options.inlineValues) {
+    if (r.options.inlineValues && !usesTapes(scene, r.options.evaluation)) {
         if (auto built = r.buildKernels(); !built) {
             r.scene = std::move(previous);
             return built.error();
         }
     }
     r.evaluator = std::make_unique<Evaluator>(scene);
-    r.uploadNodes(); // no render is in flight: render() waits for its fence
-    return Ok{};
+    return r.uploadNodes(); // no render is in flight: render() waits for its fence
 }
 
 Result<Image> Renderer::render(const RenderOptions& options) {

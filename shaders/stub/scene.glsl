@@ -41,3 +41,7 @@ vec4 sceneSample(vec3 p) {
     return s0;
 }
 
+
+// The scene code of large scenes includes the tape machine instead (codegen.cpp).
+#define SDFCSG_TAPE_STACK 4
+#include "tape.glsl"

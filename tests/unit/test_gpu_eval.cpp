@@ -3,6 +3,7 @@
 // scene, with bounds skipping on and off, and with the bounds tests left out of the code.
 #include "gpu_nodes.h"
 #include "gpu_test.h"
+#include "prune.h"
 #include "shared.h"
 #include "vk.h"
 
@@ -26,12 +27,15 @@ struct Probe {
     // The result is read back through a staging copy, as on GPUs whose storage memory is not
     // mappable (lavapipe's always is), so that path runs under validation too.
     bool viaStaging;
+    // Pruned tapes (shaders/tape.glsl), held to the CPU's pruned field (engine/src/prune.cpp).
+    bool tapes = false;
 };
 
 constexpr Probe kProbes[] = {
     {"bounds skipping on", true, true, false},
     {"bounds skipping off, staging read-back", true, false, true},
     {"bounds tests left out", false, false, false},
+    {"pruned tapes", true, true, false, true},
 };
 
 // Runs probe.comp over `points`; returns (rgb colour, distance) per point.
@@ -40,6 +44,7 @@ std::vector<glm::vec4> probeGpu(Context& context, const Scene& scene,
     Context::Impl& ctx = context.impl();
     CodegenOptions codegen;
     codegen.boundsTests = probe.boundsTests;
+    codegen.evaluation = probe.tapes ? Evaluation::Tapes : Evaluation::Inlined;
     const std::string glsl = generateSceneGlsl(scene, codegen);
     if (!probe.boundsTests) {
         EXPECT_EQ(glsl.find("Needs("), std::string::npos) << glsl;
@@ -53,6 +58,7 @@ std::vector<glm::vec4> probeGpu(Context& context, const Scene& scene,
         {SDFCSG_BINDING_NODES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
         {SDFCSG_BINDING_PROBE_IN, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
         {SDFCSG_BINDING_PROBE_OUT, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+        {SDFCSG_BINDING_FIELD, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
     };
     VkShaderModule module = detail::createShaderModule(ctx, *spirv);
     VkDescriptorSetLayout setLayout = detail::createDescriptorSetLayout(ctx, bindings);
@@ -81,7 +87,9 @@ std::vector<glm::vec4> probeGpu(Context& context, const Scene& scene,
                                         detail::MemoryUse::Staging);
     detail::uploadBuffer(ctx, nodeBuffer, nodes.data(), nodes.size() * sizeof(detail::GpuNode));
     detail::uploadBuffer(ctx, in, points.data(), bytes);
-    const detail::Buffer* buffers[] = {&nodeBuffer, &in, &out};
+    detail::Buffer field;
+    EXPECT_TRUE(detail::uploadField(ctx, field, scene, evaluator, codegen.evaluation));
+    const detail::Buffer* buffers[] = {&nodeBuffer, &in, &out, &field};
     detail::writeDescriptorSet(ctx, set, bindings, buffers);
 
     uint32_t count = uint32_t(points.size());
@@ -95,7 +103,7 @@ std::vector<glm::vec4> probeGpu(Context& context, const Scene& scene,
     const auto* result = static_cast<const glm::vec4*>(detail::readback(ctx, source, &staging));
     std::vector<glm::vec4> samples(result, result + points.size());
 
-    for (detail::Buffer* b : {&nodeBuffer, &in, &out, &staging})
+    for (detail::Buffer* b : {&nodeBuffer, &in, &out, &staging, &field})
         detail::destroyBuffer(ctx, *b);
     vkDestroyPipeline(ctx.device, pipeline, nullptr);
     vkDestroyDescriptorPool(ctx.device, pool, nullptr);
@@ -141,6 +149,7 @@ std::vector<glm::vec4> samplePoints(const Evaluator& ev, size_t count, uint32_t 
 
 void expectGpuMatchesCpu(Context& context, const Scene& scene, size_t count = 2048) {
     Evaluator ev(scene);
+    const detail::PrunedField pruned = detail::pruneField(ev);
     std::vector<glm::vec4> points = samplePoints(ev, count, 12345);
     for (const Probe& probe : kProbes) {
         SCOPED_TRACE(probe.name);
@@ -150,7 +159,7 @@ void expectGpuMatchesCpu(Context& context, const Scene& scene, size_t count = 20
         std::string first;
         for (size_t i = 0; i < points.size(); ++i) {
             glm::vec3 p(points[i]);
-            Sample cpu = ev.sample(p);
+            Sample cpu = probe.tapes ? pruned.sample(ev.nodes(), p) : ev.sample(p);
             // Single precision throughout; the two sides round transforms differently.
             float tolerance = 2e-5f * (1.0f + glm::length(p)) + 1e-5f * std::abs(cpu.distance);
             if (!(std::abs(gpu[i].w - cpu.distance) <= tolerance)) {

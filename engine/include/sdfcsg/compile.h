@@ -18,7 +18,18 @@
 
 namespace sdfcsg {
 
+// How the generated scene code evaluates the tree. Inlined: every node becomes a line of code
+// (fastest for small scenes, and what a user reads in `sdfcsg glsl`). Tapes: the code is the
+// same for every scene, a stack machine (shaders/tape.glsl) that runs, per cell of an octree
+// around the solid, the nodes that can change the field there (engine/src/prune.h), read from
+// buffers; its size and build time do not grow with the scene. Auto: tapes above
+// kTapeMinNodes nodes.
+enum class Evaluation : uint8_t { Auto, Inlined, Tapes };
+inline constexpr size_t kTapeMinNodes = 160;
+bool usesTapes(const Scene& scene, Evaluation evaluation);
+
 struct CodegenOptions {
+    Evaluation evaluation = Evaluation::Auto;
     // false: numeric parameters, transforms and bounds are read from the node buffer, so
     // changing a value needs no recompile (the viewer). true: they are baked in as literals,
     // which the driver's compiler folds (fastest for one-off headless renders). Scenes of more

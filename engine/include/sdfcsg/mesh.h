@@ -11,6 +11,7 @@
 // is 1-Lipschitz) and is skipped, so the cost follows the surface area, not the volume.
 #pragma once
 
+#include "sdfcsg/compile.h"
 #include "sdfcsg/context.h"
 #include "sdfcsg/error.h"
 #include "sdfcsg/eval.h"
@@ -81,7 +82,9 @@ struct MeshStats {
 // one thread at a time (see context.h).
 class Mesher {
   public:
-    static Result<std::unique_ptr<Mesher>> create(Context& context, const Scene& scene);
+    // `evaluation`: inlined scene code or pruned tapes (CodegenOptions).
+    static Result<std::unique_ptr<Mesher>> create(Context& context, const Scene& scene,
+                                                  Evaluation evaluation = Evaluation::Auto);
     ~Mesher();
 
     // Fails with ErrorKind::Usage for bad options (empty or non-finite bounds, resolution 0)

@@ -1,6 +1,7 @@
 // sdfcsg: ray-marched images of a scene, computed in a Vulkan compute pass.
 #pragma once
 
+#include "sdfcsg/compile.h"
 #include "sdfcsg/context.h"
 #include "sdfcsg/error.h"
 #include "sdfcsg/scene.h"
@@ -72,6 +73,8 @@ struct RendererOptions {
     // that several times faster, but updateValues() must then regenerate and recompile.
     // false: values are read from a buffer, so updateValues() only uploads them (the viewer).
     bool inlineValues = true;
+    // Inlined or pruned tapes (CodegenOptions): with tapes, updateValues() never recompiles.
+    Evaluation evaluation = Evaluation::Auto;
 };
 
 class Renderer {

@@ -1,0 +1,410 @@
+// Per-region pruning (see prune.h): the tape, the octree walk that prunes it per cell, and the
+// stack machine that runs it on the CPU, instruction for instruction as shaders/tape.glsl does.
+#include "prune.h"
+
+#include "sdf.h"
+#include "shared.h"
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <thread>
+
+namespace sdfcsg::detail {
+namespace {
+
+bool isOperation(NodeKind kind) {
+    return kindInfo(kind).operation;
+}
+
+uint32_t instruction(uint32_t node, NodeKind kind) {
+    return node | uint32_t(kind) << kTapeNodeBits;
+}
+
+NodeKind opcode(uint32_t instruction) {
+    return NodeKind(instruction >> kTapeNodeBits);
+}
+
+float opValue(NodeKind kind, float a, float b, float k) {
+    return kind == NodeKind::Union          ? sdf::opUnion(a, b, k)
+           : kind == NodeKind::Intersection ? sdf::opIntersection(a, b, k)
+                                            : sdf::opDifference(a, b, k);
+}
+
+glm::vec4 opValue(NodeKind kind, glm::vec4 a, glm::vec4 b, float k) {
+    return kind == NodeKind::Union          ? sdf::opUnion(a, b, k)
+           : kind == NodeKind::Intersection ? sdf::opIntersection(a, b, k)
+                                            : sdf::opDifference(a, b, k);
+}
+
+// Runs tape[begin, end) at p. V: float (distance) or vec4 (colour, distance in w).
+template <class V>
+V run(const std::vector<FlatNode>& nodes, const uint32_t* tape, uint32_t length, glm::vec3 p) {
+    thread_local std::vector<V> stack;
+    stack.clear();
+    for (uint32_t i = 0; i < length; ++i) {
+        const uint32_t ins = tape[i];
+        const FlatNode& n = nodes[ins & kTapeNodeMask];
+        const NodeKind kind = opcode(ins);
+        if (!isOperation(kind)) {
+            float d = primitiveValue(n, p);
+            if constexpr (std::is_same_v<V, float>)
+                stack.push_back(d);
+            else
+                stack.push_back(glm::vec4(n.color, d));
+            continue;
+        }
+        V b = stack.back();
+        stack.pop_back();
+        stack.back() = opValue(kind, stack.back(), b, n.smooth);
+    }
+    return stack.back();
+}
+
+// Prunes `in` for a cell of centre c and radius r (see prune.h), appending the cell's tape to
+// `out`; returns the root value at c. The first pass runs the tape at c and notes, per
+// operation, the least (union) or greatest (intersection) value of its operands. The second
+// drops the operands that cannot matter anywhere in the cell, where each value lies within
+// v +- r, widened by `slack` for the rounding of single precision (at c here, at p on the GPU):
+//  - of a union, an operand whose lower bound is at least 2k above the least upper bound (k:
+//    the blend radius); of an intersection, the mirror image. Sharp (k = 0), the result is the
+//    same bits. Smooth, an operand 2k above the least one changes the left-to-right fold only
+//    through a chain of blends each of which passes on at most half of a change, well under
+//    1e-5 of k (the tests check 1e-5 absolute near the surface);
+//  - a subtrahend b of a difference where a + b >= k over the cell (max(a, -b) is a), and the
+//    running union a or operand b where they lie k apart (opUnion returns the other).
+struct Pruner {
+    const std::vector<FlatNode>& nodes;
+    float slack;
+    std::vector<float> value;    // per instruction of `in`: the value of the subtree it ends
+    std::vector<float> extreme;  // per node: least (union) / greatest operand value
+    std::vector<uint32_t> touched;
+    std::vector<uint32_t> ends;  // first pass: the stack, as the instructions that end its values
+    struct Segment {
+        uint32_t start; // in out
+        uint32_t end;   // its last instruction in `in` (value[end] is its value at c)
+        bool empty;     // all of it dropped
+    };
+    std::vector<Segment> stack;
+
+    // Whether the fold at `in[i]` of operation u is its first (its left operand is operand 0).
+    static bool firstFold(const uint32_t* in, uint32_t leftEnd, uint32_t instructionAt) {
+        return in[leftEnd] != in[instructionAt];
+    }
+
+    float prune(const uint32_t* in, uint32_t length, glm::vec3 c, float r,
+                std::vector<uint32_t>& out) {
+        if (value.size() < length) value.resize(length);
+        if (extreme.size() < nodes.size()) extreme.assign(nodes.size(), NAN);
+        ends.clear();
+        for (uint32_t i = 0; i < length; ++i) {
+            const FlatNode& n = nodes[in[i] & kTapeNodeMask];
+            const NodeKind kind = opcode(in[i]);
+            if (!isOperation(kind)) {
+                value[i] = primitiveValue(n, c);
+                ends.push_back(i);
+                continue;
+            }
+            const uint32_t b = ends.back();
+            ends.pop_back();
+            const uint32_t a = ends.back();
+            const uint32_t u = in[i] & kTapeNodeMask;
+            if (kind != NodeKind::Difference) {
+                float& e = extreme[u];
+                if (std::isnan(e)) touched.push_back(u), e = value[a];
+                const bool least = kind == NodeKind::Union;
+                if (firstFold(in, a, i)) e = least ? std::min(e, value[a]) : std::max(e, value[a]);
+                e = least ? std::min(e, value[b]) : std::max(e, value[b]);
+            }
+            value[i] = opValue(kind, value[a], value[b], n.smooth);
+            ends.back() = i;
+        }
+        const float root = value[length - 1];
+
+        stack.clear();
+        for (uint32_t i = 0; i < length; ++i) {
+            const uint32_t ins = in[i];
+            const NodeKind kind = opcode(ins);
+            if (!isOperation(kind)) {
+                stack.push_back({uint32_t(out.size()), i, false});
+                out.push_back(ins);
+                continue;
+            }
+            const uint32_t u = ins & kTapeNodeMask;
+            const float k = nodes[u].smooth;
+            Segment b = stack.back();
+            stack.pop_back();
+            Segment& a = stack.back();
+            const float va = value[a.end], vb = value[b.end];
+            const float gap = 2.0f * r + slack + 1e-5f * (std::abs(va) + std::abs(vb));
+            bool dropA = false, dropB = false;
+            if (kind == NodeKind::Difference) {
+                dropB = va + vb >= gap + k;
+            } else {
+                const float sign = kind == NodeKind::Union ? 1.0f : -1.0f;
+                // Far from the operation's extreme operand; or k beyond the running value.
+                const float e = sign * extreme[u] + 2.0f * k + gap;
+                dropB = sign * vb >= e || sign * (vb - va) >= gap + k;
+                dropA = (firstFold(in, a.end, i) && sign * va >= e) || sign * (va - vb) >= gap + k;
+                if (dropA && dropB) dropA = false; // keep one (only rounding could ask for both)
+            }
+            const bool keepA = !a.empty && !dropA, keepB = !b.empty && !dropB;
+            if (!keepB && !b.empty) out.resize(b.start); // b's instructions are the last ones
+            if (!keepA && !a.empty)
+                out.erase(out.begin() + a.start,
+                          keepB ? out.begin() + b.start : out.end()); // b then starts at a.start
+            if (keepA && keepB) out.push_back(ins);
+            a.empty = !keepA && !keepB;
+            if (a.empty) a.start = uint32_t(out.size());
+            a.end = i;
+        }
+        if (stack.back().empty) { // cannot happen but through rounding: keep everything
+            out.resize(stack.back().start);
+            out.insert(out.end(), in, in + length);
+        }
+        for (uint32_t u : touched)
+            extreme[u] = NAN;
+        touched.clear();
+        return root;
+    }
+};
+
+// The cube that the octree divides: the finite part of the bounds (all finite leaves' boxes
+// where a plane makes the root unbounded), widened by a leaf cell on every side, so that outside
+// it a bounded field is at least half a cell more than the distance to it.
+bool fieldCube(const Evaluator& evaluator, uint32_t levels, glm::vec3& origin, float& cell,
+               bool& bounded) {
+    Aabb box = evaluator.bounds();
+    bounded = box.finite();
+    if (!bounded) {
+        box = Aabb{};
+        for (const FlatNode& n : evaluator.nodes())
+            if (!isOperation(n.kind) && n.bounds.finite()) {
+                box.min = glm::min(box.min, n.bounds.min);
+                box.max = glm::max(box.max, n.bounds.max);
+            }
+    }
+    if (box.empty()) return false;
+    const glm::vec3 extent = box.max - box.min;
+    const float largest = std::max(std::max(extent.x, extent.y), std::max(extent.z, 1e-6f));
+    const float n = float(1u << levels);
+    cell = largest / (n - 2.0f);
+    origin = 0.5f * (box.min + box.max) - 0.5f * n * cell;
+    return true;
+}
+
+} // namespace
+
+std::vector<uint32_t> fullTape(const std::vector<FlatNode>& nodes, uint32_t& stackDepth) {
+    std::vector<uint32_t> tape;
+    stackDepth = 0;
+    if (nodes.empty()) return tape;
+    tape.reserve(2 * nodes.size());
+    // Explicit stack of (node, next child); depth of the value stack alongside.
+    struct Frame {
+        uint32_t node, next;
+    };
+    std::vector<Frame> frames{{0, 0}};
+    uint32_t depth = 0;
+    while (!frames.empty()) {
+        Frame& f = frames.back();
+        const FlatNode& n = nodes[f.node];
+        if (!isOperation(n.kind)) {
+            tape.push_back(instruction(f.node, n.kind));
+            stackDepth = std::max(stackDepth, ++depth);
+            frames.pop_back();
+        } else if (f.next < n.children.size()) {
+            if (f.next >= 2) tape.push_back(instruction(f.node, n.kind)), --depth;
+            const uint32_t child = n.children[f.next++];
+            frames.push_back({child, 0});
+        } else {
+            if (n.children.size() >= 2) tape.push_back(instruction(f.node, n.kind)), --depth;
+            frames.pop_back();
+        }
+    }
+    return tape;
+}
+
+PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) {
+    const std::vector<FlatNode>& nodes = evaluator.nodes();
+    PrunedField field;
+    field.tape = fullTape(nodes, field.stackDepth);
+    field.fullLength = uint32_t(field.tape.size());
+    if (nodes.empty() || options.levels < 2 ||
+        !fieldCube(evaluator, options.levels, field.origin, field.cell, field.bounded)) {
+        field.levels = 0;
+        field.bounded = false;
+        field.cells.assign(1, glm::uvec2(0, field.fullLength));
+        return field;
+    }
+    field.levels = options.levels;
+    const uint32_t side = field.side();
+    field.cells.assign(size_t(side) * side * side, glm::uvec2(0));
+    const float slack = 1e-5f * (field.cell * float(side) + glm::length(field.origin));
+
+    // Level by level: the cells that may hold surface, each with its tape in `tapes`.
+    struct Cell {
+        glm::uvec3 at; // in cells of its level
+        uint32_t begin, length;
+    };
+    std::vector<Cell> cells{{glm::uvec3(0), 0, field.fullLength}};
+    std::vector<uint32_t> tapes = field.tape;
+    const unsigned threads = std::max(1u, std::min(8u, std::thread::hardware_concurrency()));
+    for (uint32_t level = 0; level <= field.levels; ++level) {
+        const float size = field.cell * float(1u << (field.levels - level));
+        const float r = 0.5f * std::sqrt(3.0f) * size;
+        const bool leaf = level == field.levels;
+        // The children of this level's cells (the cells themselves at the root).
+        const uint32_t fan = level == 0 ? 1 : 8;
+        const size_t jobs = cells.size() * fan;
+        struct Out {
+            std::vector<Cell> cells;
+            std::vector<uint32_t> tapes;
+        };
+        const unsigned used = jobs > 64 ? threads : 1;
+        std::vector<Out> outs(used);
+        auto work = [&](unsigned t) {
+            Pruner pruner{nodes, slack, {}};
+            Out& out = outs[t];
+            for (size_t j = t; j < jobs; j += used) {
+                const Cell& parent = cells[j / fan];
+                const uint32_t octant = uint32_t(j % fan);
+                const glm::uvec3 at =
+                    level == 0 ? glm::uvec3(0)
+                               : parent.at * 2u +
+                                     glm::uvec3(octant & 1, octant >> 1 & 1, octant >> 2);
+                const glm::vec3 c = field.origin + (glm::vec3(at) + 0.5f) * size;
+                const uint32_t begin = uint32_t(out.tapes.size());
+                const float v = pruner.prune(tapes.data() + parent.begin, parent.length, c, r,
+                                             out.tapes);
+                if (std::abs(v) > 1.25f * r + slack) { // no surface: fill its leaf cells
+                    out.tapes.resize(begin);
+                    const uint32_t span = 1u << (field.levels - level);
+                    const glm::uvec2 entry(std::bit_cast<uint32_t>(v), kFarCell | level);
+                    for (uint32_t z = 0; z < span; ++z)
+                        for (uint32_t y = 0; y < span; ++y) {
+                            const glm::uvec3 l = at * span + glm::uvec3(0, y, z);
+                            std::fill_n(field.cells.begin() + (l.x + side * (l.y + side * l.z)),
+                                        span, entry);
+                        }
+                    continue;
+                }
+                out.cells.push_back({at, begin, uint32_t(out.tapes.size()) - begin});
+            }
+        };
+        std::vector<std::thread> pool;
+        for (unsigned t = 1; t < used; ++t)
+            pool.emplace_back(work, t);
+        work(0);
+        for (std::thread& t : pool)
+            t.join();
+        // Gather.
+        std::vector<Cell> next;
+        std::vector<uint32_t> nextTapes;
+        for (Out& out : outs) {
+            const uint32_t base = uint32_t(nextTapes.size());
+            nextTapes.insert(nextTapes.end(), out.tapes.begin(), out.tapes.end());
+            for (Cell c : out.cells) {
+                c.begin += base;
+                next.push_back(c);
+            }
+        }
+        if (leaf) {
+            const uint32_t base = field.fullLength;
+            field.tape.insert(field.tape.end(), nextTapes.begin(), nextTapes.end());
+            for (const Cell& c : next)
+                field.cells[c.at.x + side * (c.at.y + side * c.at.z)] =
+                    glm::uvec2(base + c.begin, c.length);
+        }
+        cells = std::move(next);
+        tapes = std::move(nextTapes);
+    }
+    return field;
+}
+
+namespace {
+
+// The leaf cell of p, or nullptr outside the cube.
+const glm::uvec2* cellAt(const PrunedField& f, glm::vec3 p, glm::uvec3& at) {
+    const glm::vec3 q = glm::floor((p - f.origin) / f.cell);
+    const float n = float(f.side());
+    if (f.levels == 0 || !(q.x >= 0 && q.y >= 0 && q.z >= 0 && q.x < n && q.y < n && q.z < n))
+        return nullptr;
+    at = glm::uvec3(q);
+    return &f.cells[at.x + f.side() * (at.y + f.side() * at.z)];
+}
+
+// The bound of a far cell at p.
+float farBound(const PrunedField& f, glm::uvec2 e, glm::uvec3 at, glm::vec3 p) {
+    const uint32_t shift = f.levels - (e.y & 0xffu);
+    const float size = f.cell * float(1u << shift);
+    const glm::vec3 c = f.origin + (glm::vec3(at >> shift) + 0.5f) * size;
+    const float v = std::bit_cast<float>(e.x);
+    const float away = glm::length(p - c);
+    return v > 0.0f ? v - away : v + away;
+}
+
+// Outside the cube of a bounded field.
+float outsideBound(const PrunedField& f, glm::vec3 p) {
+    Aabb cube{f.origin, f.origin + f.cell * float(f.side())};
+    return cube.signedDistance(p) + 0.5f * f.cell;
+}
+
+} // namespace
+
+float PrunedField::distance(const std::vector<FlatNode>& nodes, glm::vec3 p) const {
+    glm::uvec3 at;
+    const glm::uvec2* e = cellAt(*this, p, at);
+    if (!e) {
+        if (bounded) return outsideBound(*this, p);
+        return run<float>(nodes, tape.data(), fullLength, p);
+    }
+    if (e->y & kFarCell) return farBound(*this, *e, at, p);
+    return run<float>(nodes, tape.data() + e->x, e->y, p);
+}
+
+Sample PrunedField::sample(const std::vector<FlatNode>& nodes, glm::vec3 p) const {
+    glm::uvec3 at;
+    const glm::uvec2* e = cellAt(*this, p, at);
+    glm::vec4 v;
+    if (!e && bounded)
+        v = glm::vec4(0.0f, 0.0f, 0.0f, outsideBound(*this, p));
+    else if (!e)
+        v = run<glm::vec4>(nodes, tape.data(), fullLength, p);
+    else if (e->y & kFarCell)
+        v = glm::vec4(0.0f, 0.0f, 0.0f, farBound(*this, *e, at, p));
+    else
+        v = run<glm::vec4>(nodes, tape.data() + e->x, e->y, p);
+    return {v.w, glm::vec3(v)};
+}
+
+uint32_t PrunedField::activeLength(glm::vec3 p) const {
+    glm::uvec3 at;
+    const glm::uvec2* e = cellAt(*this, p, at);
+    if (!e) return bounded ? 0 : fullLength;
+    return e->y & kFarCell ? 0 : e->y;
+}
+
+std::vector<uint32_t> packField(const PrunedField& f) {
+    std::vector<uint32_t> out(kFieldHeaderWords + 2 * f.cells.size() + f.tape.size());
+    auto put = [&](size_t at, float v) { out[at] = std::bit_cast<uint32_t>(v); };
+    put(0, f.origin.x);
+    put(1, f.origin.y);
+    put(2, f.origin.z);
+    put(3, f.cell);
+    out[4] = f.levels;
+    out[5] = f.levels ? f.side() : 0;
+    out[6] = f.bounded ? 1u : 0u;
+    out[7] = f.fullLength;
+    const uint32_t tapeStart = uint32_t(kFieldHeaderWords + 2 * f.cells.size());
+    out[8] = tapeStart;
+    std::memcpy(out.data() + kFieldHeaderWords, f.cells.data(), f.cells.size() * 8);
+    std::copy(f.tape.begin(), f.tape.end(), out.begin() + tapeStart);
+    return out;
+}
+
+} // namespace sdfcsg::detail

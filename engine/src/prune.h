@@ -1,0 +1,76 @@
+// Per-region pruning of the CSG tree (after Lipschitz Pruning, Barbier et al., Eurographics
+// 2025; the per-tile "tapes" of Keeter's MPR, SIGGRAPH 2020).
+//
+// The tree becomes a tape: its nodes in post order, one instruction per primitive and one per
+// fold of an operation (operands fold left to right, as eval.cpp and the generated code do), run
+// by a small stack machine (this file's PrunedField::evaluate and shaders/tape.glsl). A cube
+// around the solid is refined as an octree; each cell runs its parent's tape once at its centre
+// c, and since every node's value is 1-Lipschitz, a node whose value is v at c lies within
+// [v - r, v + r] in the cell (r: the cell's half-diagonal). A fold whose operands are that far
+// apart that the operator returns one of them unchanged (opUnion returns a once b - a >= k,
+// exactly, with k the blend radius) keeps only that operand, so within the cell the pruned tape
+// gives the same bits as the whole tree. A cell whose root value exceeds its radius holds no
+// surface: it stores that value, and evaluation answers there with the bound
+// v - |p - c| (outside) or v + |p - c| (inside), never larger in magnitude than the field.
+// Cells that hold surface are refined down to the leaf level, which keeps their pruned tapes.
+#pragma once
+
+#include "sdfcsg/eval.h"
+
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace sdfcsg::detail {
+
+// Instruction: node index | NodeKind << 24. A primitive pushes its value; an operation pops b,
+// then a, and pushes op(a, b) with its blend radius.
+inline constexpr uint32_t kTapeNodeBits = 24;
+inline constexpr uint32_t kTapeNodeMask = (1u << kTapeNodeBits) - 1u;
+// A leaf cell entry (x, y): near a surface, the cell's tape [x, x + y) in PrunedField::tape;
+// far from every surface, x holds the root value at the centre of the cell of level
+// y & 0xff that was found far, and y has kFarCell set.
+inline constexpr uint32_t kFarCell = 0x80000000u;
+
+struct PruneOptions {
+    uint32_t levels = 6; // leaf cells per axis: 1 << levels
+};
+
+struct PrunedField {
+    glm::vec3 origin{0.0f}; // the cube's minimum corner
+    float cell = 1.0f;      // leaf cell side
+    uint32_t levels = 0;
+    bool bounded = false;   // outside the cube, the field is at least its distance to it
+    uint32_t fullLength = 0; // tape[0, fullLength) is the whole tree
+    uint32_t stackDepth = 0; // the most values any tape holds at once
+    std::vector<uint32_t> tape;
+    std::vector<glm::uvec2> cells; // x + n * (y + n * z), n = 1 << levels
+
+    uint32_t side() const { return 1u << levels; }
+
+    // The field at p, as sceneDistance()/sceneSample() in shaders/tape.glsl compute it.
+    float distance(const std::vector<FlatNode>& nodes, glm::vec3 p) const;
+    Sample sample(const std::vector<FlatNode>& nodes, glm::vec3 p) const;
+    // Instructions that the leaf cell holding p runs (the whole tape outside the cube), 0 in a
+    // far cell.
+    uint32_t activeLength(glm::vec3 p) const;
+};
+
+// The whole tree as a tape, and the most values it holds at once.
+std::vector<uint32_t> fullTape(const std::vector<FlatNode>& nodes, uint32_t& stackDepth);
+
+PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options = {});
+
+// What shaders/tape.glsl reads, as one buffer of 32-bit words: a header of 12 words (origin,
+// cell, levels, side, flags, full tape length, first tape word, 3 spare), the cells (two
+// words each), then the tape.
+inline constexpr uint32_t kFieldHeaderWords = 12;
+std::vector<uint32_t> packField(const PrunedField& field);
+
+// Value of a primitive node at p (eval.cpp): the kernel at the local point, times the scale.
+float primitiveValue(const FlatNode& node, glm::vec3 p);
+
+} // namespace sdfcsg::detail

@@ -1,0 +1,111 @@
+// The scene as data: the stack machine that runs a cell's pruned tape (engine/src/prune.h), the
+// scene code of scenes too large to inline. Kernels built this way are the same for every such
+// scene; the tapes, the cells and the node buffer carry everything that is the scene's own.
+// PrunedField::distance and sample in engine/src/prune.cpp are this file in C++.
+//
+// The generated scene code defines SDFCSG_TAPE_STACK (the most values a tape holds at once,
+// rounded up) before it includes this file.
+
+// Mirrors packField() in engine/src/prune.cpp: a header of 12 words (origin xyz and leaf cell
+// side as float bits, levels, cells per axis, 1 when bounded, whole-tape length, first tape
+// word), two words per leaf cell, then the tape.
+layout(std430, set = 0, binding = SDFCSG_BINDING_FIELD) readonly buffer Field {
+    uint field[];
+};
+
+float tapePrimitive(uint kind, uint i, vec3 p) {
+    vec3 q = toLocal(i, p);
+    vec4 a = nodes[i].p0;
+    float d;
+    switch (kind) {
+    case 0u: d = sdSphere(q, a.x); break;
+    case 1u: d = sdBox(q, a.xyz); break;
+    case 2u: d = sdRoundBox(q, a.xyz, a.w); break;
+    case 3u: d = sdPlane(q, a.xyz, a.w); break;
+    case 4u: d = sdTriangularPrism(q, a.x, a.y, a.z); break;
+    case 5u: d = sdTorus(q, a.x, a.y); break;
+    case 6u: d = sdCylinder(q, a.x, a.y); break;
+    case 7u: d = sdCone(q, a.x, a.y, a.z); break;
+    default: d = sdCapsule(q, a.xyz, nodes[i].p1.xyz, a.w); break;
+    }
+    return d * nodes[i].color.w;
+}
+
+const uint kTapeUnion = 9u, kTapeIntersection = 10u;
+
+float tapeDistanceRun(uint begin, uint end, vec3 p) {
+    float stack[SDFCSG_TAPE_STACK];
+    int top = -1;
+    for (uint at = begin; at < end; ++at) {
+        uint ins = field[at];
+        uint i = ins & 0xffffffu, kind = ins >> 24;
+        if (kind < kTapeUnion) {
+            stack[++top] = tapePrimitive(kind, i, p);
+        } else {
+            float b = stack[top--], a = stack[top], k = nodeSmooth(i);
+            stack[top] = kind == kTapeUnion          ? opUnion(a, b, k)
+                       : kind == kTapeIntersection ? opIntersection(a, b, k)
+                                                   : opDifference(a, b, k);
+        }
+    }
+    return stack[0];
+}
+
+vec4 tapeSampleRun(uint begin, uint end, vec3 p) {
+    vec4 stack[SDFCSG_TAPE_STACK];
+    int top = -1;
+    for (uint at = begin; at < end; ++at) {
+        uint ins = field[at];
+        uint i = ins & 0xffffffu, kind = ins >> 24;
+        if (kind < kTapeUnion) {
+            stack[++top] = withColor(i, tapePrimitive(kind, i, p));
+        } else {
+            vec4 b = stack[top--], a = stack[top];
+            float k = nodeSmooth(i);
+            stack[top] = kind == kTapeUnion          ? opUnion(a, b, k)
+                       : kind == kTapeIntersection ? opIntersection(a, b, k)
+                                                   : opDifference(a, b, k);
+        }
+    }
+    return stack[0];
+}
+
+// Where p's value comes from: x: 0 to run the tape [y, z), 1 for the bound w.
+uvec3 tapeCell(vec3 p, out float bound) {
+    vec3 origin = vec3(uintBitsToFloat(field[0]), uintBitsToFloat(field[1]),
+                       uintBitsToFloat(field[2]));
+    float cell = uintBitsToFloat(field[3]);
+    uint levels = field[4], side = field[5], tapeStart = field[8];
+    vec3 q = floor((p - origin) / cell);
+    bound = 0.0;
+    if (side == 0u || any(lessThan(q, vec3(0.0))) || any(greaterThanEqual(q, vec3(float(side))))) {
+        if (field[6] == 0u) return uvec3(0u, tapeStart, tapeStart + field[7]); // the whole tape
+        // Bounded: the cube holds the bounds and a cell more on every side.
+        vec3 top = origin + cell * float(side);
+        bound = boundsDistance(origin, top, p) + 0.5 * cell;
+        return uvec3(1u, 0u, 0u);
+    }
+    uvec3 at = uvec3(q);
+    uint entry = 12u + 2u * (at.x + side * (at.y + side * at.z));
+    uint x = field[entry], y = field[entry + 1u];
+    if ((y & 0x80000000u) == 0u) return uvec3(0u, tapeStart + x, tapeStart + x + y);
+    // Far from every surface: the root value v at the centre of the cell found far.
+    uint shift = levels - (y & 0xffu);
+    float size = cell * float(1u << shift);
+    vec3 centre = origin + (vec3(at >> shift) + 0.5) * size;
+    float v = uintBitsToFloat(x), away = length(p - centre);
+    bound = v > 0.0 ? v - away : v + away;
+    return uvec3(1u, 0u, 0u);
+}
+
+float tapeDistance(vec3 p) {
+    float bound;
+    uvec3 c = tapeCell(p, bound);
+    return c.x == 1u ? bound : tapeDistanceRun(c.y, c.z, p);
+}
+
+vec4 tapeSample(vec3 p) {
+    float bound;
+    uvec3 c = tapeCell(p, bound);
+    return c.x == 1u ? vec4(0.0, 0.0, 0.0, bound) : tapeSampleRun(c.y, c.z, p);
+}
