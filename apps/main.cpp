@@ -146,6 +146,8 @@ Options:
   --grid                a ground grid under the solid (lines a power of ten apart)
   --skip, --no-skip     force bounds skipping on or off (default: on for GPUs, off for
                         CPU devices, where it only adds work; the image is the same)
+  --evaluation E        auto (default), inlined (every node a line of the kernel) or
+                        tapes (per-region pruned tapes; the default above 160 nodes)
   --device NAME         Vulkan device: index or part of its name (also SDFCSG_DEVICE)
   --validation          enable the Vulkan validation layer
 )";
@@ -174,10 +176,27 @@ class ProgressBar {
     int shown_ = -1;
 };
 
+// --evaluation auto|inlined|tapes (CodegenOptions); false with a message when it is neither.
+bool parseEvaluation(const Args& args, const char* command, sdfcsg::Evaluation& out) {
+    // kUsage comes from usageError(), which prints the message.
+    if (!args.has("--evaluation")) return true;
+    const std::string v = args.get("--evaluation");
+    if (v == "auto")
+        out = sdfcsg::Evaluation::Auto;
+    else if (v == "inlined")
+        out = sdfcsg::Evaluation::Inlined;
+    else if (v == "tapes")
+        out = sdfcsg::Evaluation::Tapes;
+    else
+        return usageError(command, "--evaluation expects auto, inlined or tapes, got '" + v + "'"),
+               false;
+    return true;
+}
+
 int cmdRender(int argc, char** argv) {
     Args args("render", argc, argv,
               {"-o", "--output", "--width", "--height", "--mode", "--eye", "--target", "--fov",
-               "--aa", "--boxes", "--device"},
+               "--aa", "--boxes", "--device", "--evaluation"},
               {"--no-shadows", "--no-ao", "--grid", "--skip", "--no-skip", "--validation", "--help",
                "-h"});
     if (args.has("--help") || args.has("-h")) return std::fputs(kRenderHelp, stdout), kOk;
@@ -237,7 +256,9 @@ int cmdRender(int argc, char** argv) {
     auto context = sdfcsg::Context::create(contextOptions);
     if (!context) return fail(context.error());
     catchInterrupts();
-    auto renderer = sdfcsg::Renderer::create(**context, *scene);
+    sdfcsg::RendererOptions rendererOptions;
+    if (!parseEvaluation(args, "render", rendererOptions.evaluation)) return kUsage;
+    auto renderer = sdfcsg::Renderer::create(**context, *scene, rendererOptions);
     if (!renderer) return fail(renderer.error());
     auto image = [&] {
         ProgressBar bar("rendering"); // erased again when the render ends
@@ -267,6 +288,7 @@ Options:
                          of a few cells)
   --stats                print the grid, brick and mesh sizes, the time per stage and the
                          peak memory
+  --evaluation E          auto (default), inlined or tapes, as for render
   --device NAME          Vulkan device: index or part of its name (also SDFCSG_DEVICE)
   --validation           enable the Vulkan validation layer
 )";
@@ -327,7 +349,8 @@ int cmdMesh(int argc, char** argv) {
         return std::chrono::duration<double>(Clock::now() - t0).count();
     };
     Args args("mesh", argc, argv,
-              {"-o", "--output", "--resolution", "--voxel-size", "--bounds", "--device"},
+              {"-o", "--output", "--resolution", "--voxel-size", "--bounds", "--device",
+               "--evaluation"},
               {"--stats", "--validation", "--help", "-h"});
     if (args.has("--help") || args.has("-h")) return std::fputs(kMeshHelp, stdout), kOk;
     if (!args.error.empty()) return usageError("mesh", args.error);
@@ -368,7 +391,9 @@ int cmdMesh(int argc, char** argv) {
     if (!context) return fail(context.error());
     catchInterrupts();
     auto t0 = Clock::now();
-    auto mesher = sdfcsg::Mesher::create(**context, *scene);
+    sdfcsg::Evaluation evaluation = sdfcsg::Evaluation::Auto;
+    if (!parseEvaluation(args, "mesh", evaluation)) return kUsage;
+    auto mesher = sdfcsg::Mesher::create(**context, *scene, evaluation);
     if (!mesher) return fail(mesher.error());
     const double compileSeconds = secondsSince(t0);
 

@@ -78,7 +78,8 @@ void surface(vec3 ro, vec3 rd, vec4 ends, inout Trace r, out vec3 albedo) {
                 }
             }
         } else if (phase == kOcclusion) {
-            r.ao += (t - d) * weight;
+            // A far cell's bound (tape.glsl) says only that nothing is nearer: no occlusion.
+            r.ao += (t - (s.r < 0.0 ? max(d, t) : d)) * weight;
             weight *= 0.95;
             tap += 1;
             t += aoScale * 0.03;
@@ -89,6 +90,12 @@ void surface(vec3 ro, vec3 rd, vec4 ends, inout Trace r, out vec3 albedo) {
         } else { // kShadow
             if (d < eps * 0.5) {
                 res = 0.0;
+            } else if (s.r < 0.0) {
+                // A bound from a cell far from every surface (tape.glsl): it only steps, and
+                // does not count against the steps (each is at least a cell's radius). Taken as
+                // a distance it would narrow the penumbra's cone and darken lit surfaces.
+                t += max(d, eps);
+                tap -= 1;
             } else {
                 float y = d * d / (2.0 * ph);
                 float w = sqrt(max(d * d - y * y, 0.0));

@@ -104,8 +104,9 @@ float tapeDistance(vec3 p) {
     return c.x == 1u ? bound : tapeDistanceRun(c.y, c.z, p);
 }
 
+// Where the value is a bound, the colour is -1: the shade pass's soft shadows tell the two apart.
 vec4 tapeSample(vec3 p) {
     float bound;
     uvec3 c = tapeCell(p, bound);
-    return c.x == 1u ? vec4(0.0, 0.0, 0.0, bound) : tapeSampleRun(c.y, c.z, p);
+    return c.x == 1u ? vec4(-1.0, -1.0, -1.0, bound) : tapeSampleRun(c.y, c.z, p);
 }

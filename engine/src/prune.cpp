@@ -173,6 +173,12 @@ struct Pruner {
     }
 };
 
+// A cell is far from every surface when its centre value exceeds this many radii: its bound is
+// then at least a radius, which keeps the soft shadows' ratio of distance to travel (and so the
+// shading) what the whole tree gives; at 1.25 radii, shadow rays crossing cell corners darkened
+// lit surfaces in blotches.
+constexpr float kFarRadii = 2.0f;
+
 // The cube that the octree divides: the finite part of the bounds (all finite leaves' boxes
 // where a plane makes the root unbounded), widened by a leaf cell on every side, so that outside
 // it a bounded field is at least half a cell more than the distance to it.
@@ -281,7 +287,7 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) 
                 const uint32_t begin = uint32_t(out.tapes.size());
                 const float v = pruner.prune(tapes.data() + parent.begin, parent.length, c, r,
                                              out.tapes);
-                if (std::abs(v) > 1.25f * r + slack) { // no surface: fill its leaf cells
+                if (std::abs(v) > kFarRadii * r + slack) { // no surface: fill its leaf cells
                     out.tapes.resize(begin);
                     const uint32_t span = 1u << (field.levels - level);
                     const glm::uvec2 entry(std::bit_cast<uint32_t>(v), kFarCell | level);
@@ -372,11 +378,11 @@ Sample PrunedField::sample(const std::vector<FlatNode>& nodes, glm::vec3 p) cons
     const glm::uvec2* e = cellAt(*this, p, at);
     glm::vec4 v;
     if (!e && bounded)
-        v = glm::vec4(0.0f, 0.0f, 0.0f, outsideBound(*this, p));
+        v = glm::vec4(-1.0f, -1.0f, -1.0f, outsideBound(*this, p));
     else if (!e)
         v = run<glm::vec4>(nodes, tape.data(), fullLength, p);
     else if (e->y & kFarCell)
-        v = glm::vec4(0.0f, 0.0f, 0.0f, farBound(*this, *e, at, p));
+        v = glm::vec4(-1.0f, -1.0f, -1.0f, farBound(*this, *e, at, p));
     else
         v = run<glm::vec4>(nodes, tape.data() + e->x, e->y, p);
     return {v.w, glm::vec3(v)};

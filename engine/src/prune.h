@@ -51,7 +51,8 @@ struct PrunedField {
 
     uint32_t side() const { return 1u << levels; }
 
-    // The field at p, as sceneDistance()/sceneSample() in shaders/tape.glsl compute it.
+    // The field at p, as sceneDistance()/sceneSample() in shaders/tape.glsl compute it; where
+    // the value is a bound, the sample's colour is -1.
     float distance(const std::vector<FlatNode>& nodes, glm::vec3 p) const;
     Sample sample(const std::vector<FlatNode>& nodes, glm::vec3 p) const;
     // Instructions that the leaf cell holding p runs (the whole tape outside the cube), 0 in a
