@@ -216,6 +216,53 @@ TEST_P(SceneRender, BoundsSkippingDoesNotChangeTheImage) {
     EXPECT_GE(double(maskSame) / infoOn.size(), 0.999);
 }
 
+// Pruned tapes against the inlined tree: the same hits and depths, and the same colours but
+// where a far cell's bound steers a shadow ray or an occlusion tap differently.
+void expectTapesMatchInlined(Context& context, const Scene& scene, uint32_t width,
+                             uint32_t height) {
+    RenderOptions options;
+    options.width = width, options.height = height;
+    std::optional<Image> images[2];
+    std::vector<PixelInfo> infos[2];
+    for (int tapes = 0; tapes < 2; ++tapes) {
+        RendererOptions made;
+        made.evaluation = tapes ? Evaluation::Tapes : Evaluation::Inlined;
+        auto renderer = Renderer::create(context, scene, made);
+        ASSERT_TRUE(renderer) << renderer.error().str();
+        auto image = (*renderer)->render(options);
+        ASSERT_TRUE(image) << image.error().str();
+        images[tapes] = std::move(*image);
+        infos[tapes] = (*renderer)->lastPixelInfo();
+    }
+    // The two march with other steps (a far cell's bound is shorter than the field), so their
+    // hits may lie apart by the hit tolerance: up to half a pixel's footprint.
+    const float footprint = 2.0f * std::tan(glm::radians(cameraFor(scene, Evaluator(scene),
+                                                                 float(width) / float(height))
+                                                           .fov) *
+                                            0.5f) /
+                            float(height);
+    size_t agree = 0, hits = 0, colourOff = 0;
+    for (size_t i = 0; i < infos[0].size(); ++i) {
+        const PixelInfo &a = infos[0][i], &b = infos[1][i];
+        const bool hit = a.depth >= 0.0f;
+        agree += hit == (b.depth >= 0.0f) &&
+                 (!hit || std::abs(a.depth - b.depth) <= footprint * a.depth + 1e-3f);
+        if (!hit) continue;
+        ++hits;
+        int worst = 0;
+        for (int c = 0; c < 3; ++c)
+            worst = std::max(worst, std::abs(int(images[0]->rgba[4 * i + c]) -
+                                             int(images[1]->rgba[4 * i + c])));
+        colourOff += worst > 24;
+    }
+    EXPECT_GE(double(agree) / double(infos[0].size()), 0.995) << scene.file;
+    EXPECT_LE(double(colourOff), 0.02 * double(hits)) << scene.file;
+}
+
+TEST_P(SceneRender, PrunedTapesMatchTheInlinedTree) {
+    expectTapesMatchInlined(context(), loadOrDie(GetParam()), 160, 120);
+}
+
 TEST_P(SceneRender, DefaultCameraIsTheScenesOrTheFramedOne) {
     Scene scene = loadOrDie(GetParam());
     Evaluator ev(scene);
@@ -238,6 +285,15 @@ fs::path scenePath(const char* name) {
 }
 
 class Render : public GpuTest {};
+
+// The benchmark scenes (assets/bench) at a reduced size: thousands of nodes, which the inlined
+// path still compiles in tens of seconds on lavapipe, so only the two smaller ones.
+TEST_F(Render, BenchmarkScenesRenderTheSameWithTapes) {
+    for (const char* name : {"molecule_1k.json", "groups_1k.json"}) {
+        Scene scene = loadOrDie((fs::path(SDFCSG_SOURCE_DIR) / "assets/bench" / name).string());
+        expectTapesMatchInlined(context(), scene, 96, 72);
+    }
+}
 
 TEST_F(Render, AllModesRenderWhatTheyPromise) {
     Scene scene = loadOrDie(scenePath("snowman.json"));
