@@ -7,8 +7,8 @@
 // rounded up) before it includes this file.
 
 // Mirrors packField() in engine/src/prune.cpp: a header of 12 words (origin xyz and leaf cell
-// side as float bits, levels, cells per axis, 1 when bounded, whole-tape length, first tape
-// word), two words per leaf cell, then the tape.
+// side as float bits, levels, leaf cells per axis xyz, 1 when bounded, whole-tape length, first
+// tape word), two words per leaf cell, then the tape.
 layout(std430, set = 0, binding = SDFCSG_BINDING_FIELD) readonly buffer Field {
     uint field[];
 };
@@ -75,18 +75,19 @@ uvec3 tapeCell(vec3 p, out float bound) {
     vec3 origin = vec3(uintBitsToFloat(field[0]), uintBitsToFloat(field[1]),
                        uintBitsToFloat(field[2]));
     float cell = uintBitsToFloat(field[3]);
-    uint levels = field[4], side = field[5], tapeStart = field[8];
+    uint levels = field[4], tapeStart = field[10];
+    uvec3 dims = uvec3(field[5], field[6], field[7]);
     vec3 q = floor((p - origin) / cell);
     bound = 0.0;
-    if (side == 0u || any(lessThan(q, vec3(0.0))) || any(greaterThanEqual(q, vec3(float(side))))) {
-        if (field[6] == 0u) return uvec3(0u, tapeStart, tapeStart + field[7]); // the whole tape
-        // Bounded: the cube holds the bounds and a cell more on every side.
-        vec3 top = origin + cell * float(side);
+    if (dims.x == 0u || any(lessThan(q, vec3(0.0))) || any(greaterThanEqual(q, vec3(dims)))) {
+        if (field[8] == 0u) return uvec3(0u, tapeStart, tapeStart + field[9]); // the whole tape
+        // Bounded: the grid holds the bounds and a cell more on every side.
+        vec3 top = origin + cell * vec3(dims);
         bound = boundsDistance(origin, top, p) + 0.5 * cell;
         return uvec3(1u, 0u, 0u);
     }
     uvec3 at = uvec3(q);
-    uint entry = 12u + 2u * (at.x + side * (at.y + side * at.z));
+    uint entry = 12u + 2u * (at.x + dims.x * (at.y + dims.y * at.z));
     uint x = field[entry], y = field[entry + 1u];
     if ((y & 0x80000000u) == 0u) return uvec3(0u, tapeStart + x, tapeStart + x + y);
     // Far from every surface: the root value v at the centre of the cell found far.

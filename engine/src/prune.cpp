@@ -179,14 +179,15 @@ struct Pruner {
 // lit surfaces in blotches.
 constexpr float kFarRadii = 2.0f;
 
-// The cube that the octree divides: the finite part of the bounds (all finite leaves' boxes
-// where a plane makes the root unbounded), widened by a leaf cell on every side, so that outside
-// it a bounded field is at least half a cell more than the distance to it.
-bool fieldCube(const Evaluator& evaluator, uint32_t levels, glm::vec3& origin, float& cell,
-               bool& bounded) {
+// The grid that the octrees divide: the finite part of the bounds (all finite leaves' boxes where
+// a plane makes the root unbounded) and a leaf cell more on every side, so that outside it a
+// bounded field is at least half a cell more than the distance to it. Leaf cells are cubes sized
+// so that the box holds about options.cells of them; the top level is a grid of cubes of
+// 2^levels leaf cells, each the root of an octree.
+bool fieldGrid(const Evaluator& evaluator, const PruneOptions& options, PrunedField& f) {
     Aabb box = evaluator.bounds();
-    bounded = box.finite();
-    if (!bounded) {
+    f.bounded = box.finite();
+    if (!f.bounded) {
         box = Aabb{};
         for (const FlatNode& n : evaluator.nodes())
             if (!isOperation(n.kind) && n.bounds.finite()) {
@@ -197,9 +198,14 @@ bool fieldCube(const Evaluator& evaluator, uint32_t levels, glm::vec3& origin, f
     if (box.empty()) return false;
     const glm::vec3 extent = box.max - box.min;
     const float largest = std::max(std::max(extent.x, extent.y), std::max(extent.z, 1e-6f));
-    const float n = float(1u << levels);
-    cell = largest / (n - 2.0f);
-    origin = 0.5f * (box.min + box.max) - 0.5f * n * cell;
+    // Thin boxes: at least a 64th of the largest extent on every axis, so the cells stay few.
+    const glm::vec3 padded = glm::max(extent, glm::vec3(largest / 64.0f));
+    f.cell = std::cbrt(padded.x * padded.y * padded.z / float(options.cells));
+    const float top = f.cell * float(1u << options.levels);
+    const glm::uvec3 tops = glm::uvec3(glm::ceil((extent + 2.0f * f.cell) / top));
+    f.levels = options.levels;
+    f.dims = tops * (1u << f.levels);
+    f.origin = 0.5f * (box.min + box.max) - 0.5f * glm::vec3(f.dims) * f.cell;
     return true;
 }
 
@@ -240,24 +246,28 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) 
     PrunedField field;
     field.tape = fullTape(nodes, field.stackDepth);
     field.fullLength = uint32_t(field.tape.size());
-    if (nodes.empty() || options.levels < 2 ||
-        !fieldCube(evaluator, options.levels, field.origin, field.cell, field.bounded)) {
+    if (nodes.empty() || options.levels < 1 || !fieldGrid(evaluator, options, field)) {
         field.levels = 0;
         field.bounded = false;
         field.cells.assign(1, glm::uvec2(0, field.fullLength));
         return field;
     }
-    field.levels = options.levels;
-    const uint32_t side = field.side();
-    field.cells.assign(size_t(side) * side * side, glm::uvec2(0));
-    const float slack = 1e-5f * (field.cell * float(side) + glm::length(field.origin));
+    const glm::uvec3 dims = field.dims;
+    field.cells.assign(size_t(dims.x) * dims.y * dims.z, glm::uvec2(0));
+    const float slack = 1e-5f * (field.cell * float(dims.x + dims.y + dims.z) +
+                                 glm::length(field.origin));
 
     // Level by level: the cells that may hold surface, each with its tape in `tapes`.
     struct Cell {
         glm::uvec3 at; // in cells of its level
         uint32_t begin, length;
     };
-    std::vector<Cell> cells{{glm::uvec3(0), 0, field.fullLength}};
+    std::vector<Cell> cells;
+    const glm::uvec3 tops = dims >> field.levels;
+    for (uint32_t z = 0; z < tops.z; ++z)
+        for (uint32_t y = 0; y < tops.y; ++y)
+            for (uint32_t x = 0; x < tops.x; ++x)
+                cells.push_back({glm::uvec3(x, y, z), 0, field.fullLength});
     std::vector<uint32_t> tapes = field.tape;
     const unsigned threads = std::max(1u, std::min(8u, std::thread::hardware_concurrency()));
     for (uint32_t level = 0; level <= field.levels; ++level) {
@@ -265,7 +275,7 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) 
         const float r = 0.5f * std::sqrt(3.0f) * size;
         const bool leaf = level == field.levels;
         // The children of this level's cells (the cells themselves at the root).
-        const uint32_t fan = level == 0 ? 1 : 8;
+        const uint32_t fan = level == 0 ? 1 : 8; // the top cells themselves at level 0
         const size_t jobs = cells.size() * fan;
         struct Out {
             std::vector<Cell> cells;
@@ -280,7 +290,7 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) 
                 const Cell& parent = cells[j / fan];
                 const uint32_t octant = uint32_t(j % fan);
                 const glm::uvec3 at =
-                    level == 0 ? glm::uvec3(0)
+                    level == 0 ? parent.at
                                : parent.at * 2u +
                                      glm::uvec3(octant & 1, octant >> 1 & 1, octant >> 2);
                 const glm::vec3 c = field.origin + (glm::vec3(at) + 0.5f) * size;
@@ -294,7 +304,7 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) 
                     for (uint32_t z = 0; z < span; ++z)
                         for (uint32_t y = 0; y < span; ++y) {
                             const glm::uvec3 l = at * span + glm::uvec3(0, y, z);
-                            std::fill_n(field.cells.begin() + (l.x + side * (l.y + side * l.z)),
+                            std::fill_n(field.cells.begin() + (l.x + dims.x * (l.y + dims.y * l.z)),
                                         span, entry);
                         }
                     continue;
@@ -323,7 +333,7 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) 
             const uint32_t base = field.fullLength;
             field.tape.insert(field.tape.end(), nextTapes.begin(), nextTapes.end());
             for (const Cell& c : next)
-                field.cells[c.at.x + side * (c.at.y + side * c.at.z)] =
+                field.cells[c.at.x + dims.x * (c.at.y + dims.y * c.at.z)] =
                     glm::uvec2(base + c.begin, c.length);
         }
         cells = std::move(next);
@@ -337,11 +347,11 @@ namespace {
 // The leaf cell of p, or nullptr outside the cube.
 const glm::uvec2* cellAt(const PrunedField& f, glm::vec3 p, glm::uvec3& at) {
     const glm::vec3 q = glm::floor((p - f.origin) / f.cell);
-    const float n = float(f.side());
-    if (f.levels == 0 || !(q.x >= 0 && q.y >= 0 && q.z >= 0 && q.x < n && q.y < n && q.z < n))
+    const glm::vec3 n(f.dims);
+    if (f.levels == 0 || !(q.x >= 0 && q.y >= 0 && q.z >= 0 && q.x < n.x && q.y < n.y && q.z < n.z))
         return nullptr;
     at = glm::uvec3(q);
-    return &f.cells[at.x + f.side() * (at.y + f.side() * at.z)];
+    return &f.cells[at.x + f.dims.x * (at.y + f.dims.y * at.z)];
 }
 
 // The bound of a far cell at p.
@@ -356,7 +366,7 @@ float farBound(const PrunedField& f, glm::uvec2 e, glm::uvec3 at, glm::vec3 p) {
 
 // Outside the cube of a bounded field.
 float outsideBound(const PrunedField& f, glm::vec3 p) {
-    Aabb cube{f.origin, f.origin + f.cell * float(f.side())};
+    Aabb cube{f.origin, f.origin + f.cell * glm::vec3(f.dims)};
     return cube.signedDistance(p) + 0.5f * f.cell;
 }
 
@@ -403,11 +413,13 @@ std::vector<uint32_t> packField(const PrunedField& f) {
     put(2, f.origin.z);
     put(3, f.cell);
     out[4] = f.levels;
-    out[5] = f.levels ? f.side() : 0;
-    out[6] = f.bounded ? 1u : 0u;
-    out[7] = f.fullLength;
+    out[5] = f.levels ? f.dims.x : 0;
+    out[6] = f.dims.y;
+    out[7] = f.dims.z;
+    out[8] = f.bounded ? 1u : 0u;
+    out[9] = f.fullLength;
     const uint32_t tapeStart = uint32_t(kFieldHeaderWords + 2 * f.cells.size());
-    out[8] = tapeStart;
+    out[10] = tapeStart;
     std::memcpy(out.data() + kFieldHeaderWords, f.cells.data(), f.cells.size() * 8);
     std::copy(f.tape.begin(), f.tape.end(), out.begin() + tapeStart);
     return out;

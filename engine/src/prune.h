@@ -36,20 +36,20 @@ inline constexpr uint32_t kTapeNodeMask = (1u << kTapeNodeBits) - 1u;
 inline constexpr uint32_t kFarCell = 0x80000000u;
 
 struct PruneOptions {
-    uint32_t levels = 6; // leaf cells per axis: 1 << levels
+    uint32_t levels = 5;          // octree levels below the top grid's cells; 0: no pruning
+    uint32_t cells = 1u << 18;    // about this many leaf cells in the bounds
 };
 
 struct PrunedField {
-    glm::vec3 origin{0.0f}; // the cube's minimum corner
+    glm::vec3 origin{0.0f}; // the grid's minimum corner
     float cell = 1.0f;      // leaf cell side
-    uint32_t levels = 0;
-    bool bounded = false;   // outside the cube, the field is at least its distance to it
+    uint32_t levels = 0;    // a top cell holds 2^levels leaf cells per axis
+    glm::uvec3 dims{0};     // leaf cells per axis
+    bool bounded = false;   // outside the grid, the field is at least its distance to it
     uint32_t fullLength = 0; // tape[0, fullLength) is the whole tree
     uint32_t stackDepth = 0; // the most values any tape holds at once
     std::vector<uint32_t> tape;
-    std::vector<glm::uvec2> cells; // x + n * (y + n * z), n = 1 << levels
-
-    uint32_t side() const { return 1u << levels; }
+    std::vector<glm::uvec2> cells; // x + dims.x * (y + dims.y * z)
 
     // The field at p, as sceneDistance()/sceneSample() in shaders/tape.glsl compute it; where
     // the value is a bound, the sample's colour is -1.
@@ -66,8 +66,8 @@ std::vector<uint32_t> fullTape(const std::vector<FlatNode>& nodes, uint32_t& sta
 PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options = {});
 
 // What shaders/tape.glsl reads, as one buffer of 32-bit words: a header of 12 words (origin,
-// cell, levels, side, flags, full tape length, first tape word, 3 spare), the cells (two
-// words each), then the tape.
+// cell, levels, dims, 1 when bounded, full tape length, first tape word, 1 spare), the cells
+// (two words each), then the tape.
 inline constexpr uint32_t kFieldHeaderWords = 12;
 std::vector<uint32_t> packField(const PrunedField& field);
 
