@@ -242,11 +242,13 @@ Evaluator::Evaluator(const Scene& scene) {
                 box.min = glm::min(box.min, nodes_[c].bounds.min);
                 box.max = glm::max(box.max, nodes_[c].bounds.max);
             }
-            // However many operands, the fold never goes more than k below their minimum: the
-            // smooth minimum grows with each operand, and smin(m - k, m) = m - k, so from
-            // operands >= m every fold stays >= m - k. Boxes widened by k then bound it.
+            // Each fold goes at most k/4 below the smaller operand, and however many operands,
+            // the fold never goes more than k below their minimum: the smooth minimum grows
+            // with each operand, and smin(m - k, m) = m - k, so from operands >= m every fold
+            // stays >= m - k. Boxes widened by the lesser of the two then bound it.
             if (n.smooth > 0.0f) {
-                float grow = n.smooth * (1.0f + 1e-5f);
+                const float folds = float(n.children.size() - 1);
+                float grow = n.smooth * std::min(1.0f, 0.25f * folds) * (1.0f + 1e-5f);
                 box.min -= grow;
                 box.max += grow;
             }

@@ -259,8 +259,10 @@ TEST(Codegen, LiteralSharpOperationsTakeTheShortForm) {
 
 // Past 1024 nodes inlining would make glslang quadratic; such scenes read the buffer.
 TEST(Codegen, HugeScenesAreNotInlined) {
+    EXPECT_NE(generateSceneGlsl(smoothChain(1100)).find("tape.glsl"), std::string::npos);
     CodegenOptions inl;
     inl.inlineParams = true;
+    inl.evaluation = Evaluation::Inlined; // by default, such scenes run pruned tapes
     EXPECT_EQ(generateSceneGlsl(smoothChain(1000), inl).find("nodes["), std::string::npos);
     EXPECT_NE(generateSceneGlsl(smoothChain(1100), inl).find("nodes["), std::string::npos);
 }
