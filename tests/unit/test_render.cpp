@@ -219,7 +219,7 @@ TEST_P(SceneRender, BoundsSkippingDoesNotChangeTheImage) {
 // Pruned tapes against the inlined tree: the same hits and depths, and the same colours but
 // where a far cell's bound steers a shadow ray or an occlusion tap differently.
 void expectTapesMatchInlined(Context& context, const Scene& scene, uint32_t width,
-                             uint32_t height) {
+                             uint32_t height, double colourShare = 0.02) {
     RenderOptions options;
     options.width = width, options.height = height;
     std::optional<Image> images[2];
@@ -256,7 +256,7 @@ void expectTapesMatchInlined(Context& context, const Scene& scene, uint32_t widt
         colourOff += worst > 24;
     }
     EXPECT_GE(double(agree) / double(infos[0].size()), 0.995) << scene.file;
-    EXPECT_LE(double(colourOff), 0.02 * double(hits)) << scene.file;
+    EXPECT_LE(double(colourOff), colourShare * double(hits)) << scene.file;
 }
 
 TEST_P(SceneRender, PrunedTapesMatchTheInlinedTree) {
@@ -286,13 +286,13 @@ fs::path scenePath(const char* name) {
 
 class Render : public GpuTest {};
 
-// The benchmark scenes (assets/bench) at a reduced size: thousands of nodes, which the inlined
-// path still compiles in tens of seconds on lavapipe, so only the two smaller ones.
-TEST_F(Render, BenchmarkScenesRenderTheSameWithTapes) {
-    for (const char* name : {"molecule_1k.json", "groups_1k.json"}) {
-        Scene scene = loadOrDie((fs::path(SDFCSG_SOURCE_DIR) / "assets/bench" / name).string());
-        expectTapesMatchInlined(context(), scene, 96, 72);
-    }
+// Random scenes of a few hundred nodes, every kind and operation, sharp and smooth: as many
+// as the inlined path compiles in a few seconds on lavapipe (test_prune holds the benchmark
+// scenes' pruned field to the whole tree on the CPU).
+TEST_F(Render, RandomScenesRenderTheSameWithTapes) {
+    for (uint32_t seed : {4u, 9u})
+        // Random scenes pack many surfaces into shadow rays' way: more colours differ.
+        expectTapesMatchInlined(context(), randomScene(seed, 220), 96, 72, 0.06);
 }
 
 TEST_F(Render, AllModesRenderWhatTheyPromise) {
