@@ -3,7 +3,6 @@
 #include "prune.h"
 
 #include "sdf.h"
-#include "shared.h"
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
