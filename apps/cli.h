@@ -3,6 +3,7 @@
 
 #include <sdfcsg/error.h>
 
+#include <string>
 #include <string_view>
 
 namespace sdfcsg::app {
@@ -25,9 +26,38 @@ int fail(const Error& e);
 int usageError(std::string_view command, std::string_view message);
 
 // From the first SIGINT or SIGTERM on, interrupted() is true, and long work (renders, mesh
-// extraction) stops at its next progress check, before any output is written. A second signal
-// ends the process at once.
+// extraction) stops at its next progress check, before any output is written. Work that cannot
+// be cancelled (a kernel build inside the driver) does not hold the command up: a watchdog ends
+// it with kInterrupted well within a second of the signal, though never while a Finishing lives.
+// A second signal ends the process at once.
 void catchInterrupts();
 bool interrupted();
+
+// Prints `message` as the reason the command stops (once, whoever stops it) and returns
+// kInterrupted.
+int stopInterrupted(const std::string& message);
+
+// While one lives, an interrupted command is not ended: the span of writing an output whole, or
+// the recording and report an interrupted command leaves. Keep it short.
+class Finishing {
+  public:
+    Finishing();
+    ~Finishing();
+    Finishing(const Finishing&) = delete;
+    Finishing& operator=(const Finishing&) = delete;
+};
+
+// Runs `write`, which writes an output whole or not at all, under a Finishing.
+template <class Write> Status writeWhole(Write&& write) {
+    Finishing finishing;
+    return write();
+}
+
+// The same, unless the command was interrupted.
+template <class Write> Status writeOutput(Write&& write) {
+    Finishing finishing;
+    if (interrupted()) return Error::message(ErrorKind::Cancelled, "<output>", "cancelled");
+    return write();
+}
 
 } // namespace sdfcsg::app

@@ -260,33 +260,32 @@ int generateAndWrite(std::string_view command, std::string_view request, Generat
     GenerateStats stats;
     auto generated = generateScene(request, options, &stats);
     printer.clear();
-    // Also when interrupted or failed: the exchanges so far are what a bug report needs.
-    if (auto saved = recording.save(); !saved) return fail(saved.error());
-    if (!generated) {
-        if (generated.error().kind == ErrorKind::Cancelled && interrupted() &&
-            !recording.recordPath.empty()) {
-            std::fprintf(stderr,
-                         "sdfcsg: interrupted; %s was not written, the exchanges so far "
-                         "are in %s\n",
-                         out.c_str(), recording.recordPath.c_str());
-            return kInterrupted;
+    {
+        Finishing finishing;
+        // Also when interrupted or failed: the exchanges so far are what a bug report needs.
+        if (auto saved = recording.save(); !saved) return fail(saved.error());
+        if (!generated) {
+            if (generated.error().kind == ErrorKind::Cancelled && interrupted() &&
+                !recording.recordPath.empty())
+                return stopInterrupted("sdfcsg: interrupted; " + out +
+                                       " was not written, the exchanges so far are in " +
+                                       recording.recordPath);
+            return fail(generated.error());
         }
-        return fail(generated.error());
     }
-
-    if (auto written = writeFileAtomic(out, generated->json); !written)
+    if (auto written = writeOutput([&] { return writeFileAtomic(out, generated->json); });
+        !written)
         return fail(written.error());
     printSummary(out, *generated, stats);
     if (const std::string png = args.get("--render"); !png.empty()) {
         Renders renders;
         auto image = renders.render(generated->scene, 800, 600);
-        if (!image && image.error().kind == ErrorKind::Cancelled && interrupted()) {
-            std::fprintf(stderr, "sdfcsg: interrupted; %s was written, %s was not\n", out.c_str(),
-                         png.c_str());
-            return kInterrupted;
-        }
-        if (!image) return fail(image.error());
-        if (auto written = writePng(*image, png); !written) return fail(written.error());
+        Status written = image ? writeOutput([&] { return writePng(*image, png); })
+                               : Status(image.error());
+        if (!written && written.error().kind == ErrorKind::Cancelled && interrupted())
+            return stopInterrupted("sdfcsg: interrupted; " + out + " was written, " + png +
+                                   " was not");
+        if (!written) return fail(written.error());
     }
     return kOk;
 }
@@ -618,7 +617,8 @@ int runEvalPrompts(int argc, char** argv) {
             std::fprintf(stderr, "%s\n", generated.error().str().c_str());
         } else {
             const std::string base = (fs::path(dir) / twoDigits(i + 1)).string();
-            if (auto w = writeFileAtomic(base + ".json", generated->json); !w)
+            if (auto w = writeWhole([&] { return writeFileAtomic(base + ".json", generated->json); });
+                !w)
                 return fail(w.error());
             for (const Diagnostic& w : generated->warnings)
                 std::fprintf(stderr, "warning: %s: %s\n", w.path.c_str(), w.message.c_str());
@@ -631,12 +631,14 @@ int runEvalPrompts(int argc, char** argv) {
             if (!image) {
                 row.error = {"render: " + image.error().diagnostics.front().message};
             } else {
-                if (auto w = writePng(*image, base + ".png"); !w) return fail(w.error());
+                if (auto w = writeWhole([&] { return writePng(*image, base + ".png"); }); !w)
+                    return fail(w.error());
                 row.image = std::move(*image);
             }
         }
         rows.push_back(std::move(row));
     }
+    Finishing finishing; // an interrupted run still leaves its recording and report
     if (auto saved = recording.save(); !saved) return fail(saved.error());
     const std::string report = evalReport(rows, prompts.size());
     std::fputs(report.c_str(), stdout);
@@ -644,11 +646,10 @@ int runEvalPrompts(int argc, char** argv) {
         return fail(w.error());
     if (auto w = writePng(contactSheet(rows, 256), fs::path(dir) / "contact-sheet.png"); !w)
         return fail(w.error());
-    if (interrupted()) {
-        std::fprintf(stderr, "sdfcsg: interrupted after %s of %zu; the report covers those\n",
-                     counted(rows.size(), "prompt").c_str(), prompts.size());
-        return kInterrupted;
-    }
+    if (interrupted())
+        return stopInterrupted("sdfcsg: interrupted after " + counted(rows.size(), "prompt") +
+                               " of " + std::to_string(prompts.size()) +
+                               "; the report covers those");
     return kOk;
 }
 

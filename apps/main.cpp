@@ -267,7 +267,8 @@ int cmdRender(int argc, char** argv) {
         return (*renderer)->render(options);
     }();
     if (!image) return fail(image.error());
-    if (auto written = sdfcsg::writePng(*image, out); !written) return fail(written.error());
+    if (auto written = writeOutput([&] { return sdfcsg::writePng(*image, out); }); !written)
+        return fail(written.error());
     return kOk;
 }
 
@@ -406,7 +407,8 @@ int cmdMesh(int argc, char** argv) {
     }();
     if (!mesh) return fail(mesh.error());
     t0 = Clock::now();
-    if (auto written = sdfcsg::writeMesh(*mesh, out, *format); !written)
+    if (auto written = writeOutput([&] { return sdfcsg::writeMesh(*mesh, out, *format); });
+        !written)
         return fail(written.error());
     const double writeSeconds = secondsSince(t0);
 

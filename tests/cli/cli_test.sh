@@ -158,30 +158,39 @@ check "eval-prompts replay without repairs" 0 "$bin" eval-prompts prompts.txt --
 expect_text "eval problems" eval-bad/report.txt "           answer: root.children[1].radius: expected a positive number, got -0.6"
 expect_text "eval repeated example" eval-bad/report.txt "note: prompt 2 nearly repeats the request of an example in the system prompt (\"A robot with a square body, two legs, two arms and an antenna.\"), so its first-try validity is inflated"
 
-# Ctrl-C: long work stops at its next progress check (or, before the handler is installed, the
-# signal ends the process), exits 130 and leaves neither the output nor a temporary behind. Each
-# job takes half a minute or more uninterrupted, so the signal always comes in the middle.
-interrupt() { # interrupt NAME OUTPUT COMMAND...: sends SIGINT a second after the start
-    name=$1 output=$2
-    shift 2
+# Ctrl-C and SIGTERM: long work stops at its next progress check, and work that cannot be
+# cancelled (a kernel build inside the driver) is ended by a watchdog; either way the command
+# exits 130 within a second of the signal and leaves neither the output nor a temporary behind.
+# Each job takes half a minute or more uninterrupted, so the signal always comes in the middle.
+interrupt() { # interrupt NAME SIGNAL OUTPUT COMMAND...: sends SIGNAL two seconds after the start
+    name=$1 signal=$2 output=$3
+    shift 3
     # A background job of a script starts with SIGINT ignored: restore the default first.
     env --default-signal=INT "$@" >out.txt 2>err.txt &
     pid=$!
-    sleep 1
-    kill -INT "$pid"
+    sleep 2
+    start=$(date +%s%N)
+    kill -"$signal" "$pid"
     wait "$pid"
     rc=$?
-    if [ "$rc" -ne 130 ] || [ -e "$output" ] || ls | grep -q '\.tmp-'; then
-        echo "FAIL $name: exit $rc, expected 130 and no output"; ls; cat err.txt
+    ms=$((($(date +%s%N) - start) / 1000000))
+    if [ "$rc" -ne 130 ] || [ "$ms" -gt 1000 ] || [ -e "$output" ] || ls | grep -q '\.tmp-'; then
+        echo "FAIL $name: exit $rc after $ms ms, expected 130 within 1000 ms and no output"
+        ls; cat err.txt
         failures=$((failures + 1))
     else
         passed=$((passed + 1))
     fi
 }
-interrupt "mesh interrupted" big.ply "$bin" mesh "$src/assets/scenes/house.json" -o big.ply \
+interrupt "mesh interrupted" INT big.ply "$bin" mesh "$src/assets/scenes/house.json" -o big.ply \
     --resolution 2048
-interrupt "render interrupted" big.png "$bin" render "$src/assets/scenes/house.json" -o big.png \
-    --width 4096 --height 4096 --aa 2
+interrupt "render interrupted" TERM big.png "$bin" render "$src/assets/scenes/house.json" \
+    -o big.png --width 4096 --height 4096 --aa 2
+# Inlined, the 1,000 spheres of molecule_1k take far longer than two seconds to compile.
+interrupt "kernel build interrupted" TERM big.ply env SDFCSG_CACHE_DIR=off \
+    MESA_SHADER_CACHE_DISABLE=true "$bin" mesh "$src/assets/bench/molecule_1k.json" -o big.ply \
+    --evaluation inlined
+expect_text "kernel build interrupted message" err.txt "sdfcsg: interrupted; nothing was written"
 
 # Ctrl-C while a language model is awaited (skipped without python3): a stand-in answers the
 # first request and holds the next. generate keeps the exchanges so far in its --record file;
@@ -197,7 +206,7 @@ if command -v python3 >/dev/null 2>&1; then
         slow="--base-url http://127.0.0.1:$(cat port.txt)/v1 --model test-model"
     }
     slow_llm 1
-    interrupt "generate interrupted" int.json "$bin" generate "a ball" -o int.json $slow --record int-rec.json
+    interrupt "generate interrupted" INT int.json "$bin" generate "a ball" -o int.json $slow --record int-rec.json
     expect_text "generate interrupted message" err.txt "sdfcsg: interrupted; int.json was not written, the exchanges so far are in int-rec.json"
     [ "$(grep -c '"url":' int-rec.json)" = 1 ] ||
         { echo "FAIL the recording of an interrupted generate"; cat int-rec.json; failures=$((failures + 1)); }
@@ -205,7 +214,7 @@ if command -v python3 >/dev/null 2>&1; then
     echo '{"version": 1, "root": {"type": "sphere", "radius": 1}}' >answer.json
     slow_llm 1
     printf 'A ball\nA snowman\n' >prompts.txt
-    interrupt "eval-prompts interrupted" eval-int/02.json "$bin" eval-prompts prompts.txt --out eval-int $slow
+    interrupt "eval-prompts interrupted" TERM eval-int/02.json "$bin" eval-prompts prompts.txt --out eval-int $slow
     expect_text "eval-prompts interrupted report" eval-int/report.txt "interrupted after 1 prompt of 2; what follows covers those"
     [ -s eval-int/01.json ] && [ -s eval-int/contact-sheet.png ] ||
         { echo "FAIL eval-prompts interrupted outputs"; ls eval-int; failures=$((failures + 1)); }
