@@ -48,7 +48,17 @@ void surface(vec3 ro, vec3 rd, vec4 ends, inout Trace r, out vec3 albedo) {
     float res = 1.0, ph = 1.0e20, shadowEnd = 0.0; // shadow ray (IQ's improved soft shadow)
 
     while (phase != kDone) {
+#ifdef SDFCSG_TAPE_STACK
+        // Tapes: the one call site matters not (the scene is a loop, not inlined code), and
+        // only the colour needs the colour stack.
+        vec4 s;
+        if (phase == kColor)
+            s = sceneSample(origin + dir * t);
+        else
+            s = tapeTap(origin + dir * t);
+#else
         vec4 s = sceneSample(origin + dir * t);
+#endif
         float d = s.w;
         bool nextLight = false;
 

@@ -105,6 +105,15 @@ float tapeDistance(vec3 p) {
     return c.x == 1u ? bound : tapeDistanceRun(c.y, c.z, p);
 }
 
+// For the shade pass's taps, which need no colour: the distance in w, and r -1 where it is a
+// bound (as tapeSample gives), else 0. The float stack is about half the work of the colour one.
+vec4 tapeTap(vec3 p) {
+    float bound;
+    uvec3 c = tapeCell(p, bound);
+    return c.x == 1u ? vec4(-1.0, 0.0, 0.0, bound)
+                     : vec4(0.0, 0.0, 0.0, tapeDistanceRun(c.y, c.z, p));
+}
+
 // Where the value is a bound, the colour is -1: the shade pass's soft shadows tell the two apart.
 vec4 tapeSample(vec3 p) {
     float bound;
