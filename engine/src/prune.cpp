@@ -8,6 +8,7 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -282,10 +283,11 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) 
         };
         const unsigned used = jobs > 64 ? threads : 1;
         std::vector<Out> outs(used);
+        std::atomic<bool> overBudget{false};
         auto work = [&](unsigned t) {
             Pruner pruner{nodes, slack, {}};
             Out& out = outs[t];
-            for (size_t j = t; j < jobs; j += used) {
+            for (size_t j = t; j < jobs && !overBudget; j += used) {
                 const Cell& parent = cells[j / fan];
                 const uint32_t octant = uint32_t(j % fan);
                 const glm::uvec3 at =
@@ -309,6 +311,7 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) 
                     continue;
                 }
                 out.cells.push_back({at, begin, uint32_t(out.tapes.size()) - begin});
+                if (out.tapes.size() > options.maxWords / used) overBudget = true;
             }
         };
         std::vector<std::thread> pool;
@@ -317,6 +320,25 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) 
         work(0);
         for (std::thread& t : pool)
             t.join();
+        if (overBudget) {
+            // Tapes that prune this little would exceed the budget: the parents' tapes serve
+            // their leaf cells (the top cells': the whole tape). Every bound written so far
+            // holds; the parents' cells only run longer tapes.
+            const uint32_t span = 1u << (field.levels - (level == 0 ? 0 : level - 1));
+            const uint32_t base = uint32_t(field.tape.size());
+            if (level > 0) field.tape.insert(field.tape.end(), tapes.begin(), tapes.end());
+            for (const Cell& c : cells) {
+                const glm::uvec2 entry = level > 0 ? glm::uvec2(base + c.begin, c.length)
+                                                   : glm::uvec2(0, field.fullLength);
+                for (uint32_t z = 0; z < span; ++z)
+                    for (uint32_t y = 0; y < span; ++y) {
+                        const glm::uvec3 l = c.at * span + glm::uvec3(0, y, z);
+                        std::fill_n(field.cells.begin() + (l.x + dims.x * (l.y + dims.y * l.z)),
+                                    span, entry);
+                    }
+            }
+            return field;
+        }
         // Gather.
         std::vector<Cell> next;
         std::vector<uint32_t> nextTapes;

@@ -5,6 +5,7 @@
 #include "gpu_test.h"
 #include "mesh_checks.h"
 #include "mesh_reference.h"
+#include "prune.h"
 
 #include <numbers>
 
@@ -121,6 +122,34 @@ TEST_P(BundledSceneMesh, IsClosedManifoldWhereTheSurfaceFitsTheBounds) {
 
 INSTANTIATE_TEST_SUITE_P(Scenes, BundledSceneMesh, ::testing::ValuesIn(bundledScenes()),
                          sceneTestName);
+
+// The benchmark scenes (assets/bench, meshed from pruned tapes) at a reduced resolution: closed,
+// manifold, and every vertex within a voxel of the surface, by the CPU's pruned field (which the
+// prune tests hold to the whole tree near the surface; the whole tree at half a million vertices
+// would take minutes).
+TEST_F(MeshTest, BenchmarkScenesAreClosedWithVerticesOnTheSurface) {
+    const std::filesystem::path dir = std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/bench";
+    for (const char* name : {"molecule_1k", "groups_1k", "flat_4k", "forest_10k"}) {
+        SCOPED_TRACE(name);
+        const Scene scene = loadOrDie(dir / (std::string(name) + ".json"));
+        const Evaluator evaluator(scene);
+        MeshOptions options;
+        options.resolution = 96;
+        MeshStats stats;
+        const Mesh mesh = extract(scene, options, &stats);
+        const MeshProperties m = measureMesh(mesh);
+        SCOPED_TRACE(m.str());
+        EXPECT_GT(m.triangles, 1000u);
+        EXPECT_FALSE(stats.surfaceCut);
+        EXPECT_TRUE(m.closedManifold());
+        EXPECT_GT(m.volume, 0.0);
+        const detail::PrunedField field = detail::pruneField(evaluator);
+        float worst = 0.0f;
+        for (const glm::vec3& p : mesh.positions)
+            worst = std::max(worst, std::abs(field.distance(evaluator.nodes(), p)));
+        EXPECT_LE(worst, stats.voxelSize);
+    }
+}
 
 // The GPU result against the CPU reference on the grid the GPU reports: same counts, same
 // vertices (positions, normals, colours) within float tolerance, same oriented triangles.

@@ -45,10 +45,12 @@ std::vector<glm::vec3> points(const Evaluator& ev, size_t count, uint32_t seed) 
 
 // Pruned against whole-tree evaluation at every point; returns the mean tape length run at the
 // points that ran one.
-double expectPrunedMatchesFull(const Scene& scene, size_t count = 3000, uint32_t levels = 5) {
+double expectPrunedMatchesFull(const Scene& scene, size_t count = 3000, uint32_t levels = 5,
+                               size_t maxWords = detail::PruneOptions{}.maxWords) {
     Evaluator ev(scene);
     detail::PruneOptions options;
     options.levels = levels;
+    options.maxWords = maxWords;
     const detail::PrunedField field = detail::pruneField(ev, options);
     size_t wrong = 0, overBound = 0, ran = 0;
     double length = 0.0;
@@ -153,6 +155,24 @@ TEST(Prune, SmoothUnionBoundsDoNotGrowWithItsOperands) {
     // And they still bound the field: its value is never below their signed distance.
     for (glm::vec3 p : points(ev, 3000, 5))
         EXPECT_GE(ev.distance(p), b.signedDistance(p) - 1e-6f);
+}
+
+// 2,000 spheres nearly on top of each other prune to little: past the budget, refinement stops,
+// so the tapes stay within it (about 4,000 words a cell; the sphere's shell crosses some 20,000 leaf cells), and
+// the coarser cells still give the whole tree's values.
+TEST(Prune, TreesThatPruneLittleStayWithinTheBudget) {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> jitter(-0.01f, 0.01f);
+    std::vector<Tree> spheres;
+    for (int i = 0; i < 2000; ++i)
+        spheres.push_back(sphere(0.5f).at(jitter(rng), jitter(rng), jitter(rng)));
+    const Scene scene = makeScene(unite(std::move(spheres), 0.05f), "<overlapping>");
+    const size_t budget = size_t(1) << 18;
+    detail::PruneOptions options;
+    options.maxWords = budget;
+    const detail::PrunedField field = detail::pruneField(Evaluator(scene), options);
+    EXPECT_LE(field.tape.size(), field.fullLength + budget + 2 * field.fullLength);
+    expectPrunedMatchesFull(scene, 1000, 5, budget);
 }
 
 TEST(Prune, BenchmarkScenesMatchTheWholeTree) {

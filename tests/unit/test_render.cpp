@@ -16,6 +16,8 @@
 #include <fstream>
 #include <random>
 
+#include <sys/resource.h>
+
 namespace sdfcsg::test {
 namespace {
 
@@ -293,6 +295,45 @@ TEST_F(Render, RandomScenesRenderTheSameWithTapes) {
     for (uint32_t seed : {4u, 9u})
         // Random scenes pack many surfaces into shadow rays' way: more colours differ.
         expectTapesMatchInlined(context(), randomScene(seed, 220), 96, 72, 0.06);
+}
+
+// A scene at the node and nesting limits (Limits: 16,384 nodes, 64 nested operations) renders at
+// 1280 x 720 and meshes at resolution 256, the process staying under 2 GiB resident: a chain of
+// 63 smooth unions inside the root, and a field of 16,256 primitives of four kinds.
+TEST_F(Render, SceneAtTheLimitsRendersAndMeshesUnderTwoGiB) {
+    Tree chain = sphere(0.6f).at(0.0f, 1.0f, 0.0f);
+    for (int d = 1; d < 64; ++d)
+        chain = unite({std::move(chain), box(0.3f, 0.3f, 0.3f).at(0.1f * float(d), 1.0f, 0.0f)},
+                      0.05f);
+    std::vector<Tree> parts{std::move(chain)};
+    const Tree kinds[] = {sphere(0.3f), box(0.3f, 0.2f, 0.3f), cylinder(0.25f, 0.4f),
+                          torus(0.25f, 0.08f)};
+    for (int i = 0; i < 16256; ++i) {
+        Tree t = kinds[i % 4];
+        parts.push_back(t.at(float(i % 128) - 64.0f, 0.0f, float(i / 128) - 64.0f));
+    }
+    const Scene built = makeScene(unite(std::move(parts)), "<limits>");
+    ASSERT_EQ(built.nodes.size(), size_t(Limits{}.maxNodes));
+    auto scene = parseScene(toJson(built), "<limits>"); // within the limits, exactly
+    ASSERT_TRUE(scene) << scene.error().str();
+    auto deeper = parseScene(toJson(built), "<limits>", Limits{.maxDepth = 63});
+    ASSERT_FALSE(deeper);
+
+    auto renderer = Renderer::create(context(), *scene);
+    ASSERT_TRUE(renderer) << renderer.error().str();
+    RenderOptions options;
+    options.width = 1280;
+    options.height = 720;
+    auto image = (*renderer)->render(options);
+    ASSERT_TRUE(image) << image.error().str();
+    MeshOptions meshOptions;
+    meshOptions.resolution = 256;
+    auto mesh = extractMesh(context(), *scene, meshOptions);
+    ASSERT_TRUE(mesh) << mesh.error().str();
+    EXPECT_GT(mesh->triangleCount(), 100000u);
+    rusage usage{};
+    ::getrusage(RUSAGE_SELF, &usage);
+    EXPECT_LT(double(usage.ru_maxrss) * 1024.0, 2.0 * double(1u << 30)) << "peak resident";
 }
 
 TEST_F(Render, AllModesRenderWhatTheyPromise) {
