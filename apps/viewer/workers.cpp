@@ -3,6 +3,8 @@
 #include "edit.h"
 #include "picking.h"
 
+#include <sdfcsg/compile.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -225,6 +227,20 @@ RenderOutput RenderWorker::process(const RenderJob& job) {
         liveRate_ > 0 ? liveRate_ : bakedRate_ * (context_.cpuDevice() ? 6.0 : 1.0);
     const bool bakeSooner =
         !job.preview && bakedRate_ > 0 && bakeSeconds_ + bakedRate_ * pixels < liveRate * pixels;
+    // A scene evaluated from pruned tapes reads every value from buffers, so its one renderer
+    // takes value edits itself, previews and still frames alike: no live renderer, no bake.
+    const bool tapes = usesTapes(*job.scene, Evaluation::Auto);
+    if (tapes && baked_ && bakedVersion_ != job.sceneVersion &&
+        sameStructure(*bakedScene_, *job.scene)) {
+        if (auto updated = baked_->updateValues(*job.scene); updated) {
+            bakedScene_ = job.scene;
+            bakedVersion_ = job.sceneVersion;
+            drawn_.reset();
+            failure_.reset();
+        } else {
+            failure_ = updated.error();
+        }
+    }
     Renderer* renderer = nullptr;
     if (baked_ && bakedVersion_ == job.sceneVersion) {
         renderer = baked_.get();
@@ -260,7 +276,7 @@ RenderOutput RenderWorker::process(const RenderJob& job) {
             renderer = baked_.get();
             // A structure on screen: its live renderer is built now, so that the first value
             // edit is already an upload.
-            if (!live_ && !liveBuilder_->pendingStructure(*job.scene))
+            if (!tapes && !live_ && !liveBuilder_->pendingStructure(*job.scene))
                 liveBuilder_->request(job.scene, job.sceneVersion);
         } else {
             failedVersion_ = job.sceneVersion;

@@ -119,6 +119,44 @@ TEST_F(ViewerGpu, ValueEditsUploadAndStructuralEditsRecompile) {
     EXPECT_EQ(afterRemoval.scene->nodes.size(), 2u);
 }
 
+// A scene evaluated from pruned tapes (molecule_1k: 1,000 spheres) has one renderer, which takes
+// value edits itself: the edited still frame comes without a compile, no second renderer is
+// built, and it shows what a renderer made for the edited scene shows.
+TEST_F(ViewerGpu, ValueEditsOfALargeSceneRedrawWithoutACompile) {
+    auto scene = std::make_shared<const Scene>(
+        test::loadOrDie(std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/bench/molecule_1k.json"));
+    RenderWorker worker(context());
+    RenderJob job;
+    job.options.width = 160;
+    job.options.height = 120;
+    job.options.camera = frameCamera(Evaluator(*scene), 160.0f / 120.0f);
+    auto render = [&](std::shared_ptr<const Scene> s, uint64_t version) {
+        job.scene = std::move(s);
+        job.sceneVersion = version;
+        ++job.id;
+        worker.submit(job);
+        RenderOutput out = wait(worker);
+        EXPECT_FALSE(out.error) << out.error->str();
+        return out;
+    };
+    RenderOutput first = render(scene, 1);
+    EXPECT_GT(first.compileSeconds, 0.0);
+    const float r = 0.06f; // twice the radius of the first sphere (node 1)
+    auto edited = std::make_shared<const Scene>(*setValue(*scene, 1, "radius", std::span(&r, 1)));
+    RenderOutput after = render(edited, 2);
+    EXPECT_EQ(after.compileSeconds, 0.0);
+    EXPECT_GT(after.renderSeconds, 0.0);
+    EXPECT_EQ(after.scene, edited);
+    EXPECT_FALSE(worker.compiling());
+    EXPECT_FALSE(worker.refinementPending(2));
+    EXPECT_NE(after.image.rgba, first.image.rgba);
+    auto fresh = Renderer::create(context(), *edited);
+    ASSERT_TRUE(fresh) << fresh.error().str();
+    auto expected = (*fresh)->render(job.options);
+    ASSERT_TRUE(expected) << expected.error().str();
+    EXPECT_EQ(differingFraction(after.image, *expected, 1), 0.0);
+}
+
 // A selected node's visible surface is tinted and outlined in still frames, inside its
 // projected bounds only; choosing another node redraws the highlight, not the image.
 TEST_F(ViewerGpu, SelectionIsHighlighted) {
