@@ -8,7 +8,6 @@ layout(std140, set = 0, binding = SDFCSG_BINDING_MESH_GRID) uniform MeshGrid {
     uvec4 cells; // xyz: cells per axis; w: root-finding steps per vertex
     uvec4 bricks; // xyz: bricks per axis
     vec4 cull;   // x: a brick whose centre value exceeds this in magnitude holds no surface
-    uvec4 lists; // x: primitive lists in the scene code (engine/src/primitive_lists.h)
 } grid;
 
 layout(push_constant) uniform MeshPush {

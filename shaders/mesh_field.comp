@@ -17,23 +17,6 @@
 #include "nodes.glsl"
 #include "mesh_common.glsl"
 
-// What the scene code's primitive lists read: per region (cull pass: a block of
-// SDFCSG_MESH_CULL_BLOCK^3 bricks; others: active brick slot + 1 and a cell around it), each
-// list's [begin, end) in sceneList.
-layout(std430, set = 0, binding = SDFCSG_BINDING_MESH_LIST_RANGES) readonly buffer ListRanges {
-    uint sceneListRanges[];
-};
-layout(std430, set = 0, binding = SDFCSG_BINDING_MESH_LIST_ITEMS) readonly buffer ListItems {
-    uint sceneList[];
-};
-uint sceneRegion = 0u;
-uint sceneListBegin(uint list) {
-    return sceneListRanges[(sceneRegion * grid.lists.x + list) * 2u];
-}
-uint sceneListEnd(uint list) {
-    return sceneListRanges[(sceneRegion * grid.lists.x + list) * 2u + 1u];
-}
-
 #include "scene.glsl"
 #include "mesh_rows.glsl"
 #include "mesh_tables.glsl"
@@ -74,11 +57,7 @@ void cull() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= push.count) return;
     uint brick = push.first + i;
-    uvec3 b = brickCoords(brick);
-    uvec3 blocks = (grid.bricks.xyz + SDFCSG_MESH_CULL_BLOCK - 1u) / SDFCSG_MESH_CULL_BLOCK;
-    uvec3 block = b / SDFCSG_MESH_CULL_BLOCK;
-    sceneRegion = block.x + blocks.x * (block.y + blocks.y * block.z);
-    uvec3 s0 = b * SDFCSG_MESH_BRICK;
+    uvec3 s0 = brickCoords(brick) * SDFCSG_MESH_BRICK;
     vec3 centre = samplePosition(s0) + 0.5 * SDFCSG_MESH_BRICK * grid.origin.w;
     float d = sceneDistance(centre);
     map[brick] = abs(d) <= grid.cull.x ? 1u : 0u;
@@ -103,7 +82,6 @@ void classify() {
     uint batchSlot = gl_WorkGroupID.x;
     if (batchSlot >= push.count) return; // uniform in the workgroup
     uint slot = push.first + batchSlot;
-    sceneRegion = slot + 1u;
     uint block = batchSlot * SDFCSG_MESH_BRICK_BLOCK;
     uint record = slot * SDFCSG_MESH_RECORD;
     uvec3 brick = brickCoords(activeBricks[slot]) * SDFCSG_MESH_BRICK;
@@ -158,7 +136,6 @@ void placeVertices() {
     uint batchSlot = gl_WorkGroupID.x;
     if (batchSlot >= push.count) return;
     uint slot = push.first + batchSlot;
-    sceneRegion = slot + 1u;
     uvec3 b = brickCoords(activeBricks[slot]) * SDFCSG_MESH_BRICK;
     uint count = counts[slot].x;
     uint first = bases[slot].x - push.vertexBase;

@@ -35,7 +35,6 @@
 #define SDFCSG_MESH_BRICK_EDGES 1536     // 3 edges per owned sample
 #define SDFCSG_MESH_GROUP_X 64           // cull and vertex passes
 #define SDFCSG_MESH_RECORD 209           // 2 * 8 * 8 + 9 * 9
-#define SDFCSG_MESH_CULL_BLOCK 4         // the cull pass's primitive lists: per 4^3 bricks
 #define SDFCSG_MESH_NO_BRICK 0xffffffffu // brick map entry of a skipped brick
 
 #define SDFCSG_BINDING_MESH_GRID 0     // uniform MeshGrid: origin, cell size, counts
@@ -53,8 +52,6 @@
 #define SDFCSG_BINDING_MESH_VERTICES 10 // float[]: 9 per vertex: position, normal, colour
 #define SDFCSG_BINDING_MESH_INDICES 11  // uint[]: 3 per triangle
 #define SDFCSG_BINDING_MESH_STATUS 12   // uint[2]: surface cut, brick skipped wrongly
-#define SDFCSG_BINDING_MESH_LIST_RANGES 13 // uint[]: per region and primitive list, begin, end
-#define SDFCSG_BINDING_MESH_LIST_ITEMS 14  // uint[]: the lists' node indices
 
 #define SDFCSG_MAX_LIGHTS 4
 #define SDFCSG_MAX_CLIP_BOXES 8 // boxes that hold every surface; rays skip the space outside them

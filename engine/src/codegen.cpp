@@ -7,7 +7,6 @@
 #include "sdfcsg/compile.h"
 
 #include "gpu_nodes.h"
-#include "primitive_lists.h"
 #include "prune.h"
 
 #include <algorithm>
@@ -90,29 +89,16 @@ void appendVector(std::string& out, const float* v, int count) {
 class Emitter {
   public:
     Emitter(const Scene& scene, std::string& out, const std::vector<detail::GpuNode>* literals,
-            std::vector<detail::PrimitiveList> lists, bool boundsTests)
-        : scene_(scene), out_(out), lit_(literals), lists_(std::move(lists)),
-          operands_(scene.nodes.size()), tests_(boundsTests) {
-        std::vector<bool> listed(scene.nodes.size(), false);
-        for (const detail::PrimitiveList& list : lists_)
-            for (uint32_t m : list.members)
-                listed[m] = true;
-        for (uint32_t i = 0; i < scene.nodes.size(); ++i)
-            for (uint32_t c : scene.nodes[i].children)
-                if (!listed[c]) operands_[i].push_back(c);
-    }
+            bool boundsTests)
+        : scene_(scene), out_(out), lit_(literals), tests_(boundsTests) {}
 
-    // The buffer-mode wrappers, e.g. `float boxNode(uint i, vec3 p)`, for the kinds in use (with
-    // values inlined, for the kinds in primitive lists only).
+    // The buffer-mode wrappers, e.g. `float boxNode(uint i, vec3 p)`, for the kinds in use (none
+    // with values inlined).
     void helpers() {
+        if (lit_) return;
         std::array<bool, kNodeKindCount> used{};
-        if (lit_)
-            for (const detail::PrimitiveList& list : lists_)
-                used[size_t(list.kind)] = true;
-        else
-            for (const Node& n : scene_.nodes)
-                used[size_t(n.kind)] = true;
-        if (std::find(used.begin(), used.end(), true) == used.end()) return;
+        for (const Node& n : scene_.nodes)
+            used[size_t(n.kind)] = true;
         for (int k = 0; k <= int(NodeKind::Capsule); ++k) {
             if (!used[size_t(k)]) continue;
             const Call& call = kCalls[k];
@@ -138,18 +124,15 @@ class Emitter {
         out_ += sample ? "vec4 sceneSample(vec3 p) {\n" : "float sceneDistance(vec3 p) {\n";
         struct Frame {
             uint32_t node, next, depth;
-            bool declared; // the operation's variable exists before its first inline operand
         };
         std::vector<Frame> stack;
         uint32_t current = 0, depth = 0;
         for (;;) {
             const Node& n = scene_.nodes[current];
             if (kindInfo(n.kind).operation) {
-                const bool declared = openLists(current, depth);
-                const std::vector<uint32_t>& operands = operands_[current];
+                const std::vector<uint32_t>& operands = n.children;
                 if (!operands.empty()) {
-                    stack.push_back({current, 1, depth, declared});
-                    if (declared) guard(current, operands[0], depth);
+                    stack.push_back({current, 1, depth});
                     current = operands[0];
                     ++depth;
                     continue;
@@ -170,9 +153,9 @@ class Emitter {
                 }
                 Frame& f = stack.back();
                 const Node& op = scene_.nodes[f.node];
-                const std::vector<uint32_t>& operands = operands_[f.node];
+                const std::vector<uint32_t>& operands = op.children;
                 const uint32_t child = operands[f.next - 1];
-                if (f.next == 1 && !f.declared) {
+                if (f.next == 1) {
                     indent(f.depth);
                     declare(f.node);
                     var(child);
@@ -193,42 +176,6 @@ class Emitter {
 
   private:
     void indent(uint32_t depth) { out_.append(4 * (depth + 1), ' '); }
-
-    // For a union with primitive lists: declares its variable as "nothing" and folds in each
-    // list's operands in a loop over the kernel's list for the current region. Returns whether
-    // it did.
-    bool openLists(uint32_t op, uint32_t depth) {
-        bool opened = false;
-        for (size_t g = 0; g < lists_.size(); ++g) {
-            const detail::PrimitiveList& list = lists_[g];
-            if (list.unionNode != op) continue;
-            if (!opened) {
-                indent(depth);
-                declare(op);
-                out_ += sample_ ? "vec4(0.0, 0.0, 0.0, 1e30)" : "1e30";
-                comment(op);
-                opened = true;
-            }
-            const std::string k = "k" + std::to_string(g);
-            indent(depth + 1);
-            out_ += "for (uint " + k + " = sceneListBegin(" + std::to_string(g) + "u); " + k +
-                    " < sceneListEnd(" + std::to_string(g) + "u); ++" + k + ") { // " +
-                    std::to_string(list.members.size()) + " " +
-                    std::string(kindInfo(list.kind).name) + " operands, those near the region\n";
-            indent(depth + 2);
-            var(op);
-            out_ += " = sharpUnion(";
-            var(op);
-            out_ += ", ";
-            const std::string call = std::string(kCalls[int(list.kind)].helper) +
-                                     "(sceneList[" + k + "], p)";
-            out_ += sample_ ? "withColor(sceneList[" + k + "], " + call + ")" : call;
-            out_ += ");\n";
-            indent(depth + 1);
-            out_ += "}\n";
-        }
-        return opened;
-    }
 
     void var(uint32_t i) {
         out_ += sample_ ? 's' : 'd';
@@ -372,8 +319,6 @@ class Emitter {
     const Scene& scene_;
     std::string& out_;
     const std::vector<detail::GpuNode>* lit_; // null: values come from the node buffer
-    std::vector<detail::PrimitiveList> lists_;
-    std::vector<std::vector<uint32_t>> operands_; // per operation, those not in a list
     bool tests_;                                  // CodegenOptions::boundsTests
     bool sample_ = false;
 };
@@ -418,10 +363,7 @@ std::string generateSceneGlsl(const Scene& scene, const CodegenOptions& options)
     std::vector<detail::GpuNode> literals;
     if (inlined) literals = detail::packNodes(evaluator);
     out.reserve(out.size() + scene.nodes.size() * (inlined ? 500 : 200));
-    Emitter emitter(scene, out, inlined ? &literals : nullptr,
-                    options.primitiveLists ? detail::primitiveLists(scene, evaluator)
-                                           : std::vector<detail::PrimitiveList>{},
-                    options.boundsTests);
+    Emitter emitter(scene, out, inlined ? &literals : nullptr, options.boundsTests);
     emitter.helpers();
     emitter.function(false);
     out += '\n';

@@ -15,7 +15,6 @@
 #include "camera.h"
 #include "gpu_nodes.h"
 #include "mc_tables.h"
-#include "primitive_lists.h"
 #include "shader_compile.h"
 #include "vk.h"
 
@@ -42,7 +41,6 @@ using detail::MemoryUse;
 
 constexpr uint32_t kBrick = SDFCSG_MESH_BRICK;
 constexpr uint32_t kBatchBricks = 4096;      // bricks sampled and classified per submission
-constexpr uint32_t kCullBlock = SDFCSG_MESH_CULL_BLOCK;
 constexpr uint32_t kMaxGroups = 65535;       // the minimum maxComputeWorkGroupCount[0]
 constexpr uint64_t kMaxActive = 1u << 22; // slots * SDFCSG_MESH_RECORD fits a uint32_t index
 // Bytes each active brick holds for the whole extraction: slot, record, counts, bases.
@@ -58,7 +56,6 @@ struct MeshGrid {
     glm::uvec4 cells;
     glm::uvec4 bricks;
     glm::vec4 cull;
-    glm::uvec4 lists;
 };
 
 // Mirrors MeshPush in shaders/mesh_common.glsl.
@@ -80,8 +77,6 @@ constexpr detail::Binding kBindings[] = {
     {SDFCSG_BINDING_MESH_VERTICES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
     {SDFCSG_BINDING_MESH_INDICES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
     {SDFCSG_BINDING_MESH_STATUS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-    {SDFCSG_BINDING_MESH_LIST_RANGES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-    {SDFCSG_BINDING_MESH_LIST_ITEMS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
     {SDFCSG_BINDING_FIELD, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
 };
 constexpr size_t kBindingCount = std::size(kBindings);
@@ -196,7 +191,6 @@ double secondsSince(std::chrono::steady_clock::time_point start) {
 struct Mesher::Impl {
     Context::Impl& ctx;
     std::unique_ptr<Evaluator> evaluator;
-    std::vector<detail::PrimitiveList> lists; // as in the generated scene code
 
     VkShaderModule modules[2] = {}; // field (cull, classify, vertices), triangles
     VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
@@ -238,8 +232,6 @@ struct Mesher::Impl {
         case SDFCSG_BINDING_MESH_TABLES:
         case SDFCSG_BINDING_MESH_ACTIVE:
         case SDFCSG_BINDING_MESH_BASES:
-        case SDFCSG_BINDING_MESH_LIST_RANGES:
-        case SDFCSG_BINDING_MESH_LIST_ITEMS:
         case SDFCSG_BINDING_FIELD: return MemoryUse::Upload;
         case SDFCSG_BINDING_MESH_MAP: // written by the cull pass, read and rewritten by the host
         case SDFCSG_BINDING_MESH_COUNTS:
@@ -337,39 +329,6 @@ struct Mesher::Impl {
     // than distance somewhere, and its result is wrong.
     bool skippedSurface = false;
     Result<Mesh> run(const MeshOptions& options, MeshStats& stats, bool cullBricks);
-
-    // For the cull pass (`active` null), region i is block i of kCullBlock^3 bricks; for the
-    // others, region 0 is unused and region slot + 1 is active brick `slot` and one cell around
-    // it (the normal taps reach a little past the brick). Each region gets the list members
-    // that can be nearest in it.
-    Status uploadLists(const Grid& g, const std::vector<uint32_t>* active) {
-        std::vector<uint32_t> items, ranges;
-        if (!active) {
-            glm::uvec3 blocks = (g.bricks + kCullBlock - 1u) / kCullBlock;
-            float side = g.h * float(kBrick * kCullBlock);
-            for (uint32_t z = 0; z < blocks.z; ++z)
-                for (uint32_t y = 0; y < blocks.y; ++y)
-                    for (uint32_t x = 0; x < blocks.x; ++x) {
-                        glm::vec3 lo = g.origin + side * glm::vec3(x, y, z);
-                        detail::pruneLists(lists, *evaluator, Aabb{lo, lo + side}, items, ranges);
-                    }
-        } else {
-            ranges.resize(2 * lists.size(), 0);
-        }
-        for (uint32_t brick : active ? *active : std::vector<uint32_t>{}) {
-            glm::uvec3 b(brick % g.bricks.x, (brick / g.bricks.x) % g.bricks.y,
-                         brick / (g.bricks.x * g.bricks.y));
-            glm::vec3 lo = g.origin + g.h * (glm::vec3(b * kBrick) - 1.0f);
-            detail::pruneLists(lists, *evaluator, Aabb{lo, lo + g.h * float(kBrick + 2)}, items,
-                               ranges);
-        }
-        for (auto [binding, data] : {std::pair{SDFCSG_BINDING_MESH_LIST_RANGES, &ranges},
-                                     std::pair{SDFCSG_BINDING_MESH_LIST_ITEMS, &items}}) {
-            if (auto ok = reserve(binding, data->size() * 4); !ok) return ok.error();
-            detail::uploadBuffer(ctx, buffer(binding), data->data(), data->size() * 4);
-        }
-        return Ok{};
-    }
 };
 
 Mesher::Mesher(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -382,13 +341,10 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
     Impl& m = *impl;
     m.evaluator = std::make_unique<Evaluator>(scene);
 
-    const bool tapes = usesTapes(scene, evaluation);
-    if (!tapes) m.lists = detail::primitiveLists(scene, *m.evaluator);
     // Bounds tests pay off only where branches are real (see RenderOptions::boundsSkipping).
     const uint32_t skipping = m.ctx.properties.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU;
     CodegenOptions codegen;
     codegen.inlineParams = true;
-    codegen.primitiveLists = true;
     codegen.evaluation = evaluation;
     codegen.boundsTests = skipping != 0;
     const std::string sceneGlsl = generateSceneGlsl(scene, codegen);
@@ -531,15 +487,12 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
     gridUniform.bricks = glm::uvec4(g.bricks, 0);
     const float halfDiagonal = 0.5f * std::sqrt(3.0f) * float(kBrick) * g.h;
     gridUniform.cull = glm::vec4(cullBricks ? halfDiagonal * 1.001f : INFINITY, 0, 0, 0);
-    gridUniform.lists = glm::uvec4(uint32_t(lists.size()), 0, 0, 0);
     detail::uploadBuffer(ctx, buffer(SDFCSG_BINDING_MESH_GRID), &gridUniform, sizeof gridUniform);
     const uint32_t zero[2] = {0, 0};
     detail::uploadBuffer(ctx, buffer(SDFCSG_BINDING_MESH_STATUS), zero, sizeof zero);
 
-    // Cull, with every primitive list whole.
+    // Cull.
     auto t0 = Clock::now();
-    if (!lists.empty())
-        if (auto ok = uploadLists(g, nullptr); !ok) return ok.error();
     if (auto ok = reserve(SDFCSG_BINDING_MESH_MAP, g.brickCount * 4); !ok) return ok.error();
     {
         VkCommandBuffer cmd = begin(cull);
@@ -587,11 +540,6 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
     if (activeCount) detail::uploadBuffer(ctx, buffer(SDFCSG_BINDING_MESH_ACTIVE), active.data(),
                                           active.size() * 4);
     notePeak(map.size() * 4);
-    if (!lists.empty()) {
-        t0 = Clock::now();
-        if (auto ok = uploadLists(g, &active); !ok) return ok.error();
-        stage("lists", t0);
-    }
 
     Mesh mesh;
     std::vector<glm::uvec2> bases(activeCount);

@@ -81,7 +81,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         break;
     default:
         options.inlineParams = true;
-        options.primitiveLists = true;
         kernel = "mesh_field.comp";
     }
     const std::string glsl = sdfcsg::generateSceneGlsl(*scene, options);

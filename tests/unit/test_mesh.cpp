@@ -197,9 +197,8 @@ TEST_F(MeshTest, MatchesTheCpuReference) {
     expectMatchesReference(context(), randomScene(11, 16), "random scene 11");
 }
 
-// Sharp unions of many primitives of one kind are evaluated per brick over the primitives near
-// it (engine/src/primitive_lists.h); the mesh must not change.
-TEST_F(MeshTest, PrimitiveListsMatchTheCpuReference) {
+// Sharp unions of many primitives, separate or nested in a difference, against the reference.
+TEST_F(MeshTest, UnionsOfManyPrimitivesMatchTheCpuReference) {
     {
         // Reference scene B: 64 separate spheres (the slab between the layers touches none).
         MeshOptions options;

@@ -36,11 +36,6 @@ struct CodegenOptions {
     // than 1024 nodes always read the buffer: glslang's time grows with the square of the
     // number of distinct literals.
     bool inlineParams = false;
-    // Sharp unions of many primitives of one kind evaluate those operands in a loop over a list
-    // that the kernel chooses per region of space (the mesher's bricks, holding only the
-    // primitives near the brick): see primitiveLists() in engine/src/primitive_lists.h. The
-    // kernel must then declare what the generated code calls (shaders/mesh_field.comp does).
-    bool primitiveLists = false;
     // Whether each operand of a union or difference is guarded by a test of its bounds, which
     // the kernels turn on or off with a specialisation constant (kBoundsSkipping in
     // shaders/nodes.glsl). false leaves the tests out, for kernels that would turn them off:
