@@ -257,6 +257,16 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) 
     const float slack = 1e-5f * (field.cell * float(dims.x + dims.y + dims.z) +
                                  glm::length(field.origin));
 
+    // Sets every leaf entry under the cell `at` of `level` (in cells of its level).
+    auto fillLeaves = [&](glm::uvec3 at, uint32_t level, glm::uvec2 entry) {
+        const uint32_t span = 1u << (field.levels - level);
+        for (uint32_t z = 0; z < span; ++z)
+            for (uint32_t y = 0; y < span; ++y) {
+                const glm::uvec3 l = at * span + glm::uvec3(0, y, z);
+                std::fill_n(field.cells.begin() + (l.x + dims.x * (l.y + dims.y * l.z)), span,
+                            entry);
+            }
+    };
     // Level by level: the cells that may hold surface, each with its tape in `tapes`.
     struct Cell {
         glm::uvec3 at; // in cells of its level
@@ -300,14 +310,8 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) 
                                              out.tapes);
                 if (std::abs(v) > kFarRadii * r + slack) { // no surface: fill its leaf cells
                     out.tapes.resize(begin);
-                    const uint32_t span = 1u << (field.levels - level);
-                    const glm::uvec2 entry(std::bit_cast<uint32_t>(v), kFarCell | level);
-                    for (uint32_t z = 0; z < span; ++z)
-                        for (uint32_t y = 0; y < span; ++y) {
-                            const glm::uvec3 l = at * span + glm::uvec3(0, y, z);
-                            std::fill_n(field.cells.begin() + (l.x + dims.x * (l.y + dims.y * l.z)),
-                                        span, entry);
-                        }
+                    fillLeaves(at, level,
+                               glm::uvec2(std::bit_cast<uint32_t>(v), kFarCell | level));
                     continue;
                 }
                 out.cells.push_back({at, begin, uint32_t(out.tapes.size()) - begin});
@@ -324,19 +328,12 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) 
             // Tapes that prune this little would exceed the budget: the parents' tapes serve
             // their leaf cells (the top cells': the whole tape). Every bound written so far
             // holds; the parents' cells only run longer tapes.
-            const uint32_t span = 1u << (field.levels - (level == 0 ? 0 : level - 1));
             const uint32_t base = uint32_t(field.tape.size());
             if (level > 0) field.tape.insert(field.tape.end(), tapes.begin(), tapes.end());
-            for (const Cell& c : cells) {
-                const glm::uvec2 entry = level > 0 ? glm::uvec2(base + c.begin, c.length)
-                                                   : glm::uvec2(0, field.fullLength);
-                for (uint32_t z = 0; z < span; ++z)
-                    for (uint32_t y = 0; y < span; ++y) {
-                        const glm::uvec3 l = c.at * span + glm::uvec3(0, y, z);
-                        std::fill_n(field.cells.begin() + (l.x + dims.x * (l.y + dims.y * l.z)),
-                                    span, entry);
-                    }
-            }
+            for (const Cell& c : cells)
+                fillLeaves(c.at, level == 0 ? 0 : level - 1,
+                           level > 0 ? glm::uvec2(base + c.begin, c.length)
+                                     : glm::uvec2(0, field.fullLength));
             return field;
         }
         // Gather.
