@@ -39,9 +39,21 @@ std::vector<GpuNode> packNodes(const Evaluator& evaluator) {
 
 Result<bool> uploadField(Context::Impl& ctx, Buffer& buffer, const Scene& scene,
                          const Evaluator& evaluator, Evaluation evaluation) {
-    std::vector<uint32_t> words = usesTapes(scene, evaluation)
-                                      ? packField(pruneField(evaluator))
-                                      : std::vector<uint32_t>(kFieldHeaderWords, 0u);
+    std::vector<uint32_t> words(kFieldHeaderWords, 0u);
+    if (usesTapes(scene, evaluation)) {
+        const PrunedField field = pruneField(evaluator);
+        if (const double mean = field.meanActiveLength(); mean > kMaxMeanCellInstructions)
+            return Error(ErrorKind::Limit,
+                         Diagnostic{scene.file, "root",
+                                    "the tree prunes too little to render or mesh in bounded "
+                                    "time: near its surface, a region evaluates " +
+                                        std::to_string(uint32_t(mean)) +
+                                        " instructions on average, above the limit of " +
+                                        std::to_string(kMaxMeanCellInstructions) +
+                                        " (many primitives that all overlap in one smooth "
+                                        "operation do this)"});
+        words = packField(field);
+    }
     const VkDeviceSize bytes = words.size() * sizeof(uint32_t);
     bool made = false;
     if (!buffer.buffer || buffer.size < bytes) {

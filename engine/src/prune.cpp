@@ -360,6 +360,14 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) 
     return field;
 }
 
+double PrunedField::meanActiveLength() const {
+    double sum = 0.0;
+    size_t near = 0;
+    for (const glm::uvec2& c : cells)
+        if (!(c.y & kFarCell)) sum += c.y, ++near;
+    return near ? sum / double(near) : 0.0;
+}
+
 namespace {
 
 // The leaf cell of p, or nullptr outside the cube.

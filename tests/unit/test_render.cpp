@@ -336,6 +336,29 @@ TEST_F(Render, SceneAtTheLimitsRendersAndMeshesUnderTwoGiB) {
     EXPECT_LT(double(usage.ru_maxrss) * 1024.0, 2.0 * double(1u << 30)) << "peak resident";
 }
 
+// 2,000 spheres that all overlap in one smooth union prune to nearly nothing: every region near
+// the surface would evaluate all of them, so the renderer and the mesher refuse the scene before
+// any work, naming the limit.
+TEST_F(Render, TreesThatPruneTooLittleAreRefused) {
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> jitter(-0.01f, 0.01f);
+    std::vector<Tree> spheres;
+    for (int i = 0; i < 2000; ++i)
+        spheres.push_back(sphere(0.5f).at(jitter(rng), jitter(rng), jitter(rng)));
+    const Scene scene = makeScene(unite(std::move(spheres), 0.05f), "blob.json");
+    const std::string expected =
+        "blob.json: root: the tree prunes too little to render or mesh in bounded time: near its "
+        "surface, a region evaluates 3999 instructions on average, above the limit of 1024 (many "
+        "primitives that all overlap in one smooth operation do this)";
+    auto renderer = Renderer::create(context(), scene);
+    ASSERT_FALSE(renderer);
+    EXPECT_EQ(renderer.error().kind, ErrorKind::Limit);
+    EXPECT_EQ(renderer.error().str(), expected);
+    auto mesher = Mesher::create(context(), scene);
+    ASSERT_FALSE(mesher);
+    EXPECT_EQ(mesher.error().str(), expected);
+}
+
 TEST_F(Render, AllModesRenderWhatTheyPromise) {
     Scene scene = loadOrDie(scenePath("snowman.json"));
     auto renderer = Renderer::create(context(), scene);
