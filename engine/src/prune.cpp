@@ -96,7 +96,8 @@ struct Pruner {
         return in[leftEnd] != in[instructionAt];
     }
 
-    float prune(const uint32_t* in, uint32_t length, glm::vec3 c, float r,
+    // A cell whose root value exceeds `far` in magnitude needs no tape: pass 2 is skipped.
+    float prune(const uint32_t* in, uint32_t length, glm::vec3 c, float r, float far,
                 std::vector<uint32_t>& out) {
         if (value.size() < length) value.resize(length);
         if (extreme.size() < nodes.size()) extreme.assign(nodes.size(), NAN);
@@ -124,6 +125,7 @@ struct Pruner {
             ends.back() = i;
         }
         const float root = value[length - 1];
+        if (std::abs(root) > far) return resetExtremes(), root;
 
         stack.clear();
         for (uint32_t i = 0; i < length; ++i) {
@@ -166,10 +168,14 @@ struct Pruner {
             out.resize(stack.back().start);
             out.insert(out.end(), in, in + length);
         }
+        resetExtremes();
+        return root;
+    }
+
+    void resetExtremes() {
         for (uint32_t u : touched)
             extreme[u] = NAN;
         touched.clear();
-        return root;
     }
 };
 
@@ -306,10 +312,10 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) 
                                      glm::uvec3(octant & 1, octant >> 1 & 1, octant >> 2);
                 const glm::vec3 c = field.origin + (glm::vec3(at) + 0.5f) * size;
                 const uint32_t begin = uint32_t(out.tapes.size());
-                const float v = pruner.prune(tapes.data() + parent.begin, parent.length, c, r,
-                                             out.tapes);
-                if (std::abs(v) > kFarRadii * r + slack) { // no surface: fill its leaf cells
-                    out.tapes.resize(begin);
+                const float far = kFarRadii * r + slack;
+                const float v =
+                    pruner.prune(tapes.data() + parent.begin, parent.length, c, r, far, out.tapes);
+                if (std::abs(v) > far) { // no surface: fill its leaf cells
                     fillLeaves(at, level,
                                glm::uvec2(std::bit_cast<uint32_t>(v), kFarCell | level));
                     continue;
