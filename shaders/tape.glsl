@@ -32,42 +32,69 @@ float tapePrimitive(uint kind, uint i, vec3 p) {
 }
 
 const uint kTapeUnion = 9u, kTapeIntersection = 10u;
+// packField(): on a primitive, the next instruction is the operation that folds it in.
+const uint kTapeFold = 0x10000000u;
 
+float tapeOp(uint kind, float a, float b, float k) {
+    return kind == kTapeUnion          ? opUnion(a, b, k)
+         : kind == kTapeIntersection ? opIntersection(a, b, k)
+                                     : opDifference(a, b, k);
+}
+
+vec4 tapeOp(uint kind, vec4 a, vec4 b, float k) {
+    return kind == kTapeUnion          ? opUnion(a, b, k)
+         : kind == kTapeIntersection ? opIntersection(a, b, k)
+                                     : opDifference(a, b, k);
+}
+
+// The top of the stack stays in `acc`; a primitive that its operation folds in at once (most
+// of them: a left fold is primitive, operation, primitive, operation...) goes straight into
+// it. On CPU devices this keeps most instructions off the stack array, which every lane
+// indexes on its own, and makes nearly every iteration take the same path.
 float tapeDistanceRun(uint begin, uint end, vec3 p) {
     float stack[SDFCSG_TAPE_STACK];
     int top = -1;
+    float acc = 0.0;
     for (uint at = begin; at < end; ++at) {
         uint ins = field[at];
-        uint i = ins & 0xffffffu, kind = ins >> 24;
+        uint i = ins & 0xffffffu, kind = (ins >> 24) & 0xfu;
         if (kind < kTapeUnion) {
-            stack[++top] = tapePrimitive(kind, i, p);
+            float d = tapePrimitive(kind, i, p);
+            if ((ins & kTapeFold) != 0u) {
+                uint op = field[++at];
+                acc = tapeOp(op >> 24, acc, d, nodeSmooth(op & 0xffffffu));
+            } else {
+                stack[++top] = acc;
+                acc = d;
+            }
         } else {
-            float b = stack[top--], a = stack[top], k = nodeSmooth(i);
-            stack[top] = kind == kTapeUnion          ? opUnion(a, b, k)
-                       : kind == kTapeIntersection ? opIntersection(a, b, k)
-                                                   : opDifference(a, b, k);
+            acc = tapeOp(kind, stack[top--], acc, nodeSmooth(i));
         }
     }
-    return stack[0];
+    return acc;
 }
 
 vec4 tapeSampleRun(uint begin, uint end, vec3 p) {
     vec4 stack[SDFCSG_TAPE_STACK];
     int top = -1;
+    vec4 acc = vec4(0.0);
     for (uint at = begin; at < end; ++at) {
         uint ins = field[at];
-        uint i = ins & 0xffffffu, kind = ins >> 24;
+        uint i = ins & 0xffffffu, kind = (ins >> 24) & 0xfu;
         if (kind < kTapeUnion) {
-            stack[++top] = withColor(i, tapePrimitive(kind, i, p));
+            vec4 d = withColor(i, tapePrimitive(kind, i, p));
+            if ((ins & kTapeFold) != 0u) {
+                uint op = field[++at];
+                acc = tapeOp(op >> 24, acc, d, nodeSmooth(op & 0xffffffu));
+            } else {
+                stack[++top] = acc;
+                acc = d;
+            }
         } else {
-            vec4 b = stack[top--], a = stack[top];
-            float k = nodeSmooth(i);
-            stack[top] = kind == kTapeUnion          ? opUnion(a, b, k)
-                       : kind == kTapeIntersection ? opIntersection(a, b, k)
-                                                   : opDifference(a, b, k);
+            acc = tapeOp(kind, stack[top--], acc, nodeSmooth(i));
         }
     }
-    return stack[0];
+    return acc;
 }
 
 // Where p's value comes from: x: 0 to run the tape [y, z), 1 for the bound w.

@@ -453,7 +453,21 @@ std::vector<uint32_t> packField(const PrunedField& f) {
     const uint32_t tapeStart = uint32_t(kFieldHeaderWords + 2 * f.cells.size());
     out[10] = tapeStart;
     std::memcpy(out.data() + kFieldHeaderWords, f.cells.data(), f.cells.size() * 8);
-    std::copy(f.tape.begin(), f.tape.end(), out.begin() + tapeStart);
+    uint32_t* tape = out.data() + tapeStart;
+    std::copy(f.tape.begin(), f.tape.end(), tape);
+    // Within each tape, a primitive whose operation follows at once is marked, so that the
+    // shader folds it into the running value without the stack (shaders/tape.glsl).
+    std::vector<bool> marked(f.tape.size() + 1, false); // by first word: cells share tapes
+    auto mark = [&](uint32_t begin, uint32_t length) {
+        if (marked[begin]) return;
+        marked[begin] = true;
+        for (uint32_t t = begin; t + 1 < begin + length; ++t)
+            if (!isOperation(opcode(f.tape[t])) && isOperation(opcode(f.tape[t + 1])))
+                tape[t] |= kTapeFold;
+    };
+    mark(0, f.fullLength);
+    for (const glm::uvec2& c : f.cells)
+        if (!(c.y & kFarCell)) mark(c.x, c.y);
     return out;
 }
 
