@@ -35,16 +35,20 @@ const uint kTapeUnion = 9u, kTapeIntersection = 10u;
 // packField(): on a primitive, the next instruction is the operation that folds it in.
 const uint kTapeFold = 0x10000000u;
 
+// One blend for the three operations, which the compiler would otherwise all evaluate and
+// select from: intersection(a, b) is -union(-a, -b) and difference(a, b) intersection(a, -b),
+// bit for bit as sdf.glsl computes them (negation rounds symmetrically).
 float tapeOp(uint kind, float a, float b, float k) {
-    return kind == kTapeUnion          ? opUnion(a, b, k)
-         : kind == kTapeIntersection ? opIntersection(a, b, k)
-                                     : opDifference(a, b, k);
+    float s = kind == kTapeUnion ? 1.0 : -1.0;
+    float c = kind == kTapeIntersection || kind == kTapeUnion ? b : -b;
+    return s * opUnion(s * a, s * c, k);
 }
 
 vec4 tapeOp(uint kind, vec4 a, vec4 b, float k) {
-    return kind == kTapeUnion          ? opUnion(a, b, k)
-         : kind == kTapeIntersection ? opIntersection(a, b, k)
-                                     : opDifference(a, b, k);
+    float s = kind == kTapeUnion ? 1.0 : -1.0;
+    float c = kind == kTapeIntersection || kind == kTapeUnion ? b.w : -b.w;
+    vec4 u = opUnion(vec4(a.rgb, s * a.w), vec4(b.rgb, s * c), k);
+    return vec4(u.rgb, s * u.w);
 }
 
 // The top of the stack stays in `acc`; a primitive that its operation folds in at once (most
