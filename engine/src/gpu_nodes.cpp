@@ -37,9 +37,12 @@ std::vector<GpuNode> packNodes(const Evaluator& evaluator) {
     return out;
 }
 
-Result<bool> uploadField(Context::Impl& ctx, Buffer& buffer, const Scene& scene,
-                         const Evaluator& evaluator, Evaluation evaluation) {
-    std::vector<uint32_t> words(kFieldHeaderWords, 0u);
+std::vector<uint32_t> emptyField() {
+    return std::vector<uint32_t>(kFieldHeaderWords, 0u);
+}
+
+Result<std::vector<uint32_t>> fieldWords(const Scene& scene, const Evaluator& evaluator,
+                                         Evaluation evaluation) {
     if (usesTapes(scene, evaluation)) {
         const PrunedField field = pruneField(evaluator);
         if (const double mean = field.meanActiveLength(); mean > kMaxMeanCellInstructions)
@@ -52,8 +55,12 @@ Result<bool> uploadField(Context::Impl& ctx, Buffer& buffer, const Scene& scene,
                                         std::to_string(kMaxMeanCellInstructions) +
                                         " (many primitives that all overlap in one smooth "
                                         "operation do this)"});
-        words = packField(field);
+        return packField(field);
     }
+    return emptyField();
+}
+
+Result<bool> uploadField(Context::Impl& ctx, Buffer& buffer, std::span<const uint32_t> words) {
     const VkDeviceSize bytes = words.size() * sizeof(uint32_t);
     bool made = false;
     if (!buffer.buffer || buffer.size < bytes) {

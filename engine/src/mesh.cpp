@@ -30,6 +30,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <future>
 #include <thread>
 #include <vector>
 
@@ -340,6 +341,10 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
     auto impl = std::make_unique<Impl>(context.impl());
     Impl& m = *impl;
     m.evaluator = std::make_unique<Evaluator>(scene);
+    // Pruned on the host while the kernels build, as in Renderer::create.
+    auto fieldWords = std::async(std::launch::async, [&] {
+        return detail::fieldWords(scene, *m.evaluator, evaluation);
+    });
 
     // Bounds tests pay off only where branches are real (see RenderOptions::boundsSkipping).
     const uint32_t skipping = m.ctx.properties.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU;
@@ -399,8 +404,7 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
                          nodes.size() * sizeof nodes[0]);
     detail::uploadBuffer(m.ctx, m.buffer(SDFCSG_BINDING_MESH_TABLES), tables.data(),
                          tables.size() * 4);
-    if (auto made = detail::uploadField(m.ctx, m.buffer(SDFCSG_BINDING_FIELD), scene, *m.evaluator,
-                                        evaluation);
+    if (auto made = detail::uploadField(m.ctx, m.buffer(SDFCSG_BINDING_FIELD), detail::emptyField());
         !made)
         return made.error();
     MeshGrid empty = {};
@@ -427,6 +431,11 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
         std::chrono::steady_clock::now() - start;
     if (helperMs > 0.0 && verticesMs.count() > 0.25 * helperMs) detail::compileHelperMissed(m.ctx);
     m.warmUp(m.triangles);
+    auto words = fieldWords.get();
+    if (!words) return words.error();
+    auto made = detail::uploadField(m.ctx, m.buffer(SDFCSG_BINDING_FIELD), *words);
+    if (!made) return made.error();
+    if (*made) m.writeDescriptors();
     return std::unique_ptr<Mesher>(new Mesher(std::move(impl)));
 }
 

@@ -66,8 +66,8 @@ struct PrunedField {
 };
 
 // The work bound: a scene whose cells near the surface run more instructions than this on
-// average is refused before any work (a smooth union of hundreds of primitives that all overlap:
-// on lavapipe, a 1280 x 720 frame at this mean takes about half a minute).
+// average is refused before it renders or meshes (a smooth union of hundreds of primitives that
+// all overlap; on lavapipe, a 1280 x 720 frame at this mean takes about half a minute).
 inline constexpr uint32_t kMaxMeanCellInstructions = 1024;
 
 // The whole tree as a tape, and the most values it holds at once.

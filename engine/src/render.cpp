@@ -21,6 +21,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <future>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -381,11 +382,11 @@ struct Renderer::Impl {
         detail::submitAndWait(ctx);
     }
 
-    // The node buffer, and the pruned field where the kernels run tapes.
-    Status uploadNodes() {
+    // The node buffer, and the field (detail::fieldWords()).
+    Status uploadNodes(std::span<const uint32_t> fieldWords) {
         std::vector<detail::GpuNode> packed = detail::packNodes(*evaluator);
         detail::uploadBuffer(ctx, nodes, packed.data(), packed.size() * sizeof(detail::GpuNode));
-        auto made = detail::uploadField(ctx, field, scene, *evaluator, options.evaluation);
+        auto made = detail::uploadField(ctx, field, fieldWords);
         if (!made) return made.error();
         if (*made) writeDescriptors();
         return Ok{};
@@ -581,6 +582,11 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene
     r.scene = scene;
     r.evaluator = std::make_unique<Evaluator>(scene);
     r.nodeCount = uint32_t(scene.nodes.size());
+    // Pruned on the host while the kernels build (with tapes, they are the same for every
+    // scene): on the forest benchmark scene, most of the prune's time.
+    auto fieldWords = std::async(std::launch::async, [&] {
+        return detail::fieldWords(scene, *r.evaluator, options.evaluation);
+    });
 
     auto shared = sharedPasses(r.ctx);
     if (!shared) return shared.error();
@@ -602,7 +608,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene
                              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, detail::MemoryUse::Upload);
     if (!nodes) return nodes.error();
     r.nodes = *nodes;
-    if (auto uploaded = r.uploadNodes(); !uploaded) return uploaded.error();
+    if (auto uploaded = r.uploadNodes(detail::emptyField()); !uploaded) return uploaded.error();
     if (auto reserved = r.reserve(64 * 64); !reserved) return reserved.error();
     if (auto reserved = r.reserveSamples(64 * 64, 64); !reserved) return reserved.error();
     if (auto built = r.buildKernels(); !built) return built.error();
@@ -612,6 +618,9 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene
     r.pipeline(SDFCSG_RAYMARCH_PASS_CLIP, false);
     r.pipeline(SDFCSG_RAYMARCH_PASS_ENDS, false);
     r.pipeline(SDFCSG_RAYMARCH_PASS_LIGHT, false);
+    auto words = fieldWords.get();
+    if (!words) return words.error();
+    if (auto uploaded = r.uploadNodes(*words); !uploaded) return uploaded.error();
     return std::unique_ptr<Renderer>(new Renderer(std::move(impl)));
 }
 
@@ -629,7 +638,13 @@ Status Renderer::updateValues(const Scene& scene) {
         }
     }
     r.evaluator = std::make_unique<Evaluator>(scene);
-    return r.uploadNodes(); // no render is in flight: render() waits for its fence
+    auto words = detail::fieldWords(scene, *r.evaluator, r.options.evaluation);
+    if (!words) {
+        r.scene = std::move(previous);
+        r.evaluator = std::make_unique<Evaluator>(r.scene);
+        return words.error();
+    }
+    return r.uploadNodes(*words); // no render is in flight: render() waits for its fence
 }
 
 Result<Image> Renderer::render(const RenderOptions& options) {

@@ -88,7 +88,9 @@ std::vector<glm::vec4> probeGpu(Context& context, const Scene& scene,
     detail::uploadBuffer(ctx, nodeBuffer, nodes.data(), nodes.size() * sizeof(detail::GpuNode));
     detail::uploadBuffer(ctx, in, points.data(), bytes);
     detail::Buffer field;
-    EXPECT_TRUE(detail::uploadField(ctx, field, scene, evaluator, codegen.evaluation));
+    auto words = detail::fieldWords(scene, evaluator, codegen.evaluation);
+    EXPECT_TRUE(words) << words.error().str();
+    EXPECT_TRUE(detail::uploadField(ctx, field, words ? *words : detail::emptyField()));
     const detail::Buffer* buffers[] = {&nodeBuffer, &in, &out, &field};
     detail::writeDescriptorSet(ctx, set, bindings, buffers);
 

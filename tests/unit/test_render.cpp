@@ -338,7 +338,7 @@ TEST_F(Render, SceneAtTheLimitsRendersAndMeshesUnderTwoGiB) {
 
 // 2,000 spheres that all overlap in one smooth union prune to nearly nothing: every region near
 // the surface would evaluate all of them, so the renderer and the mesher refuse the scene before
-// any work, naming the limit.
+// any render, naming the limit.
 TEST_F(Render, TreesThatPruneTooLittleAreRefused) {
     std::mt19937 rng(3);
     std::uniform_real_distribution<float> jitter(-0.01f, 0.01f);
