@@ -32,8 +32,9 @@ float tapePrimitive(uint kind, uint i, vec3 p) {
 }
 
 const uint kTapeUnion = 9u, kTapeIntersection = 10u;
-// packField(): on a primitive, the next instruction is the operation that folds it in.
-const uint kTapeFold = 0x10000000u;
+// packField(): bits 28-29 of a primitive, when its operation follows at once, hold that
+// operation's kind less 8, and the next word its blend radius.
+const uint kTapeFoldShift = 28u;
 
 // One blend for the three operations, which the compiler would otherwise all evaluate and
 // select from: intersection(a, b) is -union(-a, -b) and difference(a, b) intersection(a, -b),
@@ -64,9 +65,9 @@ float tapeDistanceRun(uint begin, uint end, vec3 p) {
         uint i = ins & 0xffffffu, kind = (ins >> 24) & 0xfu;
         if (kind < kTapeUnion) {
             float d = tapePrimitive(kind, i, p);
-            if ((ins & kTapeFold) != 0u) {
-                uint op = field[++at];
-                acc = tapeOp(op >> 24, acc, d, nodeSmooth(op & 0xffffffu));
+            uint fold = ins >> kTapeFoldShift;
+            if (fold != 0u) {
+                acc = tapeOp(fold + 8u, acc, d, uintBitsToFloat(field[++at]));
             } else {
                 stack[++top] = acc;
                 acc = d;
@@ -87,9 +88,9 @@ vec4 tapeSampleRun(uint begin, uint end, vec3 p) {
         uint i = ins & 0xffffffu, kind = (ins >> 24) & 0xfu;
         if (kind < kTapeUnion) {
             vec4 d = withColor(i, tapePrimitive(kind, i, p));
-            if ((ins & kTapeFold) != 0u) {
-                uint op = field[++at];
-                acc = tapeOp(op >> 24, acc, d, nodeSmooth(op & 0xffffffu));
+            uint fold = ins >> kTapeFoldShift;
+            if (fold != 0u) {
+                acc = tapeOp(fold + 8u, acc, d, uintBitsToFloat(field[++at]));
             } else {
                 stack[++top] = acc;
                 acc = d;

@@ -55,7 +55,7 @@ Result<std::vector<uint32_t>> fieldWords(const Scene& scene, const Evaluator& ev
                                         std::to_string(kMaxMeanCellInstructions) +
                                         " (many primitives that all overlap in one smooth "
                                         "operation do this)"});
-        return packField(field);
+        return packField(field, evaluator.nodes());
     }
     return emptyField();
 }

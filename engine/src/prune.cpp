@@ -437,7 +437,7 @@ uint32_t PrunedField::activeLength(glm::vec3 p) const {
     return e->y & kFarCell ? 0 : e->y;
 }
 
-std::vector<uint32_t> packField(const PrunedField& f) {
+std::vector<uint32_t> packField(const PrunedField& f, const std::vector<FlatNode>& nodes) {
     std::vector<uint32_t> out(kFieldHeaderWords + 2 * f.cells.size() + f.tape.size());
     auto put = [&](size_t at, float v) { out[at] = std::bit_cast<uint32_t>(v); };
     put(0, f.origin.x);
@@ -455,15 +455,18 @@ std::vector<uint32_t> packField(const PrunedField& f) {
     std::memcpy(out.data() + kFieldHeaderWords, f.cells.data(), f.cells.size() * 8);
     uint32_t* tape = out.data() + tapeStart;
     std::copy(f.tape.begin(), f.tape.end(), tape);
-    // Within each tape, a primitive whose operation follows at once is marked, so that the
-    // shader folds it into the running value without the stack (shaders/tape.glsl).
+    // Within each tape, a primitive whose operation follows at once carries the operation, so
+    // that the shader folds it into the running value without the stack (shaders/tape.glsl).
     std::vector<bool> marked(f.tape.size() + 1, false); // by first word: cells share tapes
     auto mark = [&](uint32_t begin, uint32_t length) {
         if (marked[begin]) return;
         marked[begin] = true;
         for (uint32_t t = begin; t + 1 < begin + length; ++t)
-            if (!isOperation(opcode(f.tape[t])) && isOperation(opcode(f.tape[t + 1])))
-                tape[t] |= kTapeFold;
+            if (!isOperation(opcode(f.tape[t])) && isOperation(opcode(f.tape[t + 1]))) {
+                const uint32_t op = f.tape[t + 1];
+                tape[t] |= (uint32_t(opcode(op)) - 8u) << kTapeFoldShift;
+                tape[t + 1] = std::bit_cast<uint32_t>(nodes[op & kTapeNodeMask].smooth);
+            }
     };
     mark(0, f.fullLength);
     for (const glm::uvec2& c : f.cells)

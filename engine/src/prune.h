@@ -79,9 +79,11 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options =
 // cell, levels, dims, 1 when bounded, full tape length, first tape word, 1 spare), the cells
 // (two words each), then the tape.
 inline constexpr uint32_t kFieldHeaderWords = 12;
-// In the packed tapes only: a primitive whose operation is the next instruction (tape.glsl).
-inline constexpr uint32_t kTapeFold = 1u << 28;
-std::vector<uint32_t> packField(const PrunedField& field);
+// In the packed tapes only: a primitive whose operation is the next instruction carries that
+// operation's kind less 8 (union 1, intersection 2, difference 3) at this bit, and the next
+// word is then the operation's blend radius, as float bits (tape.glsl).
+inline constexpr uint32_t kTapeFoldShift = 28;
+std::vector<uint32_t> packField(const PrunedField& field, const std::vector<FlatNode>& nodes);
 
 // Value of a primitive node at p (eval.cpp): the kernel at the local point, times the scale.
 float primitiveValue(const FlatNode& node, glm::vec3 p);
