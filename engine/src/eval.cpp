@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 #include <numbers>
 #include <type_traits>
 
@@ -174,7 +175,12 @@ float primitiveValue(const FlatNode& node, glm::vec3 p) {
 
 } // namespace detail
 
-Evaluator::Evaluator(const Scene& scene) {
+struct Evaluator::Pruned {
+    std::once_flag once;
+    detail::PrunedField field;
+};
+
+Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
     const size_t count = scene.nodes.size();
     nodes_.resize(count);
     if (count == 0) return;
@@ -282,6 +288,12 @@ Sample Evaluator::sample(glm::vec3 p, uint32_t node) const {
     if (node >= nodes_.size()) return {INFINITY, kDefaultColor};
     glm::vec4 v = evaluate<glm::vec4>(nodes_, node, p, skipping_);
     return {v.w, glm::vec3(v)};
+}
+
+float Evaluator::prunedDistance(glm::vec3 p) const {
+    if (nodes_.empty()) return INFINITY;
+    std::call_once(pruned_->once, [&] { pruned_->field = detail::pruneField(*this); });
+    return pruned_->field.distance(nodes_, p);
 }
 
 Camera frameCamera(const Evaluator& evaluator, float aspect, float fov) {

@@ -5,7 +5,6 @@
 #include "gpu_test.h"
 #include "mesh_checks.h"
 #include "mesh_reference.h"
-#include "prune.h"
 
 #include <numbers>
 
@@ -124,9 +123,9 @@ INSTANTIATE_TEST_SUITE_P(Scenes, BundledSceneMesh, ::testing::ValuesIn(bundledSc
                          sceneTestName);
 
 // The benchmark scenes (assets/bench, meshed from pruned tapes) at a reduced resolution: closed,
-// manifold, and every vertex within a voxel of the surface, by the CPU's pruned field (which the
-// prune tests hold to the whole tree near the surface; the whole tree at half a million vertices
-// would take minutes).
+// manifold, and every vertex within a voxel of the surface, by the CPU evaluator's pruned field
+// (which the prune tests hold to the whole tree near the surface; the whole tree at half a
+// million vertices would take minutes).
 TEST_F(MeshTest, BenchmarkScenesAreClosedWithVerticesOnTheSurface) {
     const std::filesystem::path dir = std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/bench";
     for (const char* name : {"molecule_1k", "groups_1k", "flat_4k", "forest_10k"}) {
@@ -143,10 +142,9 @@ TEST_F(MeshTest, BenchmarkScenesAreClosedWithVerticesOnTheSurface) {
         EXPECT_FALSE(stats.surfaceCut);
         EXPECT_TRUE(m.closedManifold());
         EXPECT_GT(m.volume, 0.0);
-        const detail::PrunedField field = detail::pruneField(evaluator);
         float worst = 0.0f;
         for (const glm::vec3& p : mesh.positions)
-            worst = std::max(worst, std::abs(field.distance(evaluator.nodes(), p)));
+            worst = std::max(worst, std::abs(evaluator.prunedDistance(p)));
         EXPECT_LE(worst, stats.voxelSize);
     }
 }

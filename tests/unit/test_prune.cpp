@@ -157,6 +157,27 @@ TEST(Prune, SmoothUnionBoundsDoNotGrowWithItsOperands) {
         EXPECT_GE(ev.distance(p), b.signedDistance(p) - 1e-6f);
 }
 
+// The evaluator's pruned path is that field: the same values, near the surface the whole tree's.
+TEST(Prune, TheEvaluatorsPrunedDistanceIsThePrunedField) {
+    const Scene scene = molecule(1000, 0.03f, 0.026f);
+    const Evaluator ev(scene);
+    const detail::PrunedField field = detail::pruneField(ev);
+    const Evaluator copy = ev;
+    size_t near = 0;
+    for (glm::vec3 p : points(ev, 1000, 9)) {
+        const float d = ev.prunedDistance(p), full = ev.distance(p);
+        EXPECT_EQ(d, field.distance(ev.nodes(), p));
+        EXPECT_EQ(copy.prunedDistance(p), d);
+        if (field.activeLength(p) > 0) { // a cell near the surface: the whole tree's value
+            ++near;
+            EXPECT_NEAR(d, full, 1e-5f * (1.0f + std::abs(full)));
+        } else { // a bound
+            EXPECT_TRUE(full > 0.0f ? d > 0.0f && d <= full : d < 0.0f && d >= full);
+        }
+    }
+    EXPECT_GT(near, 100u);
+}
+
 // 2,000 spheres nearly on top of each other prune to little: past the budget, refinement stops,
 // so the tapes stay within it (about 4,000 words a cell; the sphere's shell crosses some 20,000 leaf cells), and
 // the coarser cells still give the whole tree's values.

@@ -11,6 +11,7 @@
 #include <glm/vec3.hpp>
 
 #include <limits>
+#include <memory>
 #include <vector>
 
 namespace sdfcsg {
@@ -58,6 +59,12 @@ class Evaluator {
     // The same for the subtree rooted at nodes()[node] alone (picking, per-node tests).
     float distance(glm::vec3 p, uint32_t node) const;
     Sample sample(glm::vec3 p, uint32_t node) const;
+    // The field evaluated per region from pruned tapes, as the GPU kernels of large scenes
+    // evaluate it (docs/scale.md): distance() to 1e-5 near the surface, elsewhere a bound of the
+    // same sign and no larger magnitude. Far faster than distance() on scenes of thousands of
+    // nodes, for many points; the first call prunes (about 0.1 s for 1,000 nodes), and copies
+    // of this evaluator share the result.
+    float prunedDistance(glm::vec3 p) const;
     // Bounds of the whole solid; infinite along axes where a plane reaches.
     const Aabb& bounds() const { return nodes_[0].bounds; }
     const std::vector<FlatNode>& nodes() const { return nodes_; }
@@ -67,8 +74,10 @@ class Evaluator {
     void setBoundsSkipping(bool on) { skipping_ = on; }
 
   private:
+    struct Pruned; // eval.cpp
     std::vector<FlatNode> nodes_;
     bool skipping_ = true;
+    std::shared_ptr<Pruned> pruned_;
 };
 
 // A camera looking at the finite part of the scene's bounds from the front and slightly above.
