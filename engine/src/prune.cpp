@@ -179,10 +179,12 @@ struct Pruner {
     }
 };
 
-// A cell is far from every surface when its centre value exceeds this many radii: its bound is
-// then at least a radius, which keeps the soft shadows' ratio of distance to travel (and so the
-// shading) what the whole tree gives; at 1.25 radii, shadow rays crossing cell corners darkened
-// lit surfaces in blotches.
+// A cell is far from every surface when its centre value exceeds its radius and this many leaf
+// radii less one: its bound is then at least a leaf cell's radius everywhere in it, which keeps
+// the soft shadows' ratio of distance to travel (and so the shading) what the whole tree gives
+// (at 1.25 leaf radii, shadow rays crossing cell corners darkened lit surfaces in blotches). A
+// coarse cell needs no more than that, so it stops refining as soon as it holds no surface
+// (forest_10k: a third less pruning time, the same leaf tapes).
 constexpr float kFarRadii = 2.0f;
 
 // The grid that the octrees divide: the finite part of the bounds (all finite leaves' boxes where
@@ -289,6 +291,7 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) 
     for (uint32_t level = 0; level <= field.levels; ++level) {
         const float size = field.cell * float(1u << (field.levels - level));
         const float r = 0.5f * std::sqrt(3.0f) * size;
+        const float leafR = 0.5f * std::sqrt(3.0f) * field.cell;
         const bool leaf = level == field.levels;
         // The children of this level's cells (the cells themselves at the root).
         const uint32_t fan = level == 0 ? 1 : 8; // the top cells themselves at level 0
@@ -312,7 +315,7 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) 
                                      glm::uvec3(octant & 1, octant >> 1 & 1, octant >> 2);
                 const glm::vec3 c = field.origin + (glm::vec3(at) + 0.5f) * size;
                 const uint32_t begin = uint32_t(out.tapes.size());
-                const float far = kFarRadii * r + slack;
+                const float far = r + (kFarRadii - 1.0f) * leafR + slack;
                 const float v =
                     pruner.prune(tapes.data() + parent.begin, parent.length, c, r, far, out.tapes);
                 if (std::abs(v) > far) { // no surface: fill its leaf cells
