@@ -5,7 +5,7 @@ struct Node {
     vec4 p0, p1;           // kernel parameters (half extents etc.), see kernelParams() in sdf.h
     vec4 color;            // rgb resolved colour; w: accumulated scale (world = scale * local)
     vec4 bmin;             // xyz: world bounds minimum; w: smooth radius in world units
-    vec4 bmax;             // xyz: world bounds maximum
+    vec4 bmax;             // xyz: world bounds maximum; w: blend profile (sdf.glsl)
 };
 
 layout(std430, set = 0, binding = SDFCSG_BINDING_NODES) readonly buffer Nodes {
@@ -37,6 +37,7 @@ float nodeBoundsDistance(uint i, vec3 p) {
 // Helpers for the generated scene code (engine/src/codegen.cpp), which also defines one
 // `float <kind>Node(uint i, vec3 p)` per primitive kind it uses.
 float nodeSmooth(uint i) { return nodes[i].bmin.w; }
+uint nodeBlend(uint i) { return uint(nodes[i].bmax.w); }
 vec4 withColor(uint i, float d) { return vec4(nodes[i].color.rgb, d); }
 
 // Node indices of 256 and up are spelt nodeIndex(i / 256, i % 256): glslang looks up every

@@ -1,127 +1,293 @@
-// The SDF function library: exact distance functions after Inigo Quilez
-// (https://iquilezles.org/articles/distfunctions/, .../distfunctions2d/, .../smin/) and the CSG
-// operators. engine/src/sdf.h implements the same formulas line by line in C++; tests hold the
-// two together. Every primitive is centred at the origin of its local frame and takes the
-// kernel parameters that packNodes() derives (half extents, half heights), not the JSON values.
+// The SDF function library, one source for both languages: the kernels include it as GLSL and
+// engine/src/sdf.h includes it as C++ with GLM standing in for GLSL, so the CPU evaluator and the
+// GPU evaluate the same formulas. It is written in the dialect the two share: float literals with
+// an f suffix, no swizzles (vec2(p.x, p.z), vec3(v)), no out parameters, functions marked SDF_FN.
+//
+// Exact distance functions after Inigo Quilez (https://iquilezles.org/articles/distfunctions/,
+// .../smin/). Every primitive is centred at the origin of its local frame and takes the kernel
+// parameters that its table entry's kernel() derives (engine/src/nodes.cpp: half extents, half
+// heights), not the JSON values. Adding a primitive: its table entry, its formula here and its
+// line in sdPrimitive() below (docs/vocabulary.md).
 
-float dot2(vec2 v) { return dot(v, v); }
-float dot2(vec3 v) { return dot(v, v); }
+#ifndef SDF_FN
+#define SDF_FN
+#endif
 
-float sdSphere(vec3 p, float r) { return length(p) - r; }
+SDF_FN float dot2(vec2 v) { return dot(v, v); }
+SDF_FN float dot2(vec3 v) { return dot(v, v); }
+
+SDF_FN float sdSphere(vec3 p, float r) { return length(p) - r; }
 
 // b: half extents.
-float sdBox(vec3 p, vec3 b) {
+SDF_FN float sdBox(vec3 p, vec3 b) {
     vec3 q = abs(p) - b;
-    return length(max(q, 0.0)) + min(max(q.x, max(q.y, q.z)), 0.0);
+    return length(max(q, 0.0f)) + min(max(q.x, max(q.y, q.z)), 0.0f);
 }
 
 // b: half extents including the rounding r (r <= min(b)).
-float sdRoundBox(vec3 p, vec3 b, float r) {
+SDF_FN float sdRoundBox(vec3 p, vec3 b, float r) {
     vec3 q = abs(p) - b + r;
-    return length(max(q, 0.0)) + min(max(q.x, max(q.y, q.z)), 0.0) - r;
+    return length(max(q, 0.0f)) + min(max(q.x, max(q.y, q.z)), 0.0f) - r;
 }
 
 // n: unit normal; the solid is where dot(p, n) < offset.
-float sdPlane(vec3 p, vec3 n, float offset) { return dot(p, n) - offset; }
+SDF_FN float sdPlane(vec3 p, vec3 n, float offset) { return dot(p, n) - offset; }
 
 // Isosceles triangle in xy (base width 2*hw at y = -h/2, apex at y = +h/2) extruded to z in
 // [-hl, hl]: IQ's exact sdTriangleIsosceles (apex at t = 0, base at t.y = h) and opExtrusion.
-float sdTriangularPrism(vec3 p, float hw, float h, float hl) {
+SDF_FN float sdTriangularPrism(vec3 p, float hw, float h, float hl) {
     vec2 q = vec2(hw, h);
-    vec2 t = vec2(abs(p.x), 0.5 * h - p.y);
-    vec2 a = t - q * clamp(dot(t, q) / dot(q, q), 0.0, 1.0);
-    vec2 b = t - q * vec2(clamp(t.x / q.x, 0.0, 1.0), 1.0);
+    vec2 t = vec2(abs(p.x), 0.5f * h - p.y);
+    vec2 a = t - q * clamp(dot(t, q) / dot(q, q), 0.0f, 1.0f);
+    vec2 b = t - q * vec2(clamp(t.x / q.x, 0.0f, 1.0f), 1.0f);
     vec2 d = min(vec2(dot(a, a), -(t.x * q.y - t.y * q.x)), vec2(dot(b, b), -(t.y - q.y)));
     float d2 = -sqrt(d.x) * sign(d.y);
     vec2 w = vec2(d2, abs(p.z) - hl);
-    return min(max(w.x, w.y), 0.0) + length(max(w, 0.0));
+    return min(max(w.x, w.y), 0.0f) + length(max(w, 0.0f));
 }
 
 // Ring around the y axis.
-float sdTorus(vec3 p, float major, float minor) {
-    vec2 q = vec2(length(p.xz) - major, p.y);
+SDF_FN float sdTorus(vec3 p, float major, float minor) {
+    vec2 q = vec2(length(vec2(p.x, p.z)) - major, p.y);
     return length(q) - minor;
 }
 
 // Capped cylinder along y; hh: half height.
-float sdCylinder(vec3 p, float r, float hh) {
-    vec2 d = abs(vec2(length(p.xz), p.y)) - vec2(r, hh);
-    return min(max(d.x, d.y), 0.0) + length(max(d, 0.0));
+SDF_FN float sdCylinder(vec3 p, float r, float hh) {
+    vec2 d = abs(vec2(length(vec2(p.x, p.z)), p.y)) - vec2(r, hh);
+    return min(max(d.x, d.y), 0.0f) + length(max(d, 0.0f));
 }
 
 // IQ's exact sdCappedCone: radius r1 at y = -hh, r2 at y = +hh.
-float sdCone(vec3 p, float r1, float hh, float r2) {
-    vec2 q = vec2(length(p.xz), p.y);
+SDF_FN float sdCone(vec3 p, float r1, float hh, float r2) {
+    vec2 q = vec2(length(vec2(p.x, p.z)), p.y);
     vec2 k1 = vec2(r2, hh);
-    vec2 k2 = vec2(r2 - r1, 2.0 * hh);
-    vec2 ca = vec2(q.x - min(q.x, (q.y < 0.0) ? r1 : r2), abs(q.y) - hh);
-    vec2 cb = q - k1 + k2 * clamp(dot(k1 - q, k2) / dot2(k2), 0.0, 1.0);
-    float s = (cb.x < 0.0 && ca.y < 0.0) ? -1.0 : 1.0;
+    vec2 k2 = vec2(r2 - r1, 2.0f * hh);
+    vec2 ca = vec2(q.x - min(q.x, (q.y < 0.0f) ? r1 : r2), abs(q.y) - hh);
+    vec2 cb = q - k1 + k2 * clamp(dot(k1 - q, k2) / dot2(k2), 0.0f, 1.0f);
+    float s = (cb.x < 0.0f && ca.y < 0.0f) ? -1.0f : 1.0f;
     return s * sqrt(min(dot2(ca), dot2(cb)));
 }
 
-float sdCapsule(vec3 p, vec3 a, vec3 b, float r) {
+SDF_FN float sdCapsule(vec3 p, vec3 a, vec3 b, float r) {
     vec3 pa = p - a, ba = b - a;
-    float h = clamp(dot(pa, ba) / max(dot(ba, ba), 1e-30), 0.0, 1.0);
+    float h = clamp(dot(pa, ba) / max(dot(ba, ba), 1e-30f), 0.0f, 1.0f);
     return length(pa - ba * h) - r;
+}
+
+// Not exact: the unit sphere's distance in the frame scaled by the radii (inv: their inverses),
+// times the smallest radius. That is 1-Lipschitz and zero on the surface, so it never exceeds
+// the true distance, and it is at least the true distance times min/max of the radii.
+SDF_FN float sdEllipsoid(vec3 p, vec3 inv, float smallest) {
+    return (length(p * inv) - 1.0f) * smallest;
+}
+
+// Regular hexagon in xz (corners on the x axis, apothem ap) extruded along y to [-hh, hh]; IQ's
+// sdHexPrism with its axis on y.
+SDF_FN float sdHexPrism(vec3 p, float ap, float hh) {
+    const vec3 k = vec3(-0.8660254f, 0.5f, 0.57735027f);
+    vec2 q = abs(vec2(p.x, p.z));
+    q -= 2.0f * min(dot(vec2(k.x, k.y), q), 0.0f) * vec2(k.x, k.y);
+    vec2 d = vec2(length(q - vec2(clamp(q.x, -k.z * ap, k.z * ap), ap)) * sign(q.y - ap),
+                  abs(p.y) - hh);
+    return min(max(d.x, d.y), 0.0f) + length(max(d, 0.0f));
+}
+
+// Regular octahedron with its vertices at distance s on the axes (IQ's exact form).
+SDF_FN float sdOctahedron(vec3 p, float s) {
+    vec3 a = abs(p);
+    float m = a.x + a.y + a.z - s;
+    vec3 q;
+    if (3.0f * a.x < m)
+        q = a;
+    else if (3.0f * a.y < m)
+        q = vec3(a.y, a.z, a.x);
+    else if (3.0f * a.z < m)
+        q = vec3(a.z, a.x, a.y);
+    else
+        return m * 0.57735027f;
+    float k = clamp(0.5f * (q.z - q.y + s), 0.0f, s);
+    return length(vec3(q.x, q.y - s + k, q.z - k));
+}
+
+// Square pyramid of base side w at y = -hh and apex at y = +hh, in the frame scaled by 1 / w
+// (unit base at y = 0, apex height h = 2 hh / w): IQ's sdPyramid for the sloped faces, and the
+// base square where it is nearer (below the base plane, and inside when the base is the nearer
+// face), which his form leaves out.
+SDF_FN float sdPyramid(vec3 p, float w, float h, float hh) {
+    vec3 u = vec3(p.x, p.y + hh, p.z) / w;
+    vec2 xz = abs(vec2(u.x, u.z));
+    if (u.y < 0.0f) return length(vec3(max(xz - 0.5f, 0.0f), u.y)) * w;
+    float m2 = h * h + 0.25f;
+    xz = (xz.y > xz.x) ? vec2(xz.y, xz.x) : xz;
+    xz -= 0.5f;
+    vec3 q = vec3(xz.y, h * u.y - 0.5f * xz.x, h * xz.x + 0.5f * u.y);
+    float s = max(-q.x, 0.0f);
+    float t = clamp((q.y - 0.5f * xz.y) / (m2 + 0.25f), 0.0f, 1.0f);
+    float a = m2 * (q.x + s) * (q.x + s) + q.y * q.y;
+    float b = m2 * (q.x + 0.5f * t) * (q.x + 0.5f * t) + (q.y - m2 * t) * (q.y - m2 * t);
+    float d2 = min(q.y, -q.x * m2 - q.y * 0.5f) > 0.0f ? 0.0f : min(a, b);
+    float d = sqrt((d2 + q.z * q.z) / m2) * sign(q.z);
+    return (d < 0.0f ? max(d, -u.y) : d) * w;
+}
+
+// Cylinder along y (radius r, half height hh) whose rim is rounded by rr: the cylinder of
+// radius r - rr and half height hh - rr grown by rr.
+SDF_FN float sdRoundedCylinder(vec3 p, float r, float hh, float rr) {
+    vec2 d = vec2(length(vec2(p.x, p.z)) - r, abs(p.y) - hh);
+    return min(max(d.x, d.y), 0.0f) + length(max(d, 0.0f)) - rr;
+}
+
+// The hull of a sphere of radius r1 at y = -h/2 and one of r2 at y = +h/2 (IQ's sdRoundCone);
+// b = (r1 - r2) / h and a = sqrt(1 - b b), |r1 - r2| < h.
+SDF_FN float sdRoundCone(vec3 p, float r1, float r2, float h, float b, float a) {
+    vec2 q = vec2(length(vec2(p.x, p.z)), p.y + 0.5f * h);
+    float k = dot(q, vec2(-b, a));
+    if (k < 0.0f) return length(q) - r1;
+    if (k > a * h) return length(q - vec2(0.0f, h)) - r2;
+    return dot(q, vec2(a, b)) - r1;
+}
+
+// Chain link in the xy plane: a stadium of straight half length le along y and end radius r1,
+// swept by a circle of radius r2 (IQ's sdLink).
+SDF_FN float sdLink(vec3 p, float le, float r1, float r2) {
+    vec3 q = vec3(p.x, max(abs(p.y) - le, 0.0f), p.z);
+    return length(vec2(length(vec2(q.x, q.y)) - r1, q.z)) - r2;
+}
+
+// Arc of a ring around the y axis, symmetric about +z, reaching the angle whose sine and cosine
+// are sn and cs either side of it (IQ's sdCappedTorus with its axis on y).
+SDF_FN float sdCappedTorus(vec3 p, float ra, float rb, float sn, float cs) {
+    vec2 q = vec2(abs(p.x), p.z);
+    float k = (cs * q.x > sn * q.y) ? dot(q, vec2(sn, cs)) : length(q);
+    return sqrt(max(dot(p, p) + ra * ra - 2.0f * ra * k, 0.0f)) - rb;
 }
 
 // CSG operators: IQ's polynomial smooth minimum with blend radius k, and smooth max(a, b) =
 // -smin(-a, -b). Once the operands differ by k or more the blend factor is exactly 0 or 1, so
-// those cases return an operand unchanged: this makes bounds skipping exact in floating point
-// (the skipped operand could not have changed a single bit) and gives k = 0 the sharp operator
-// (ties go to the first operand). Selects rather than branches: both sides are a few
-// instructions, and every branch costs CPU drivers (lavapipe) compile time. The vec4 forms carry
-// colour in rgb and the distance in w; colour blends by the same factor.
+// those cases return an operand unchanged: this makes bounds skipping and pruning exact in
+// floating point (the dropped operand could not have changed a single bit) and gives k = 0 the
+// sharp operator (ties go to the first operand). Selects rather than branches: both sides are a
+// few instructions, and every branch costs CPU drivers (lavapipe) compile time. The vec4 forms
+// carry colour in rgb and the distance in w; colour blends by the same factor.
 // Difference(a, b) = max(a, -b).
-float opUnion(float a, float b, float k) {
-    float h = clamp(0.5 + 0.5 * (b - a) / max(k, 1e-30), 0.0, 1.0);
-    float blend = mix(b, a, h) - k * h * (1.0 - h);
+SDF_FN float opUnion(float a, float b, float k) {
+    float h = clamp(0.5f + 0.5f * (b - a) / max(k, 1e-30f), 0.0f, 1.0f);
+    float blend = mix(b, a, h) - k * h * (1.0f - h);
     float r = (a - b >= k) ? b : blend;
     return (b - a >= k) ? a : r;
 }
 
-float opIntersection(float a, float b, float k) {
-    float h = clamp(0.5 - 0.5 * (b - a) / max(k, 1e-30), 0.0, 1.0);
-    float blend = mix(b, a, h) + k * h * (1.0 - h);
+SDF_FN float opIntersection(float a, float b, float k) {
+    float h = clamp(0.5f - 0.5f * (b - a) / max(k, 1e-30f), 0.0f, 1.0f);
+    float blend = mix(b, a, h) + k * h * (1.0f - h);
     float r = (b - a >= k) ? b : blend;
     return (a - b >= k) ? a : r;
 }
 
-float opDifference(float a, float b, float k) { return opIntersection(a, -b, k); }
+SDF_FN float opDifference(float a, float b, float k) { return opIntersection(a, -b, k); }
 
-vec4 opUnion(vec4 a, vec4 b, float k) {
-    float h = clamp(0.5 + 0.5 * (b.w - a.w) / max(k, 1e-30), 0.0, 1.0);
-    vec4 blend = vec4(mix(b.rgb, a.rgb, h), mix(b.w, a.w, h) - k * h * (1.0 - h));
+SDF_FN vec4 opUnion(vec4 a, vec4 b, float k) {
+    float h = clamp(0.5f + 0.5f * (b.w - a.w) / max(k, 1e-30f), 0.0f, 1.0f);
+    vec4 blend = vec4(mix(vec3(b), vec3(a), h), mix(b.w, a.w, h) - k * h * (1.0f - h));
     vec4 r = (a.w - b.w >= k) ? b : blend;
     return (b.w - a.w >= k) ? a : r;
 }
 
-vec4 opIntersection(vec4 a, vec4 b, float k) {
-    float h = clamp(0.5 - 0.5 * (b.w - a.w) / max(k, 1e-30), 0.0, 1.0);
-    vec4 blend = vec4(mix(b.rgb, a.rgb, h), mix(b.w, a.w, h) + k * h * (1.0 - h));
+SDF_FN vec4 opIntersection(vec4 a, vec4 b, float k) {
+    float h = clamp(0.5f - 0.5f * (b.w - a.w) / max(k, 1e-30f), 0.0f, 1.0f);
+    vec4 blend = vec4(mix(vec3(b), vec3(a), h), mix(b.w, a.w, h) + k * h * (1.0f - h));
     vec4 r = (b.w - a.w >= k) ? b : blend;
     return (a.w - b.w >= k) ? a : r;
 }
 
-vec4 opDifference(vec4 a, vec4 b, float k) { return opIntersection(a, vec4(b.rgb, -b.w), k); }
+SDF_FN vec4 opDifference(vec4 a, vec4 b, float k) {
+    return opIntersection(a, vec4(vec3(b), -b.w), k);
+}
 
-// The operators at k = 0, for code that knows k is 0: the same bits as opUnion(a, b, 0.0) and
+// The operators at k = 0, for code that knows k is 0: the same bits as opUnion(a, b, 0.0f) and
 // the others (the blend is never chosen), in one comparison. The full forms cost lavapipe's
-// compiler and every evaluation their unused blend: for the house scene, a sixth of the
-// ray-march kernels' compile time.
-float sharpUnion(float a, float b) { return a <= b ? a : b; }
-float sharpIntersection(float a, float b) { return a >= b ? a : b; }
-float sharpDifference(float a, float b) { return a >= -b ? a : -b; }
-vec4 sharpUnion(vec4 a, vec4 b) { return a.w <= b.w ? a : b; }
-vec4 sharpIntersection(vec4 a, vec4 b) { return a.w >= b.w ? a : b; }
-vec4 sharpDifference(vec4 a, vec4 b) { return a.w >= -b.w ? a : vec4(b.rgb, -b.w); }
+// compiler and every evaluation their unused blend.
+SDF_FN float sharpUnion(float a, float b) { return a <= b ? a : b; }
+SDF_FN float sharpIntersection(float a, float b) { return a >= b ? a : b; }
+SDF_FN float sharpDifference(float a, float b) { return a >= -b ? a : -b; }
+SDF_FN vec4 sharpUnion(vec4 a, vec4 b) { return a.w <= b.w ? a : b; }
+SDF_FN vec4 sharpIntersection(vec4 a, vec4 b) { return a.w >= b.w ? a : b; }
+SDF_FN vec4 sharpDifference(vec4 a, vec4 b) { return a.w >= -b.w ? a : vec4(vec3(b), -b.w); }
+
+// Blend profiles (the "blend" field; 0, the polynomial, is opUnion above). Each union is
+// min(a, b) - k w(h) with h = max(k - |a - b|, 0) / k: round (1) is the circular fillet, of
+// radius k where the surfaces meet at a right angle; chamfer (2) cuts the corner along
+// a + b = k, as hg_sdf's does, with half its slope so that the field stays 1-Lipschitz. Both
+// pass at most half of a change in either operand on, are exact once |a - b| >= k and never
+// dip more than k below min(a, b), which pruning and the bounds rely on (engine/src/prune.cpp).
+SDF_FN float blendDip(float h, uint style) {
+    return style == 2u ? 0.5f * h : 0.5f * (1.0f + h - sqrt(max(1.0f + 2.0f * h - h * h, 0.0f)));
+}
+
+SDF_FN float opUnion(float a, float b, float k, uint style) {
+    if (style == 0u) return opUnion(a, b, k);
+    float h = max(k - abs(a - b), 0.0f) / max(k, 1e-30f);
+    float blend = min(a, b) - k * blendDip(h, style);
+    float r = (a - b >= k) ? b : blend;
+    return (b - a >= k) ? a : r;
+}
+
+SDF_FN float opIntersection(float a, float b, float k, uint style) {
+    return style == 0u ? opIntersection(a, b, k) : -opUnion(-a, -b, k, style);
+}
+
+SDF_FN float opDifference(float a, float b, float k, uint style) {
+    return opIntersection(a, -b, k, style);
+}
+
+SDF_FN vec4 opUnion(vec4 a, vec4 b, float k, uint style) {
+    if (style == 0u) return opUnion(a, b, k);
+    float h = clamp(0.5f + 0.5f * (b.w - a.w) / max(k, 1e-30f), 0.0f, 1.0f);
+    return vec4(mix(vec3(b), vec3(a), h), opUnion(a.w, b.w, k, style));
+}
+
+SDF_FN vec4 opIntersection(vec4 a, vec4 b, float k, uint style) {
+    if (style == 0u) return opIntersection(a, b, k);
+    float h = clamp(0.5f - 0.5f * (b.w - a.w) / max(k, 1e-30f), 0.0f, 1.0f);
+    return vec4(mix(vec3(b), vec3(a), h), opIntersection(a.w, b.w, k, style));
+}
+
+SDF_FN vec4 opDifference(vec4 a, vec4 b, float k, uint style) {
+    return opIntersection(a, vec4(vec3(b), -b.w), k, style);
+}
 
 // Tap i (0..3) of the four-tap tetrahedral difference, the tetrahedron k = (1, -1): k.xyy,
 // k.yyx, k.yxy, k.xxx. The normal at p is normalize(sum of tap(i) * f(p + tap(i) * e)).
-vec3 tetraTap(int i) {
-    return i == 0 ? vec3(1.0, -1.0, -1.0)
-         : i == 1 ? vec3(-1.0, -1.0, 1.0)
-         : i == 2 ? vec3(-1.0, 1.0, -1.0)
-                  : vec3(1.0);
+SDF_FN vec3 tetraTap(int i) {
+    return i == 0 ? vec3(1.0f, -1.0f, -1.0f)
+         : i == 1 ? vec3(-1.0f, -1.0f, 1.0f)
+         : i == 2 ? vec3(-1.0f, 1.0f, -1.0f)
+                  : vec3(1.0f);
 }
+
+// A primitive's local distance by its kind (NodeKind's numbering) and kernel parameters (a:
+// slots 0-3, b: slots 4-7). `kinds` has bit k set for each kind the caller may pass; a constant,
+// it leaves a kernel the formulas of its scene's kinds alone.
+#define SDF_IS(n) (kind == n && ((kinds >> n) & 1u) != 0u)
+SDF_FN float sdPrimitive(uint kind, vec3 q, vec4 a, vec4 b, uint kinds) {
+    if (SDF_IS(0u)) return sdSphere(q, a.x);
+    if (SDF_IS(1u)) return sdBox(q, vec3(a));
+    if (SDF_IS(2u)) return sdRoundBox(q, vec3(a), a.w);
+    if (SDF_IS(3u)) return sdPlane(q, vec3(a), a.w);
+    if (SDF_IS(4u)) return sdTriangularPrism(q, a.x, a.y, a.z);
+    if (SDF_IS(5u)) return sdTorus(q, a.x, a.y);
+    if (SDF_IS(6u)) return sdCylinder(q, a.x, a.y);
+    if (SDF_IS(7u)) return sdCone(q, a.x, a.y, a.z);
+    if (SDF_IS(8u)) return sdCapsule(q, vec3(a), vec3(b), a.w);
+    if (SDF_IS(9u)) return sdEllipsoid(q, vec3(a), a.w);
+    if (SDF_IS(10u)) return sdHexPrism(q, a.x, a.y);
+    if (SDF_IS(11u)) return sdOctahedron(q, a.x);
+    if (SDF_IS(12u)) return sdPyramid(q, a.x, a.y, a.z);
+    if (SDF_IS(13u)) return sdRoundedCylinder(q, a.x, a.y, a.z);
+    if (SDF_IS(14u)) return sdRoundCone(q, a.x, a.y, a.z, a.w, b.x);
+    if (SDF_IS(15u)) return sdLink(q, a.x, a.y, a.z);
+    if (SDF_IS(16u)) return sdCappedTorus(q, a.x, a.y, a.z, a.w);
+    return 1e30f;
+}
+#undef SDF_IS

@@ -25,6 +25,16 @@
 
 #define SDFCSG_PROBE_GROUP_X 64
 
+// A tape instruction (engine/src/prune.h, shaders/tape.glsl): the node's index in the low bits
+// and its kind (NodeKind) above them. In the packed tapes, a primitive whose operation follows at
+// once also carries that operation (its kind less SDFCSG_TAPE_FIRST_OPERATION, plus 1) and its
+// blend profile, and the next word holds the blend radius.
+#define SDFCSG_TAPE_NODE_BITS 20
+#define SDFCSG_TAPE_KIND_SHIFT 20 // 6 bits
+#define SDFCSG_TAPE_FOLD_SHIFT 26 // 2 bits
+#define SDFCSG_TAPE_BLEND_SHIFT 28 // 2 bits
+#define SDFCSG_TAPE_FIRST_OPERATION 17 // NodeKind::Union; then intersection, difference
+
 // Mesh extraction (engine/src/mesh.cpp, shaders/mesh_*.comp). The grid's samples are split into
 // bricks of SDFCSG_MESH_BRICK^3; a brick also reads the samples one step past its far faces, so
 // it holds SDFCSG_MESH_BRICK_SAMPLES^3 values and owns the cells and edges that start at its own

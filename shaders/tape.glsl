@@ -4,7 +4,8 @@
 // PrunedField::distance and sample in engine/src/prune.cpp are this file in C++.
 //
 // The generated scene code defines SDFCSG_TAPE_STACK (the most values a tape holds at once,
-// rounded up) before it includes this file.
+// rounded up) and SDFCSG_TAPE_KINDS (a bit for each primitive kind the scene holds) before it
+// includes this file.
 
 // Mirrors packField() in engine/src/prune.cpp: a header of 12 words (origin xyz and leaf cell
 // side as float bits, levels, leaf cells per axis xyz, 1 when bounded, whole-tape length, first
@@ -14,41 +15,25 @@ layout(std430, set = 0, binding = SDFCSG_BINDING_FIELD) readonly buffer Field {
 };
 
 float tapePrimitive(uint kind, uint i, vec3 p) {
-    vec3 q = toLocal(i, p);
-    vec4 a = nodes[i].p0;
-    float d;
-    switch (kind) {
-    case 0u: d = sdSphere(q, a.x); break;
-    case 1u: d = sdBox(q, a.xyz); break;
-    case 2u: d = sdRoundBox(q, a.xyz, a.w); break;
-    case 3u: d = sdPlane(q, a.xyz, a.w); break;
-    case 4u: d = sdTriangularPrism(q, a.x, a.y, a.z); break;
-    case 5u: d = sdTorus(q, a.x, a.y); break;
-    case 6u: d = sdCylinder(q, a.x, a.y); break;
-    case 7u: d = sdCone(q, a.x, a.y, a.z); break;
-    default: d = sdCapsule(q, a.xyz, nodes[i].p1.xyz, a.w); break;
-    }
-    return d * nodes[i].color.w;
+    return sdPrimitive(kind, toLocal(i, p), nodes[i].p0, nodes[i].p1, SDFCSG_TAPE_KINDS) *
+           nodes[i].color.w;
 }
 
-const uint kTapeUnion = 9u, kTapeIntersection = 10u;
-// packField(): bits 28-29 of a primitive, when its operation follows at once, hold that
-// operation's kind less 8, and the next word its blend radius.
-const uint kTapeFoldShift = 28u;
+const uint kTapeUnion = uint(SDFCSG_TAPE_FIRST_OPERATION), kTapeIntersection = kTapeUnion + 1u;
 
 // One blend for the three operations, which the compiler would otherwise all evaluate and
 // select from: intersection(a, b) is -union(-a, -b) and difference(a, b) intersection(a, -b),
 // bit for bit as sdf.glsl computes them (negation rounds symmetrically).
-float tapeOp(uint kind, float a, float b, float k) {
+float tapeOp(uint kind, float a, float b, float k, uint blend) {
     float s = kind == kTapeUnion ? 1.0 : -1.0;
     float c = kind == kTapeIntersection || kind == kTapeUnion ? b : -b;
-    return s * opUnion(s * a, s * c, k);
+    return s * opUnion(s * a, s * c, k, blend);
 }
 
-vec4 tapeOp(uint kind, vec4 a, vec4 b, float k) {
+vec4 tapeOp(uint kind, vec4 a, vec4 b, float k, uint blend) {
     float s = kind == kTapeUnion ? 1.0 : -1.0;
     float c = kind == kTapeIntersection || kind == kTapeUnion ? b.w : -b.w;
-    vec4 u = opUnion(vec4(a.rgb, s * a.w), vec4(b.rgb, s * c), k);
+    vec4 u = opUnion(vec4(a.rgb, s * a.w), vec4(b.rgb, s * c), k, blend);
     return vec4(u.rgb, s * u.w);
 }
 
@@ -62,18 +47,20 @@ float tapeDistanceRun(uint begin, uint end, vec3 p) {
     float acc = 0.0;
     for (uint at = begin; at < end; ++at) {
         uint ins = field[at];
-        uint i = ins & 0xffffffu, kind = (ins >> 24) & 0xfu;
+        uint i = ins & ((1u << SDFCSG_TAPE_NODE_BITS) - 1u);
+        uint kind = (ins >> SDFCSG_TAPE_KIND_SHIFT) & 0x3fu;
         if (kind < kTapeUnion) {
             float d = tapePrimitive(kind, i, p);
-            uint fold = ins >> kTapeFoldShift;
+            uint fold = (ins >> SDFCSG_TAPE_FOLD_SHIFT) & 3u;
             if (fold != 0u) {
-                acc = tapeOp(fold + 8u, acc, d, uintBitsToFloat(field[++at]));
+                acc = tapeOp(fold + kTapeUnion - 1u, acc, d, uintBitsToFloat(field[++at]),
+                             ins >> SDFCSG_TAPE_BLEND_SHIFT);
             } else {
                 stack[++top] = acc;
                 acc = d;
             }
         } else {
-            acc = tapeOp(kind, stack[top--], acc, nodeSmooth(i));
+            acc = tapeOp(kind, stack[top--], acc, nodeSmooth(i), nodeBlend(i));
         }
     }
     return acc;
@@ -85,18 +72,20 @@ vec4 tapeSampleRun(uint begin, uint end, vec3 p) {
     vec4 acc = vec4(0.0);
     for (uint at = begin; at < end; ++at) {
         uint ins = field[at];
-        uint i = ins & 0xffffffu, kind = (ins >> 24) & 0xfu;
+        uint i = ins & ((1u << SDFCSG_TAPE_NODE_BITS) - 1u);
+        uint kind = (ins >> SDFCSG_TAPE_KIND_SHIFT) & 0x3fu;
         if (kind < kTapeUnion) {
             vec4 d = withColor(i, tapePrimitive(kind, i, p));
-            uint fold = ins >> kTapeFoldShift;
+            uint fold = (ins >> SDFCSG_TAPE_FOLD_SHIFT) & 3u;
             if (fold != 0u) {
-                acc = tapeOp(fold + 8u, acc, d, uintBitsToFloat(field[++at]));
+                acc = tapeOp(fold + kTapeUnion - 1u, acc, d, uintBitsToFloat(field[++at]),
+                             ins >> SDFCSG_TAPE_BLEND_SHIFT);
             } else {
                 stack[++top] = acc;
                 acc = d;
             }
         } else {
-            acc = tapeOp(kind, stack[top--], acc, nodeSmooth(i));
+            acc = tapeOp(kind, stack[top--], acc, nodeSmooth(i), nodeBlend(i));
         }
     }
     return acc;

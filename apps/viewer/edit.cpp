@@ -32,6 +32,8 @@ void defaultParams(Node& node) {
         if (p.required) {
             float x = p.check == Check::NonNegative ? 0.1f : 0.5f;
             if (p.name == "minor_radius") x = 0.15f;
+            if (p.name == "top_radius") x = 0.25f;
+            if (p.unit == "degrees") x = 270.0f;
             if (p.name == "size" || p.name == "height" || p.name == "length" || p.name == "width")
                 x = 1.0f;
             v[0] = v[1] = v[2] = x;
@@ -46,62 +48,25 @@ void defaultParams(Node& node) {
     }
 }
 
-// About half the width of a primitive, from its sizes.
+// About half the width of a primitive, from its bounds.
 float halfExtent(const Node& node) {
-    const auto& p = node.params;
-    switch (node.kind) {
-    case NodeKind::Sphere:
-        return p[0];
-    case NodeKind::Box:
-    case NodeKind::RoundBox:
-        return 0.5f * std::max({p[0], p[1], p[2]});
-    case NodeKind::TriangularPrism:
-        return 0.5f * std::max({p[0], p[1], p[2]});
-    case NodeKind::Torus:
-        return p[0] + p[1];
-    case NodeKind::Cylinder:
-    case NodeKind::Cone:
-        return std::max(p[0], 0.5f * p[1]);
-    case NodeKind::Capsule: {
-        glm::vec3 a(p[0], p[1], p[2]), b(p[3], p[4], p[5]);
-        return p[6] + 0.5f * glm::length(b - a);
-    }
-    default:
+    const KindInfo& info = kindInfo(node.kind);
+    glm::vec3 lo, hi;
+    if (!info.bounds || !info.bounds(info.kernel(node.params), lo, hi))
         return 0.5f; // unbounded (a plane): the defaults' scale
-    }
+    const glm::vec3 half = 0.5f * (hi - lo);
+    return std::max({half.x, half.y, half.z});
 }
 
-// Sizes a primitive's required lengths to about `h` across each half, in the proportions of
-// defaultParams().
+// Sizes a primitive to about `h` across each half, in the proportions of defaultParams().
 void sizeLike(Node& node, float h) {
-    if (!(h > 0.0f) || !std::isfinite(h)) return;
-    auto& p = node.params;
-    switch (node.kind) {
-    case NodeKind::Sphere:
-        p[0] = h;
-        break;
-    case NodeKind::Box:
-        p[0] = p[1] = p[2] = 2 * h;
-        break;
-    case NodeKind::RoundBox:
-        p[0] = p[1] = p[2] = 2 * h, p[3] = 0.2f * h;
-        break;
-    case NodeKind::TriangularPrism:
-        p[0] = p[1] = p[2] = 2 * h;
-        break;
-    case NodeKind::Torus:
-        p[0] = 0.7f * h, p[1] = 0.3f * h;
-        break;
-    case NodeKind::Cylinder:
-    case NodeKind::Cone:
-        p[0] = h, p[1] = 2 * h;
-        break;
-    case NodeKind::Capsule:
-        p[0] = p[2] = p[3] = p[5] = 0.0f, p[1] = -0.5f * h, p[4] = 0.5f * h, p[6] = 0.5f * h;
-        break;
-    default:
-        break;
-    }
+    if (!(h > 0.0f) || !std::isfinite(h) || kindInfo(node.kind).operation) return;
+    defaultParams(node);
+    const float factor = h / halfExtent(node);
+    for (const ParamInfo& p : kindInfo(node.kind).params)
+        if (p.unit == "length" || p.unit == "point")
+            for (int k = 0; k < (p.type == ValueType::Vec3 ? 3 : 1); ++k)
+                node.params[p.slot + k] *= factor;
 }
 
 const ParamInfo* findParam(NodeKind kind, std::string_view name) {

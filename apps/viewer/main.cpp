@@ -636,10 +636,22 @@ void valueEditor(Viewer& v) {
         float min = p.check == Check::Positive      ? 1e-3f
                     : p.check == Check::NonNegative ? 0.0f
                                                     : -1e6f;
+        if (p.type == ValueType::Choice) {
+            const size_t chosen = std::min(size_t(n.params[p.slot]), p.choices.size() - 1);
+            if (ImGui::BeginCombo(name.c_str(), std::string(p.choices[chosen]).c_str())) {
+                for (size_t c = 0; c < p.choices.size(); ++c)
+                    if (ImGui::Selectable(std::string(p.choices[c]).c_str(), c == chosen) &&
+                        c != chosen)
+                        edited(name.c_str(), {float(c)});
+                ImGui::EndCombo();
+            }
+            continue;
+        }
         if (p.type == ValueType::Number) {
             float value = n.params[p.slot];
-            if (ImGui::DragFloat(name.c_str(), &value, 0.01f, min, 1e6f, "%.3f"))
-                edited(name.c_str(), {std::max(value, min)});
+            if (ImGui::DragFloat(name.c_str(), &value, 0.01f, min, std::min(p.maximum, 1e6f),
+                                 "%.3f"))
+                edited(name.c_str(), {std::clamp(value, min, p.maximum)});
         } else {
             float value[3] = {n.params[p.slot], n.params[p.slot + 1], n.params[p.slot + 2]};
             if (ImGui::DragFloat3(name.c_str(), value, 0.01f, min, 1e6f, "%.3f"))

@@ -142,11 +142,11 @@ V evaluate(const std::vector<FlatNode>& nodes, uint32_t root, glm::vec3 p, bool 
             if (f.next == 1) {
                 f.acc = value;
             } else if (op.kind == NodeKind::Union) {
-                f.acc = sdf::opUnion(f.acc, value, op.smooth);
+                f.acc = sdf::opUnion(f.acc, value, op.smooth, op.blend);
             } else if (op.kind == NodeKind::Intersection) {
-                f.acc = sdf::opIntersection(f.acc, value, op.smooth);
+                f.acc = sdf::opIntersection(f.acc, value, op.smooth, op.blend);
             } else {
-                f.acc = sdf::opDifference(f.acc, value, op.smooth);
+                f.acc = sdf::opDifference(f.acc, value, op.smooth, op.blend);
             }
             while (f.next < op.children.size() && skipping && op.kind != NodeKind::Intersection) {
                 float bd = nodes[op.children[f.next]].bounds.signedDistance(p);
@@ -222,6 +222,7 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
         n.color = src.color ? *src.color : upNode ? upNode->color : kDefaultColor;
         n.params = sdf::kernelParams(src.kind, src.params);
         n.smooth = isOperation(src.kind) ? float(double(src.params[0]) * a.scale) : 0.0f;
+        n.blend = isOperation(src.kind) ? uint32_t(src.params[1]) : 0u;
         n.children = src.children;
     }
 
@@ -248,13 +249,15 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
                 box.min = glm::min(box.min, nodes_[c].bounds.min);
                 box.max = glm::max(box.max, nodes_[c].bounds.max);
             }
-            // Each fold goes at most k/4 below the smaller operand, and however many operands,
-            // the fold never goes more than k below their minimum: the smooth minimum grows
-            // with each operand, and smin(m - k, m) = m - k, so from operands >= m every fold
-            // stays >= m - k. Boxes widened by the lesser of the two then bound it.
+            // Each fold goes at most k/4 below the smaller operand (k/2 chamfered, k (1 - 1/sqrt 2)
+            // round), and however many operands, the fold never goes more than k below their
+            // minimum: every blend grows with each operand, and blends m - k and m to m - k, so
+            // from operands >= m every fold stays >= m - k. Boxes widened by the lesser of the
+            // two then bound it.
             if (n.smooth > 0.0f) {
                 const float folds = float(n.children.size() - 1);
-                float grow = n.smooth * std::min(1.0f, 0.25f * folds) * (1.0f + 1e-5f);
+                const float dip = n.blend == 2 ? 0.5f : n.blend == 1 ? 0.29289322f : 0.25f;
+                float grow = n.smooth * std::min(1.0f, dip * folds) * (1.0f + 1e-5f);
                 box.min -= grow;
                 box.max += grow;
             }

@@ -31,7 +31,7 @@ std::vector<GpuNode> packNodes(const Evaluator& evaluator) {
         g.p1 = glm::vec4(n.params[4], n.params[5], n.params[6], n.params[7]);
         g.color = glm::vec4(n.color, n.scale);
         g.bmin = glm::vec4(clampHuge(n.bounds.min), n.smooth);
-        g.bmax = glm::vec4(clampHuge(n.bounds.max), 0.0f);
+        g.bmax = glm::vec4(clampHuge(n.bounds.max), float(n.blend));
         out.push_back(g);
     }
     return out;

@@ -18,7 +18,7 @@ struct GpuNode {
     glm::vec4 p0, p1;           // kernel parameters, slots 0..3 and 4..7 (sdf::kernelParams)
     glm::vec4 color;            // rgb resolved colour; w accumulated scale
     glm::vec4 bmin;             // xyz world bounds minimum (-SDFCSG_HUGE if unbounded); w smooth
-    glm::vec4 bmax;             // xyz world bounds maximum (+SDFCSG_HUGE if unbounded)
+    glm::vec4 bmax;             // xyz world bounds maximum (+SDFCSG_HUGE if unbounded); w blend
 };
 static_assert(sizeof(GpuNode) == 128, "GpuNode must match the std430 Node in nodes.glsl");
 

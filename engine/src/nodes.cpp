@@ -1,5 +1,8 @@
 #include "sdfcsg/nodes.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace sdfcsg {
 namespace {
 
@@ -48,25 +51,205 @@ constexpr ParamInfo kCapsule[] = {
     {"b", Vec3, Any, 3, true, {}, "point", "Second end point of the axis segment."},
     {"radius", Number, Positive, 6, true, {}, "length", "Radius."},
 };
+constexpr ParamInfo kEllipsoid[] = {
+    {"radii", Vec3, Positive, 0, true, {}, "length", "Semi-axes along x, y and z."},
+};
+constexpr ParamInfo kHexPrism[] = {
+    {"radius", Number, Positive, 0, true, {}, "length",
+     "Distance from the axis to the corners of the hexagon (two of them lie on the x axis)."},
+    {"height", Number, Positive, 1, true, {}, "length", "Full height along y."},
+};
+constexpr ParamInfo kOctahedron[] = {
+    {"radius", Number, Positive, 0, true, {}, "length", "Distance from the centre to each vertex."},
+};
+constexpr ParamInfo kPyramid[] = {
+    {"width", Number, Positive, 0, true, {}, "length", "Side of the square base (in xz)."},
+    {"height", Number, Positive, 1, true, {}, "length", "Height from the base to the apex (y)."},
+};
+constexpr ParamInfo kRoundedCylinder[] = {
+    {"radius", Number, Positive, 0, true, {}, "length", "Radius, rounding included."},
+    {"height", Number, Positive, 1, true, {}, "length", "Full height along y, rounding included."},
+    {"rounding", Number, NonNegative, 2, true, {}, "length",
+     "Radius of the rounded rims; clamped to the radius and to half the height."},
+};
+constexpr ParamInfo kRoundCone[] = {
+    {"radius", Number, Positive, 0, true, {}, "length", "Radius of the bottom sphere."},
+    {"top_radius", Number, Positive, 1, true, {}, "length", "Radius of the top sphere."},
+    {"height", Number, Positive, 2, true, {}, "length",
+     "Distance between the two spheres' centres (y); where one sphere holds the other, the "
+     "solid is the larger sphere."},
+};
+constexpr ParamInfo kLink[] = {
+    {"length", Number, NonNegative, 0, true, {}, "length",
+     "Length of the straight sides (y); 0 gives a torus standing in the xy plane."},
+    {"major_radius", Number, Positive, 1, true, {}, "length",
+     "Radius of the centre line's round ends."},
+    {"minor_radius", Number, Positive, 2, true, {}, "length", "Radius of the wire."},
+};
+constexpr ParamInfo kCappedTorus[] = {
+    {"major_radius", Number, Positive, 0, true, {}, "length",
+     "Radius of the ring's centre line, in the xz plane."},
+    {"minor_radius", Number, Positive, 1, true, {}, "length", "Radius of the tube."},
+    {"angle", Number, Positive, 2, true, {}, "degrees",
+     "Angle the arc spans, centred on +z; 360 closes the ring.", 360.0f},
+};
+constexpr std::string_view kBlends[] = {"smooth", "round", "chamfer"};
 constexpr ParamInfo kOperation[] = {
     {"smooth", Number, NonNegative, 0, false, {0, 0, 0}, "length",
-     "Blend radius of the polynomial smooth minimum/maximum; 0 gives sharp edges. "
-     "Colours blend by the same factor."},
+     "Blend radius where the operands meet; 0 gives sharp edges. Colours blend over the same "
+     "width."},
+    {"blend", Choice, Any, 1, false, {0, 0, 0}, "profile",
+     "Profile of the blend: \"smooth\" (polynomial smooth minimum/maximum), \"round\" (a "
+     "circular fillet, of radius `smooth` where the surfaces meet at a right angle) or "
+     "\"chamfer\" (a flat bevel cutting `smooth` off each surface).",
+     3.4e38f, kBlends},
 };
 
+// Kernel parameters and local bounds (see KindInfo::kernel and ::bounds).
+using glm::vec3;
+Params halve3(const Params& v) { return {0.5f * v[0], 0.5f * v[1], 0.5f * v[2]}; }
+bool symmetric(vec3 half, vec3& lo, vec3& hi) { return lo = -half, hi = half, true; }
+
+constexpr KernelArg kA0[] = {{0, 1}};
+constexpr KernelArg kA3[] = {{0, 3}};
+constexpr KernelArg kA3A1[] = {{0, 3}, {3, 1}};
+constexpr KernelArg kA0A1[] = {{0, 1}, {1, 1}};
+constexpr KernelArg kA0A1A2[] = {{0, 1}, {1, 1}, {2, 1}};
+constexpr KernelArg kA0A1A2A3[] = {{0, 1}, {1, 1}, {2, 1}, {3, 1}};
+constexpr KernelArg kCapsuleArgs[] = {{0, 3}, {4, 3}, {3, 1}};
+constexpr KernelArg kRoundConeArgs[] = {{0, 1}, {1, 1}, {2, 1}, {3, 1}, {4, 1}};
+
 constexpr KindInfo kKinds[] = {
-    {NodeKind::Sphere, "sphere", false, kSphere, "Sphere centred at the origin."},
-    {NodeKind::Box, "box", false, kBox, "Axis-aligned box centred at the origin."},
-    {NodeKind::RoundBox, "round_box", false, kRoundBox, "Box with rounded edges, centred at the origin."},
-    {NodeKind::Plane, "plane", false, kPlane, "Half-space bounded by a plane (infinite)."},
+    {NodeKind::Sphere, "sphere", false, kSphere, "Sphere centred at the origin.", "sdSphere", kA0,
+     [](const Params& v) -> Params { return {v[0]}; },
+     [](const Params& k, vec3& lo, vec3& hi) { return symmetric(vec3(k[0]), lo, hi); }},
+    {NodeKind::Box, "box", false, kBox, "Axis-aligned box centred at the origin.", "sdBox", kA3,
+     halve3,
+     [](const Params& k, vec3& lo, vec3& hi) { return symmetric({k[0], k[1], k[2]}, lo, hi); }},
+    {NodeKind::RoundBox, "round_box", false, kRoundBox,
+     "Box with rounded edges, centred at the origin.", "sdRoundBox", kA3A1,
+     [](const Params& v) -> Params {
+         vec3 b = 0.5f * vec3(v[0], v[1], v[2]);
+         return {b.x, b.y, b.z, std::min(v[3], std::min(b.x, std::min(b.y, b.z)))};
+     },
+     [](const Params& k, vec3& lo, vec3& hi) { return symmetric({k[0], k[1], k[2]}, lo, hi); }},
+    {NodeKind::Plane, "plane", false, kPlane, "Half-space bounded by a plane (infinite).",
+     "sdPlane", kA3A1,
+     [](const Params& v) -> Params {
+         vec3 n(v[0], v[1], v[2]);
+         float len = std::sqrt(n.x * n.x + n.y * n.y + n.z * n.z);
+         n = len > 0.0f ? n / len : vec3(0.0f, 1.0f, 0.0f);
+         return {n.x, n.y, n.z, v[3]};
+     },
+     [](const Params&, vec3&, vec3&) { return false; }},
     {NodeKind::TriangularPrism, "triangular_prism", false, kTriangularPrism,
      "Isosceles triangle in the xy plane (apex up, +y) extruded along z, its bounding box centred at "
-     "the origin. A gable roof is one of these."},
-    {NodeKind::Torus, "torus", false, kTorus, "Ring around the y axis, centred at the origin."},
-    {NodeKind::Cylinder, "cylinder", false, kCylinder, "Capped cylinder along y, centred at the origin."},
+     "the origin. A gable roof is one of these.",
+     "sdTriangularPrism", kA0A1A2,
+     [](const Params& v) -> Params { return {0.5f * v[0], v[1], 0.5f * v[2]}; },
+     [](const Params& k, vec3& lo, vec3& hi) {
+         return symmetric({k[0], 0.5f * k[1], k[2]}, lo, hi);
+     }},
+    {NodeKind::Torus, "torus", false, kTorus, "Ring around the y axis, centred at the origin.",
+     "sdTorus", kA0A1, [](const Params& v) -> Params { return {v[0], v[1]}; },
+     [](const Params& k, vec3& lo, vec3& hi) {
+         return symmetric({k[0] + k[1], k[1], k[0] + k[1]}, lo, hi);
+     }},
+    {NodeKind::Cylinder, "cylinder", false, kCylinder,
+     "Capped cylinder along y, centred at the origin.", "sdCylinder", kA0A1,
+     [](const Params& v) -> Params { return {v[0], 0.5f * v[1]}; },
+     [](const Params& k, vec3& lo, vec3& hi) { return symmetric({k[0], k[1], k[0]}, lo, hi); }},
     {NodeKind::Cone, "cone", false, kCone,
-     "Capped cone along y, base at the bottom, centred at the origin (half way up)."},
-    {NodeKind::Capsule, "capsule", false, kCapsule, "Segment from a to b swept by a sphere."},
+     "Capped cone along y, base at the bottom, centred at the origin (half way up).", "sdCone",
+     kA0A1A2, [](const Params& v) -> Params { return {v[0], 0.5f * v[1], v[2]}; },
+     [](const Params& k, vec3& lo, vec3& hi) {
+         float r = std::max(k[0], k[2]);
+         return symmetric({r, k[1], r}, lo, hi);
+     }},
+    {NodeKind::Capsule, "capsule", false, kCapsule, "Segment from a to b swept by a sphere.",
+     "sdCapsule", kCapsuleArgs,
+     [](const Params& v) -> Params { return {v[0], v[1], v[2], v[6], v[3], v[4], v[5]}; },
+     [](const Params& k, vec3& lo, vec3& hi) {
+         vec3 a(k[0], k[1], k[2]), b(k[4], k[5], k[6]);
+         lo = vec3(std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)) - k[3];
+         hi = vec3(std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)) + k[3];
+         return true;
+     }},
+    {NodeKind::Ellipsoid, "ellipsoid", false, kEllipsoid,
+     "Ellipsoid centred at the origin. Its field is a bound, not the exact distance: never above "
+     "it, and at least the distance times the smallest over the largest radius.",
+     "sdEllipsoid", kA3A1,
+     [](const Params& v) -> Params {
+         return {1.0f / v[0], 1.0f / v[1], 1.0f / v[2], std::min(v[0], std::min(v[1], v[2]))};
+     },
+     [](const Params& k, vec3& lo, vec3& hi) {
+         return symmetric({1.0f / k[0], 1.0f / k[1], 1.0f / k[2]}, lo, hi);
+     }},
+    {NodeKind::HexPrism, "hex_prism", false, kHexPrism,
+     "Regular hexagonal prism along y, centred at the origin (a nut, a bolt head, a pencil).",
+     "sdHexPrism", kA0A1,
+     [](const Params& v) -> Params { return {v[0] * 0.8660254f, 0.5f * v[1]}; },
+     [](const Params& k, vec3& lo, vec3& hi) {
+         return symmetric({k[0] / 0.8660254f, k[1], k[0]}, lo, hi);
+     }},
+    {NodeKind::Octahedron, "octahedron", false, kOctahedron,
+     "Regular octahedron with its vertices on the axes, centred at the origin.", "sdOctahedron",
+     kA0, [](const Params& v) -> Params { return {v[0]}; },
+     [](const Params& k, vec3& lo, vec3& hi) { return symmetric(vec3(k[0]), lo, hi); }},
+    {NodeKind::Pyramid, "pyramid", false, kPyramid,
+     "Square pyramid, base at the bottom, apex up (+y), its bounding box centred at the origin.",
+     "sdPyramid", kA0A1A2,
+     [](const Params& v) -> Params { return {v[0], v[1] / v[0], 0.5f * v[1]}; },
+     [](const Params& k, vec3& lo, vec3& hi) {
+         return symmetric({0.5f * k[0], k[2], 0.5f * k[0]}, lo, hi);
+     }},
+    {NodeKind::RoundedCylinder, "rounded_cylinder", false, kRoundedCylinder,
+     "Cylinder along y with rounded rims, centred at the origin.", "sdRoundedCylinder", kA0A1A2,
+     [](const Params& v) -> Params {
+         float rr = std::min(v[2], std::min(v[0], 0.5f * v[1]));
+         return {v[0] - rr, 0.5f * v[1] - rr, rr};
+     },
+     [](const Params& k, vec3& lo, vec3& hi) {
+         float r = k[0] + k[2];
+         return symmetric({r, k[1] + k[2], r}, lo, hi);
+     }},
+    {NodeKind::RoundCone, "round_cone", false, kRoundCone,
+     "Two spheres on the y axis and the cone that joins them (their convex hull), the spheres' "
+     "centres at -height/2 and +height/2.",
+     "sdRoundCone", kRoundConeArgs,
+     [](const Params& v) -> Params {
+         // Where one sphere holds the other the smaller one shrinks to just inside the larger,
+         // which keeps the formula's slope defined and the solid the larger sphere.
+         float r1 = v[0], r2 = v[1], h = v[2];
+         const float gap = 0.999f * h;
+         if (r1 - r2 > gap) r2 = r1 - gap;
+         if (r2 - r1 > gap) r1 = r2 - gap;
+         float b = (r1 - r2) / h;
+         return {r1, r2, h, b, std::sqrt(std::max(1.0f - b * b, 0.0f))};
+     },
+     [](const Params& k, vec3& lo, vec3& hi) {
+         float r = std::max(k[0], k[1]);
+         lo = vec3(-r, -0.5f * k[2] - k[0], -r);
+         hi = vec3(r, 0.5f * k[2] + k[1], r);
+         return true;
+     }},
+    {NodeKind::Link, "link", false, kLink,
+     "Chain link standing in the xy plane, long along y, centred at the origin.", "sdLink",
+     kA0A1A2, [](const Params& v) -> Params { return {0.5f * v[0], v[1], v[2]}; },
+     [](const Params& k, vec3& lo, vec3& hi) {
+         return symmetric({k[1] + k[2], k[0] + k[1] + k[2], k[2]}, lo, hi);
+     }},
+    {NodeKind::CappedTorus, "capped_torus", false, kCappedTorus,
+     "Arc of a ring around the y axis (a horseshoe, a handle), centred on +z.", "sdCappedTorus",
+     kA0A1A2A3,
+     [](const Params& v) -> Params {
+         const double half = 0.5 * double(v[2]) * 3.14159265358979323846 / 180.0;
+         return {v[0], v[1], float(std::sin(half)), float(std::cos(half))};
+     },
+     [](const Params& k, vec3& lo, vec3& hi) {
+         float r = k[0] + k[1];
+         return symmetric({r, k[1], r}, lo, hi);
+     }},
     {NodeKind::Union, "union", true, kOperation, "All children together."},
     {NodeKind::Intersection, "intersection", true, kOperation, "What all children have in common."},
     {NodeKind::Difference, "difference", true, kOperation, "The first child minus all the others."},

@@ -292,15 +292,31 @@ void SceneReader::readParam(const ParamInfo& p, std::optional<element> value,
     if (!value) {
         if (p.required) {
             problems_.add(path, "missing required key \"" + std::string(p.name) + "\" (" +
-                                    expectedText(p.type, p.check) + ")");
+                                    expectedText(p) + ")");
             ok = false;
         }
         std::copy_n(p.fallback, p.type == ValueType::Vec3 ? 3 : 1, slot);
         return;
     }
     const std::string keyPath = member(path, p.name);
-    if (p.type == ValueType::Number) {
+    if (p.type == ValueType::Choice) {
+        std::string_view name;
+        if (value->is_string()) name = value->get_string().value_unsafe();
+        const auto found = std::find(p.choices.begin(), p.choices.end(), name);
+        if (value->is_string() && found != p.choices.end()) {
+            *slot = float(found - p.choices.begin());
+            return;
+        }
+        std::string hint = value->is_string() ? didYouMean(name, p.choices) : "";
+        problems_.add(keyPath, "expected " + expectedText(p) + ", got " + describe(*value) + hint);
+        ok = false;
+    } else if (p.type == ValueType::Number) {
         auto n = readNumber(*value, keyPath, p.check, problems_);
+        if (n && *n > p.maximum) {
+            problems_.add(keyPath, "expected at most " + formatFloat(p.maximum) + ", got " +
+                                       describe(*value));
+            n.reset();
+        }
         if (n) *slot = static_cast<float>(*n);
         ok = ok && n.has_value();
     } else {

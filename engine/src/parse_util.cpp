@@ -260,6 +260,24 @@ std::string expectedText(ValueType type, Check check) {
     return {};
 }
 
+std::string expectedText(const ParamInfo& p) {
+    if (p.type == ValueType::Choice) {
+        std::string out = "one of ";
+        for (size_t i = 0; i < p.choices.size(); ++i) {
+            if (i > 0) out += i + 1 == p.choices.size() ? " or " : ", ";
+            out += "\"" + std::string(p.choices[i]) + "\"";
+        }
+        return out;
+    }
+    std::string out = expectedText(p.type, p.check);
+    if (p.type == ValueType::Number && p.maximum < 3.4e38f) {
+        char buf[32];
+        std::snprintf(buf, sizeof buf, "%g", double(p.maximum));
+        out += " up to " + std::string(buf);
+    }
+    return out;
+}
+
 std::optional<double> readNumber(element value, const std::string& path, Check check,
                                  Problems& problems) {
     const std::string expected = expectedText(ValueType::Number, check);

@@ -72,6 +72,8 @@ std::string joinNames(std::span<const std::string_view> names, std::string_view 
 
 // What a value of this type and check must be, e.g. "a positive number".
 std::string expectedText(ValueType type, Check check);
+// What a node parameter takes: its type and check, its maximum, its choices.
+std::string expectedText(const ParamInfo& p);
 
 // Typed readers. On failure they report one problem (with path) and return nothing.
 std::optional<double> readNumber(element value, const std::string& path, Check check,

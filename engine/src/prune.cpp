@@ -22,23 +22,18 @@ bool isOperation(NodeKind kind) {
 }
 
 uint32_t instruction(uint32_t node, NodeKind kind) {
-    return node | uint32_t(kind) << kTapeNodeBits;
+    return node | uint32_t(kind) << kTapeKindShift;
 }
 
 NodeKind opcode(uint32_t instruction) {
-    return NodeKind(instruction >> kTapeNodeBits);
+    return NodeKind(instruction >> kTapeKindShift);
 }
 
-float opValue(NodeKind kind, float a, float b, float k) {
-    return kind == NodeKind::Union          ? sdf::opUnion(a, b, k)
-           : kind == NodeKind::Intersection ? sdf::opIntersection(a, b, k)
-                                            : sdf::opDifference(a, b, k);
-}
-
-glm::vec4 opValue(NodeKind kind, glm::vec4 a, glm::vec4 b, float k) {
-    return kind == NodeKind::Union          ? sdf::opUnion(a, b, k)
-           : kind == NodeKind::Intersection ? sdf::opIntersection(a, b, k)
-                                            : sdf::opDifference(a, b, k);
+template <class V> V opValue(const FlatNode& op, V a, V b) {
+    return op.kind == NodeKind::Union ? sdf::opUnion(a, b, op.smooth, op.blend)
+           : op.kind == NodeKind::Intersection
+               ? sdf::opIntersection(a, b, op.smooth, op.blend)
+               : sdf::opDifference(a, b, op.smooth, op.blend);
 }
 
 // Runs tape[begin, end) at p. V: float (distance) or vec4 (colour, distance in w).
@@ -60,7 +55,7 @@ V run(const std::vector<FlatNode>& nodes, const uint32_t* tape, uint32_t length,
         }
         V b = stack.back();
         stack.pop_back();
-        stack.back() = opValue(kind, stack.back(), b, n.smooth);
+        stack.back() = opValue(n, stack.back(), b);
     }
     return stack.back();
 }
@@ -121,7 +116,7 @@ struct Pruner {
                 if (firstFold(in, a, i)) e = least ? std::min(e, value[a]) : std::max(e, value[a]);
                 e = least ? std::min(e, value[b]) : std::max(e, value[b]);
             }
-            value[i] = opValue(kind, value[a], value[b], n.smooth);
+            value[i] = opValue(n, value[a], value[b]);
             ends.back() = i;
         }
         const float root = value[length - 1];
@@ -466,9 +461,10 @@ std::vector<uint32_t> packField(const PrunedField& f, const std::vector<FlatNode
         marked[begin] = true;
         for (uint32_t t = begin; t + 1 < begin + length; ++t)
             if (!isOperation(opcode(f.tape[t])) && isOperation(opcode(f.tape[t + 1]))) {
-                const uint32_t op = f.tape[t + 1];
-                tape[t] |= (uint32_t(opcode(op)) - 8u) << kTapeFoldShift;
-                tape[t + 1] = std::bit_cast<uint32_t>(nodes[op & kTapeNodeMask].smooth);
+                const FlatNode& op = nodes[f.tape[t + 1] & kTapeNodeMask];
+                tape[t] |= (uint32_t(op.kind) - uint32_t(NodeKind::Union) + 1u) << kTapeFoldShift |
+                           op.blend << SDFCSG_TAPE_BLEND_SHIFT;
+                tape[t + 1] = std::bit_cast<uint32_t>(op.smooth);
             }
     };
     mark(0, f.fullLength);

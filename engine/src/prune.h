@@ -16,6 +16,7 @@
 #pragma once
 
 #include "sdfcsg/eval.h"
+#include "shared.h"
 
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
@@ -26,9 +27,11 @@
 
 namespace sdfcsg::detail {
 
-// Instruction: node index | NodeKind << 24. A primitive pushes its value; an operation pops b,
-// then a, and pushes op(a, b) with its blend radius.
-inline constexpr uint32_t kTapeNodeBits = 24;
+// Instruction: node index | NodeKind << kTapeKindShift. A primitive pushes its value; an
+// operation pops b, then a, and pushes op(a, b) with its blend radius and profile.
+inline constexpr uint32_t kTapeNodeBits = SDFCSG_TAPE_NODE_BITS;
+inline constexpr uint32_t kTapeKindShift = SDFCSG_TAPE_KIND_SHIFT;
+static_assert(uint32_t(NodeKind::Union) == SDFCSG_TAPE_FIRST_OPERATION);
 inline constexpr uint32_t kTapeNodeMask = (1u << kTapeNodeBits) - 1u;
 // A leaf cell entry (x, y): near a surface, the cell's tape [x, x + y) in PrunedField::tape;
 // far from every surface, x holds the root value at the centre of the cell of level
@@ -80,9 +83,10 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options =
 // (two words each), then the tape.
 inline constexpr uint32_t kFieldHeaderWords = 12;
 // In the packed tapes only: a primitive whose operation is the next instruction carries that
-// operation's kind less 8 (union 1, intersection 2, difference 3) at this bit, and the next
-// word is then the operation's blend radius, as float bits (tape.glsl).
-inline constexpr uint32_t kTapeFoldShift = 28;
+// operation (union 1, intersection 2, difference 3) at this bit and its blend profile at
+// SDFCSG_TAPE_BLEND_SHIFT, and the next word is then the operation's blend radius, as float
+// bits (tape.glsl).
+inline constexpr uint32_t kTapeFoldShift = SDFCSG_TAPE_FOLD_SHIFT;
 std::vector<uint32_t> packField(const PrunedField& field, const std::vector<FlatNode>& nodes);
 
 // Value of a primitive node at p (eval.cpp): the kernel at the local point, times the scale.

@@ -13,6 +13,12 @@ std::string number(float v) {
 }
 
 std::string describeValue(const ParamInfo& p) {
+    if (p.type == ValueType::Choice) {
+        std::string names;
+        for (std::string_view c : p.choices)
+            names += (names.empty() ? "\"" : ", \"") + std::string(c) + "\"";
+        return names;
+    }
     std::string kind = p.type == ValueType::Vec3 ? "[x, y, z]" : "number";
     switch (p.check) {
     case Check::Any: break;
@@ -20,11 +26,14 @@ std::string describeValue(const ParamInfo& p) {
     case Check::NonNegative: kind += p.type == ValueType::Vec3 ? ", each >= 0" : ", >= 0"; break;
     case Check::NonZero: kind += ", not zero"; break;
     }
+    if (p.maximum < 3.4e38f) kind += ", <= " + number(p.maximum);
     return kind;
 }
 
 std::string fallback(const ParamInfo& p) {
     if (p.required) return "required";
+    if (p.type == ValueType::Choice)
+        return "default \"" + std::string(p.choices[size_t(p.fallback[0])]) + "\"";
     if (p.type == ValueType::Number) return "default " + number(p.fallback[0]);
     return "default [" + number(p.fallback[0]) + ", " + number(p.fallback[1]) + ", " +
            number(p.fallback[2]) + "]";

@@ -47,7 +47,10 @@ void nodeMembers(JsonWriter& w, const Node& node) {
         const float* v = node.params.data() + p.slot;
         const int n = p.type == ValueType::Vec3 ? 3 : 1;
         if (!p.required && std::equal(v, v + n, p.fallback)) continue;
-        if (n == 3) {
+        if (p.type == ValueType::Choice) {
+            w.key(p.name);
+            w.string(p.choices[std::min(size_t(v[0]), p.choices.size() - 1)]);
+        } else if (n == 3) {
             vec3(w, p.name, glm::vec3(v[0], v[1], v[2]));
         } else {
             w.key(p.name);

@@ -143,14 +143,26 @@ void param(JsonWriter& w, const ParamInfo& p) {
     w.beginObject();
     w.key("description");
     w.string(std::string(p.doc) + " Unit: " + std::string(p.unit) + ".");
-    if (p.type == ValueType::Number) {
+    if (p.type == ValueType::Choice) {
+        w.key("enum");
+        w.beginArray(Layout::Inline);
+        for (std::string_view c : p.choices)
+            w.string(c);
+        w.endArray();
+    } else if (p.type == ValueType::Number) {
         numberBody(w, p.check);
+        if (p.maximum < 3.4e38f) {
+            w.key("maximum");
+            w.number(p.maximum);
+        }
     } else {
         vec3Body(w, p.check);
     }
     if (!p.required) {
         w.key("default");
-        if (p.type == ValueType::Number) {
+        if (p.type == ValueType::Choice) {
+            w.string(p.choices[size_t(p.fallback[0])]);
+        } else if (p.type == ValueType::Number) {
             w.number(p.fallback[0]);
         } else {
             w.beginArray(Layout::Inline);

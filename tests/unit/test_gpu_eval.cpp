@@ -202,6 +202,14 @@ const std::map<std::string, std::string>& primitiveExamples() {
         {"cylinder", R"("radius": 0.6, "height": 1.5)"},
         {"cone", R"("radius": 0.7, "height": 1.3, "top_radius": 0.2)"},
         {"capsule", R"("a": [-0.5, -0.3, 0.1], "b": [0.6, 0.4, -0.2], "radius": 0.3)"},
+        {"ellipsoid", R"("radii": [0.9, 0.5, 0.7])"},
+        {"hex_prism", R"("radius": 0.7, "height": 1.2)"},
+        {"octahedron", R"("radius": 0.9)"},
+        {"pyramid", R"("width": 1.2, "height": 1.1)"},
+        {"rounded_cylinder", R"("radius": 0.6, "height": 1.4, "rounding": 0.15)"},
+        {"round_cone", R"("radius": 0.5, "top_radius": 0.2, "height": 1.1)"},
+        {"link", R"("length": 0.6, "major_radius": 0.4, "minor_radius": 0.12)"},
+        {"capped_torus", R"("major_radius": 0.8, "minor_radius": 0.2, "angle": 250)"},
     };
     return examples;
 }
@@ -258,6 +266,25 @@ TEST_F(GpuEval, OperationsMatchTheCpu) {
         ]}})");
     ASSERT_FALSE(scene.nodes.empty());
     expectGpuMatchesCpu(context(), scene, 4096);
+}
+
+// Each blend profile on each operation, in the inlined, buffer and tape kernels alike.
+TEST_F(GpuEval, BlendProfilesMatchTheCpu) {
+    for (const char* blend : {"round", "chamfer"}) {
+        SCOPED_TRACE(blend);
+        const std::string b = std::string(R"("blend": ")") + blend + "\"";
+        Scene scene = parseOrDie(R"({"version": 1, "root": {"type": "union", "smooth": 0.2, )" + b +
+                                 R"(, "children": [
+            {"type": "difference", "smooth": 0.15, )" + b + R"(, "color": [0.8, 0.8, 0.2], "children": [
+                {"type": "intersection", "smooth": 0.2, )" + b + R"(, "children": [
+                    {"type": "box", "size": [1.5, 1.5, 1.5], "color": [1, 0, 0]},
+                    {"type": "sphere", "radius": 1.0, "color": [0, 1, 0]}]},
+                {"type": "cylinder", "radius": 0.4, "height": 3, "color": [0, 0, 1]}]},
+            {"type": "box", "size": [0.6, 2.4, 0.6], "translate": [0.9, 0, 0], "color": [0.2, 0.9, 0.4]}
+            ]}})");
+        ASSERT_FALSE(scene.nodes.empty());
+        expectGpuMatchesCpu(context(), scene, 4096);
+    }
 }
 
 class BundledEval : public GpuTest, public ::testing::WithParamInterface<fs::path> {};

@@ -76,7 +76,9 @@ std::vector<BadInput> badInputs() {
     for (int i = 0; i < 4; ++i)
         fiveLights += R"(, {"direction": [0, -1, 0]})";
     const std::string kinds = "sphere, box, round_box, plane, triangular_prism, torus, cylinder, "
-                              "cone, capsule, union, intersection or difference";
+                              "cone, capsule, ellipsoid, hex_prism, octahedron, pyramid, "
+                              "rounded_cylinder, round_cone, link, capped_torus, union, "
+                              "intersection or difference";
     return {
         // JSON syntax: line and column of the first problem.
         {"empty", "", "scene.json:1:1: expected a JSON value, got end of input"},
@@ -220,6 +222,28 @@ std::vector<BadInput> badInputs() {
         {"round box radius too large",
          scene(R"({"type": "round_box", "size": [1, 2, 3], "radius": 0.6})"),
          "scene.json: root.radius: expected at most half the smallest size (0.5), got 0.6"},
+        {"capped torus angle beyond a turn",
+         scene(R"({"type": "capped_torus", "major_radius": 1, "minor_radius": 0.2, "angle": 400})"),
+         "scene.json: root.angle: expected at most 360, got 400"},
+        {"capped torus angle missing",
+         scene(R"({"type": "capped_torus", "major_radius": 1, "minor_radius": 0.2})"),
+         R"(scene.json: root: missing required key "angle" (a positive number up to 360))"},
+        {"ellipsoid radii missing", scene(R"({"type": "ellipsoid"})"),
+         R"(scene.json: root: missing required key "radii" (an array of 3 positive numbers))"},
+        {"ellipsoid radius given as a number", scene(R"({"type": "ellipsoid", "radii": 1})"),
+         "scene.json: root.radii: expected an array of 3 positive numbers, got 1"},
+        {"link length negative",
+         scene(R"({"type": "link", "length": -1, "major_radius": 1, "minor_radius": 0.2})"),
+         "scene.json: root.length: expected a non-negative number, got -1"},
+        {"hex prism with a misspelt key", scene(R"({"type": "hex_prism", "raduis": 1, "height": 1})"),
+         "scene.json: root: unknown key \"raduis\"; did you mean \"radius\"?\nscene.json: root: "
+         "missing required key \"radius\" (a positive number)"},
+        {"misspelt blend",
+         scene(R"({"type": "union", "smooth": 0.1, "blend": "chamfr", "children": [{"type": "sphere", "radius": 1}]})"),
+         R"(scene.json: root.blend: expected one of "smooth", "round" or "chamfer", got "chamfr"; did you mean "chamfer"?)"},
+        {"blend not a string",
+         scene(R"({"type": "union", "smooth": 0.1, "blend": 2, "children": [{"type": "sphere", "radius": 1}]})"),
+         R"(scene.json: root.blend: expected one of "smooth", "round" or "chamfer", got 2)"},
         {"primitive with children", scene(R"({"type": "sphere", "radius": 1, "children": []})"),
          "scene.json: root: a sphere takes no \"children\"; only union, intersection and "
          "difference do"},

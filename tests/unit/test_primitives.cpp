@@ -134,6 +134,64 @@ double minimise(const std::function<double(double)>& f, double lo, double hi, in
     return std::min(bestValue, f(0.5 * (a + b)));
 }
 
+// The profile of the hull of two circles on the axis (centres (0, y1) and (0, y2), y1 < y2, radii
+// r1 and r2) in the (r, y) half-plane, as a fine polygon from the bottom to the top of the axis.
+std::vector<dvec2> twoCircleHull(double y1, double r1, double y2, double r2) {
+    const double b = (r1 - r2) / (y2 - y1), a = std::sqrt(1 - b * b);
+    const double tangent = std::atan2(b, a);
+    std::vector<dvec2> out;
+    const int n = 6000;
+    for (int i = 0; i <= n; ++i) {
+        double t = -M_PI / 2 + (tangent + M_PI / 2) * i / n;
+        out.push_back({r1 * std::cos(t), y1 + r1 * std::sin(t)});
+    }
+    for (int i = 0; i <= n; ++i) {
+        double t = tangent + (M_PI / 2 - tangent) * i / n;
+        out.push_back({r2 * std::cos(t), y2 + r2 * std::sin(t)});
+    }
+    out.front().x = out.back().x = 0;
+    return out;
+}
+
+// Distance from p to the arc of the circle of centre c and radius r in the plane spanned by the
+// unit vectors u and v, from angle t0 to t1 (radians, measured from u towards v).
+double arcDistance(dvec3 p, dvec3 c, dvec3 u, dvec3 v, double r, double t0, double t1) {
+    dvec3 q = p - c;
+    double t = std::atan2(dot(q, v), dot(q, u));
+    while (t < t0) t += 2 * M_PI;
+    auto at = [&](double a) { return c + r * (std::cos(a) * u + std::sin(a) * v); };
+    double d = std::min(length(p - at(t0)), length(p - at(t1)));
+    if (t <= t1) d = std::min(d, length(p - at(t)));
+    return d;
+}
+
+// Signed distance to the ellipsoid with semi-axes e (Eberly, "Distance from a point to an
+// ellipse, an ellipsoid or a hyperellipsoid"): the root t of sum (e_i y_i / (t + e_i^2))^2 = 1
+// by bisection, for a point off the coordinate planes.
+double ellipsoidDistance(dvec3 p, dvec3 e) {
+    dvec3 y = abs(p);
+    auto f = [&](double t) {
+        double s = 0;
+        for (int i = 0; i < 3; ++i) {
+            double r = e[i] * y[i] / (t + e[i] * e[i]);
+            s += r * r;
+        }
+        return s - 1;
+    };
+    const double smallest = std::min({e.x, e.y, e.z});
+    double lo = -smallest * smallest, hi = length(y) * std::max({e.x, e.y, e.z}) + 1;
+    for (int i = 0; i < 200; ++i) {
+        double mid = 0.5 * (lo + hi);
+        (f(mid) > 0 ? lo : hi) = mid;
+    }
+    double t = 0.5 * (lo + hi);
+    dvec3 x;
+    for (int i = 0; i < 3; ++i)
+        x[i] = e[i] * e[i] * y[i] / (t + e[i] * e[i]);
+    double d = length(y - x);
+    return f(0) > 0 ? d : -d;
+}
+
 // ---- Cases ----
 
 struct Case {
@@ -230,6 +288,86 @@ std::vector<Case> cases() {
             "capsule (a == b)", NodeKind::Capsule, {0.1f, 0.2f, 0.3f, 0.1f, 0.2f, 0.3f, 0.5f},
             [](dvec3 p) { return length(p - dvec3(0.1, 0.2, 0.3)) - 0.5; }, 0.5);
     }
+    for (dvec2 rh : {dvec2(0.7, 1.2), dvec2(1.5, 0.3)}) {
+        Polytope poly;
+        for (double y : {-rh.y / 2, rh.y / 2})
+            for (int i = 0; i < 6; ++i)
+                poly.vertices.push_back(
+                    {rh.x * std::cos(i * M_PI / 3), y, rh.x * std::sin(i * M_PI / 3)});
+        poly.faces = {{0, 1, 2, 3, 4, 5}, {6, 7, 8, 9, 10, 11}};
+        for (int i = 0; i < 6; ++i)
+            poly.faces.push_back({i, (i + 1) % 6, 6 + (i + 1) % 6, 6 + i});
+        add(
+            "hex_prism", NodeKind::HexPrism, {float(rh.x), float(rh.y)},
+            [poly](dvec3 p) { return poly.signedDistance(p); }, std::max(rh.x, rh.y / 2));
+    }
+    for (double s : {0.9, 2.0}) {
+        Polytope poly;
+        poly.vertices = {{s, 0, 0}, {-s, 0, 0}, {0, s, 0}, {0, -s, 0}, {0, 0, s}, {0, 0, -s}};
+        for (int x : {0, 1})
+            for (int y : {2, 3})
+                for (int z : {4, 5})
+                    poly.faces.push_back({x, y, z});
+        add(
+            "octahedron", NodeKind::Octahedron, {float(s)},
+            [poly](dvec3 p) { return poly.signedDistance(p); }, s);
+    }
+    for (dvec2 wh : {dvec2(1.2, 1.1), dvec2(2.0, 0.4), dvec2(0.5, 2.5)}) {
+        const double w = wh.x / 2, hh = wh.y / 2;
+        Polytope poly;
+        poly.vertices = {{-w, -hh, -w}, {w, -hh, -w}, {w, -hh, w}, {-w, -hh, w}, {0, hh, 0}};
+        poly.faces = {{0, 1, 2, 3}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}};
+        add(
+            "pyramid", NodeKind::Pyramid, {float(wh.x), float(wh.y)},
+            [poly](dvec3 p) { return poly.signedDistance(p); }, std::max(w, hh));
+    }
+    for (dvec3 rhr : {dvec3(0.6, 1.4, 0.15), dvec3(1.0, 0.5, 0.25), dvec3(0.4, 2.0, 0.0)}) {
+        const double r = rhr.x - rhr.z, hh = rhr.y / 2 - rhr.z, rr = rhr.z;
+        add(
+            "rounded_cylinder", NodeKind::RoundedCylinder,
+            {float(rhr.x), float(rhr.y), float(rhr.z)},
+            [r, hh, rr](dvec3 p) {
+                return revolvedDistance(p, {{0, -hh}, {r, -hh}, {r, hh}, {0, hh}}) - rr;
+            },
+            std::max(rhr.x, rhr.y / 2));
+    }
+    for (dvec3 c : {dvec3(0.5, 0.2, 1.1), dvec3(0.2, 0.6, 0.9), dvec3(0.4, 0.4, 0.5)}) {
+        std::vector<dvec2> profile = twoCircleHull(-c.z / 2, c.x, c.z / 2, c.y);
+        add(
+            "round_cone", NodeKind::RoundCone, {float(c.x), float(c.y), float(c.z)},
+            [profile](dvec3 p) { return revolvedDistance(p, profile); },
+            c.z / 2 + std::max(c.x, c.y));
+    }
+    for (dvec3 l : {dvec3(0.6, 0.4, 0.12), dvec3(0.0, 0.7, 0.2)}) {
+        const double le = l.x / 2, r1 = l.y, r2 = l.z;
+        add(
+            "link", NodeKind::Link, {float(l.x), float(l.y), float(l.z)},
+            [le, r1, r2](dvec3 p) {
+                const dvec3 x(1, 0, 0), y(0, 1, 0);
+                double d = std::min(
+                    {arcDistance(p, {0, le, 0}, x, y, r1, 0, M_PI),
+                     arcDistance(p, {0, -le, 0}, x, y, r1, M_PI, 2 * M_PI)});
+                if (le > 0)
+                    for (double side : {-r1, r1}) {
+                        dvec3 a(side, -le, 0), b(side, le, 0);
+                        double t = std::clamp(dot(p - a, b - a) / dot(b - a, b - a), 0.0, 1.0);
+                        d = std::min(d, length(p - (a + (b - a) * t)));
+                    }
+                return d - r2;
+            },
+            le + r1 + r2);
+    }
+    for (dvec3 t : {dvec3(0.8, 0.2, 90), dvec3(1.0, 0.3, 250), dvec3(0.6, 0.15, 360)}) {
+        const double ra = t.x, rb = t.y, half = t.z / 2 * M_PI / 180;
+        add(
+            "capped_torus " + std::to_string(int(t.z)), NodeKind::CappedTorus,
+            {float(t.x), float(t.y), float(t.z)},
+            [ra, rb, half](dvec3 p) {
+                // The arc centred on +z in the xz plane: from +z towards +x is angle 0 upwards.
+                return arcDistance(p, dvec3(0), {0, 0, 1}, {1, 0, 0}, ra, -half, half) - rb;
+            },
+            ra + rb);
+    }
     return out;
 }
 
@@ -250,6 +388,7 @@ std::vector<glm::vec3> samplePoints(double size, uint32_t seed) {
 
 TEST(Primitives, EveryKindHasACase) {
     std::vector<bool> seen(kNodeKindCount, false);
+    seen[size_t(NodeKind::Ellipsoid)] = true; // a bound: EllipsoidIsABoundWithinItsFactor
     for (const Case& c : cases())
         seen[size_t(c.kind)] = true;
     for (const KindInfo& k : nodeKinds())
@@ -298,6 +437,29 @@ TEST(Primitives, UnitGradientAwayFromSurface) {
             EXPECT_NEAR(length(g), 1.0, 2e-3) << "at (" << p.x << ", " << p.y << ", " << p.z << ")";
         }
         EXPECT_GT(checked, total / 2) << "the gradient was checked at too few points";
+    }
+}
+
+// The ellipsoid's field is not its distance: never above it, at least the distance times the
+// smallest over the largest radius, and exact on a sphere.
+TEST(Primitives, EllipsoidIsABoundWithinItsFactor) {
+    for (dvec3 e : {dvec3(0.9, 0.5, 0.7), dvec3(2.0, 0.3, 1.0), dvec3(0.6, 0.6, 0.6)}) {
+        SCOPED_TRACE(std::to_string(e.x) + " " + std::to_string(e.y) + " " + std::to_string(e.z));
+        const sdf::Params k =
+            sdf::kernelParams(NodeKind::Ellipsoid, {float(e.x), float(e.y), float(e.z)});
+        const double factor = std::min({e.x, e.y, e.z}) / std::max({e.x, e.y, e.z});
+        int inside = 0;
+        for (glm::vec3 p : samplePoints(std::max({e.x, e.y, e.z}), 9)) {
+            const double truth = ellipsoidDistance(dvec3(p), e);
+            const double value = sdf::evalPrimitive(NodeKind::Ellipsoid, p, k);
+            const double tolerance = 1e-5 * std::max(1.0, double(glm::length(p)));
+            inside += truth < 0;
+            EXPECT_EQ(value < 0, truth < 0) << p.x << " " << p.y << " " << p.z;
+            EXPECT_LE(std::abs(value), std::abs(truth) + tolerance);
+            EXPECT_GE(std::abs(value), std::abs(truth) * factor - tolerance);
+            if (factor == 1.0) EXPECT_NEAR(value, truth, tolerance);
+        }
+        EXPECT_GT(inside, 20);
     }
 }
 

@@ -45,6 +45,8 @@ std::string numberText(double v) {
 // components also keep the one rule a schema cannot state (a round box's radius at most half
 // its smallest size).
 std::string validValue(simdjson::dom::element property) {
+    if (simdjson::dom::array choices; property["enum"].get(choices) == simdjson::SUCCESS)
+        return simdjson::to_string(choices.at(0));
     std::string_view type = property["type"];
     if (type == "number") return "0.5";
     return "[1, 1, 1]";
@@ -128,6 +130,14 @@ TEST(Schema, EveryKindAndParameterOfTheTableAppears) {
             std::string_view doc = prop["description"];
             EXPECT_TRUE(doc.starts_with(p.doc)) << doc;
             EXPECT_NE(doc.find(p.unit), std::string_view::npos) << "the unit is documented";
+            if (p.type == ValueType::Choice) {
+                std::vector<std::string> names;
+                for (auto c : prop["enum"].get_array())
+                    names.emplace_back(std::string_view(c));
+                EXPECT_EQ(names, std::vector<std::string>(p.choices.begin(), p.choices.end()));
+                EXPECT_EQ(std::string_view(prop["default"]), p.choices[size_t(p.fallback[0])]);
+                continue;
+            }
             EXPECT_EQ(std::string_view(prop["type"]),
                       p.type == ValueType::Number ? "number" : "array");
             auto bounds = p.type == ValueType::Number ? prop : prop["items"];
@@ -142,6 +152,7 @@ TEST(Schema, EveryKindAndParameterOfTheTableAppears) {
             if (!p.required && p.type == ValueType::Number) {
                 EXPECT_EQ(double(prop["default"]), p.fallback[0]);
             }
+            EXPECT_EQ(prop["maximum"].error() == simdjson::SUCCESS, p.maximum < 3.4e38f);
         }
         EXPECT_EQ(def["properties"].get_object().size(), expectedProps) << "nothing else";
     }

@@ -37,6 +37,7 @@ struct FlatNode {
     float scale;         // accumulated uniform scale: world distance = scale * local distance
     glm::vec3 color;     // resolved (inherited) colour
     float smooth;        // operations: blend radius in world units
+    uint32_t blend;      // operations: the blend profile (the "blend" field's index)
     std::array<float, kMaxParams> params; // the kernel's parameters (half extents, unit normal,
                                           // ...): kernelParams() in engine/src/sdf.h
     Aabb bounds;         // world bounds; the node's value at p is >= bounds.signedDistance(p)

@@ -1,10 +1,14 @@
 // sdfcsg: the one table of node kinds.
 //
 // The parser, the validator, the JSON Schema, the documentation, the CPU evaluator and the GLSL
-// emitter are all driven by this table, so adding a primitive starts here (and in the two
-// formula files, engine/src/sdf.h and shaders/sdf.glsl, which tests hold to each other).
+// emitter are all driven by this table, so adding a primitive is its entry here (engine/src/
+// nodes.cpp) and its formula in shaders/sdf.glsl, which both the CPU and the GPU compile
+// (docs/vocabulary.md).
 #pragma once
 
+#include <glm/vec3.hpp>
+
+#include <array>
 #include <cstdint>
 #include <span>
 #include <string_view>
@@ -21,16 +25,28 @@ enum class NodeKind : uint8_t {
     Cylinder,
     Cone,
     Capsule,
+    Ellipsoid,
+    HexPrism,
+    Octahedron,
+    Pyramid,
+    RoundedCylinder,
+    RoundCone,
+    Link,
+    CappedTorus,
+    // Operations (nodes with children) from here on.
     Union,
     Intersection,
     Difference,
 };
-inline constexpr int kNodeKindCount = 12;
+inline constexpr int kNodeKindCount = 20;
+inline constexpr NodeKind kFirstOperation = NodeKind::Union;
 
 // Every node stores its numeric parameters in this many float slots (see ParamInfo::slot).
 inline constexpr int kMaxParams = 8;
+using Params = std::array<float, kMaxParams>;
 
-enum class ValueType : uint8_t { Number, Vec3 };
+// Choice: one of ParamInfo::choices by name, stored as its index.
+enum class ValueType : uint8_t { Number, Vec3, Choice };
 enum class Check : uint8_t {
     Any,         // any finite value
     Positive,    // > 0 (each component for vectors)
@@ -47,6 +63,14 @@ struct ParamInfo {
     float fallback[3];     // value when an optional parameter is absent
     std::string_view unit; // "length", "unit vector", ...
     std::string_view doc;
+    float maximum = 3.4e38f;                      // Number: the largest value accepted
+    std::span<const std::string_view> choices{};  // Choice: the names, in stored order
+};
+
+// How the inlined GLSL calls a primitive's formula: the kernel parameters after the local point,
+// as (first slot, component count).
+struct KernelArg {
+    uint8_t slot, count;
 };
 
 struct KindInfo {
@@ -55,6 +79,15 @@ struct KindInfo {
     bool operation;        // has "children"
     std::span<const ParamInfo> params;
     std::string_view doc;
+    // Primitives only. The formula in shaders/sdf.glsl and its arguments after the point.
+    std::string_view function{};
+    std::span<const KernelArg> args{};
+    // What the formula takes, from the JSON values (half extents and the like), so that the
+    // shaders do no arithmetic on them.
+    Params (*kernel)(const Params& values) = nullptr;
+    // The exact local bounding box of the solid, from the kernel parameters; false when it has
+    // none (a plane).
+    bool (*bounds)(const Params& kernel, glm::vec3& lo, glm::vec3& hi) = nullptr;
 };
 
 // Keys every node may carry besides its parameters.
