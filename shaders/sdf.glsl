@@ -291,3 +291,112 @@ SDF_FN float sdPrimitive(uint kind, vec3 q, vec4 a, vec4 b, uint kinds) {
     return 1e30f;
 }
 #undef SDF_IS
+
+// ---- Value and domain operations (NodeKind's numbering; kernel parameters from their table
+// entries' kernelAround) ----
+
+// Shell (20): a skin of half thickness a.x about the surface; offset (21): moved out by a.x.
+SDF_FN float valueOp(uint kind, float d, vec4 a) {
+    return kind == 20u ? abs(d) - a.x : d - a.x;
+}
+
+// Domain operations evaluate their child at one or more points of the child's space (the
+// candidates) and combine the values: the least of them, for the copies of a repetition. A point
+// p here is in the node's local space. Repeat (22): a: spacing, G; b: count, M packed a byte per
+// axis. Along each axis the candidates are the nearest copy, then in turn M more either side,
+// then one more towards p, or every copy when that is as many: the nearest copy to any point of
+// a child that reaches M copies either side is among them (engine/src/nodes.cpp, repeatKernel).
+SDF_FN uint repeatAxisCount(float n, float m) {
+    return n <= 1.0f ? 1u : (2.0f * m + 2.0f >= n ? uint(n) : uint(2.0f * m + 2.0f));
+}
+
+SDF_FN float repeatAxisM(float packed, uint axis) {
+    return float((uint(packed) >> (8u * axis)) & 255u);
+}
+
+// Copy index along one axis for candidate c of that axis, -1 when there is none.
+SDF_FN float repeatAxisIndex(float x, float s, float n, float m, uint c) {
+    float nearest = clamp(floor(x / s + 0.5f * (n - 1.0f) + 0.5f), 0.0f, n - 1.0f);
+    float toward = x - (nearest - 0.5f * (n - 1.0f)) * s >= 0.0f ? 1.0f : -1.0f;
+    float i;
+    if (2.0f * m + 2.0f >= n) {
+        i = mod(nearest + float(c), n);
+    } else {
+        float j = float((c + 1u) / 2u);
+        i = c == 0u ? nearest
+            : c == uint(2.0f * m + 1.0f) ? nearest + (m + 1.0f) * toward
+            : (c % 2u == 1u ? nearest + j * toward : nearest - j * toward);
+    }
+    return (i < 0.0f || i > n - 1.0f) ? -1.0f : i;
+}
+
+SDF_FN uint polarCount(vec4 a, vec4 b) {
+    return a.x <= 1.0f ? 1u : (b.x >= a.x ? uint(a.x) : uint(2.0f * b.x + 2.0f));
+}
+
+SDF_FN uint domainCount(uint kind, vec4 a, vec4 b) {
+    if (kind == 22u)
+        return repeatAxisCount(b.x, repeatAxisM(b.w, 0u)) *
+               repeatAxisCount(b.y, repeatAxisM(b.w, 1u)) *
+               repeatAxisCount(b.z, repeatAxisM(b.w, 2u));
+    if (kind == 23u) return polarCount(a, b);
+    return 1u;
+}
+
+// Candidate c's point in the child's space; w is 1 where the candidate is no copy (beyond the
+// ends of a repetition), else 0.
+SDF_FN vec4 domainPoint(uint kind, vec3 p, vec4 a, vec4 b, uint c) {
+    if (kind == 22u) {
+        float mx = repeatAxisM(b.w, 0u), my = repeatAxisM(b.w, 1u), mz = repeatAxisM(b.w, 2u);
+        uint kx = repeatAxisCount(b.x, mx), ky = repeatAxisCount(b.y, my);
+        float ix = repeatAxisIndex(p.x, a.x, b.x, mx, c % kx);
+        float iy = repeatAxisIndex(p.y, a.y, b.y, my, (c / kx) % ky);
+        float iz = repeatAxisIndex(p.z, a.z, b.z, mz, c / (kx * ky));
+        vec3 i = vec3(ix, iy, iz);
+        vec3 o = (i - 0.5f * (vec3(b) - 1.0f)) * vec3(a);
+        return vec4(p - o, (ix < 0.0f || iy < 0.0f || iz < 0.0f) ? 1.0f : 0.0f);
+    }
+    if (kind == 23u) {
+        // Copy i is the child turned about y by i times the sector a.z, at angle i a.z from +x
+        // towards -z.
+        float n = a.x, m = b.x;
+        float nearest = floor(atan(-p.z, p.x) / a.z + 0.5f);
+        float toward = atan(-p.z, p.x) - nearest * a.z >= 0.0f ? 1.0f : -1.0f;
+        float j = float((c + 1u) / 2u);
+        float i = m >= n ? nearest + float(c)
+                  : c == 0u ? nearest
+                  : c == uint(2.0f * m + 1.0f) ? nearest + (m + 1.0f) * toward
+                  : (c % 2u == 1u ? nearest + j * toward : nearest - j * toward);
+        float angle = mod(i, n) * a.z;
+        float cs = cos(angle), sn = sin(angle);
+        return vec4(p.x * cs - p.z * sn - a.y, p.y, p.x * sn + p.z * cs, 0.0f);
+    }
+    if (kind == 24u) {
+        float k = a.w;
+        vec3 m = abs(p);
+        if (k > 0.0f) m = sqrt(p * p + k * k);
+        return vec4(a.x != 0.0f ? m.x : p.x, a.y != 0.0f ? m.y : p.y, a.z != 0.0f ? m.z : p.z, 0.0f);
+    }
+    if (kind == 25u) return vec4(p - clamp(p, -vec3(a), vec3(a)), 0.0f);
+    if (kind == 26u) {
+        float cs = cos(a.x * p.y), sn = sin(a.x * p.y);
+        return vec4(cs * p.x + sn * p.z, p.y, -sn * p.x + cs * p.z, 0.0f);
+    }
+    if (kind == 27u) {
+        float cs = cos(a.x * p.x), sn = sin(a.x * p.x);
+        return vec4(cs * p.x + sn * p.y, -sn * p.x + cs * p.y, p.z, 0.0f);
+    }
+    float s = 1.0f + (a.y - 1.0f) * clamp((p.y + a.x) / (2.0f * a.x), 0.0f, 1.0f); // taper (28)
+    return vec4(p.x / s, p.y, p.z / s, 0.0f);
+}
+
+// Twist, bend and taper stretch space: their child sees points clamped into the node's bounds,
+// and its value is divided by the Lipschitz bound over them (b.w holds its inverse).
+SDF_FN bool domainClamps(uint kind) { return kind >= 26u; }
+
+// The node's value in its local units from the least of its candidates' values.
+SDF_FN float domainFinish(uint kind, vec3 p, float best, vec4 a, vec4 b) {
+    if (kind == 22u) return min(best, a.w);
+    if (kind == 23u) return a.w >= 0.0f ? min(best, length(vec2(p.x, p.z)) * a.w) : best;
+    return domainClamps(kind) ? best * b.w : best;
+}

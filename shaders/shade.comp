@@ -98,14 +98,15 @@ void surface(vec3 ro, vec3 rd, vec4 ends, inout Trace r, out vec3 albedo) {
                 nextLight = true;
             }
         } else { // kShadow
-            if (d < eps * 0.5) {
-                res = 0.0;
-            } else if (s.r < 0.0) {
+            if (s.r < 0.0) {
                 // A bound from a cell far from every surface (tape.glsl): it only steps, and
                 // does not count against the steps (each is at least a cell's radius). Taken as
-                // a distance it would narrow the penumbra's cone and darken lit surfaces.
+                // a distance it would narrow the penumbra's cone and darken lit surfaces, and
+                // where leaf cells are small beside the hit epsilon, read as a hit.
                 t += max(d, eps);
                 tap -= 1;
+            } else if (d < eps * 0.5) {
+                res = 0.0;
             } else {
                 float y = d * d / (2.0 * ph);
                 float w = sqrt(max(d * d - y * y, 0.0));

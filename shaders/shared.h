@@ -34,6 +34,7 @@
 #define SDFCSG_TAPE_FOLD_SHIFT 26 // 2 bits
 #define SDFCSG_TAPE_BLEND_SHIFT 28 // 2 bits
 #define SDFCSG_TAPE_FIRST_OPERATION 17 // NodeKind::Union; then intersection, difference
+#define SDFCSG_TAPE_DOMAIN_END 63     // the kind of the instruction that ends a domain's child
 
 // Mesh extraction (engine/src/mesh.cpp, shaders/mesh_*.comp). The grid's samples are split into
 // bricks of SDFCSG_MESH_BRICK^3; a brick also reads the samples one step past its far faces, so

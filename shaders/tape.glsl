@@ -4,8 +4,8 @@
 // PrunedField::distance and sample in engine/src/prune.cpp are this file in C++.
 //
 // The generated scene code defines SDFCSG_TAPE_STACK (the most values a tape holds at once,
-// rounded up) and SDFCSG_TAPE_KINDS (a bit for each primitive kind the scene holds) before it
-// includes this file.
+// rounded up), SDFCSG_TAPE_KINDS (a bit for each kind the scene holds) and SDFCSG_TAPE_DOMAINS
+// (the most domain operations nested in one another, 0 for none) before it includes this file.
 
 // Mirrors packField() in engine/src/prune.cpp: a header of 12 words (origin xyz and leaf cell
 // side as float bits, levels, leaf cells per axis xyz, 1 when bounded, whole-tape length, first
@@ -37,59 +37,29 @@ vec4 tapeOp(uint kind, vec4 a, vec4 b, float k, uint blend) {
     return vec4(u.rgb, s * u.w);
 }
 
-// The top of the stack stays in `acc`; a primitive that its operation folds in at once (most
-// of them: a left fold is primitive, operation, primitive, operation...) goes straight into
-// it. On CPU devices this keeps most instructions off the stack array, which every lane
-// indexes on its own, and makes nearly every iteration take the same path.
-float tapeDistanceRun(uint begin, uint end, vec3 p) {
-    float stack[SDFCSG_TAPE_STACK];
-    int top = -1;
-    float acc = 0.0;
-    for (uint at = begin; at < end; ++at) {
-        uint ins = field[at];
-        uint i = ins & ((1u << SDFCSG_TAPE_NODE_BITS) - 1u);
-        uint kind = (ins >> SDFCSG_TAPE_KIND_SHIFT) & 0x3fu;
-        if (kind < kTapeUnion) {
-            float d = tapePrimitive(kind, i, p);
-            uint fold = (ins >> SDFCSG_TAPE_FOLD_SHIFT) & 3u;
-            if (fold != 0u) {
-                acc = tapeOp(fold + kTapeUnion - 1u, acc, d, uintBitsToFloat(field[++at]),
-                             ins >> SDFCSG_TAPE_BLEND_SHIFT);
-            } else {
-                stack[++top] = acc;
-                acc = d;
-            }
-        } else {
-            acc = tapeOp(kind, stack[top--], acc, nodeSmooth(i), nodeBlend(i));
-        }
-    }
-    return acc;
-}
+#define TAPE_VALUE float
+#define TAPE_RUN tapeDistanceRun
+#define TAPE_LEAF(i, d) (d)
+#define TAPE_DIST(v) (v)
+#define TAPE_WITH(v, d) (d)
+#include "tape_run.glsl"
+#undef TAPE_VALUE
+#undef TAPE_RUN
+#undef TAPE_LEAF
+#undef TAPE_DIST
+#undef TAPE_WITH
 
-vec4 tapeSampleRun(uint begin, uint end, vec3 p) {
-    vec4 stack[SDFCSG_TAPE_STACK];
-    int top = -1;
-    vec4 acc = vec4(0.0);
-    for (uint at = begin; at < end; ++at) {
-        uint ins = field[at];
-        uint i = ins & ((1u << SDFCSG_TAPE_NODE_BITS) - 1u);
-        uint kind = (ins >> SDFCSG_TAPE_KIND_SHIFT) & 0x3fu;
-        if (kind < kTapeUnion) {
-            vec4 d = withColor(i, tapePrimitive(kind, i, p));
-            uint fold = (ins >> SDFCSG_TAPE_FOLD_SHIFT) & 3u;
-            if (fold != 0u) {
-                acc = tapeOp(fold + kTapeUnion - 1u, acc, d, uintBitsToFloat(field[++at]),
-                             ins >> SDFCSG_TAPE_BLEND_SHIFT);
-            } else {
-                stack[++top] = acc;
-                acc = d;
-            }
-        } else {
-            acc = tapeOp(kind, stack[top--], acc, nodeSmooth(i), nodeBlend(i));
-        }
-    }
-    return acc;
-}
+#define TAPE_VALUE vec4
+#define TAPE_RUN tapeSampleRun
+#define TAPE_LEAF(i, d) withColor(i, d)
+#define TAPE_DIST(v) (v).w
+#define TAPE_WITH(v, d) vec4((v).rgb, d)
+#include "tape_run.glsl"
+#undef TAPE_VALUE
+#undef TAPE_RUN
+#undef TAPE_LEAF
+#undef TAPE_DIST
+#undef TAPE_WITH
 
 // Where p's value comes from: x: 0 to run the tape [y, z), 1 for the bound w.
 uvec3 tapeCell(vec3 p, out float bound) {
@@ -119,6 +89,9 @@ uvec3 tapeCell(vec3 p, out float bound) {
     bound = v > 0.0 ? v - away : v + away;
     return uvec3(1u, 0u, 0u);
 }
+
+// The side of a leaf cell (1 where the field is not pruned).
+float tapeLeafSide() { return field[4] == 0u ? 1e30 : uintBitsToFloat(field[3]); }
 
 float tapeDistance(vec3 p) {
     float bound;

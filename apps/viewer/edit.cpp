@@ -36,6 +36,11 @@ void defaultParams(Node& node) {
             if (p.unit == "degrees") x = 270.0f;
             if (p.name == "size" || p.name == "height" || p.name == "length" || p.name == "width")
                 x = 1.0f;
+            if (p.check == Check::Count) x = p.type == ValueType::Number ? 6.0f : 3.0f;
+            if (p.unit == "degrees per unit length") x = 45.0f;
+            if (p.name == "spacing") x = 1.5f;
+            if (p.name == "thickness" || p.name == "distance") x = 0.05f;
+            if (node.kind == NodeKind::Elongate) x = 0.25f;
             v[0] = v[1] = v[2] = x;
             if (p.name == "a") v[0] = 0.0f, v[1] = -0.5f, v[2] = 0.0f;
             if (p.name == "b") v[0] = 0.0f, v[1] = 0.5f, v[2] = 0.0f;

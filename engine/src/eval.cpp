@@ -113,15 +113,37 @@ template <class V> float dist(const V& v) {
         return v.w;
 }
 
+Role roleOf(NodeKind kind) {
+    return kindInfo(kind).role;
+}
+
+glm::vec4 kernelA(const FlatNode& n) {
+    return {n.params[0], n.params[1], n.params[2], n.params[3]};
+}
+glm::vec4 kernelB(const FlatNode& n) {
+    return {n.params[4], n.params[5], n.params[6], n.params[7]};
+}
+
+template <class V> V withDistance(V v, float d) {
+    if constexpr (std::is_same_v<V, float>)
+        return d;
+    else
+        return glm::vec4(glm::vec3(v), d);
+}
+
 // The generated code's walk, iteratively: a frame per open operation holds the running fold
 // and the next child to visit. Operand i > 0 of a union is skipped when its bounds lie at least
 // k beyond the running value, a subtrahend when they lie at least k beyond its negation; with
-// sdf.glsl's exact operator ends, the skipped operand could not have changed the result.
+// sdf.glsl's exact operator ends, the skipped operand could not have changed the result. A
+// domain operation evaluates its child at each of its candidate points (sdf.glsl, domainPoint)
+// whose bounds could lower the least value so far, as shaders/tape.glsl does.
 template <class V>
 V evaluate(const std::vector<FlatNode>& nodes, uint32_t root, glm::vec3 p, bool skipping) {
     struct Frame {
         uint32_t node, next;
         V acc;
+        glm::vec3 outer{0.0f}, local{0.0f}; // domain operations: the point outside, and local
+        uint32_t candidate = 0, count = 0;
     };
     thread_local std::vector<Frame> stack;
     stack.clear();
@@ -129,7 +151,17 @@ V evaluate(const std::vector<FlatNode>& nodes, uint32_t root, glm::vec3 p, bool 
     for (;;) {
         const FlatNode& n = nodes[current];
         if (isOperation(n.kind)) {
-            stack.push_back({current, 1, V{}});
+            Frame f{current, 1, V{}};
+            if (roleOf(n.kind) == Role::Domain) {
+                const uint32_t kind = uint32_t(n.kind);
+                f.outer = p;
+                f.local = localPoint(
+                    n, sdf::domainClamps(kind) ? glm::clamp(p, n.bounds.min, n.bounds.max) : p);
+                f.count = sdf::domainCount(kind, kernelA(n), kernelB(n));
+                f.acc = withDistance(V{}, INFINITY);
+                p = glm::vec3(sdf::domainPoint(kind, f.local, kernelA(n), kernelB(n), 0));
+            }
+            stack.push_back(f);
             current = n.children[0];
             continue;
         }
@@ -139,6 +171,36 @@ V evaluate(const std::vector<FlatNode>& nodes, uint32_t root, glm::vec3 p, bool 
             if (stack.empty()) return value;
             Frame& f = stack.back();
             const FlatNode& op = nodes[f.node];
+            const Role role = roleOf(op.kind);
+            if (role == Role::Value) {
+                value = withDistance(value, sdf::valueOp(uint32_t(op.kind), dist(value), kernelA(op)));
+                stack.pop_back();
+                continue;
+            }
+            if (role == Role::Domain) {
+                const uint32_t kind = uint32_t(op.kind);
+                if (dist(value) < dist(f.acc)) f.acc = value;
+                const FlatNode& child = nodes[op.children[0]];
+                bool again = false;
+                while (!again && ++f.candidate < f.count) {
+                    const glm::vec4 q =
+                        sdf::domainPoint(kind, f.local, kernelA(op), kernelB(op), f.candidate);
+                    again = q.w == 0.0f && (!skipping || child.bounds.signedDistance(glm::vec3(q)) <
+                                                             dist(f.acc));
+                    if (again) p = glm::vec3(q);
+                }
+                if (again) {
+                    current = op.children[0];
+                    break;
+                }
+                float d = sdf::domainFinish(kind, f.local, dist(f.acc), kernelA(op), kernelB(op)) *
+                          op.scale;
+                if (sdf::domainClamps(kind)) d = std::max(d, op.bounds.signedDistance(f.outer));
+                value = withDistance(f.acc, d);
+                p = f.outer;
+                stack.pop_back();
+                continue;
+            }
             if (f.next == 1) {
                 f.acc = value;
             } else if (op.kind == NodeKind::Union) {
@@ -173,6 +235,10 @@ float primitiveValue(const FlatNode& node, glm::vec3 p) {
     return leaf<float>(node, p);
 }
 
+glm::vec3 nodeLocalPoint(const FlatNode& node, glm::vec3 p) {
+    return localPoint(node, p);
+}
+
 } // namespace detail
 
 struct Evaluator::Pruned {
@@ -200,8 +266,10 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
         for (uint32_t c : src.children)
             parent[c] = uint32_t(i);
         const bool hasParent = parent[i] != UINT32_MAX;
-        const Acc& up = hasParent ? acc[parent[i]] : identity;
         const FlatNode* upNode = hasParent ? &nodes_[parent[i]] : nullptr;
+        // A domain operation's child starts a frame: its transforms act in the child space.
+        const bool opensFrame = upNode && roleOf(upNode->kind) == Role::Domain;
+        const Acc& up = hasParent && !opensFrame ? acc[parent[i]] : identity;
 
         glm::dmat3 r = rotation(src.transform.rotate);
         double s = src.transform.scale;
@@ -216,33 +284,69 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
 
         FlatNode& n = nodes_[i];
         n.kind = src.kind;
+        n.frame = !upNode ? kWorldFrame : opensFrame ? parent[i] : upNode->frame;
         n.toLocal = glm::mat3(a.toLocal);
         n.offset = glm::vec3(a.offset);
         n.scale = float(a.scale);
         n.color = src.color ? *src.color : upNode ? upNode->color : kDefaultColor;
         n.params = sdf::kernelParams(src.kind, src.params);
-        n.smooth = isOperation(src.kind) ? float(double(src.params[0]) * a.scale) : 0.0f;
-        n.blend = isOperation(src.kind) ? uint32_t(src.params[1]) : 0u;
+        const bool boolean = roleOf(src.kind) == Role::Boolean;
+        n.smooth = boolean ? float(double(src.params[0]) * a.scale) : 0.0f;
+        n.blend = boolean ? uint32_t(src.params[1]) : 0u;
         n.children = src.children;
     }
 
-    // Pass 2, children first: bounds.
+    // Pass 2, children first: bounds, and the kernel parameters of the operations that take
+    // their child's bounds.
+    auto toFrame = [&](size_t i, glm::vec3 lo, glm::vec3 hi) {
+        glm::dvec3 wlo(INFINITY), whi(-INFINITY);
+        for (int c = 0; c < 8; ++c) {
+            glm::dvec3 corner(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z);
+            glm::dvec3 w = acc[i].toWorld * corner + acc[i].origin;
+            wlo = glm::min(wlo, w);
+            whi = glm::max(whi, w);
+        }
+        return outwardBox(wlo, whi);
+    };
     for (size_t i = count; i-- > 0;) {
         FlatNode& n = nodes_[i];
+        const KindInfo& info = kindInfo(n.kind);
         if (!isOperation(n.kind)) {
             glm::vec3 lo, hi;
-            if (!sdf::localBounds(n.kind, n.params, lo, hi)) {
+            n.bounds = sdf::localBounds(n.kind, n.params, lo, hi) ? toFrame(i, lo, hi)
+                                                                 : infiniteBox();
+        } else if (info.role == Role::Value) {
+            // Lengths in the frame's units, as the child's values are.
+            Params values = scene.nodes[i].params;
+            values[0] = float(double(values[0]) * acc[i].scale);
+            const Aabb& child = nodes_[n.children[0]].bounds;
+            n.params = info.kernelAround(values, child.min, child.max);
+            n.bounds = child;
+            if (child.finite()) info.boundsAround(n.params, child.min, child.max, n.bounds.min,
+                                                  n.bounds.max);
+        } else if (info.role == Role::Domain) {
+            const Aabb& child = nodes_[n.children[0]].bounds;
+            if (!child.finite()) { // refused by the parser, but for mirror and elongate
+                n.params = info.kernelAround(scene.nodes[i].params, glm::vec3(0), glm::vec3(0));
                 n.bounds = infiniteBox();
                 continue;
             }
-            glm::dvec3 wlo(INFINITY), whi(-INFINITY);
-            for (int c = 0; c < 8; ++c) {
-                glm::dvec3 corner(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z);
-                glm::dvec3 w = acc[i].toWorld * corner + acc[i].origin;
-                wlo = glm::min(wlo, w);
-                whi = glm::max(whi, w);
+            n.params = info.kernelAround(scene.nodes[i].params, child.min, child.max);
+            glm::vec3 lo, hi;
+            info.boundsAround(n.params, child.min, child.max, lo, hi);
+            n.bounds = toFrame(i, lo, hi);
+            if (info.lipschitz) {
+                // Over the node's bounds (which the child's points are clamped to) in local space.
+                glm::vec3 llo(INFINITY), lhi(-INFINITY);
+                for (int c = 0; c < 8; ++c) {
+                    const glm::vec3 corner(c & 1 ? n.bounds.max.x : n.bounds.min.x,
+                                           c & 2 ? n.bounds.max.y : n.bounds.min.y,
+                                           c & 4 ? n.bounds.max.z : n.bounds.min.z);
+                    const glm::vec3 l = localPoint(n, corner);
+                    llo = glm::min(llo, l), lhi = glm::max(lhi, l);
+                }
+                n.params[7] = 1.0f / info.lipschitz(n.params, llo, lhi);
             }
-            n.bounds = outwardBox(wlo, whi);
         } else if (n.kind == NodeKind::Union) {
             Aabb box;
             for (uint32_t c : n.children) {
@@ -282,14 +386,26 @@ Sample Evaluator::sample(glm::vec3 p) const {
     return sample(p, 0);
 }
 
+namespace {
+
+// The node itself, or the outermost domain operation it lies in: the subtree that takes world
+// points.
+uint32_t worldSubtree(const std::vector<FlatNode>& nodes, uint32_t node) {
+    while (nodes[node].frame != kWorldFrame)
+        node = nodes[node].frame;
+    return node;
+}
+
+} // namespace
+
 float Evaluator::distance(glm::vec3 p, uint32_t node) const {
     if (node >= nodes_.size()) return INFINITY; // an empty scene is empty space
-    return evaluate<float>(nodes_, node, p, skipping_);
+    return evaluate<float>(nodes_, worldSubtree(nodes_, node), p, skipping_);
 }
 
 Sample Evaluator::sample(glm::vec3 p, uint32_t node) const {
     if (node >= nodes_.size()) return {INFINITY, kDefaultColor};
-    glm::vec4 v = evaluate<glm::vec4>(nodes_, node, p, skipping_);
+    glm::vec4 v = evaluate<glm::vec4>(nodes_, worldSubtree(nodes_, node), p, skipping_);
     return {v.w, glm::vec3(v)};
 }
 
@@ -306,7 +422,7 @@ Camera frameCamera(const Evaluator& evaluator, float aspect, float fov) {
     if (!box.finite()) {
         box = Aabb{};
         for (const FlatNode& n : evaluator.nodes()) {
-            if (isOperation(n.kind) || !n.bounds.finite()) continue;
+            if (isOperation(n.kind) || !n.bounds.finite() || n.frame != kWorldFrame) continue;
             box.min = glm::min(box.min, n.bounds.min);
             box.max = glm::max(box.max, n.bounds.max);
         }

@@ -31,7 +31,9 @@ std::vector<GpuNode> packNodes(const Evaluator& evaluator) {
         g.p1 = glm::vec4(n.params[4], n.params[5], n.params[6], n.params[7]);
         g.color = glm::vec4(n.color, n.scale);
         g.bmin = glm::vec4(clampHuge(n.bounds.min), n.smooth);
-        g.bmax = glm::vec4(clampHuge(n.bounds.max), float(n.blend));
+        // Domain operations: w holds their child's index, whose bounds the tape machine reads.
+        const bool domain = kindInfo(n.kind).role == Role::Domain;
+        g.bmax = glm::vec4(clampHuge(n.bounds.max), domain ? float(n.children[0]) : float(n.blend));
         out.push_back(g);
     }
     return out;

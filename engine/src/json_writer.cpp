@@ -9,7 +9,10 @@ namespace sdfcsg::detail {
 
 std::string formatNumber(double value) {
     char buf[32];
-    auto [end, ec] = std::to_chars(buf, buf + sizeof buf, value);
+    // Whole numbers as integers (1000000, not 1e+06), so readers that want integers get them.
+    const bool whole = value == std::trunc(value) && std::abs(value) < 1e15;
+    auto [end, ec] = whole ? std::to_chars(buf, buf + sizeof buf, value, std::chars_format::fixed)
+                           : std::to_chars(buf, buf + sizeof buf, value);
     return std::string(buf, end);
 }
 

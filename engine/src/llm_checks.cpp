@@ -85,7 +85,8 @@ Extent sceneExtent(const Evaluator& evaluator) {
         return e;
     }
     for (const FlatNode& n : evaluator.nodes()) {
-        if (!n.children.empty() || n.kind == NodeKind::Plane) continue;
+        // Inside a domain operation bounds are in the operation's child space, not the world's.
+        if (!n.children.empty() || n.kind == NodeKind::Plane || n.frame != kWorldFrame) continue;
         if (n.bounds.finite()) {
             e.add(n.bounds.min, n.bounds.max);
         } else {

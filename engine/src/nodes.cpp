@@ -105,10 +105,107 @@ constexpr ParamInfo kOperation[] = {
      3.4e38f, kBlends},
 };
 
+constexpr ParamInfo kShell[] = {
+    {"thickness", Number, Positive, 0, true, {}, "length", "Thickness of the skin."},
+};
+constexpr ParamInfo kOffset[] = {
+    {"distance", Number, Any, 0, true, {}, "length",
+     "How far the surface moves outwards; negative moves it inwards."},
+};
+constexpr ParamInfo kRepeat[] = {
+    {"count", Vec3, Count, 0, true, {}, "copies", "Copies along x, y and z (1: no repetition)."},
+    {"spacing", Vec3, Positive, 3, true, {}, "length",
+     "Distance between neighbouring copies' centres along x, y and z."},
+};
+constexpr ParamInfo kPolarRepeat[] = {
+    {"count", Number, Count, 0, true, {}, "copies", "Copies around the axis."},
+    {"radius", Number, Any, 1, false, {0, 0, 0}, "length",
+     "How far the child moves along +x before it is copied around the y axis."},
+};
+constexpr std::string_view kMirrorAxes[] = {"x", "y", "z", "xy", "xz", "yz", "xyz"};
+constexpr uint32_t kMirrorMasks[] = {1, 2, 4, 3, 5, 6, 7};
+constexpr ParamInfo kMirror[] = {
+    {"axes", Choice, Any, 0, false, {0, 0, 0}, "axes",
+     "The axes whose planes through the origin mirror the child: \"x\" keeps x >= 0 and "
+     "mirrors it to x < 0, and so on.",
+     3.4e38f, kMirrorAxes},
+    {"smooth", Number, NonNegative, 1, false, {0, 0, 0}, "length",
+     "Blend radius of the seam at each mirror plane; 0 gives the exact mirror image."},
+};
+constexpr ParamInfo kElongate[] = {
+    {"length", Vec3, NonNegative, 0, true, {}, "length",
+     "How far apart the halves move along x, y and z."},
+};
+constexpr ParamInfo kTwist[] = {
+    {"angle", Number, Any, 0, true, {}, "degrees per unit length",
+     "Turn about y per unit of height (positive: counter-clockwise seen from +y)."},
+};
+constexpr ParamInfo kBend[] = {
+    {"angle", Number, Any, 0, true, {}, "degrees per unit length",
+     "Turn in the xy plane per unit along x."},
+};
+constexpr ParamInfo kTaper[] = {
+    {"height", Number, Positive, 0, true, {}, "length",
+     "Height over which the scale changes, centred on y = 0."},
+    {"top_scale", Number, Positive, 1, true, {}, "factor",
+     "Scale of x and z at y = +height/2 (1 at y = -height/2)."},
+};
+
 // Kernel parameters and local bounds (see KindInfo::kernel and ::bounds).
 using glm::vec3;
 Params halve3(const Params& v) { return {0.5f * v[0], 0.5f * v[1], 0.5f * v[2]}; }
 bool symmetric(vec3 half, vec3& lo, vec3& hi) { return lo = -half, hi = half, true; }
+float radians(float degrees) { return float(double(degrees) * 3.14159265358979323846 / 180.0); }
+
+// The largest distance from the y axis (reach) or from the z axis (reachXY) over a box.
+float reach(vec3 lo, vec3 hi) {
+    const float x = std::max(-lo.x, hi.x), z = std::max(-lo.z, hi.z);
+    return std::sqrt(x * x + z * z);
+}
+float reachXY(vec3 lo, vec3 hi) {
+    const float x = std::max(-lo.x, hi.x), y = std::max(-lo.y, hi.y);
+    return std::sqrt(x * x + y * y);
+}
+
+// The largest singular value of the identity plus a column of length a, a bound of the twist's
+// and the bend's Jacobians where the turn per unit times the distance from the axis is a.
+float stretch(float a) { return 0.5f * (a + std::sqrt(a * a + 4.0f)) * (1.0f + 1e-6f); }
+
+// Repeat: spacing s, count n, and per axis the copies either side of the nearest that can reach
+// a point (M, packed a byte each); the evaluation takes the nearest copy, M more either side and
+// one more towards the point, or all n when that is as many (shaders/sdf.glsl, domainCandidate).
+// When some axis needs M > 0, copies further away are at least G away, and the value is at most
+// G (so that it stays continuous and 1-Lipschitz); with M = 0 everywhere it is exact.
+Params repeatKernel(const Params& v, vec3 lo, vec3 hi) {
+    Params k{v[3], v[4], v[5], 3.4e38f, v[0], v[1], v[2], 0.0f};
+    uint32_t packed = 0;
+    for (int a = 0; a < 3; ++a) {
+        const float s = v[3 + a], n = v[a], ext = std::max(-lo[a], hi[a]);
+        const float m = std::clamp(std::ceil(ext / s - 0.5f), 0.0f, 255.0f);
+        packed |= uint32_t(m) << (8 * a);
+        if (n > 1.0f && 2.0f * m + 2.0f < n && m > 0.0f)
+            k[3] = std::min(k[3], (m + 1.0f) * s - ext);
+    }
+    k[7] = float(packed);
+    return k;
+}
+
+// Polar repeat: count N, radius, sector angle, and the copies either side of the nearest that
+// can reach a point (M), from the child's angular half extent beta seen from the axis. Beyond
+// them the copies are at least gamma = (M + 1) sector - beta away in angle, so at least
+// |p.xz| sin(gamma) away: slot 3 holds sin(min(gamma, 90 degrees)) when M > 0, else -1 (exact);
+// a child that reaches the axis takes every copy.
+Params polarKernel(const Params& v, vec3 lo, vec3 hi) {
+    const float n = v[0], sector = float(2.0 * 3.14159265358979323846 / double(v[0]));
+    const float x0 = lo.x + v[1], z = std::max(-lo.z, hi.z);
+    const float beta = x0 > 0.0f ? std::atan2(z, x0) : 3.14159265f;
+    float m = std::ceil(beta / sector - 0.5f);
+    if (2.0f * m + 2.0f >= n) m = n; // every copy
+    float g = -1.0f;
+    if (m > 0.0f && m < n)
+        g = std::sin(std::min((m + 1.0f) * sector - beta, 1.5707963f)) * (1.0f - 1e-6f);
+    return {n, v[1], sector, g, m};
+}
 
 constexpr KernelArg kA0[] = {{0, 1}};
 constexpr KernelArg kA3[] = {{0, 3}};
@@ -250,9 +347,108 @@ constexpr KindInfo kKinds[] = {
          float r = k[0] + k[1];
          return symmetric({r, k[1], r}, lo, hi);
      }},
-    {NodeKind::Union, "union", true, kOperation, "All children together."},
-    {NodeKind::Intersection, "intersection", true, kOperation, "What all children have in common."},
-    {NodeKind::Difference, "difference", true, kOperation, "The first child minus all the others."},
+    {NodeKind::Union, "union", true, kOperation, "All children together.", {}, {}, nullptr,
+     nullptr, Role::Boolean},
+    {NodeKind::Intersection, "intersection", true, kOperation, "What all children have in common.",
+     {}, {}, nullptr, nullptr, Role::Boolean},
+    {NodeKind::Difference, "difference", true, kOperation, "The first child minus all the others.",
+     {}, {}, nullptr, nullptr, Role::Boolean},
+    {NodeKind::Shell, "shell", true, kShell,
+     "Its child hollowed to a skin of the given thickness, centred on the child's surface (an "
+     "onion). Cut it open with a difference to see inside.",
+     {}, {}, nullptr, nullptr, Role::Value,
+     [](const Params& v, vec3, vec3) -> Params { return {0.5f * v[0]}; },
+     [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
+         outLo = lo - k[0], outHi = hi + k[0];
+     }},
+    {NodeKind::Offset, "offset", true, kOffset,
+     "Its child grown by a distance (rounding its edges), or shrunk by a negative one.", {}, {},
+     nullptr, nullptr, Role::Value, [](const Params& v, vec3, vec3) -> Params { return {v[0]}; },
+     [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
+         outLo = lo - std::max(k[0], 0.0f), outHi = hi + std::max(k[0], 0.0f);
+     }},
+    {NodeKind::Repeat, "repeat", true, kRepeat,
+     "A grid of copies of its child, centred on the origin: count copies along each axis, "
+     "spacing apart. Costs about one copy to evaluate, however many there are.",
+     {}, {}, nullptr, nullptr, Role::Domain, repeatKernel,
+     [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
+         const vec3 span = 0.5f * (vec3(k[4], k[5], k[6]) - 1.0f) * vec3(k[0], k[1], k[2]);
+         outLo = lo - span, outHi = hi + span;
+     }},
+    {NodeKind::PolarRepeat, "polar_repeat", true, kPolarRepeat,
+     "Copies of its child around the y axis, evenly spaced: the child moved radius along +x, "
+     "then turned about y by each multiple of 360 / count degrees. Costs about one copy.",
+     {}, {}, nullptr, nullptr, Role::Domain, polarKernel,
+     [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
+         const float r = reach(lo + vec3(k[1], 0, 0), hi + vec3(k[1], 0, 0));
+         outLo = vec3(-r, lo.y, -r), outHi = vec3(r, hi.y, r);
+     }},
+    {NodeKind::Mirror, "mirror", true, kMirror,
+     "Its child's part on the positive side of each chosen axis plane, and that part's mirror "
+     "image (a symmetric shape from one half).",
+     {}, {}, nullptr, nullptr, Role::Domain,
+     [](const Params& v, vec3, vec3) -> Params {
+         const uint32_t mask = kMirrorMasks[size_t(v[0])];
+         return {float(mask & 1), float(mask >> 1 & 1), float(mask >> 2 & 1), v[1]};
+     },
+     [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
+         for (int a = 0; a < 3; ++a) {
+             const float e = std::max(hi[a], 0.0f);
+             outLo[a] = k[a] != 0.0f ? -e : lo[a];
+             outHi[a] = k[a] != 0.0f ? e : hi[a];
+         }
+     }},
+    {NodeKind::Elongate, "elongate", true, kElongate,
+     "Its child cut through its centre planes and stretched apart by the given lengths: a sphere "
+     "becomes a capsule or a rounded box, a torus a stadium-shaped ring.",
+     {}, {}, nullptr, nullptr, Role::Domain,
+     [](const Params& v, vec3, vec3) -> Params { return {0.5f * v[0], 0.5f * v[1], 0.5f * v[2]}; },
+     [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
+         outLo = lo - vec3(k[0], k[1], k[2]), outHi = hi + vec3(k[0], k[1], k[2]);
+     }},
+    {NodeKind::Twist, "twist", true, kTwist,
+     "Its child twisted about the y axis, turning by the given angle per unit of height. The "
+     "field is divided by the twist's Lipschitz bound, so it stays safe to trace.",
+     {}, {}, nullptr, nullptr, Role::Domain,
+     [](const Params& v, vec3, vec3) -> Params { return {radians(v[0])}; },
+     [](const Params&, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
+         const float r = reach(lo, hi);
+         outLo = vec3(-r, lo.y, -r), outHi = vec3(r, hi.y, r);
+     },
+     [](const Params& k, vec3 lo, vec3 hi) { return stretch(std::abs(k[0]) * reach(lo, hi)); }},
+    {NodeKind::Bend, "bend", true, kBend,
+     "Its child bent in the xy plane about the z axis, turning by the given angle per unit "
+     "along x: a bar along x becomes an arc. The field is divided by the bend's Lipschitz "
+     "bound.",
+     {}, {}, nullptr, nullptr, Role::Domain,
+     [](const Params& v, vec3, vec3) -> Params { return {radians(v[0])}; },
+     [](const Params&, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
+         const float r = reachXY(lo, hi);
+         outLo = vec3(-r, -r, lo.z), outHi = vec3(r, r, hi.z);
+     },
+     [](const Params& k, vec3 lo, vec3 hi) { return stretch(std::abs(k[0]) * reachXY(lo, hi)); }},
+    {NodeKind::Taper, "taper", true, kTaper,
+     "Its child scaled in x and z by a factor that changes linearly with height: 1 at y = "
+     "-height/2, top_scale at y = +height/2, constant beyond. The field is divided by the "
+     "taper's Lipschitz bound.",
+     {}, {}, nullptr, nullptr, Role::Domain,
+     [](const Params& v, vec3, vec3) -> Params { return {0.5f * v[0], v[1]}; },
+     [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
+         const float top = k[1];
+         outLo = vec3(std::min(lo.x, lo.x * top), lo.y, std::min(lo.z, lo.z * top));
+         outHi = vec3(std::max(hi.x, hi.x * top), hi.y, std::max(hi.z, hi.z * top));
+     },
+     [](const Params& k, vec3 lo, vec3 hi) {
+         // q = (x / s, y, z / s): diag(1/s, 1, 1/s) plus the column of d/dy, of length
+         // r |s'| / s^2; s is linear in y, so its least value over the box is at an end.
+         const float hh = k[0], top = k[1];
+         auto scale = [&](float y) {
+             return 1.0f + (top - 1.0f) * std::clamp((y + hh) / (2.0f * hh), 0.0f, 1.0f);
+         };
+         const float least = std::min({scale(lo.y), scale(hi.y), 1.0f, top});
+         const float slope = std::abs(top - 1.0f) / (2.0f * hh);
+         return std::max(1.0f / least, 1.0f) + reach(lo, hi) * slope / (least * least);
+     }},
 };
 static_assert(sizeof(kKinds) / sizeof(kKinds[0]) == kNodeKindCount);
 

@@ -399,10 +399,13 @@ std::optional<dom::array> SceneReader::readNode(element value, std::string path,
 
     auto children = valueOf("children");
     if (!kind->operation) {
-        if (children)
-            problems_.add(p,
-                          article(kind->name) +
-                              " takes no \"children\"; only union, intersection and difference do");
+        if (children) {
+            std::vector<std::string_view> operations;
+            for (const KindInfo& k : nodeKinds())
+                if (k.operation) operations.push_back(k.name);
+            problems_.add(p, article(kind->name) + " takes no \"children\"; only operations (" +
+                                 joinNames(operations, "and") + ") do");
+        }
         return std::nullopt;
     }
     if (!children) {
@@ -417,6 +420,12 @@ std::optional<dom::array> SceneReader::readNode(element value, std::string path,
     dom::array array = asArray(*children);
     if (array.size() == 0) {
         problems_.add(member(p, "children"), "expected at least one child node, got []");
+        return std::nullopt;
+    }
+    if (kind->role != Role::Boolean && array.size() != 1) {
+        problems_.add(member(p, "children"),
+                      "expected exactly one child node (wrap several in a union), got " +
+                          std::to_string(array.size()));
         return std::nullopt;
     }
     if (tooDeep) {
@@ -446,6 +455,15 @@ void checkCombinedTransforms(const Scene& scene, Problems& problems) {
         for (uint32_t c : node.children)
             scale[c] = scale[i];
         const FlatNode& f = evaluator.nodes()[i];
+        const KindInfo& info = kindInfo(node.kind);
+        if (info.role == Role::Domain && node.kind != NodeKind::Mirror &&
+            node.kind != NodeKind::Elongate && !node.children.empty() &&
+            !evaluator.nodes()[node.children[0]].bounds.finite()) {
+            problems.add(node.path, article(info.name) +
+                                        " needs a bounded child, and its child reaches infinity "
+                                        "(a plane does)");
+            return;
+        }
         if (std::isfinite(f.scale) && f.scale > 0.0f && finite(f.toLocal[0]) &&
             finite(f.toLocal[1]) && finite(f.toLocal[2]) && finite(f.offset) &&
             std::isfinite(f.smooth))

@@ -245,6 +245,8 @@ std::string expectedText(ValueType type, Check check) {
             return "a non-negative number";
         case Check::NonZero:
             return "a non-zero number";
+        case Check::Count:
+            return "a whole number from 1 to 1000000";
         }
     }
     switch (check) {
@@ -256,6 +258,8 @@ std::string expectedText(ValueType type, Check check) {
         return "an array of 3 non-negative numbers";
     case Check::NonZero:
         return "a non-zero vector of 3 numbers";
+    case Check::Count:
+        return "an array of 3 whole numbers from 1 to 1000000";
     }
     return {};
 }
@@ -296,6 +300,7 @@ std::optional<double> readNumber(element value, const std::string& path, Check c
     const bool ok = check == Check::Positive      ? f > 0.0f
                     : check == Check::NonNegative ? f >= 0.0f
                     : check == Check::NonZero     ? f != 0.0f
+                    : check == Check::Count       ? f >= 1.0f && f == std::floor(f) && f <= 1e6f
                                                   : true;
     if (!ok) {
         problems.add(path, "expected " + expected + ", got " + describe(value) +

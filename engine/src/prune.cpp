@@ -36,26 +36,92 @@ template <class V> V opValue(const FlatNode& op, V a, V b) {
                : sdf::opDifference(a, b, op.smooth, op.blend);
 }
 
+Role roleOf(NodeKind kind) {
+    return kindInfo(kind).role;
+}
+
+bool isDomainEnd(uint32_t ins) {
+    return (ins >> kTapeKindShift) == kTapeDomainEnd;
+}
+
+glm::vec4 kernelA(const FlatNode& n) {
+    return {n.params[0], n.params[1], n.params[2], n.params[3]};
+}
+glm::vec4 kernelB(const FlatNode& n) {
+    return {n.params[4], n.params[5], n.params[6], n.params[7]};
+}
+
+float distanceOf(float v) { return v; }
+float distanceOf(glm::vec4 v) { return v.w; }
+float withDistance(float, float d) { return d; }
+glm::vec4 withDistance(glm::vec4 v, float d) { return {glm::vec3(v), d}; }
+
 // Runs tape[begin, end) at p. V: float (distance) or vec4 (colour, distance in w).
 template <class V>
 V run(const std::vector<FlatNode>& nodes, const uint32_t* tape, uint32_t length, glm::vec3 p) {
+    struct Domain {
+        glm::vec3 outer, local;
+        V best;
+        uint32_t candidate, count, body;
+    };
     thread_local std::vector<V> stack;
+    thread_local std::vector<Domain> domains;
     stack.clear();
+    domains.clear();
     for (uint32_t i = 0; i < length; ++i) {
         const uint32_t ins = tape[i];
         const FlatNode& n = nodes[ins & kTapeNodeMask];
+        if (isDomainEnd(ins)) {
+            Domain& d = domains.back();
+            const uint32_t kind = uint32_t(n.kind);
+            const V v = stack.back();
+            stack.pop_back();
+            if (distanceOf(v) < distanceOf(d.best)) d.best = v;
+            const FlatNode& child = nodes[n.children[0]];
+            bool again = false;
+            while (!again && ++d.candidate < d.count) {
+                const glm::vec4 q = sdf::domainPoint(kind, d.local, kernelA(n), kernelB(n),
+                                                     d.candidate);
+                again = q.w == 0.0f &&
+                        child.bounds.signedDistance(glm::vec3(q)) < distanceOf(d.best);
+                if (again) p = glm::vec3(q);
+            }
+            if (again) {
+                i = d.body - 1;
+                continue;
+            }
+            float value =
+                sdf::domainFinish(kind, d.local, distanceOf(d.best), kernelA(n), kernelB(n)) *
+                n.scale;
+            if (sdf::domainClamps(kind)) value = std::max(value, n.bounds.signedDistance(d.outer));
+            stack.push_back(withDistance(d.best, value));
+            p = d.outer;
+            domains.pop_back();
+            continue;
+        }
         const NodeKind kind = opcode(ins);
-        if (!isOperation(kind)) {
+        const Role role = roleOf(kind);
+        if (role == Role::Primitive) {
             float d = primitiveValue(n, p);
             if constexpr (std::is_same_v<V, float>)
                 stack.push_back(d);
             else
                 stack.push_back(glm::vec4(n.color, d));
-            continue;
+        } else if (role == Role::Domain) {
+            const uint32_t k = uint32_t(kind);
+            const glm::vec3 local =
+                nodeLocalPoint(n, sdf::domainClamps(k) ? glm::clamp(p, n.bounds.min, n.bounds.max) : p);
+            domains.push_back({p, local, withDistance(V{}, INFINITY), 0,
+                               sdf::domainCount(k, kernelA(n), kernelB(n)), i + 1});
+            p = glm::vec3(sdf::domainPoint(k, local, kernelA(n), kernelB(n), 0));
+        } else if (role == Role::Value) {
+            stack.back() = withDistance(
+                stack.back(), sdf::valueOp(uint32_t(kind), distanceOf(stack.back()), kernelA(n)));
+        } else {
+            V b = stack.back();
+            stack.pop_back();
+            stack.back() = opValue(n, stack.back(), b);
         }
-        V b = stack.back();
-        stack.pop_back();
-        stack.back() = opValue(n, stack.back(), b);
     }
     return stack.back();
 }
@@ -72,8 +138,11 @@ V run(const std::vector<FlatNode>& nodes, const uint32_t* tape, uint32_t length,
 //    1e-5 of k (the tests check 1e-5 absolute near the surface);
 //  - a subtrahend b of a difference where a + b >= k over the cell (max(a, -b) is a), and the
 //    running union a or operand b where they lie k apart (opUnion returns the other).
+// A domain operation's instructions (its own, its child's and the end) stay whole: the pruner
+// takes its value at c like a primitive's and keeps or drops it as one.
 struct Pruner {
     const std::vector<FlatNode>& nodes;
+    const std::vector<uint32_t>& spans; // per domain node: its instructions, the end included
     float slack;
     std::vector<float> value;    // per instruction of `in`: the value of the subtree it ends
     std::vector<float> extreme;  // per node: least (union) / greatest operand value
@@ -98,11 +167,25 @@ struct Pruner {
         if (extreme.size() < nodes.size()) extreme.assign(nodes.size(), NAN);
         ends.clear();
         for (uint32_t i = 0; i < length; ++i) {
-            const FlatNode& n = nodes[in[i] & kTapeNodeMask];
+            const uint32_t node = in[i] & kTapeNodeMask;
+            const FlatNode& n = nodes[node];
             const NodeKind kind = opcode(in[i]);
-            if (!isOperation(kind)) {
+            const Role role = roleOf(kind);
+            if (role == Role::Primitive) {
                 value[i] = primitiveValue(n, c);
                 ends.push_back(i);
+                continue;
+            }
+            if (role == Role::Domain) {
+                const uint32_t end = i + spans[node] - 1;
+                value[end] = run<float>(nodes, in + i, spans[node], c);
+                ends.push_back(end);
+                i = end;
+                continue;
+            }
+            if (role == Role::Value) {
+                value[i] = sdf::valueOp(uint32_t(kind), value[ends.back()], kernelA(n));
+                ends.back() = i;
                 continue;
             }
             const uint32_t b = ends.back();
@@ -126,9 +209,17 @@ struct Pruner {
         for (uint32_t i = 0; i < length; ++i) {
             const uint32_t ins = in[i];
             const NodeKind kind = opcode(ins);
-            if (!isOperation(kind)) {
-                stack.push_back({uint32_t(out.size()), i, false});
-                out.push_back(ins);
+            const Role role = roleOf(kind);
+            if (role == Role::Primitive || role == Role::Domain) {
+                const uint32_t span = role == Role::Domain ? spans[ins & kTapeNodeMask] : 1;
+                stack.push_back({uint32_t(out.size()), i + span - 1, false});
+                out.insert(out.end(), in + i, in + i + span);
+                i += span - 1;
+                continue;
+            }
+            if (role == Role::Value) {
+                if (!stack.back().empty) out.push_back(ins);
+                stack.back().end = i;
                 continue;
             }
             const uint32_t u = ins & kTapeNodeMask;
@@ -193,7 +284,7 @@ bool fieldGrid(const Evaluator& evaluator, const PruneOptions& options, PrunedFi
     if (!f.bounded) {
         box = Aabb{};
         for (const FlatNode& n : evaluator.nodes())
-            if (!isOperation(n.kind) && n.bounds.finite()) {
+            if (!isOperation(n.kind) && n.bounds.finite() && n.frame == kWorldFrame) {
                 box.min = glm::min(box.min, n.bounds.min);
                 box.max = glm::max(box.max, n.bounds.max);
             }
@@ -228,15 +319,19 @@ std::vector<uint32_t> fullTape(const std::vector<FlatNode>& nodes, uint32_t& sta
     while (!frames.empty()) {
         Frame& f = frames.back();
         const FlatNode& n = nodes[f.node];
-        if (!isOperation(n.kind)) {
+        const Role role = roleOf(n.kind);
+        if (role == Role::Primitive) {
             tape.push_back(instruction(f.node, n.kind));
             stackDepth = std::max(stackDepth, ++depth);
             frames.pop_back();
         } else if (f.next < n.children.size()) {
+            if (role == Role::Domain) tape.push_back(instruction(f.node, n.kind));
             if (f.next >= 2) tape.push_back(instruction(f.node, n.kind)), --depth;
             const uint32_t child = n.children[f.next++];
             frames.push_back({child, 0});
         } else {
+            if (role == Role::Domain) tape.push_back(f.node | kTapeDomainEnd << kTapeKindShift);
+            if (role == Role::Value) tape.push_back(instruction(f.node, n.kind));
             if (n.children.size() >= 2) tape.push_back(instruction(f.node, n.kind)), --depth;
             frames.pop_back();
         }
@@ -249,6 +344,14 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) 
     PrunedField field;
     field.tape = fullTape(nodes, field.stackDepth);
     field.fullLength = uint32_t(field.tape.size());
+    std::vector<uint32_t> spans(nodes.size(), 0), begins;
+    for (uint32_t i = 0; i < field.fullLength; ++i) {
+        const uint32_t ins = field.tape[i];
+        if (isDomainEnd(ins))
+            spans[ins & kTapeNodeMask] = i + 1 - begins.back(), begins.pop_back();
+        else if (roleOf(opcode(ins)) == Role::Domain)
+            begins.push_back(i);
+    }
     if (nodes.empty() || options.levels < 1 || !fieldGrid(evaluator, options, field)) {
         field.levels = 0;
         field.bounded = false;
@@ -299,7 +402,7 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) 
         std::vector<Out> outs(used);
         std::atomic<bool> overBudget{false};
         auto work = [&](unsigned t) {
-            Pruner pruner{nodes, slack, {}};
+            Pruner pruner{nodes, spans, slack, {}};
             Out& out = outs[t];
             for (size_t j = t; j < jobs && !overBudget; j += used) {
                 const Cell& parent = cells[j / fan];
@@ -460,7 +563,9 @@ std::vector<uint32_t> packField(const PrunedField& f, const std::vector<FlatNode
         if (marked[begin]) return;
         marked[begin] = true;
         for (uint32_t t = begin; t + 1 < begin + length; ++t)
-            if (!isOperation(opcode(f.tape[t])) && isOperation(opcode(f.tape[t + 1]))) {
+            if (!isDomainEnd(f.tape[t]) && !isDomainEnd(f.tape[t + 1]) &&
+                roleOf(opcode(f.tape[t])) == Role::Primitive &&
+                roleOf(opcode(f.tape[t + 1])) == Role::Boolean) {
                 const FlatNode& op = nodes[f.tape[t + 1] & kTapeNodeMask];
                 tape[t] |= (uint32_t(op.kind) - uint32_t(NodeKind::Union) + 1u) << kTapeFoldShift |
                            op.blend << SDFCSG_TAPE_BLEND_SHIFT;

@@ -105,8 +105,13 @@ void ref(JsonWriter& w, std::string_view key, std::string_view target, std::stri
 // {"type":"number"} with the bound of a Check.
 void numberBody(JsonWriter& w, Check check) {
     w.key("type");
-    w.string("number");
-    if (check == Check::Positive) {
+    w.string(check == Check::Count ? "integer" : "number");
+    if (check == Check::Count) {
+        w.key("minimum");
+        w.number(1.0);
+        w.key("maximum");
+        w.number(1e6);
+    } else if (check == Check::Positive) {
         w.key("exclusiveMinimum");
         w.number(0.0);
     } else if (check == Check::NonNegative) {

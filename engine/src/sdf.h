@@ -19,6 +19,7 @@
 namespace sdfcsg::sdf {
 
 using glm::abs, glm::clamp, glm::dot, glm::length, glm::max, glm::min, glm::mix, glm::sign;
+using glm::atan, glm::cos, glm::floor, glm::mod, glm::sin, glm::sqrt;
 using glm::vec2, glm::vec3, glm::vec4;
 using std::sqrt;
 using uint = uint32_t;

@@ -161,7 +161,9 @@ void expectGpuMatchesCpu(Context& context, const Scene& scene, size_t count = 20
         std::string first;
         for (size_t i = 0; i < points.size(); ++i) {
             glm::vec3 p(points[i]);
-            Sample cpu = probe.tapes ? pruned.sample(ev.nodes(), p) : ev.sample(p);
+            // Scenes with value and domain operations run on tapes whatever is asked.
+            const bool tapes = probe.tapes || usesTapes(scene, Evaluation::Inlined);
+            Sample cpu = tapes ? pruned.sample(ev.nodes(), p) : ev.sample(p);
             // Single precision throughout; the two sides round transforms differently.
             float tolerance = 2e-5f * (1.0f + glm::length(p)) + 1e-5f * std::abs(cpu.distance);
             if (!(std::abs(gpu[i].w - cpu.distance) <= tolerance)) {
@@ -266,6 +268,50 @@ TEST_F(GpuEval, OperationsMatchTheCpu) {
         ]}})");
     ASSERT_FALSE(scene.nodes.empty());
     expectGpuMatchesCpu(context(), scene, 4096);
+}
+
+// One example of every value and domain operation, around a child that shows what they do.
+const std::map<std::string, std::string>& operationExamples() {
+    static const std::map<std::string, std::string> examples = {
+        {"shell", R"("thickness": 0.1)"},
+        {"offset", R"("distance": 0.15)"},
+        {"repeat", R"("count": [3, 2, 4], "spacing": [1.1, 0.9, 0.8])"},
+        {"polar_repeat", R"("count": 7, "radius": 1.2)"},
+        {"mirror", R"("axes": "xz", "smooth": 0.1)"},
+        {"elongate", R"("length": [0.6, 0.2, 0.4])"},
+        {"twist", R"("angle": 60)"},
+        {"bend", R"("angle": 30)"},
+        {"taper", R"("height": 1.2, "top_scale": 0.4)"},
+    };
+    return examples;
+}
+
+TEST_F(GpuEval, OperationsAreAllCovered) {
+    for (const KindInfo& kind : nodeKinds()) {
+        if (kind.role != Role::Value && kind.role != Role::Domain) continue;
+        EXPECT_TRUE(operationExamples().count(std::string(kind.name))) << kind.name;
+    }
+}
+
+TEST_F(GpuEval, EveryValueAndDomainOperationMatchesTheCpu) {
+    for (const auto& [type, params] : operationExamples()) {
+        SCOPED_TRACE(type);
+        // Transformed itself, around a transformed child, inside a smooth union, and with a
+        // repeat around it so that domains nest.
+        const std::string op = R"({"type": ")" + type + R"(", )" + params +
+                               R"(, "rotate": [10, 25, -5], "scale": 0.9, "translate": [0.1, -0.2, 0.1],
+              "children": [{"type": "round_box", "size": [0.5, 0.8, 0.3], "radius": 0.05,
+                 "translate": [0.2, 0.1, -0.1], "rotate": [0, 30, 10], "color": [0.9, 0.3, 0.1]}]})";
+        Scene scene = parseOrDie(R"({"version": 1, "root": {"type": "union", "smooth": 0.2,
+            "children": [)" + op + R"(,
+            {"type": "sphere", "radius": 0.4, "translate": [1.1, 0.6, 0.2], "color": [0.1, 0.4, 0.9]}]}})");
+        ASSERT_FALSE(scene.nodes.empty());
+        expectGpuMatchesCpu(context(), scene, 4096);
+        Scene nested = parseOrDie(R"({"version": 1, "root": {"type": "repeat", "count": [2, 1, 2],
+            "spacing": [4, 1, 4], "children": [)" + op + "]}}");
+        ASSERT_FALSE(nested.nodes.empty());
+        expectGpuMatchesCpu(context(), nested, 2048);
+    }
 }
 
 // Each blend profile on each operation, in the inlined, buffer and tape kernels alike.

@@ -78,7 +78,8 @@ std::vector<BadInput> badInputs() {
     const std::string kinds = "sphere, box, round_box, plane, triangular_prism, torus, cylinder, "
                               "cone, capsule, ellipsoid, hex_prism, octahedron, pyramid, "
                               "rounded_cylinder, round_cone, link, capped_torus, union, "
-                              "intersection or difference";
+                              "intersection, difference, shell, offset, repeat, polar_repeat, "
+                              "mirror, elongate, twist, bend or taper";
     return {
         // JSON syntax: line and column of the first problem.
         {"empty", "", "scene.json:1:1: expected a JSON value, got end of input"},
@@ -245,8 +246,9 @@ std::vector<BadInput> badInputs() {
          scene(R"({"type": "union", "smooth": 0.1, "blend": 2, "children": [{"type": "sphere", "radius": 1}]})"),
          R"(scene.json: root.blend: expected one of "smooth", "round" or "chamfer", got 2)"},
         {"primitive with children", scene(R"({"type": "sphere", "radius": 1, "children": []})"),
-         "scene.json: root: a sphere takes no \"children\"; only union, intersection and "
-         "difference do"},
+         "scene.json: root: a sphere takes no \"children\"; only operations (union, intersection, "
+         "difference, shell, offset, repeat, polar_repeat, mirror, elongate, twist, bend and "
+         "taper) do"},
         {"operation without children", scene(R"({"type": "intersection"})"),
          R"(scene.json: root: missing required key "children" (a non-empty array of nodes))"},
         {"empty children", scene(R"({"type": "union", "children": []})"),

@@ -49,7 +49,8 @@ std::string validValue(simdjson::dom::element property) {
         return simdjson::to_string(choices.at(0));
     std::string_view type = property["type"];
     if (type == "number") return "0.5";
-    return "[1, 1, 1]";
+    if (type == "integer") return "2";
+    return std::string_view(property["items"]["type"]) == "integer" ? "[2, 2, 2]" : "[1, 1, 1]";
 }
 
 std::string node(const KindInfo& kind, const std::string& extra) {
@@ -138,13 +139,20 @@ TEST(Schema, EveryKindAndParameterOfTheTableAppears) {
                 EXPECT_EQ(std::string_view(prop["default"]), p.choices[size_t(p.fallback[0])]);
                 continue;
             }
-            EXPECT_EQ(std::string_view(prop["type"]),
-                      p.type == ValueType::Number ? "number" : "array");
+            const bool count = p.check == Check::Count;
+            EXPECT_EQ(std::string_view(prop["type"]), p.type == ValueType::Number
+                                                          ? (count ? "integer" : "number")
+                                                          : "array");
             auto bounds = p.type == ValueType::Number ? prop : prop["items"];
+            if (count) {
+                EXPECT_EQ(std::string_view(bounds["type"]), "integer");
+                EXPECT_EQ(double(bounds["minimum"]), 1.0);
+                EXPECT_EQ(double(bounds["maximum"]), 1e6);
+            }
             EXPECT_EQ(bounds["exclusiveMinimum"].error() == simdjson::SUCCESS,
                       p.check == Check::Positive);
             EXPECT_EQ(bounds["minimum"].error() == simdjson::SUCCESS,
-                      p.check == Check::NonNegative);
+                      p.check == Check::NonNegative || count);
             EXPECT_EQ(prop["not"].error() == simdjson::SUCCESS, p.check == Check::NonZero);
             EXPECT_EQ(std::find(required.begin(), required.end(), p.name) != required.end(),
                       p.required);
@@ -152,7 +160,7 @@ TEST(Schema, EveryKindAndParameterOfTheTableAppears) {
             if (!p.required && p.type == ValueType::Number) {
                 EXPECT_EQ(double(prop["default"]), p.fallback[0]);
             }
-            EXPECT_EQ(prop["maximum"].error() == simdjson::SUCCESS, p.maximum < 3.4e38f);
+            EXPECT_EQ(bounds["maximum"].error() == simdjson::SUCCESS, p.maximum < 3.4e38f || count);
         }
         EXPECT_EQ(def["properties"].get_object().size(), expectedProps) << "nothing else";
     }

@@ -420,6 +420,25 @@ TEST(ViewerEdit, StructuralEditsKeepTheSceneValid) {
     EXPECT_EQ(reordered->nodes[reordered->nodes[cut].children[0]].name, "hole");
 }
 
+TEST(ViewerEdit, EveryKindCanBeAddedWithItsDefaults) {
+    const Scene scene = twoSpheres();
+    for (const KindInfo& kind : nodeKinds()) {
+        SCOPED_TRACE(std::string(kind.name));
+        uint32_t added = 0;
+        auto grown = addChild(scene, 0, kind.kind, &added);
+        ASSERT_TRUE(grown) << grown.error().str();
+        EXPECT_EQ(grown->nodes[added].kind, kind.kind);
+        // A value or domain operation takes one child: a second is refused by the validator.
+        if (kind.operation && kind.role != Role::Boolean) {
+            auto second = addChild(*grown, added, NodeKind::Sphere);
+            ASSERT_FALSE(second);
+            EXPECT_NE(second.error().str().find("expected exactly one child node"),
+                      std::string::npos)
+                << second.error().str();
+        }
+    }
+}
+
 constexpr const char* kGroups = R"({
   "version": 1,
   "root": {"type": "union", "name": "all", "children": [
@@ -791,7 +810,8 @@ TEST(ViewerScript, RefusesNumbersThatAreNotFinite) {
                                     "s.txt:4:1: pick: expected a finite number, got \"1e99\"\n"
                                     "s.txt:5:1: zoom: expected a positive factor, got \"0\"\n"
                                     "s.txt:6:1: op: expected one of union, intersection, "
-                                    "difference, got \"sphere\"");
+                                    "difference, shell, offset, repeat, polar_repeat, mirror, "
+                                    "elongate, twist, bend, taper, got \"sphere\"");
 }
 
 TEST(ViewerScript, ParentTakesANodeAndAPosition) {

@@ -10,6 +10,7 @@
 #include <glm/mat3x3.hpp>
 #include <glm/vec3.hpp>
 
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <vector>
@@ -29,18 +30,25 @@ struct Aabb {
     float signedDistance(glm::vec3 p) const;
 };
 
-// A node with everything resolved to world space. Index-aligned with Scene::nodes.
+// The frame of nodes outside every domain operation.
+inline constexpr uint32_t kWorldFrame = UINT32_MAX;
+
+// A node with everything resolved to the space of its frame: the world, or for the nodes inside
+// a domain operation (repeat, twist, ...) the space that operation evaluates its child in.
+// Index-aligned with Scene::nodes.
 struct FlatNode {
     NodeKind kind;
-    glm::mat3 toLocal;   // world -> local linear part (rotation transposed, divided by scale)
-    glm::vec3 offset;    // local = toLocal * world + offset
-    float scale;         // accumulated uniform scale: world distance = scale * local distance
+    uint32_t frame;      // the domain operation whose child space this node lives in, or
+                         // kWorldFrame
+    glm::mat3 toLocal;   // frame -> local linear part (rotation transposed, divided by scale)
+    glm::vec3 offset;    // local = toLocal * frame point + offset
+    float scale;         // accumulated uniform scale: frame distance = scale * local distance
     glm::vec3 color;     // resolved (inherited) colour
     float smooth;        // operations: blend radius in world units
     uint32_t blend;      // operations: the blend profile (the "blend" field's index)
     std::array<float, kMaxParams> params; // the kernel's parameters (half extents, unit normal,
-                                          // ...): kernelParams() in engine/src/sdf.h
-    Aabb bounds;         // world bounds; the node's value at p is >= bounds.signedDistance(p)
+                                          // ...): KindInfo::kernel and ::kernelAround
+    Aabb bounds;         // bounds in the frame; the node's value at p is >= bounds.signedDistance(p)
     std::vector<uint32_t> children;
 };
 
@@ -57,7 +65,8 @@ class Evaluator {
     float distance(glm::vec3 p) const;
     // Distance and blended colour.
     Sample sample(glm::vec3 p) const;
-    // The same for the subtree rooted at nodes()[node] alone (picking, per-node tests).
+    // The same for the subtree rooted at nodes()[node] alone (picking, per-node tests); for a
+    // node inside a domain operation, the outermost such operation's subtree.
     float distance(glm::vec3 p, uint32_t node) const;
     Sample sample(glm::vec3 p, uint32_t node) const;
     // The field evaluated per region from pruned tapes, as the GPU kernels of large scenes

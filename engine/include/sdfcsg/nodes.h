@@ -33,12 +33,23 @@ enum class NodeKind : uint8_t {
     RoundCone,
     Link,
     CappedTorus,
-    // Operations (nodes with children) from here on.
+    // Operations (nodes with children) from here on: the Boolean ones,
     Union,
     Intersection,
     Difference,
+    // those that change their one child's value,
+    Shell,
+    Offset,
+    // and those that change the space their one child is evaluated in (domain operations).
+    Repeat,
+    PolarRepeat,
+    Mirror,
+    Elongate,
+    Twist,
+    Bend,
+    Taper,
 };
-inline constexpr int kNodeKindCount = 20;
+inline constexpr int kNodeKindCount = 29;
 inline constexpr NodeKind kFirstOperation = NodeKind::Union;
 
 // Every node stores its numeric parameters in this many float slots (see ParamInfo::slot).
@@ -52,6 +63,7 @@ enum class Check : uint8_t {
     Positive,    // > 0 (each component for vectors)
     NonNegative, // >= 0
     NonZero,     // a vector of non-zero length (normalised on load)
+    Count,       // a whole number >= 1 (each component for vectors)
 };
 
 struct ParamInfo {
@@ -73,6 +85,10 @@ struct KernelArg {
     uint8_t slot, count;
 };
 
+// What a kind is: a primitive, a Boolean operation of any number of children, an operation on
+// one child's value, or one on the space its one child is evaluated in.
+enum class Role : uint8_t { Primitive, Boolean, Value, Domain };
+
 struct KindInfo {
     NodeKind kind;
     std::string_view name; // JSON "type"
@@ -88,6 +104,17 @@ struct KindInfo {
     // The exact local bounding box of the solid, from the kernel parameters; false when it has
     // none (a plane).
     bool (*bounds)(const Params& kernel, glm::vec3& lo, glm::vec3& hi) = nullptr;
+    Role role = Role::Primitive;
+    // Value and domain operations. What the formulas take, from the JSON values and the child's
+    // bounds in the space it is evaluated in; and the node's own bounds from those.
+    Params (*kernelAround)(const Params& values, glm::vec3 childLo, glm::vec3 childHi) = nullptr;
+    void (*boundsAround)(const Params& kernel, glm::vec3 childLo, glm::vec3 childHi, glm::vec3& lo,
+                         glm::vec3& hi) = nullptr;
+    // Domain operations that stretch space (twist, bend, taper): a Lipschitz bound of the map
+    // from the node's local space to its child's over the box [lo, hi] of that local space. The
+    // child's value is divided by it, and the map only sees points clamped into the node's
+    // bounds (the formula in shaders/sdf.glsl, domainFinish).
+    float (*lipschitz)(const Params& kernel, glm::vec3 lo, glm::vec3 hi) = nullptr;
 };
 
 // Keys every node may carry besides its parameters.

@@ -1,0 +1,173 @@
+// The value and domain operations on the CPU: each against the explicit construction it stands
+// for (a repeat against the union of its copies, an elongated sphere against a capsule, ...),
+// the stretching ones as 1-Lipschitz fields with the right sign, and the pruned tapes against
+// the tree walk.
+#include "prune.h"
+
+#include <sdfcsg/eval.h>
+
+#include <gtest/gtest.h>
+
+#include <glm/geometric.hpp>
+
+#include <cmath>
+#include <random>
+#include <string>
+
+namespace sdfcsg {
+namespace {
+
+Scene parse(const std::string& root) {
+    auto scene = parseScene(R"({"version": 1, "root": )" + root + "}", "test.json");
+    if (!scene) ADD_FAILURE() << scene.error().str();
+    return scene ? *scene : Scene{};
+}
+
+std::vector<glm::vec3> points(uint32_t seed, int count, float reach) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(-reach, reach);
+    std::vector<glm::vec3> out;
+    for (int i = 0; i < count; ++i)
+        out.push_back({u(rng), u(rng), u(rng)});
+    return out;
+}
+
+// `field` and `explicit` agree within 1e-5 wherever the explicit one is within `near` of the
+// surface, and the field is never above it in magnitude nor of another sign elsewhere.
+void expectSameSolid(const std::string& field, const std::string& reference, float reach,
+                     float near) {
+    SCOPED_TRACE(field);
+    Evaluator a(parse(field)), b(parse(reference));
+    int close = 0;
+    for (glm::vec3 p : points(7, 6000, reach)) {
+        const float fa = a.distance(p), fb = b.distance(p);
+        if (std::abs(fb) < near) {
+            ++close;
+            ASSERT_NEAR(fa, fb, 1e-5f * (1.0f + glm::length(p))) << p.x << " " << p.y << " " << p.z;
+        } else {
+            ASSERT_EQ(fa < 0, fb < 0) << p.x << " " << p.y << " " << p.z;
+            ASSERT_LE(std::abs(fa), std::abs(fb) + 1e-5f) << p.x << " " << p.y << " " << p.z;
+        }
+    }
+    EXPECT_GT(close, 100);
+}
+
+const std::string kPart = R"({"type": "round_box", "size": [0.5, 0.3, 0.4], "radius": 0.05,
+    "rotate": [10, 20, 30], "translate": [0.05, 0.02, -0.03]})";
+
+std::string copyAt(float x, float y, float z) {
+    return R"({"type": "union", "translate": [)" + std::to_string(x) + ", " + std::to_string(y) +
+           ", " + std::to_string(z) + R"(], "children": [)" + kPart + "]}";
+}
+
+TEST(Operations, RepeatIsTheUnionOfItsCopies) {
+    std::string copies;
+    for (int i = 0; i < 3; ++i)
+        for (int k = 0; k < 2; ++k)
+            copies += (copies.empty() ? "" : ", ") + copyAt((i - 1) * 0.7f, 0, (k - 0.5f) * 0.6f);
+    expectSameSolid(R"({"type": "repeat", "count": [3, 1, 2], "spacing": [0.7, 1, 0.6],
+        "children": [)" + kPart + "]}",
+                    R"({"type": "union", "children": [)" + copies + "]}", 2.5f, 0.3f);
+}
+
+// Copies that overlap their neighbours: the window of candidates widens.
+TEST(Operations, RepeatOfOverlappingCopiesIsTheirUnion) {
+    std::string copies;
+    for (int i = 0; i < 9; ++i)
+        copies += (copies.empty() ? "" : ", ") + copyAt((i - 4) * 0.2f, 0, 0);
+    expectSameSolid(R"({"type": "repeat", "count": [9, 1, 1], "spacing": [0.2, 1, 1],
+        "children": [)" + kPart + "]}",
+                    R"({"type": "union", "children": [)" + copies + "]}", 1.2f, 0.1f);
+}
+
+TEST(Operations, PolarRepeatIsTheUnionOfItsTurnedCopies) {
+    std::string copies;
+    for (int i = 0; i < 9; ++i)
+        copies += std::string(copies.empty() ? "" : ", ") +
+                  R"({"type": "union", "rotate": [0, )" + std::to_string(i * 40.0f) +
+                  R"(, 0], "children": [{"type": "union", "translate": [1.1, 0, 0], "children": [)" +
+                  kPart + "]}]}";
+    expectSameSolid(R"({"type": "polar_repeat", "count": 9, "radius": 1.1, "children": [)" +
+                        kPart + "]}",
+                    R"({"type": "union", "children": [)" + copies + "]}", 2.5f, 0.3f);
+}
+
+TEST(Operations, MirrorOfAHalfIsItAndItsImage) {
+    const std::string ball = R"({"type": "sphere", "radius": 0.3, "translate": [0.5, 0.2, 0]})";
+    const std::string image = R"({"type": "sphere", "radius": 0.3, "translate": [-0.5, 0.2, 0]})";
+    expectSameSolid(R"({"type": "mirror", "axes": "x", "children": [)" + ball + "]}",
+                    R"({"type": "union", "children": [)" + ball + ", " + image + "]}", 1.2f, 0.2f);
+}
+
+TEST(Operations, ElongatedSphereIsACapsule) {
+    expectSameSolid(
+        R"({"type": "elongate", "length": [0, 0.8, 0], "children": [{"type": "sphere", "radius": 0.3}]})",
+        R"({"type": "capsule", "a": [0, -0.4, 0], "b": [0, 0.4, 0], "radius": 0.3})", 2.0f, 0.25f);
+}
+
+TEST(Operations, ShellAndOffsetOfASphere) {
+    expectSameSolid(
+        R"({"type": "offset", "distance": 0.1, "children": [{"type": "sphere", "radius": 0.3}]})",
+        R"({"type": "sphere", "radius": 0.4})", 2.0f, 10.0f);
+    Evaluator shell(parse(
+        R"({"type": "shell", "thickness": 0.1, "scale": 2, "children": [{"type": "sphere", "radius": 0.5}]})"));
+    EXPECT_NEAR(shell.distance({0, 0, 0}), 0.9f, 1e-6f);   // |-1| - 0.1
+    EXPECT_NEAR(shell.distance({1.5f, 0, 0}), 0.4f, 1e-6f); // |0.5| - 0.1
+    EXPECT_NEAR(shell.distance({0, 1.05f, 0}), -0.05f, 1e-6f);
+}
+
+// Twist, bend and taper: 1-Lipschitz (sampled), and negative exactly where the child is at the
+// warped point.
+TEST(Operations, StretchingOperationsStayOneLipschitz) {
+    for (const char* op : {R"("type": "twist", "angle": 120)", R"("type": "bend", "angle": 60)",
+                           R"("type": "taper", "height": 1, "top_scale": 0.3)"}) {
+        SCOPED_TRACE(op);
+        Evaluator e(parse(std::string("{") + op + R"(, "rotate": [5, 10, 0], "children": [
+            {"type": "box", "size": [0.4, 1.2, 0.3], "translate": [0.1, 0, 0]}]})"));
+        std::mt19937 rng(3);
+        std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+        int inside = 0;
+        for (glm::vec3 p : points(11, 4000, 0.9f)) {
+            const glm::vec3 step = 1e-3f * glm::normalize(glm::vec3(u(rng), u(rng), u(rng)));
+            const float slope = std::abs(e.distance(p + step) - e.distance(p)) / 1e-3f;
+            ASSERT_LE(slope, 1.0f + 2e-2f) << p.x << " " << p.y << " " << p.z;
+            inside += e.distance(p) < 0;
+        }
+        EXPECT_GT(inside, 20);
+    }
+}
+
+// The pruned tapes give the tree walk's values near the surface and a bound of the same sign,
+// never larger, elsewhere, with every operation nested in others.
+TEST(Operations, PrunedTapesAgreeWithTheTree) {
+    Scene scene = parse(R"({"type": "union", "smooth": 0.05, "children": [
+        {"type": "repeat", "count": [4, 1, 3], "spacing": [0.8, 1, 0.8], "children": [
+            {"type": "twist", "angle": 90, "children": [
+                {"type": "shell", "thickness": 0.05, "children": [
+                    {"type": "box", "size": [0.3, 0.8, 0.3]}]}]}]},
+        {"type": "polar_repeat", "count": 10, "radius": 2.2, "children": [
+            {"type": "mirror", "axes": "z", "children": [
+                {"type": "offset", "distance": 0.02, "children": [
+                    {"type": "capsule", "a": [0, 0, 0.05], "b": [0.2, 0.3, 0.1], "radius": 0.05}]}]}]},
+        {"type": "bend", "angle": 20, "translate": [0, -1, 0], "children": [
+            {"type": "taper", "height": 0.4, "top_scale": 0.5, "children": [
+                {"type": "elongate", "length": [3, 0, 0], "children": [
+                    {"type": "sphere", "radius": 0.15}]}]}]}]})");
+    Evaluator e(scene);
+    const detail::PrunedField field = detail::pruneField(e);
+    int near = 0;
+    for (glm::vec3 p : points(5, 20000, 3.0f)) {
+        const float full = e.distance(p), pruned = field.distance(e.nodes(), p);
+        if (std::abs(full) < field.cell) {
+            ++near;
+            ASSERT_NEAR(pruned, full, 1e-5f) << p.x << " " << p.y << " " << p.z;
+        } else {
+            ASSERT_EQ(pruned < 0, full < 0) << p.x << " " << p.y << " " << p.z;
+            ASSERT_LE(std::abs(pruned), std::abs(full) + 1e-5f) << p.x << " " << p.y << " " << p.z;
+        }
+    }
+    EXPECT_GT(near, 50);
+}
+
+} // namespace
+} // namespace sdfcsg
