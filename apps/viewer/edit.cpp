@@ -180,8 +180,12 @@ Result<Scene> setValue(const Scene& scene, uint32_t node, std::string_view key,
         (key == "translate" ? n.transform.translate : n.transform.rotate) =
             glm::vec3(values[0], values[1], values[2]);
     } else if (key == "scale") {
-        if (auto e = expect(1)) return *e;
-        n.transform.scale = values[0];
+        if (values.size() == 1) {
+            n.transform.scale = glm::vec3(values[0]);
+        } else {
+            if (auto e = expect(3)) return *e;
+            n.transform.scale = glm::vec3(values[0], values[1], values[2]);
+        }
     } else if (key == "color") {
         if (values.empty()) {
             n.color.reset();

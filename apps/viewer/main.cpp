@@ -661,12 +661,13 @@ void valueEditor(Viewer& v) {
         if (ImGui::IsItemDeactivatedAfterEdit()) v.doc.history().endMerge();
     }
     glm::vec3 t = n.transform.translate, r = n.transform.rotate;
-    float s = n.transform.scale;
+    glm::vec3 s = n.transform.scale;
     if (ImGui::DragFloat3("translate", &t.x, 0.01f)) edited("translate", {t.x, t.y, t.z});
     if (ImGui::IsItemDeactivatedAfterEdit()) v.doc.history().endMerge();
     if (ImGui::DragFloat3("rotate", &r.x, 0.5f)) edited("rotate", {r.x, r.y, r.z});
     if (ImGui::IsItemDeactivatedAfterEdit()) v.doc.history().endMerge();
-    if (ImGui::DragFloat("scale", &s, 0.005f, 1e-3f, 1e3f)) edited("scale", {std::max(s, 1e-3f)});
+    if (ImGui::DragFloat3("scale", &s.x, 0.005f, 1e-3f, 1e3f))
+        edited("scale", {std::max(s.x, 1e-3f), std::max(s.y, 1e-3f), std::max(s.z, 1e-3f)});
     if (ImGui::IsItemDeactivatedAfterEdit()) v.doc.history().endMerge();
     bool own = n.color.has_value();
     if (ImGui::Checkbox("own colour", &own))

@@ -272,15 +272,21 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
         const Acc& up = hasParent && !opensFrame ? acc[parent[i]] : identity;
 
         glm::dmat3 r = rotation(src.transform.rotate);
-        double s = src.transform.scale;
+        // p = R S l + t. Where S differs per axis the distance in the parent is at least the
+        // local one times the smallest factor (S's least singular value; a product's is at
+        // least the product of its factors'), which is exact for uniform scales.
+        const glm::dvec3 s(src.transform.scale);
         glm::dvec3 t(src.transform.translate);
-        glm::dmat3 inv = glm::transpose(r) * (1.0 / s);
+        const glm::dmat3 scaling(glm::dvec3(s.x, 0, 0), glm::dvec3(0, s.y, 0), glm::dvec3(0, 0, s.z));
+        const glm::dmat3 unscaling(glm::dvec3(1 / s.x, 0, 0), glm::dvec3(0, 1 / s.y, 0),
+                                   glm::dvec3(0, 0, 1 / s.z));
+        glm::dmat3 inv = unscaling * glm::transpose(r);
         Acc& a = acc[i];
         a.toLocal = inv * up.toLocal;
         a.offset = inv * (up.offset - t);
-        a.toWorld = up.toWorld * (r * s);
+        a.toWorld = up.toWorld * (r * scaling);
         a.origin = up.toWorld * t + up.origin;
-        a.scale = up.scale * s;
+        a.scale = up.scale * std::min({s.x, s.y, s.z});
 
         FlatNode& n = nodes_[i];
         n.kind = src.kind;

@@ -459,7 +459,10 @@ constexpr CommonKey kCommonKeys[] = {
      "Translation [x, y, z] in parent units, applied after rotation and scale."},
     {"rotate", R"({"type":"array","items":{"type":"number"},"minItems":3,"maxItems":3})",
      "Rotation in degrees about x, then y, then z."},
-    {"scale", R"({"type":"number","exclusiveMinimum":0})", "Uniform scale factor (> 0)."},
+    {"scale", R"({"oneOf":[{"type":"number","exclusiveMinimum":0},{"type":"array","items":{"type":"number","exclusiveMinimum":0},"minItems":3,"maxItems":3}]})",
+     "Scale factor (> 0), one for every axis or [x, y, z]. Where the factors differ the field "
+     "is scaled by the smallest, a lower bound of the distance: sphere tracing stays safe, "
+     "but takes more steps."},
     {"color", R"({"oneOf":[{"type":"array","items":{"type":"number","minimum":0,"maximum":1},"minItems":3,"maxItems":3},{"type":"string","pattern":"^#[0-9a-fA-F]{6}$"}]})",
      "Colour as [r, g, b] in 0..1 or \"#rrggbb\"; inherited by children that set none."},
     {"children", R"({"type":"array","minItems":1,"items":{"$ref":"#/$defs/node"}})",

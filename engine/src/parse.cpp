@@ -383,9 +383,18 @@ std::optional<dom::array> SceneReader::readNode(element value, std::string path,
     if (auto e = valueOf("rotate"))
         if (auto r = readVec3(*e, member(p, "rotate"), Check::Any, problems_))
             node.transform.rotate = *r;
-    if (auto e = valueOf("scale"))
-        if (auto s = readNumber(*e, member(p, "scale"), Check::Positive, problems_))
-            node.transform.scale = static_cast<float>(*s);
+    if (auto e = valueOf("scale")) {
+        if (e->is_array()) {
+            if (auto s = readVec3(*e, member(p, "scale"), Check::Positive, problems_))
+                node.transform.scale = *s;
+        } else if (!e->is_number()) {
+            problems_.add(member(p, "scale"),
+                          "expected a positive number or an array of 3 positive numbers, got " +
+                              describe(*e));
+        } else if (auto s = readNumber(*e, member(p, "scale"), Check::Positive, problems_)) {
+            node.transform.scale = glm::vec3(static_cast<float>(*s));
+        }
+    }
     if (auto e = valueOf("color")) node.color = readColor(*e, member(p, "color"), problems_);
 
     if (kind->kind == NodeKind::RoundBox && paramsOk) {
@@ -448,12 +457,15 @@ bool finite(glm::vec3 v) {
 // such node; its descendants inherit the problem.
 void checkCombinedTransforms(const Scene& scene, Problems& problems) {
     const Evaluator evaluator(scene);
-    std::vector<double> scale(scene.nodes.size(), 1.0); // the parent's, until multiplied
+    // The products of the smallest and of the largest factors: the parent's, until multiplied.
+    std::vector<double> scale(scene.nodes.size(), 1.0), largest(scene.nodes.size(), 1.0);
     for (size_t i = 0; i < scene.nodes.size(); ++i) {
         const Node& node = scene.nodes[i];
-        scale[i] *= node.transform.scale;
+        const glm::vec3 s = node.transform.scale;
+        scale[i] *= std::min({s.x, s.y, s.z});
+        largest[i] *= std::max({s.x, s.y, s.z});
         for (uint32_t c : node.children)
-            scale[c] = scale[i];
+            scale[c] = scale[i], largest[c] = largest[i];
         const FlatNode& f = evaluator.nodes()[i];
         const KindInfo& info = kindInfo(node.kind);
         if (info.role == Role::Domain && node.kind != NodeKind::Mirror &&
@@ -468,12 +480,13 @@ void checkCombinedTransforms(const Scene& scene, Problems& problems) {
             finite(f.toLocal[1]) && finite(f.toLocal[2]) && finite(f.offset) &&
             std::isfinite(f.smooth))
             continue;
+        const bool huge = largest[i] > FLT_MAX;
         char product[32]; // the product of floats, to the digits that matter here
-        std::snprintf(product, sizeof product, "%.3g", scale[i]);
+        std::snprintf(product, sizeof product, "%.3g", huge ? largest[i] : scale[i]);
         const std::string combined =
             std::string("the scales of this node and the operations above it multiply to ") +
             product;
-        if (scale[i] > FLT_MAX)
+        if (huge)
             problems.add(node.path, combined + ", beyond single precision (about 3.4e+38)");
         else if (scale[i] < FLT_MIN)
             problems.add(node.path, combined + ", too small for single precision (about 1.2e-38)");

@@ -60,9 +60,13 @@ void nodeMembers(JsonWriter& w, const Node& node) {
     const Transform& t = node.transform;
     if (t.translate != glm::vec3(0.0f)) vec3(w, "translate", t.translate);
     if (t.rotate != glm::vec3(0.0f)) vec3(w, "rotate", t.rotate);
-    if (t.scale != 1.0f) {
-        w.key("scale");
-        w.number(t.scale);
+    if (t.scale.x == t.scale.y && t.scale.y == t.scale.z) {
+        if (t.scale.x != 1.0f) {
+            w.key("scale");
+            w.number(t.scale.x);
+        }
+    } else {
+        vec3(w, "scale", t.scale);
     }
     if (node.color) color(w, "color", *node.color);
 }

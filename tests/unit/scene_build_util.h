@@ -36,7 +36,7 @@ struct Tree {
         return *this;
     }
     Tree& scaled(float s) {
-        transform.scale = s;
+        transform.scale = glm::vec3(s);
         return *this;
     }
     Tree& colored(float r, float g, float b) {

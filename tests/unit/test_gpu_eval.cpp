@@ -301,7 +301,8 @@ TEST_F(GpuEval, EveryValueAndDomainOperationMatchesTheCpu) {
         const std::string op = R"({"type": ")" + type + R"(", )" + params +
                                R"(, "rotate": [10, 25, -5], "scale": 0.9, "translate": [0.1, -0.2, 0.1],
               "children": [{"type": "round_box", "size": [0.5, 0.8, 0.3], "radius": 0.05,
-                 "translate": [0.2, 0.1, -0.1], "rotate": [0, 30, 10], "color": [0.9, 0.3, 0.1]}]})";
+                 "translate": [0.2, 0.1, -0.1], "rotate": [0, 30, 10], "scale": [1, 1.2, 0.9],
+                 "color": [0.9, 0.3, 0.1]}]})";
         Scene scene = parseOrDie(R"({"version": 1, "root": {"type": "union", "smooth": 0.2,
             "children": [)" + op + R"(,
             {"type": "sphere", "radius": 0.4, "translate": [1.1, 0.6, 0.2], "color": [0.1, 0.4, 0.9]}]}})");
@@ -314,7 +315,8 @@ TEST_F(GpuEval, EveryValueAndDomainOperationMatchesTheCpu) {
     }
 }
 
-// Each blend profile on each operation, in the inlined, buffer and tape kernels alike.
+// Each blend profile on each operation, in the inlined, buffer and tape kernels alike (and a
+// scale per axis).
 TEST_F(GpuEval, BlendProfilesMatchTheCpu) {
     for (const char* blend : {"round", "chamfer"}) {
         SCOPED_TRACE(blend);
@@ -324,7 +326,7 @@ TEST_F(GpuEval, BlendProfilesMatchTheCpu) {
             {"type": "difference", "smooth": 0.15, )" + b + R"(, "color": [0.8, 0.8, 0.2], "children": [
                 {"type": "intersection", "smooth": 0.2, )" + b + R"(, "children": [
                     {"type": "box", "size": [1.5, 1.5, 1.5], "color": [1, 0, 0]},
-                    {"type": "sphere", "radius": 1.0, "color": [0, 1, 0]}]},
+                    {"type": "sphere", "radius": 1.0, "scale": [1.2, 0.9, 1], "color": [0, 1, 0]}]},
                 {"type": "cylinder", "radius": 0.4, "height": 3, "color": [0, 0, 1]}]},
             {"type": "box", "size": [0.6, 2.4, 0.6], "translate": [0.9, 0, 0], "color": [0.2, 0.9, 0.4]}
             ]}})");

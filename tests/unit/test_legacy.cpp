@@ -63,7 +63,7 @@ void expectSameStructure(const Scene& a, const Scene& b) {
             EXPECT_NEAR(x.transform.translate[k], y.transform.translate[k], 1e-6f);
             EXPECT_NEAR(x.transform.rotate[k], y.transform.rotate[k], 1e-6f);
         }
-        EXPECT_NEAR(x.transform.scale, y.transform.scale, 1e-6f);
+        EXPECT_NEAR(glm::distance(x.transform.scale, y.transform.scale), 0.0f, 1e-6f);
         for (int k = 0; k < kMaxParams; ++k)
             EXPECT_NEAR(x.params[k], y.params[k], 1e-6f) << "slot " << k;
     }

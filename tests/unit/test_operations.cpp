@@ -137,6 +137,28 @@ TEST(Operations, StretchingOperationsStayOneLipschitz) {
     }
 }
 
+// A scale per axis: the box it makes, with the field scaled by the smallest factor, so never
+// above the exact distance and at least smallest/largest of it; the bounds hug the box.
+TEST(Operations, NonUniformScaleIsAConservativeField) {
+    const Scene scaled = parse(R"({"type": "union", "rotate": [0, 30, 0], "children": [
+        {"type": "box", "size": [1, 1, 1], "scale": [2, 1, 0.5]}]})");
+    Evaluator a(scaled);
+    Evaluator b(parse(R"({"type": "union", "rotate": [0, 30, 0], "children": [
+        {"type": "box", "size": [2, 1, 0.5]}]})"));
+    for (glm::vec3 p : points(5, 4000, 2.0f)) {
+        const float fa = a.distance(p), fb = b.distance(p);
+        ASSERT_EQ(fa < 0, fb < 0) << p.x << " " << p.y << " " << p.z;
+        ASSERT_LE(std::abs(fa), std::abs(fb) + 1e-5f);
+        ASSERT_GE(std::abs(fa), 0.25f * std::abs(fb) - 1e-5f);
+    }
+    for (int k = 0; k < 3; ++k) {
+        EXPECT_NEAR(a.bounds().min[k], b.bounds().min[k], 1e-4f);
+        EXPECT_NEAR(a.bounds().max[k], b.bounds().max[k], 1e-4f);
+    }
+    // Written back as the vector it was read as.
+    EXPECT_NE(toJson(scaled).find(R"("scale": [2, 1, 0.5])"), std::string::npos) << toJson(scaled);
+}
+
 // The pruned tapes give the tree walk's values near the surface and a bound of the same sign,
 // never larger, elsewhere, with every operation nested in others.
 TEST(Operations, PrunedTapesAgreeWithTheTree) {

@@ -214,6 +214,12 @@ std::vector<BadInput> badInputs() {
          "scene.json: root.translate[1]: expected a number, got null"},
         {"scale zero", scene(R"({"type": "sphere", "radius": 1, "scale": 0})"),
          "scene.json: root.scale: expected a positive number, got 0"},
+        {"scale of another type", scene(R"({"type": "sphere", "radius": 1, "scale": "big"})"),
+         R"(scene.json: root.scale: expected a positive number or an array of 3 positive numbers, got "big")"},
+        {"scale vector with a zero", scene(R"({"type": "sphere", "radius": 1, "scale": [1, 0, 1]})"),
+         "scene.json: root.scale[1]: expected a positive number, got 0"},
+        {"scale vector too short", scene(R"({"type": "sphere", "radius": 1, "scale": [1, 2]})"),
+         "scene.json: root.scale: expected an array of 3 positive numbers, got [1, 2]"},
         {"colour out of range", scene(R"({"type": "sphere", "radius": 1, "color": [1, 2, 0]})"),
          "scene.json: root.color[1]: expected a number in 0..1, got 2"},
         {"colour bad hex", scene(R"({"type": "sphere", "radius": 1, "color": "#12345g"})"),
@@ -548,7 +554,7 @@ TEST(Parse, ValuesLandInTheTableSlots) {
     EXPECT_EQ(s.nodes[1].params[param(K::Plane, "normal").slot + 1], 1.0f);
     EXPECT_EQ(at(1, "offset"), -1.0f);
     EXPECT_EQ(at(4, "radius"), 0.1f);
-    EXPECT_EQ(s.nodes[4].transform.scale, 0.8f);
+    EXPECT_EQ(s.nodes[4].transform.scale, glm::vec3(0.8f));
     EXPECT_EQ(at(5, "height"), 0.8f);
     EXPECT_EQ(at(9, "top_radius"), 0.1f);
     EXPECT_EQ(at(12, "top_radius"), 0.0f)
@@ -606,7 +612,7 @@ TEST(Parse, ToJsonFormat) {
     s.nodes[2].kind = NodeKind::Cone;
     s.nodes[2].params = {0.25f, 3, 0};
     s.nodes[2].transform.translate = {0, 1, 0};
-    s.nodes[2].transform.scale = 2;
+    s.nodes[2].transform.scale = glm::vec3(2);
     s.background = {0, 0, 0};
     // 2-space indentation; vectors on one line; keys in a fixed order; defaults left out
     // (smooth 0, top_radius 0, zero rotation, unit scale, no camera or lights); colours that

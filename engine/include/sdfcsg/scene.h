@@ -24,7 +24,7 @@ inline constexpr int kSceneVersion = 1;
 struct Transform {
     glm::vec3 translate{0.0f};
     glm::vec3 rotate{0.0f}; // degrees about x, then y, then z
-    float scale = 1.0f;     // uniform, > 0
+    glm::vec3 scale{1.0f};  // per axis, > 0; "scale": 2 in a file is [2, 2, 2]
 };
 
 struct Node {
