@@ -13,6 +13,19 @@
 #define SDF_FN
 #endif
 
+// Polygon and text read their outlines from data beside the nodes: in GLSL the node buffer seen
+// as vec4s (their records follow the nodes, engine/src/gpu_nodes.cpp), in C++ the node's own
+// array (engine/src/sdf.h). SDF_DATA_PARAM is the extra parameter that carries it, SDF_DATA_ARG
+// passes it on.
+#ifndef SDF_DATA
+#define SDF_DATA(i) nodeWords[i]
+#define SDF_DATA_PARAM
+#define SDF_DATA_ARG
+layout(std430, set = 0, binding = SDFCSG_BINDING_NODES) readonly buffer NodeWords {
+    vec4 nodeWords[];
+};
+#endif
+
 SDF_FN float dot2(vec2 v) { return dot(v, v); }
 SDF_FN float dot2(vec3 v) { return dot(v, v); }
 
@@ -163,6 +176,106 @@ SDF_FN float sdCappedTorus(vec3 p, float ra, float rb, float sn, float cs) {
     return sqrt(max(dot(p, p) + ra * ra - 2.0f * ra * k, 0.0f)) - rb;
 }
 
+// ---- 2D profiles: distances in the xy plane, so prisms along z as fields of space ----
+
+SDF_FN float sdCircle(vec3 p, float r) { return length(vec2(p.x, p.y)) - r; }
+
+// Half width and height bx, by (rounding included), corner radius r.
+SDF_FN float sdRectangle(vec3 p, float bx, float by, float r) {
+    vec2 q = abs(vec2(p.x, p.y)) - vec2(bx, by) + r;
+    return length(max(q, 0.0f)) + min(max(q.x, q.y), 0.0f) - r;
+}
+
+// IQ's regular polygon: circumradius r, half the sector an, cs and sn its cosine and sine.
+// Folded into the sector of the edge on top, the edge is the segment x = r cs, |y| <= r sn.
+SDF_FN float sdRegularPolygon(vec3 p, float r, float an, float cs, float sn) {
+    float bn = mod(atan(p.x, p.y) + an, 2.0f * an) - an;
+    vec2 q = length(vec2(p.x, p.y)) * vec2(cos(bn), abs(sin(bn))) - r * vec2(cs, sn);
+    q.y += clamp(-q.y, 0.0f, r * sn);
+    return length(q) * sign(q.x);
+}
+
+SDF_FN float sdSegment2(vec2 p, vec2 a, vec2 b) {
+    vec2 pa = p - a, ba = b - a;
+    return length(pa - ba * clamp(dot(pa, ba) / dot(ba, ba), 0.0f, 1.0f));
+}
+
+SDF_FN float cubeRoot(float x) { return sign(x) * pow(abs(x), 1.0f / 3.0f); }
+
+// Exact distance to the quadratic Bezier from a through control c to b (IQ's sdBezier: the
+// nearest point's parameter is a root of a cubic). The loader makes nearly straight curves lines,
+// so b - 2c + a is never near zero.
+SDF_FN float sdQuadratic2(vec2 p, vec2 a, vec2 c, vec2 b) {
+    vec2 ea = c - a, eb = a - 2.0f * c + b, ec = ea * 2.0f, ed = a - p;
+    float kk = 1.0f / dot(eb, eb);
+    float kx = kk * dot(ea, eb);
+    float ky = kk * (2.0f * dot(ea, ea) + dot(ed, eb)) / 3.0f;
+    float kz = kk * dot(ed, ea);
+    float pp = ky - kx * kx, q = kx * (2.0f * kx * kx - 3.0f * ky) + kz;
+    float h = q * q + 4.0f * pp * pp * pp;
+    float res;
+    if (h >= 0.0f) {
+        h = sqrt(h);
+        float t = clamp(cubeRoot(0.5f * (h - q)) + cubeRoot(0.5f * (-h - q)) - kx, 0.0f, 1.0f);
+        res = dot2(ed + (ec + eb * t) * t);
+    } else {
+        float z = sqrt(-pp);
+        float v = acos(clamp(q / (pp * z * 2.0f), -1.0f, 1.0f)) / 3.0f;
+        float m = cos(v), n = sin(v) * 1.732050808f;
+        float t0 = clamp((m + m) * z - kx, 0.0f, 1.0f), t1 = clamp((-n - m) * z - kx, 0.0f, 1.0f);
+        res = min(dot2(ed + (ec + eb * t0) * t0), dot2(ed + (ec + eb * t1) * t1));
+    }
+    return sqrt(min(res, min(dot2(ed), dot2(b - p))));
+}
+
+// How the segment (a line, or a quadratic through c, monotonic in y: the loader splits them)
+// winds around p: +-1 where the ray from p towards +x crosses it, counted half-open in y so a
+// ray through a shared end point counts once.
+SDF_FN float outlineCrossing(vec2 p, vec2 a, vec2 c, vec2 b, bool quadratic) {
+    if ((a.y <= p.y) == (b.y <= p.y)) return 0.0f;
+    float x;
+    if (quadratic) {
+        // y(t) = A t^2 + B t + C = p.y has one root in [0, 1]; the stable pair of formulas.
+        float qa = a.y - 2.0f * c.y + b.y, qb = 2.0f * (c.y - a.y), qc = a.y - p.y;
+        float root = sqrt(max(qb * qb - 4.0f * qa * qc, 0.0f));
+        float qq = -0.5f * (qb + (qb >= 0.0f ? root : -root));
+        float t0 = qq / (qa != 0.0f ? qa : 1e-30f), t1 = qc / (qq != 0.0f ? qq : 1e-30f);
+        float t = clamp(abs(t0 - 0.5f) < abs(t1 - 0.5f) ? t0 : t1, 0.0f, 1.0f);
+        x = mix(mix(a.x, c.x, t), mix(c.x, b.x, t), t);
+    } else {
+        x = a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y);
+    }
+    return x > p.x ? (b.y > a.y ? 1.0f : -1.0f) : 0.0f;
+}
+
+// Polygon and text: the exact distance to an outline of line and quadratic segments, negative
+// where they wind around p (non-zero rule). The data from `first` on: per glyph (a set of
+// closed contours) its box (min xy, max xy) and (first segment from `first`, segment count);
+// per segment (a, b) and (c, 1 for a quadratic else 0). A glyph whose box is farther than the
+// nearest segment so far is skipped, and one whose box does not hold p cannot wind around it.
+SDF_FN float sdOutline(vec3 p3, float firstAt, float glyphCount SDF_DATA_PARAM) {
+    vec2 p = vec2(p3.x, p3.y);
+    uint first = uint(firstAt), glyphs = uint(glyphCount);
+    float best = 1e30f, winding = 0.0f;
+    for (uint g = 0u; g < glyphs; ++g) {
+        vec4 box = SDF_DATA(first + 2u * g), range = SDF_DATA(first + 2u * g + 1u);
+        vec2 e = max(vec2(box.x - p.x, box.y - p.y), vec2(p.x - box.z, p.y - box.w));
+        bool holds = max(e.x, e.y) <= 0.0f;
+        if (!holds && dot2(max(e, 0.0f)) >= best * best) continue;
+        uint s0 = first + uint(range.x), count = uint(range.y);
+        for (uint s = 0u; s < count; ++s) {
+            vec4 ab = SDF_DATA(s0 + 2u * s), cq = SDF_DATA(s0 + 2u * s + 1u);
+            vec2 a = vec2(ab.x, ab.y), b = vec2(ab.z, ab.w), c = vec2(cq.x, cq.y);
+            bool quadratic = cq.z > 0.5f;
+            if (holds) winding += outlineCrossing(p, a, c, b, quadratic);
+            vec2 f = max(min(min(a, b), c) - p, p - max(max(a, b), c));
+            if (dot2(max(f, 0.0f)) < best * best)
+                best = min(best, quadratic ? sdQuadratic2(p, a, c, b) : sdSegment2(p, a, b));
+        }
+    }
+    return winding != 0.0f ? -best : best;
+}
+
 // CSG operators: IQ's polynomial smooth minimum with blend radius k, and smooth max(a, b) =
 // -smin(-a, -b). Once the operands differ by k or more the blend factor is exactly 0 or 1, so
 // those cases return an operand unchanged: this makes bounds skipping and pruning exact in
@@ -270,7 +383,7 @@ SDF_FN vec3 tetraTap(int i) {
 // slots 0-3, b: slots 4-7). `kinds` has bit k set for each kind the caller may pass; a constant,
 // it leaves a kernel the formulas of its scene's kinds alone.
 #define SDF_IS(n) (kind == n && ((kinds >> n) & 1u) != 0u)
-SDF_FN float sdPrimitive(uint kind, vec3 q, vec4 a, vec4 b, uint kinds) {
+SDF_FN float sdPrimitive(uint kind, vec3 q, vec4 a, vec4 b, uint kinds SDF_DATA_PARAM) {
     if (SDF_IS(0u)) return sdSphere(q, a.x);
     if (SDF_IS(1u)) return sdBox(q, vec3(a));
     if (SDF_IS(2u)) return sdRoundBox(q, vec3(a), a.w);
@@ -288,6 +401,10 @@ SDF_FN float sdPrimitive(uint kind, vec3 q, vec4 a, vec4 b, uint kinds) {
     if (SDF_IS(14u)) return sdRoundCone(q, a.x, a.y, a.z, a.w, b.x);
     if (SDF_IS(15u)) return sdLink(q, a.x, a.y, a.z);
     if (SDF_IS(16u)) return sdCappedTorus(q, a.x, a.y, a.z, a.w);
+    if (SDF_IS(17u)) return sdCircle(q, a.x);
+    if (SDF_IS(18u)) return sdRectangle(q, a.x, a.y, a.z);
+    if (SDF_IS(19u)) return sdRegularPolygon(q, a.x, a.y, a.z, a.w);
+    if (SDF_IS(20u) || SDF_IS(21u)) return sdOutline(q, a.x, a.y SDF_DATA_ARG);
     return 1e30f;
 }
 #undef SDF_IS
@@ -295,14 +412,19 @@ SDF_FN float sdPrimitive(uint kind, vec3 q, vec4 a, vec4 b, uint kinds) {
 // ---- Value and domain operations (NodeKind's numbering; kernel parameters from their table
 // entries' kernelAround) ----
 
-// Shell (20): a skin of half thickness a.x about the surface; offset (21): moved out by a.x.
+// NodeKind's numbers of the operations (engine/src/sdf.h checks them).
+const uint kKindShell = 25u, kKindOffset = 26u, kKindRepeat = 27u, kKindPolarRepeat = 28u;
+const uint kKindMirror = 29u, kKindElongate = 30u, kKindTwist = 31u, kKindBend = 32u;
+const uint kKindTaper = 33u, kKindExtrude = 34u, kKindRevolve = 35u;
+
+// Shell: a skin of half thickness a.x about the surface; offset: moved out by a.x.
 SDF_FN float valueOp(uint kind, float d, vec4 a) {
-    return kind == 20u ? abs(d) - a.x : d - a.x;
+    return kind == kKindShell ? abs(d) - a.x : d - a.x;
 }
 
 // Domain operations evaluate their child at one or more points of the child's space (the
 // candidates) and combine the values: the least of them, for the copies of a repetition. A point
-// p here is in the node's local space. Repeat (22): a: spacing, G; b: count, M packed a byte per
+// p here is in the node's local space. Repeat: a: spacing, G; b: count, M packed a byte per
 // axis. Along each axis the candidates are the nearest copy, then in turn M more either side,
 // then one more towards p, or every copy when that is as many: the nearest copy to any point of
 // a child that reaches M copies either side is among them (engine/src/nodes.cpp, repeatKernel).
@@ -335,18 +457,18 @@ SDF_FN uint polarCount(vec4 a, vec4 b) {
 }
 
 SDF_FN uint domainCount(uint kind, vec4 a, vec4 b) {
-    if (kind == 22u)
+    if (kind == kKindRepeat)
         return repeatAxisCount(b.x, repeatAxisM(b.w, 0u)) *
                repeatAxisCount(b.y, repeatAxisM(b.w, 1u)) *
                repeatAxisCount(b.z, repeatAxisM(b.w, 2u));
-    if (kind == 23u) return polarCount(a, b);
+    if (kind == kKindPolarRepeat) return polarCount(a, b);
     return 1u;
 }
 
 // Candidate c's point in the child's space; w is 1 where the candidate is no copy (beyond the
 // ends of a repetition), else 0.
 SDF_FN vec4 domainPoint(uint kind, vec3 p, vec4 a, vec4 b, uint c) {
-    if (kind == 22u) {
+    if (kind == kKindRepeat) {
         float mx = repeatAxisM(b.w, 0u), my = repeatAxisM(b.w, 1u), mz = repeatAxisM(b.w, 2u);
         uint kx = repeatAxisCount(b.x, mx), ky = repeatAxisCount(b.y, my);
         float ix = repeatAxisIndex(p.x, a.x, b.x, mx, c % kx);
@@ -356,7 +478,7 @@ SDF_FN vec4 domainPoint(uint kind, vec3 p, vec4 a, vec4 b, uint c) {
         vec3 o = (i - 0.5f * (vec3(b) - 1.0f)) * vec3(a);
         return vec4(p - o, (ix < 0.0f || iy < 0.0f || iz < 0.0f) ? 1.0f : 0.0f);
     }
-    if (kind == 23u) {
+    if (kind == kKindPolarRepeat) {
         // Copy i is the child turned about y by i times the sector a.z, at angle i a.z from +x
         // towards -z.
         float n = a.x, m = b.x;
@@ -371,32 +493,44 @@ SDF_FN vec4 domainPoint(uint kind, vec3 p, vec4 a, vec4 b, uint c) {
         float cs = cos(angle), sn = sin(angle);
         return vec4(p.x * cs - p.z * sn - a.y, p.y, p.x * sn + p.z * cs, 0.0f);
     }
-    if (kind == 24u) {
+    if (kind == kKindMirror) {
         float k = a.w;
         vec3 m = abs(p);
         if (k > 0.0f) m = sqrt(p * p + k * k);
         return vec4(a.x != 0.0f ? m.x : p.x, a.y != 0.0f ? m.y : p.y, a.z != 0.0f ? m.z : p.z, 0.0f);
     }
-    if (kind == 25u) return vec4(p - clamp(p, -vec3(a), vec3(a)), 0.0f);
-    if (kind == 26u) {
+    if (kind == kKindElongate) return vec4(p - clamp(p, -vec3(a), vec3(a)), 0.0f);
+    if (kind == kKindTwist) {
         float cs = cos(a.x * p.y), sn = sin(a.x * p.y);
         return vec4(cs * p.x + sn * p.z, p.y, -sn * p.x + cs * p.z, 0.0f);
     }
-    if (kind == 27u) {
+    if (kind == kKindBend) {
         float cs = cos(a.x * p.x), sn = sin(a.x * p.x);
         return vec4(cs * p.x + sn * p.y, -sn * p.x + cs * p.y, p.z, 0.0f);
     }
-    float s = 1.0f + (a.y - 1.0f) * clamp((p.y + a.x) / (2.0f * a.x), 0.0f, 1.0f); // taper (28)
-    return vec4(p.x / s, p.y, p.z / s, 0.0f);
+    if (kind == kKindTaper) {
+        float s = 1.0f + (a.y - 1.0f) * clamp((p.y + a.x) / (2.0f * a.x), 0.0f, 1.0f);
+        return vec4(p.x / s, p.y, p.z / s, 0.0f);
+    }
+    // Extrude and revolve cut their child at z = 0: revolve at the distance from the y axis
+    // less the offset a.x (a 1-Lipschitz map, so the value stays a distance bound).
+    if (kind == kKindExtrude) return vec4(p.x, p.y, 0.0f, 0.0f);
+    return vec4(length(vec2(p.x, p.z)) - a.x, p.y, 0.0f, 0.0f);
 }
 
 // Twist, bend and taper stretch space: their child sees points clamped into the node's bounds,
 // and its value is divided by the Lipschitz bound over them (b.w holds its inverse).
-SDF_FN bool domainClamps(uint kind) { return kind >= 26u; }
+SDF_FN bool domainClamps(uint kind) { return kind >= kKindTwist && kind <= kKindTaper; }
 
 // The node's value in its local units from the least of its candidates' values.
 SDF_FN float domainFinish(uint kind, vec3 p, float best, vec4 a, vec4 b) {
-    if (kind == 22u) return min(best, a.w);
-    if (kind == 23u) return a.w >= 0.0f ? min(best, length(vec2(p.x, p.z)) * a.w) : best;
+    if (kind == kKindRepeat) return min(best, a.w);
+    if (kind == kKindPolarRepeat) return a.w >= 0.0f ? min(best, length(vec2(p.x, p.z)) * a.w) : best;
+    if (kind == kKindExtrude) {
+        // The profile's value and |z| against the half height a.x, with edges of radius a.y
+        // (IQ's opExtrusion around the profile shrunk by the rounding).
+        vec2 w = vec2(best + a.y, abs(p.z) - a.x + a.y);
+        return min(max(w.x, w.y), 0.0f) + length(max(w, 0.0f)) - a.y;
+    }
     return domainClamps(kind) ? best * b.w : best;
 }

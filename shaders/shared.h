@@ -33,7 +33,7 @@
 #define SDFCSG_TAPE_KIND_SHIFT 20 // 6 bits
 #define SDFCSG_TAPE_FOLD_SHIFT 26 // 2 bits
 #define SDFCSG_TAPE_BLEND_SHIFT 28 // 2 bits
-#define SDFCSG_TAPE_FIRST_OPERATION 17 // NodeKind::Union; then intersection, difference
+#define SDFCSG_TAPE_FIRST_OPERATION 22 // NodeKind::Union; then intersection, difference
 #define SDFCSG_TAPE_DOMAIN_END 63     // the kind of the instruction that ends a domain's child
 
 // Mesh extraction (engine/src/mesh.cpp, shaders/mesh_*.comp). The grid's samples are split into

@@ -47,10 +47,28 @@ void defaultParams(Node& node) {
             if (p.type == ValueType::Number && p.name == "radius" && node.kind == NodeKind::Capsule)
                 v[0] = 0.2f;
         }
+        if (p.type == ValueType::Text) {
+            if (p.required) node.strings[p.slot] = "Text";
+            continue;
+        }
+        if (p.type == ValueType::Points) {
+            node.points = {{-0.5f, -0.4f}, {0.5f, -0.4f}, {0.0f, 0.5f}};
+            continue;
+        }
         int n = p.type == ValueType::Vec3 ? 3 : 1;
         for (int k = 0; k < n; ++k)
             node.params[p.slot + k] = v[k];
     }
+    if (node.kind == NodeKind::RegularPolygon) node.params[1] = 6.0f;
+    if (node.kind == NodeKind::Text) node.params[0] = 0.5f;
+}
+
+// Whether the node is an extrude or a revolve or lies inside one (where 2D profiles may go).
+bool cutsProfiles(const Scene& scene, int node) {
+    for (; node >= 0; node = parentOf(scene, uint32_t(node)))
+        if (scene.nodes[node].kind == NodeKind::Extrude || scene.nodes[node].kind == NodeKind::Revolve)
+            return true;
+    return false;
 }
 
 // About half the width of a primitive, from its bounds.
@@ -193,7 +211,11 @@ Result<Scene> setValue(const Scene& scene, uint32_t node, std::string_view key,
             if (auto e = expect(3)) return *e;
             n.color = glm::vec3(values[0], values[1], values[2]);
         }
-    } else if (const ParamInfo* p = findParam(n.kind, key)) {
+    } else if (const ParamInfo* p = findParam(n.kind, key); p && p->type == ValueType::Points) {
+        if (auto e = expect(2 * n.points.size())) return *e; // moves the points it has
+        for (size_t i = 0; i < n.points.size(); ++i)
+            n.points[i] = glm::vec2(values[2 * i], values[2 * i + 1]);
+    } else if (p && p->type != ValueType::Text) {
         if (auto e = expect(p->type == ValueType::Vec3 ? 3 : 1)) return *e;
         std::copy(values.begin(), values.end(), n.params.begin() + p->slot);
     } else {
@@ -207,11 +229,34 @@ Result<Scene> setValue(const Scene& scene, uint32_t node, std::string_view key,
     return revalidate(edited);
 }
 
+Result<Scene> setText(const Scene& scene, uint32_t node, std::string_view key,
+                      std::string_view text) {
+    if (node >= scene.nodes.size()) return badNode(scene, node);
+    Scene edited = scene;
+    Node& n = edited.nodes[node];
+    const ParamInfo* p = findParam(n.kind, key);
+    if (!p || p->type != ValueType::Text)
+        return usage(scene, node,
+                     "a " + std::string(kindInfo(n.kind).name) + " has no text \"" +
+                         std::string(key) + "\"");
+    n.strings[p->slot] = std::string(text);
+    return revalidate(edited);
+}
+
 Result<Scene> addChild(const Scene& scene, uint32_t parent, NodeKind kind, uint32_t* newIndex) {
     if (parent >= scene.nodes.size()) return badNode(scene, parent);
     if (!kindInfo(scene.nodes[parent].kind).operation)
         return usage(scene, parent, "only an operation can take children");
     Scene edited = scene;
+    if (isProfile(kind) && !cutsProfiles(scene, int(parent))) { // a profile comes extruded
+        Node extrude;
+        extrude.kind = NodeKind::Extrude;
+        defaultParams(extrude);
+        extrude.params[0] = 0.2f;
+        edited.nodes.push_back(extrude);
+        edited.nodes[parent].children.push_back(uint32_t(edited.nodes.size() - 1));
+        parent = uint32_t(edited.nodes.size() - 1);
+    }
     Node child;
     child.kind = kind;
     defaultParams(child);

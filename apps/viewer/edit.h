@@ -37,6 +37,9 @@ Result<Scene> revalidate(const Scene& scene);
 // Errors name the key and what it expects.
 Result<Scene> setValue(const Scene& scene, uint32_t node, std::string_view key,
                        std::span<const float> values);
+// A text value (a text node's string or font).
+Result<Scene> setText(const Scene& scene, uint32_t node, std::string_view key,
+                      std::string_view text);
 
 // Structural edits (a renderer must recompile after these).
 // Adds a node of `kind` with default sizes as the last child of an operation (an operation gets

@@ -647,6 +647,26 @@ void valueEditor(Viewer& v) {
             }
             continue;
         }
+        if (p.type == ValueType::Text) {
+            char text[1024];
+            std::snprintf(text, sizeof text, "%s", n.strings[p.slot].c_str());
+            if (ImGui::InputText(name.c_str(), text, sizeof text,
+                                 ImGuiInputTextFlags_EnterReturnsTrue))
+                commit(v, setText(*v.scene, id, p.name, text), std::to_string(id) + name);
+            continue;
+        }
+        if (p.type == ValueType::Points) {
+            std::vector<float> flat;
+            for (glm::vec2 q : n.points)
+                flat.insert(flat.end(), {q.x, q.y});
+            bool moved = false;
+            for (size_t i = 0; i < n.points.size(); ++i)
+                moved |= ImGui::DragFloat2(("point " + std::to_string(i)).c_str(), &flat[2 * i],
+                                           0.01f, -1e6f, 1e6f, "%.3f");
+            if (moved) edited(name.c_str(), flat);
+            if (ImGui::IsItemDeactivatedAfterEdit()) v.doc.history().endMerge();
+            continue;
+        }
         if (p.type == ValueType::Number) {
             float value = n.params[p.slot];
             if (ImGui::DragFloat(name.c_str(), &value, 0.01f, min, std::min(p.maximum, 1e6f),

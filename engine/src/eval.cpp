@@ -72,7 +72,12 @@ glm::dmat3 rotation(glm::vec3 degrees) {
 // Float bounds that contain the double ones: round outwards, then pad a little so that the
 // single-precision fields evaluated against them still never undercut them.
 Aabb outwardBox(glm::dvec3 lo, glm::dvec3 hi) {
-    double pad = 1e-5 * (glm::length(hi - lo) + glm::length(hi + lo) * 0.5) + 1e-6;
+    // Sizes from the axes a 2D profile's prism does not reach along (nodes.cpp, kProfileReach):
+    // its 1e30 would pad the others by 1e25.
+    glm::dvec3 l = lo, h = hi;
+    for (int i = 0; i < 3; ++i)
+        if (std::max(std::abs(l[i]), std::abs(h[i])) >= 1e29) l[i] = h[i] = 0.0;
+    double pad = 1e-5 * (glm::length(h - l) + glm::length(h + l) * 0.5) + 1e-6;
     Aabb box;
     for (int i = 0; i < 3; ++i) {
         box.min[i] = std::nextafter(float(lo[i] - pad), -INFINITY);
@@ -100,7 +105,9 @@ glm::vec3 localPoint(const FlatNode& n, glm::vec3 p) {
 
 // The value types of sceneDistance (float) and sceneSample (vec4: colour, distance in w).
 template <class V> V leaf(const FlatNode& n, glm::vec3 p) {
-    float d = sdf::evalPrimitive(n.kind, localPoint(n, p), n.params) * n.scale;
+    float d = sdf::evalPrimitive(n.kind, localPoint(n, p), n.params,
+                                 n.outline ? n.outline->data() : nullptr) *
+              n.scale;
     if constexpr (std::is_same_v<V, float>)
         return d;
     else
@@ -111,6 +118,20 @@ template <class V> float dist(const V& v) {
         return v;
     else
         return v.w;
+}
+
+// Polygon and text: the first record (0 here; the node buffer rebases it), the glyph count and
+// the extents of the glyphs' boxes.
+Params outlineParams(const std::vector<glm::vec4>* outline) {
+    Params k{};
+    if (!outline || outline->empty()) return k;
+    const float glyphs = (*outline)[1].z; // the first glyph record holds the count
+    glm::vec2 lo(INFINITY), hi(-INFINITY);
+    for (uint32_t g = 0; g < uint32_t(glyphs); ++g) {
+        const glm::vec4 box = (*outline)[2 * g];
+        lo = glm::min(lo, glm::vec2(box.x, box.y)), hi = glm::max(hi, glm::vec2(box.z, box.w));
+    }
+    return {0.0f, glyphs, lo.x, lo.y, hi.x, hi.y};
 }
 
 Role roleOf(NodeKind kind) {
@@ -296,6 +317,10 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
         n.scale = float(a.scale);
         n.color = src.color ? *src.color : upNode ? upNode->color : kDefaultColor;
         n.params = sdf::kernelParams(src.kind, src.params);
+        if (hasOutline(src.kind)) {
+            n.outline = src.outline;
+            n.params = outlineParams(src.outline.get());
+        }
         const bool boolean = roleOf(src.kind) == Role::Boolean;
         n.smooth = boolean ? float(double(src.params[0]) * a.scale) : 0.0f;
         n.blend = boolean ? uint32_t(src.params[1]) : 0u;

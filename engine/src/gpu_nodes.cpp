@@ -4,6 +4,7 @@
 #include "shared.h"
 
 #include <algorithm>
+#include <cstring>
 
 namespace sdfcsg::detail {
 
@@ -34,6 +35,21 @@ std::vector<GpuNode> packNodes(const Evaluator& evaluator) {
         // Domain operations: w holds their child's index, whose bounds the tape machine reads.
         const bool domain = kindInfo(n.kind).role == Role::Domain;
         g.bmax = glm::vec4(clampHuge(n.bounds.max), domain ? float(n.children[0]) : float(n.blend));
+        out.push_back(g);
+    }
+    // Polygon and text outlines after the nodes, 8 vec4 to a node's room; their first record
+    // (slot 0) becomes its index in the buffer seen as vec4s (sdf.glsl, nodeWords).
+    std::vector<glm::vec4> words;
+    for (size_t i = 0; i < evaluator.nodes().size(); ++i) {
+        const FlatNode& n = evaluator.nodes()[i];
+        if (!n.outline) continue;
+        out[i].p0.x = float(out.size() * 8 + words.size());
+        words.insert(words.end(), n.outline->begin(), n.outline->end());
+    }
+    words.resize((words.size() + 7) / 8 * 8, glm::vec4(0.0f));
+    for (size_t k = 0; k < words.size(); k += 8) {
+        GpuNode g;
+        std::memcpy(&g, &words[k], sizeof g);
         out.push_back(g);
     }
     return out;

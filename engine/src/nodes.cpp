@@ -93,6 +93,44 @@ constexpr ParamInfo kCappedTorus[] = {
     {"angle", Number, Positive, 2, true, {}, "degrees",
      "Angle the arc spans, centred on +z; 360 closes the ring.", 360.0f},
 };
+constexpr ParamInfo kCircle[] = {
+    {"radius", Number, Positive, 0, true, {}, "length", "Radius."},
+};
+constexpr ParamInfo kRectangle[] = {
+    {"width", Number, Positive, 0, true, {}, "length", "Width along x."},
+    {"height", Number, Positive, 1, true, {}, "length", "Height along y."},
+    {"rounding", Number, NonNegative, 2, false, {0, 0, 0}, "length",
+     "Radius of the rounded corners; clamped to half the smaller side."},
+};
+constexpr ParamInfo kRegularPolygon[] = {
+    {"radius", Number, Positive, 0, true, {}, "length",
+     "Distance from the centre to each corner; one edge is flat on top (+y)."},
+    {"sides", Number, Count, 1, true, {}, "sides", "Number of sides.", 64.0f, {}, 3.0f},
+};
+constexpr ParamInfo kPolygon[] = {
+    {"points", Points, Any, 0, true, {}, "points",
+     "The corners [[x, y], ...] in order, either way round: 3 to 1024 of them, edges that do "
+     "not cross (a simple polygon)."},
+};
+constexpr ParamInfo kText[] = {
+    {"text", Text, Any, 0, true, {}, "characters", "One line of text, at most 256 characters."},
+    {"size", Number, Positive, 0, false, {1, 0, 0}, "length",
+     "Font size: the height of the font's em square (capitals are about 0.7 of it)."},
+    {"font", Text, Any, 1, false, {}, "file",
+     "A TrueType or OpenType font file; empty or absent: DejaVu Sans (Debian's "
+     "fonts-dejavu-core)."},
+};
+constexpr ParamInfo kExtrude[] = {
+    {"height", Number, Positive, 0, true, {}, "length",
+     "Thickness along z, centred on the profile's plane."},
+    {"rounding", Number, NonNegative, 1, false, {0, 0, 0}, "length",
+     "Radius of the rounded edges where the sides meet the faces; clamped to half the height."},
+};
+constexpr ParamInfo kRevolve[] = {
+    {"offset", Number, Any, 0, false, {0, 0, 0}, "length",
+     "Distance of the axis from the profile's x = 0: the profile turns about the y axis after "
+     "moving +offset along x (a ring from a circle)."},
+};
 constexpr std::string_view kBlends[] = {"smooth", "round", "chamfer"};
 constexpr ParamInfo kOperation[] = {
     {"smooth", Number, NonNegative, 0, false, {0, 0, 0}, "length",
@@ -205,6 +243,18 @@ Params polarKernel(const Params& v, vec3 lo, vec3 hi) {
     if (m > 0.0f && m < n)
         g = std::sin(std::min((m + 1.0f) * sector - beta, 1.5707963f)) * (1.0f - 1e-6f);
     return {n, v[1], sector, g, m};
+}
+
+// Profiles reach this far along z, in both directions: as fields of space they are prisms, and
+// a finite reach keeps their bounds free of inf * 0 when transformed.
+constexpr float kProfileReach = 1e30f;
+bool profile(float x, float y, vec3& lo, vec3& hi) {
+    return symmetric({x, y, kProfileReach}, lo, hi);
+}
+// Polygon and text: the outline's extents in slots 2-5 (Evaluator, from Node::outline).
+bool outlineBounds(const Params& k, vec3& lo, vec3& hi) {
+    lo = vec3(k[2], k[3], -kProfileReach), hi = vec3(k[4], k[5], kProfileReach);
+    return true;
 }
 
 constexpr KernelArg kA0[] = {{0, 1}};
@@ -347,6 +397,34 @@ constexpr KindInfo kKinds[] = {
          float r = k[0] + k[1];
          return symmetric({r, k[1], r}, lo, hi);
      }},
+    {NodeKind::Circle, "circle", false, kCircle,
+     "2D profile: a circle in the xy plane, centred at the origin.", "sdCircle", kA0,
+     [](const Params& v) -> Params { return {v[0]}; },
+     [](const Params& k, vec3& lo, vec3& hi) { return profile(k[0], k[0], lo, hi); }},
+    {NodeKind::Rectangle, "rectangle", false, kRectangle,
+     "2D profile: a rectangle in the xy plane, optionally with rounded corners, centred at the "
+     "origin.",
+     "sdRectangle", kA0A1A2,
+     [](const Params& v) -> Params {
+         return {0.5f * v[0], 0.5f * v[1], std::min(v[2], 0.5f * std::min(v[0], v[1]))};
+     },
+     [](const Params& k, vec3& lo, vec3& hi) { return profile(k[0], k[1], lo, hi); }},
+    {NodeKind::RegularPolygon, "regular_polygon", false, kRegularPolygon,
+     "2D profile: a regular polygon in the xy plane, centred at the origin, an edge on top.",
+     "sdRegularPolygon", kA0A1A2A3,
+     [](const Params& v) -> Params {
+         const double half = 3.14159265358979323846 / std::max(double(v[1]), 3.0);
+         return {v[0], float(half), float(std::cos(half)), float(std::sin(half))};
+     },
+     [](const Params& k, vec3& lo, vec3& hi) { return profile(k[0], k[0], lo, hi); }},
+    {NodeKind::Polygon, "polygon", false, kPolygon,
+     "2D profile: a polygon in the xy plane from its corners, exact distance.", "sdOutline", {},
+     nullptr, outlineBounds},
+    {NodeKind::Text, "text", false, kText,
+     "2D profile: a line of text in the xy plane, set in a TrueType or OpenType font through "
+     "FreeType and centred on the origin (the middle of its outlines' extents); exact distance "
+     "to the glyphs' outlines.",
+     "sdOutline", {}, nullptr, outlineBounds},
     {NodeKind::Union, "union", true, kOperation, "All children together.", {}, {}, nullptr,
      nullptr, Role::Boolean},
     {NodeKind::Intersection, "intersection", true, kOperation, "What all children have in common.",
@@ -448,6 +526,25 @@ constexpr KindInfo kKinds[] = {
          const float least = std::min({scale(lo.y), scale(hi.y), 1.0f, top});
          const float slope = std::abs(top - 1.0f) / (2.0f * hh);
          return std::max(1.0f / least, 1.0f) + reach(lo, hi) * slope / (least * least);
+     }},
+    {NodeKind::Extrude, "extrude", true, kExtrude,
+     "The cross-section of its child in the plane z = 0 (a 2D profile: circle, rectangle, "
+     "polygon, text...) swept along z to the given thickness. Exact where the child's field is.",
+     {}, {}, nullptr, nullptr, Role::Domain,
+     [](const Params& v, vec3, vec3) -> Params {
+         return {0.5f * v[0], std::min(v[1], 0.5f * v[0])};
+     },
+     [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
+         outLo = vec3(lo.x, lo.y, -k[0]), outHi = vec3(hi.x, hi.y, k[0]);
+     }},
+    {NodeKind::Revolve, "revolve", true, kRevolve,
+     "The cross-section of its child in the plane z = 0, its part at x >= -offset, turned about "
+     "the y axis (a lathe): a vase, a chess piece, a ring.",
+     {}, {}, nullptr, nullptr, Role::Domain,
+     [](const Params& v, vec3, vec3) -> Params { return {v[0]}; },
+     [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
+         const float r = std::max(hi.x + k[0], 0.0f);
+         outLo = vec3(-r, lo.y, -r), outHi = vec3(r, hi.y, r);
      }},
 };
 static_assert(sizeof(kKinds) / sizeof(kKinds[0]) == kNodeKindCount);

@@ -8,6 +8,7 @@
 #include "json_syntax.h"
 #include "json_writer.h"
 #include "legacy.h"
+#include "outline.h"
 #include "parse_util.h"
 #include "shared.h"
 
@@ -295,11 +296,44 @@ void SceneReader::readParam(const ParamInfo& p, std::optional<element> value,
                                     expectedText(p) + ")");
             ok = false;
         }
-        std::copy_n(p.fallback, p.type == ValueType::Vec3 ? 3 : 1, slot);
+        if (p.type != ValueType::Points && p.type != ValueType::Text)
+            std::copy_n(p.fallback, p.type == ValueType::Vec3 ? 3 : 1, slot);
         return;
     }
     const std::string keyPath = member(path, p.name);
-    if (p.type == ValueType::Choice) {
+    if (p.type == ValueType::Text) {
+        // Bytes: the font's reader counts the characters (a UTF-8 one takes up to 4).
+        auto s = readString(*value, keyPath, 4 * kMaxTextCharacters, problems_);
+        if (s) node.strings[p.slot] = *s;
+        ok = ok && s.has_value();
+    } else if (p.type == ValueType::Points) {
+        const bool array = value->is_array();
+        const size_t n = array ? asArray(*value).size() : 0;
+        if (!array || n < 3 || n > kMaxPolygonPoints) {
+            problems_.add(keyPath, "expected " + expectedText(p) + ", got " +
+                                       (array ? std::to_string(n) + " points" : describe(*value)));
+            ok = false;
+            return;
+        }
+        int i = 0;
+        for (element e : asArray(*value)) {
+            const std::string at = item(keyPath, i++);
+            if (!e.is_array() || asArray(e).size() != 2) {
+                problems_.add(at, "expected a point [x, y], got " + describe(e));
+                ok = false;
+                continue;
+            }
+            glm::vec2 q(0.0f);
+            int k = 0;
+            for (element c : asArray(e)) {
+                auto x = readNumber(c, item(at, k), Check::Any, problems_);
+                if (x) q[k] = static_cast<float>(*x);
+                ok = ok && x.has_value();
+                ++k;
+            }
+            node.points.push_back(q);
+        }
+    } else if (p.type == ValueType::Choice) {
         std::string_view name;
         if (value->is_string()) name = value->get_string().value_unsafe();
         const auto found = std::find(p.choices.begin(), p.choices.end(), name);
@@ -314,6 +348,10 @@ void SceneReader::readParam(const ParamInfo& p, std::optional<element> value,
         auto n = readNumber(*value, keyPath, p.check, problems_);
         if (n && *n > p.maximum) {
             problems_.add(keyPath, "expected at most " + formatFloat(p.maximum) + ", got " +
+                                       describe(*value));
+            n.reset();
+        } else if (n && p.check == Check::Count && *n < p.least) {
+            problems_.add(keyPath, "expected at least " + formatFloat(p.least) + ", got " +
                                        describe(*value));
             n.reset();
         }
@@ -397,6 +435,25 @@ std::optional<dom::array> SceneReader::readNode(element value, std::string path,
     }
     if (auto e = valueOf("color")) node.color = readColor(*e, member(p, "color"), problems_);
 
+    if (kind->kind == NodeKind::Polygon && paramsOk) {
+        if (std::string why = polygonProblem(node.points); !why.empty())
+            problems_.add(member(p, "points"), why);
+        paramsOk = paramsOk && polygonProblem(node.points).empty();
+    }
+    if (hasOutline(kind->kind) && paramsOk) {
+        auto outline = buildOutline(node);
+        if (!outline) {
+            const bool fontProblem =
+                outline.error().diagnostics[0].message.starts_with("cannot load font");
+            problems_.add(member(p, fontProblem && !node.strings[1].empty() ? "font" : "text"),
+                          outline.error().diagnostics[0].message);
+        } else if ((*outline)->empty()) {
+            problems_.add(member(p, "text"), "expected text with something to see, got only "
+                                             "spaces");
+        } else {
+            node.outline = *outline;
+        }
+    }
     if (kind->kind == NodeKind::RoundBox && paramsOk) {
         const float* size = node.params.data();
         float limit = 0.5f * std::min({size[0], size[1], size[2]});
@@ -459,6 +516,7 @@ void checkCombinedTransforms(const Scene& scene, Problems& problems) {
     const Evaluator evaluator(scene);
     // The products of the smallest and of the largest factors: the parent's, until multiplied.
     std::vector<double> scale(scene.nodes.size(), 1.0), largest(scene.nodes.size(), 1.0);
+    std::vector<bool> inCut(scene.nodes.size(), false); // inside an extrude or a revolve
     for (size_t i = 0; i < scene.nodes.size(); ++i) {
         const Node& node = scene.nodes[i];
         const glm::vec3 s = node.transform.scale;
@@ -468,6 +526,15 @@ void checkCombinedTransforms(const Scene& scene, Problems& problems) {
             scale[c] = scale[i], largest[c] = largest[i];
         const FlatNode& f = evaluator.nodes()[i];
         const KindInfo& info = kindInfo(node.kind);
+        const bool cuts = node.kind == NodeKind::Extrude || node.kind == NodeKind::Revolve;
+        for (uint32_t c : node.children)
+            inCut[c] = inCut[i] || cuts;
+        if (isProfile(node.kind) && !inCut[i]) {
+            problems.add(node.path, article(info.name) +
+                                        " is a 2D profile: it must be inside an extrude or a "
+                                        "revolve");
+            return;
+        }
         if (info.role == Role::Domain && node.kind != NodeKind::Mirror &&
             node.kind != NodeKind::Elongate && !node.children.empty() &&
             !evaluator.nodes()[node.children[0]].bounds.finite()) {

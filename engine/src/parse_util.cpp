@@ -235,6 +235,9 @@ std::string joinNames(std::span<const std::string_view> names, std::string_view 
 }
 
 std::string expectedText(ValueType type, Check check) {
+    if (type == ValueType::Points)
+        return "an array of 3 to " + std::to_string(kMaxPolygonPoints) + " points [x, y]";
+    if (type == ValueType::Text) return "a string";
     if (type == ValueType::Number) {
         switch (check) {
         case Check::Any:
@@ -274,6 +277,8 @@ std::string expectedText(const ParamInfo& p) {
         return out;
     }
     std::string out = expectedText(p.type, p.check);
+    if (p.type == ValueType::Number && p.check == Check::Count && p.maximum < 3.4e38f)
+        return "a whole number from " + formatFloat(p.least) + " to " + formatFloat(p.maximum);
     if (p.type == ValueType::Number && p.maximum < 3.4e38f) {
         char buf[32];
         std::snprintf(buf, sizeof buf, "%g", double(p.maximum));

@@ -19,6 +19,8 @@ std::string describeValue(const ParamInfo& p) {
             names += (names.empty() ? "\"" : ", \"") + std::string(c) + "\"";
         return names;
     }
+    if (p.type == ValueType::Text) return "string";
+    if (p.type == ValueType::Points) return "[[x, y], ...]";
     std::string kind = p.type == ValueType::Vec3 ? "[x, y, z]" : "number";
     switch (p.check) {
     case Check::Any: break;
@@ -36,6 +38,7 @@ std::string fallback(const ParamInfo& p) {
     if (p.type == ValueType::Choice)
         return "default \"" + std::string(p.choices[size_t(p.fallback[0])]) + "\"";
     if (p.type == ValueType::Number) return "default " + number(p.fallback[0]);
+    if (p.type == ValueType::Text) return "default \"\"";
     return "default [" + number(p.fallback[0]) + ", " + number(p.fallback[1]) + ", " +
            number(p.fallback[2]) + "]";
 }

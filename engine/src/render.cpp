@@ -146,10 +146,14 @@ Result<std::shared_ptr<SharedPasses>> sharedPasses(Context::Impl& ctx) {
 
 } // namespace
 
+// Polygon and text outlines follow the nodes in their buffer: a new size is a new buffer.
+static size_t outlineSize(const Node& n) { return n.outline ? n.outline->size() : 0; }
+
 bool sameStructure(const Scene& a, const Scene& b) {
     if (a.nodes.size() != b.nodes.size()) return false;
     for (size_t i = 0; i < a.nodes.size(); ++i)
-        if (a.nodes[i].kind != b.nodes[i].kind || a.nodes[i].children != b.nodes[i].children)
+        if (a.nodes[i].kind != b.nodes[i].kind || a.nodes[i].children != b.nodes[i].children ||
+            outlineSize(a.nodes[i]) != outlineSize(b.nodes[i]))
             return false;
     return true;
 }
@@ -604,7 +608,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene
     if (!control) return control.error();
     r.control = *control;
     auto nodes =
-        detail::createBuffer(r.ctx, r.nodeCount * sizeof(detail::GpuNode),
+        detail::createBuffer(r.ctx, detail::packNodes(*r.evaluator).size() * sizeof(detail::GpuNode),
                              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, detail::MemoryUse::Upload);
     if (!nodes) return nodes.error();
     r.nodes = *nodes;

@@ -44,6 +44,25 @@ void nodeMembers(JsonWriter& w, const Node& node) {
         w.string(node.name);
     }
     for (const ParamInfo& p : kind.params) {
+        if (p.type == ValueType::Text) {
+            if (p.required || !node.strings[p.slot].empty()) {
+                w.key(p.name);
+                w.string(node.strings[p.slot]);
+            }
+            continue;
+        }
+        if (p.type == ValueType::Points) {
+            w.key(p.name);
+            w.beginArray(JsonWriter::Layout::Inline);
+            for (glm::vec2 q : node.points) {
+                w.beginArray(JsonWriter::Layout::Inline);
+                w.number(q.x);
+                w.number(q.y);
+                w.endArray();
+            }
+            w.endArray();
+            continue;
+        }
         const float* v = node.params.data() + p.slot;
         const int n = p.type == ValueType::Vec3 ? 3 : 1;
         if (!p.required && std::equal(v, v + n, p.fallback)) continue;

@@ -103,14 +103,14 @@ void ref(JsonWriter& w, std::string_view key, std::string_view target, std::stri
 }
 
 // {"type":"number"} with the bound of a Check.
-void numberBody(JsonWriter& w, Check check) {
+void numberBody(JsonWriter& w, Check check, double least = 1.0, double most = 1e6) {
     w.key("type");
     w.string(check == Check::Count ? "integer" : "number");
     if (check == Check::Count) {
         w.key("minimum");
-        w.number(1.0);
+        w.number(least);
         w.key("maximum");
-        w.number(1e6);
+        w.number(most);
     } else if (check == Check::Positive) {
         w.key("exclusiveMinimum");
         w.number(0.0);
@@ -154,9 +154,33 @@ void param(JsonWriter& w, const ParamInfo& p) {
         for (std::string_view c : p.choices)
             w.string(c);
         w.endArray();
+    } else if (p.type == ValueType::Text) {
+        w.key("type");
+        w.string("string");
+    } else if (p.type == ValueType::Points) {
+        w.key("type");
+        w.string("array");
+        w.key("items");
+        w.beginObject(Layout::Inline);
+        w.key("type");
+        w.string("array");
+        w.key("items");
+        w.beginObject(Layout::Inline);
+        w.key("type");
+        w.string("number");
+        w.endObject();
+        w.key("minItems");
+        w.number(2.0);
+        w.key("maxItems");
+        w.number(2.0);
+        w.endObject();
+        w.key("minItems");
+        w.number(3.0);
+        w.key("maxItems");
+        w.number(double(kMaxPolygonPoints));
     } else if (p.type == ValueType::Number) {
-        numberBody(w, p.check);
-        if (p.maximum < 3.4e38f) {
+        numberBody(w, p.check, p.least, std::min(double(p.maximum), 1e6));
+        if (p.maximum < 3.4e38f && p.check != Check::Count) {
             w.key("maximum");
             w.number(p.maximum);
         }
@@ -167,6 +191,8 @@ void param(JsonWriter& w, const ParamInfo& p) {
         w.key("default");
         if (p.type == ValueType::Choice) {
             w.string(p.choices[size_t(p.fallback[0])]);
+        } else if (p.type == ValueType::Text) {
+            w.string("");
         } else if (p.type == ValueType::Number) {
             w.number(p.fallback[0]);
         } else {

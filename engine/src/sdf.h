@@ -19,14 +19,30 @@
 namespace sdfcsg::sdf {
 
 using glm::abs, glm::clamp, glm::dot, glm::length, glm::max, glm::min, glm::mix, glm::sign;
-using glm::atan, glm::cos, glm::floor, glm::mod, glm::sin, glm::sqrt;
+using glm::acos, glm::atan, glm::cos, glm::floor, glm::mod, glm::pow, glm::sin, glm::sqrt;
 using glm::vec2, glm::vec3, glm::vec4;
 using std::sqrt;
 using uint = uint32_t;
 
 #define SDF_FN inline
+#define SDF_DATA(i) sdfData[i]
+#define SDF_DATA_PARAM , const vec4* sdfData
+#define SDF_DATA_ARG , sdfData
 #include "../../shaders/sdf.glsl"
 #undef SDF_FN
+#undef SDF_DATA
+#undef SDF_DATA_PARAM
+#undef SDF_DATA_ARG
+
+static_assert(kKindShell == uint(NodeKind::Shell) && kKindOffset == uint(NodeKind::Offset) &&
+              kKindRepeat == uint(NodeKind::Repeat) &&
+              kKindPolarRepeat == uint(NodeKind::PolarRepeat) &&
+              kKindMirror == uint(NodeKind::Mirror) && kKindElongate == uint(NodeKind::Elongate) &&
+              kKindTwist == uint(NodeKind::Twist) && kKindBend == uint(NodeKind::Bend) &&
+              kKindTaper == uint(NodeKind::Taper) && kKindExtrude == uint(NodeKind::Extrude) &&
+              kKindRevolve == uint(NodeKind::Revolve));
+static_assert(uint(NodeKind::Polygon) == 20u && uint(NodeKind::Text) == 21u &&
+              uint(NodeKind::Circle) == 17u);
 
 using sdfcsg::Params;
 
@@ -38,10 +54,12 @@ inline Params kernelParams(NodeKind kind, const Params& v) {
     return info.kernel ? info.kernel(v) : Params{v[0], v[1]}; // operations: smooth, blend
 }
 
-// Local distance of a primitive, given its kernel parameters.
-inline float evalPrimitive(NodeKind kind, vec3 p, const Params& k) {
+// Local distance of a primitive, given its kernel parameters and, for polygon and text, its
+// outline (FlatNode::outline).
+inline float evalPrimitive(NodeKind kind, vec3 p, const Params& k, const vec4* outline = nullptr) {
+    if (hasOutline(kind) && !outline) return 1e30f; // built in code without its outline
     return sdPrimitive(uint(kind), p, vec4(k[0], k[1], k[2], k[3]), vec4(k[4], k[5], k[6], k[7]),
-                       kAllKinds);
+                       kAllKinds, outline);
 }
 
 // Exact local bounding box of a primitive: lo/hi corners; false for the (unbounded) plane.

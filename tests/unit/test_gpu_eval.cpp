@@ -216,12 +216,46 @@ const std::map<std::string, std::string>& primitiveExamples() {
     return examples;
 }
 
+// 2D profiles, which extrude and revolve hold.
+const std::map<std::string, std::string>& profileExamples() {
+    static const std::map<std::string, std::string> examples = {
+        {"circle", R"("radius": 0.5)"},
+        {"rectangle", R"("width": 0.9, "height": 0.6, "rounding": 0.1)"},
+        {"regular_polygon", R"("radius": 0.6, "sides": 5)"},
+        {"polygon", R"("points": [[-0.5, -0.4], [0.6, -0.4], [0.1, 0.0], [0.3, 0.5], [-0.4, 0.3]])"},
+        {"text", R"("text": "Bo", "size": 0.8)"},
+    };
+    return examples;
+}
+
 class GpuEval : public GpuTest {};
 
 TEST_F(GpuEval, PrimitivesAreAllCovered) {
     for (const KindInfo& kind : nodeKinds()) {
         if (kind.operation) continue;
-        EXPECT_TRUE(primitiveExamples().count(std::string(kind.name))) << kind.name;
+        EXPECT_TRUE((isProfile(kind.kind) ? profileExamples() : primitiveExamples())
+                        .count(std::string(kind.name)))
+            << kind.name;
+    }
+}
+
+// Each profile extruded (with rounded edges) and revolved, transformed in the plane, beside a
+// sphere in a smooth union; their outlines travel after the nodes in the node buffer.
+TEST_F(GpuEval, EveryProfileMatchesTheCpu) {
+    for (const auto& [type, params] : profileExamples()) {
+        SCOPED_TRACE(type);
+        const std::string profile = R"({"type": ")" + type + R"(", )" + params +
+                                    R"(, "rotate": [0, 0, 20], "translate": [0.05, 0.1, 0]})";
+        Scene scene = parseOrDie(R"({"version": 1, "root": {"type": "union", "smooth": 0.2,
+            "children": [
+            {"type": "extrude", "height": 0.5, "rounding": 0.05, "rotate": [30, 20, 0],
+             "color": [0.9, 0.3, 0.1], "children": [)" + profile + R"(]},
+            {"type": "revolve", "offset": 0.2, "translate": [0, -1.2, 0], "children": [)" +
+                                 profile + R"(]},
+            {"type": "sphere", "radius": 0.4, "translate": [1.1, 0.6, 0.2], "color": [0.1, 0.4, 0.9]}
+            ]}})");
+        ASSERT_FALSE(scene.nodes.empty());
+        expectGpuMatchesCpu(context(), scene, 4096);
     }
 }
 
@@ -282,6 +316,8 @@ const std::map<std::string, std::string>& operationExamples() {
         {"twist", R"("angle": 60)"},
         {"bend", R"("angle": 30)"},
         {"taper", R"("height": 1.2, "top_scale": 0.4)"},
+        {"extrude", R"("height": 0.4, "rounding": 0.05)"},
+        {"revolve", R"("offset": 0.3)"},
     };
     return examples;
 }

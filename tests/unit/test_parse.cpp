@@ -77,9 +77,10 @@ std::vector<BadInput> badInputs() {
         fiveLights += R"(, {"direction": [0, -1, 0]})";
     const std::string kinds = "sphere, box, round_box, plane, triangular_prism, torus, cylinder, "
                               "cone, capsule, ellipsoid, hex_prism, octahedron, pyramid, "
-                              "rounded_cylinder, round_cone, link, capped_torus, union, "
-                              "intersection, difference, shell, offset, repeat, polar_repeat, "
-                              "mirror, elongate, twist, bend or taper";
+                              "rounded_cylinder, round_cone, link, capped_torus, circle, rectangle, "
+                              "regular_polygon, polygon, text, union, intersection, difference, "
+                              "shell, offset, repeat, polar_repeat, mirror, elongate, twist, bend, "
+                              "taper, extrude or revolve";
     return {
         // JSON syntax: line and column of the first problem.
         {"empty", "", "scene.json:1:1: expected a JSON value, got end of input"},
@@ -253,8 +254,8 @@ std::vector<BadInput> badInputs() {
          R"(scene.json: root.blend: expected one of "smooth", "round" or "chamfer", got 2)"},
         {"primitive with children", scene(R"({"type": "sphere", "radius": 1, "children": []})"),
          "scene.json: root: a sphere takes no \"children\"; only operations (union, intersection, "
-         "difference, shell, offset, repeat, polar_repeat, mirror, elongate, twist, bend and "
-         "taper) do"},
+         "difference, shell, offset, repeat, polar_repeat, mirror, elongate, twist, bend, "
+         "taper, extrude and revolve) do"},
         {"operation without children", scene(R"({"type": "intersection"})"),
          R"(scene.json: root: missing required key "children" (a non-empty array of nodes))"},
         {"empty children", scene(R"({"type": "union", "children": []})"),

@@ -49,7 +49,9 @@ std::string validValue(simdjson::dom::element property) {
         return simdjson::to_string(choices.at(0));
     std::string_view type = property["type"];
     if (type == "number") return "0.5";
-    if (type == "integer") return "2";
+    if (type == "integer") return "4";
+    if (type == "string") return "\"Ab\"";
+    if (std::string_view(property["items"]["type"]) == "array") return "[[0, 0], [1, 0], [0, 1]]";
     return std::string_view(property["items"]["type"]) == "integer" ? "[2, 2, 2]" : "[1, 1, 1]";
 }
 
@@ -57,6 +59,9 @@ std::string node(const KindInfo& kind, const std::string& extra) {
     std::string out = R"({"type": ")" + std::string(kind.name) + "\"";
     out += extra;
     if (kind.operation) out += R"(, "children": [{"type": "sphere", "radius": 1}])";
+    // A 2D profile goes inside an extrude, which the schema cannot require.
+    if (isProfile(kind.kind))
+        out = R"({"type": "extrude", "height": 1, "children": [)" + out + "}]";
     return R"({"version": 1, "root": )" + out + "}}";
 }
 
@@ -139,6 +144,20 @@ TEST(Schema, EveryKindAndParameterOfTheTableAppears) {
                 EXPECT_EQ(std::string_view(prop["default"]), p.choices[size_t(p.fallback[0])]);
                 continue;
             }
+            if (p.type == ValueType::Text) {
+                EXPECT_EQ(std::string_view(prop["type"]), "string");
+                EXPECT_EQ(std::find(required.begin(), required.end(), p.name) != required.end(),
+                          p.required);
+                continue;
+            }
+            if (p.type == ValueType::Points) {
+                EXPECT_EQ(std::string_view(prop["type"]), "array");
+                EXPECT_EQ(int64_t(prop["minItems"]), 3);
+                EXPECT_EQ(int64_t(prop["maxItems"]), int64_t(kMaxPolygonPoints));
+                EXPECT_EQ(int64_t(prop["items"]["minItems"]), 2);
+                EXPECT_EQ(int64_t(prop["items"]["maxItems"]), 2);
+                continue;
+            }
             const bool count = p.check == Check::Count;
             EXPECT_EQ(std::string_view(prop["type"]), p.type == ValueType::Number
                                                           ? (count ? "integer" : "number")
@@ -146,8 +165,8 @@ TEST(Schema, EveryKindAndParameterOfTheTableAppears) {
             auto bounds = p.type == ValueType::Number ? prop : prop["items"];
             if (count) {
                 EXPECT_EQ(std::string_view(bounds["type"]), "integer");
-                EXPECT_EQ(double(bounds["minimum"]), 1.0);
-                EXPECT_EQ(double(bounds["maximum"]), 1e6);
+                EXPECT_EQ(double(bounds["minimum"]), p.least);
+                EXPECT_EQ(double(bounds["maximum"]), std::min(double(p.maximum), 1e6));
             }
             EXPECT_EQ(bounds["exclusiveMinimum"].error() == simdjson::SUCCESS,
                       p.check == Check::Positive);

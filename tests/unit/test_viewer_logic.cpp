@@ -811,7 +811,8 @@ TEST(ViewerScript, RefusesNumbersThatAreNotFinite) {
                                     "s.txt:5:1: zoom: expected a positive factor, got \"0\"\n"
                                     "s.txt:6:1: op: expected one of union, intersection, "
                                     "difference, shell, offset, repeat, polar_repeat, mirror, "
-                                    "elongate, twist, bend, taper, got \"sphere\"");
+                                    "elongate, twist, bend, taper, extrude, revolve, got "
+                                    "\"sphere\"");
 }
 
 TEST(ViewerScript, ParentTakesANodeAndAPosition) {

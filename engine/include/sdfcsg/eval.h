@@ -50,6 +50,9 @@ struct FlatNode {
                                           // ...): KindInfo::kernel and ::kernelAround
     Aabb bounds;         // bounds in the frame; the node's value at p is >= bounds.signedDistance(p)
     std::vector<uint32_t> children;
+    // Polygon and text: Node::outline; the parameters then hold the glyph count (slot 1) and
+    // the outline's extents (slots 2-5).
+    std::shared_ptr<const std::vector<glm::vec4>> outline;
 };
 
 struct Sample {

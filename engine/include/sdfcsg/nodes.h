@@ -33,6 +33,12 @@ enum class NodeKind : uint8_t {
     RoundCone,
     Link,
     CappedTorus,
+    // 2D profiles: shapes in the xy plane, for extrude and revolve,
+    Circle,
+    Rectangle,
+    RegularPolygon,
+    Polygon,
+    Text,
     // Operations (nodes with children) from here on: the Boolean ones,
     Union,
     Intersection,
@@ -48,8 +54,10 @@ enum class NodeKind : uint8_t {
     Twist,
     Bend,
     Taper,
+    Extrude,
+    Revolve,
 };
-inline constexpr int kNodeKindCount = 29;
+inline constexpr int kNodeKindCount = 36;
 inline constexpr NodeKind kFirstOperation = NodeKind::Union;
 
 // Every node stores its numeric parameters in this many float slots (see ParamInfo::slot).
@@ -57,7 +65,8 @@ inline constexpr int kMaxParams = 8;
 using Params = std::array<float, kMaxParams>;
 
 // Choice: one of ParamInfo::choices by name, stored as its index.
-enum class ValueType : uint8_t { Number, Vec3, Choice };
+// Points: [[x, y], ...] in Node::points; Text: a string in Node::strings[slot].
+enum class ValueType : uint8_t { Number, Vec3, Choice, Points, Text };
 enum class Check : uint8_t {
     Any,         // any finite value
     Positive,    // > 0 (each component for vectors)
@@ -77,6 +86,7 @@ struct ParamInfo {
     std::string_view doc;
     float maximum = 3.4e38f;                      // Number: the largest value accepted
     std::span<const std::string_view> choices{};  // Choice: the names, in stored order
+    float least = 1.0f;                           // Count: the smallest value accepted
 };
 
 // How the inlined GLSL calls a primitive's formula: the kernel parameters after the local point,
@@ -88,6 +98,18 @@ struct KernelArg {
 // What a kind is: a primitive, a Boolean operation of any number of children, an operation on
 // one child's value, or one on the space its one child is evaluated in.
 enum class Role : uint8_t { Primitive, Boolean, Value, Domain };
+
+// 2D profiles are primitives of the xy plane: as fields of space they are prisms along z, and
+// only extrude and revolve, which cut them at z = 0, may hold them.
+inline constexpr bool isProfile(NodeKind kind) {
+    return kind >= NodeKind::Circle && kind <= NodeKind::Text;
+}
+// Polygon and text: their outlines' segments live beside the node (Node::outline).
+inline constexpr bool hasOutline(NodeKind kind) {
+    return kind == NodeKind::Polygon || kind == NodeKind::Text;
+}
+// A polygon's points, at most.
+inline constexpr size_t kMaxPolygonPoints = 1024;
 
 struct KindInfo {
     NodeKind kind;

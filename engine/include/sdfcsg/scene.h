@@ -7,11 +7,14 @@
 #include "sdfcsg/error.h"
 #include "sdfcsg/nodes.h"
 
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
 
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -35,6 +38,12 @@ struct Node {
     std::optional<glm::vec3> color; // unset: inherited from the parent
     std::array<float, kMaxParams> params{}; // laid out by the kind's ParamInfo::slot
     std::vector<uint32_t> children;  // indices into Scene::nodes, operations only
+    // Polygon: its points; text: its string and font (ParamInfo::slot indexes strings).
+    std::vector<glm::vec2> points;
+    std::array<std::string, 2> strings;
+    // Polygon and text: the outline's glyph records and segments, made by the loader (the
+    // layout is sdOutline's in shaders/sdf.glsl); shared by copies of the scene.
+    std::shared_ptr<const std::vector<glm::vec4>> outline;
 };
 
 struct Camera {

@@ -1,0 +1,264 @@
+// 2D profiles, extrude and revolve on the CPU: each against the 3D primitive it makes (an
+// extruded circle is a cylinder, a revolved circle a torus), polygons and text against brute
+// force over their outlines, and the font's outlines against their own geometry.
+#include "font.h"
+#include "outline.h"
+
+#include <sdfcsg/eval.h>
+
+#include <gtest/gtest.h>
+
+#include <glm/geometric.hpp>
+
+#include <cmath>
+#include <random>
+#include <string>
+
+namespace sdfcsg {
+namespace {
+
+Scene parse(const std::string& root) {
+    auto scene = parseScene(R"({"version": 1, "root": )" + root + "}", "test.json");
+    if (!scene) ADD_FAILURE() << scene.error().str();
+    return scene ? *scene : Scene{};
+}
+
+std::string errorOf(const std::string& root) {
+    auto scene = parseScene(R"({"version": 1, "root": )" + root + "}", "test.json");
+    return scene ? "accepted" : scene.error().str();
+}
+
+std::vector<glm::vec3> points(uint32_t seed, int count, float reach) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(-reach, reach);
+    std::vector<glm::vec3> out;
+    for (int i = 0; i < count; ++i)
+        out.push_back({u(rng), u(rng), u(rng)});
+    return out;
+}
+
+// Both fields agree within `tolerance` everywhere in the cube of half side `reach`.
+void expectSameField(const std::string& a, const std::string& b, float reach, float tolerance) {
+    SCOPED_TRACE(a);
+    Evaluator ea(parse(a)), eb(parse(b));
+    for (glm::vec3 p : points(3, 4000, reach))
+        ASSERT_NEAR(ea.distance(p), eb.distance(p), tolerance) << p.x << " " << p.y << " " << p.z;
+}
+
+TEST(Profiles, ExtrudedCircleIsACylinder) {
+    expectSameField(R"({"type": "extrude", "height": 0.6, "children": [
+                        {"type": "circle", "radius": 0.4}]})",
+                    R"({"type": "cylinder", "radius": 0.4, "height": 0.6, "rotate": [90, 0, 0]})",
+                    1.2f, 2e-5f);
+}
+
+TEST(Profiles, ExtrudedRectangleIsABox) {
+    expectSameField(R"({"type": "extrude", "height": 0.6, "children": [
+                        {"type": "rectangle", "width": 0.8, "height": 0.5}]})",
+                    R"({"type": "box", "size": [0.8, 0.5, 0.6]})", 1.2f, 2e-5f);
+    // Rounded corners and rounded edges: a round box.
+    expectSameField(R"({"type": "extrude", "height": 0.6, "rounding": 0.1, "children": [
+                        {"type": "rectangle", "width": 0.8, "height": 0.5, "rounding": 0.1}]})",
+                    R"({"type": "round_box", "size": [0.8, 0.5, 0.6], "radius": 0.1})", 1.2f,
+                    2e-5f);
+}
+
+TEST(Profiles, ExtrudedHexagonIsAHexPrism) {
+    expectSameField(R"({"type": "extrude", "height": 0.4, "children": [
+                        {"type": "regular_polygon", "radius": 0.5, "sides": 6}]})",
+                    R"({"type": "hex_prism", "radius": 0.5, "height": 0.4, "rotate": [90, 0, 0]})",
+                    1.2f, 2e-5f);
+}
+
+TEST(Profiles, RevolvedCircleIsATorus) {
+    expectSameField(R"({"type": "revolve", "offset": 0.6, "children": [
+                        {"type": "circle", "radius": 0.2}]})",
+                    R"({"type": "torus", "major_radius": 0.6, "minor_radius": 0.2})", 1.2f, 2e-5f);
+    // A profile moved off the axis instead of the offset: the same ring.
+    expectSameField(R"({"type": "revolve", "children": [
+                        {"type": "circle", "radius": 0.2, "translate": [0.6, 0, 0]}]})",
+                    R"({"type": "torus", "major_radius": 0.6, "minor_radius": 0.2})", 1.2f, 2e-5f);
+}
+
+TEST(Profiles, PolygonSquareIsARectangle) {
+    expectSameField(R"({"type": "extrude", "height": 0.6, "children": [
+                        {"type": "polygon", "points": [[-0.4, -0.25], [0.4, -0.25], [0.4, 0.25], [-0.4, 0.25]]}]})",
+                    R"({"type": "box", "size": [0.8, 0.5, 0.6]})", 1.2f, 2e-5f);
+}
+
+// The exact distance to a 2D polyline, and the crossing parity, by brute force.
+struct Brute {
+    std::vector<std::pair<glm::vec2, glm::vec2>> edges;
+    float distance(glm::vec2 p) const {
+        float best = INFINITY;
+        bool inside = false;
+        for (auto [a, b] : edges) {
+            const glm::vec2 pa = p - a, ba = b - a;
+            const float h = glm::clamp(glm::dot(pa, ba) / glm::dot(ba, ba), 0.0f, 1.0f);
+            best = std::min(best, glm::length(pa - ba * h));
+            if ((a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y))
+                inside = !inside;
+        }
+        return inside ? -best : best;
+    }
+};
+
+TEST(Profiles, PolygonIsTheExactDistanceToItsEdges) {
+    const std::vector<glm::vec2> pts = {{-0.5f, -0.5f}, {0.5f, -0.5f}, {0.5f, 0.0f}, {0.0f, 0.0f},
+                                        {0.1f, 0.4f},   {-0.3f, 0.6f}, {-0.5f, 0.1f}};
+    std::string json;
+    Brute brute;
+    for (size_t i = 0; i < pts.size(); ++i) {
+        json += (i ? ", [" : "[") + std::to_string(pts[i].x) + ", " + std::to_string(pts[i].y) + "]";
+        brute.edges.push_back({pts[i], pts[(i + 1) % pts.size()]});
+    }
+    // Clockwise or not, the same solid.
+    for (bool reversed : {false, true}) {
+        std::string list = json;
+        if (reversed) {
+            list.clear();
+            for (size_t i = pts.size(); i-- > 0;)
+                list += (list.empty() ? "[" : ", [") + std::to_string(pts[i].x) + ", " +
+                        std::to_string(pts[i].y) + "]";
+        }
+        Evaluator e(parse(R"({"type": "extrude", "height": 100, "children": [
+            {"type": "polygon", "points": [)" + list + "]}]}"));
+        for (glm::vec3 p : points(9, 3000, 0.9f)) {
+            const float expected = brute.distance({p.x, p.y});
+            ASSERT_NEAR(e.distance(glm::vec3(p.x, p.y, 0.0f)), expected, 2e-5f)
+                << p.x << " " << p.y << (reversed ? " reversed" : "");
+        }
+    }
+}
+
+TEST(Profiles, BadProfilesGiveExactMessages) {
+    EXPECT_EQ(errorOf(R"({"type": "circle", "radius": 1})"),
+              "test.json: root: a circle is a 2D profile: it must be inside an extrude or a revolve");
+    EXPECT_EQ(errorOf(R"({"type": "extrude", "height": 1, "children": [
+                  {"type": "polygon", "points": [[0, 0], [1, 0]]}]})"),
+              "test.json: root.children[0].points: expected an array of 3 to 1024 points [x, y], "
+              "got 2 points");
+    EXPECT_EQ(errorOf(R"({"type": "extrude", "height": 1, "children": [
+                  {"type": "polygon", "points": [[0, 0], [1, 1], [1, 0], [0, 1]]}]})"),
+              "test.json: root.children[0].points: edges 0 and 2 cross (an edge joins a point to "
+              "the next); expected a simple polygon");
+    EXPECT_EQ(errorOf(R"({"type": "extrude", "height": 1, "children": [
+                  {"type": "polygon", "points": [[0, 0], [1, 0], [1, 0], [0, 1]]}]})"),
+              "test.json: root.children[0].points: points 1 and 2 are the same; expected a simple "
+              "polygon");
+    EXPECT_EQ(errorOf(R"({"type": "extrude", "height": 1, "children": [
+                  {"type": "polygon", "points": [[0, 0], [1], [0, 1]]}]})"),
+              "test.json: root.children[0].points[1]: expected a point [x, y], got [1]");
+    EXPECT_EQ(errorOf(R"({"type": "extrude", "height": 1, "children": [
+                  {"type": "regular_polygon", "radius": 1, "sides": 2}]})"),
+              "test.json: root.children[0].sides: expected at least 3, got 2");
+    EXPECT_EQ(errorOf(R"({"type": "extrude", "height": 1, "children": [
+                  {"type": "regular_polygon", "radius": 1, "sides": 65}]})"),
+              "test.json: root.children[0].sides: expected at most 64, got 65");
+    EXPECT_EQ(errorOf(R"({"type": "extrude", "height": 1, "children": [
+                  {"type": "text", "text": 5}]})"),
+              "test.json: root.children[0].text: expected a string, got 5");
+    EXPECT_EQ(errorOf(R"({"type": "extrude", "height": 1, "children": [
+                  {"type": "text", "text": "a\u000ab"}]})"),
+              "test.json: root.children[0].text: text is one line: it may not hold a line break");
+    EXPECT_EQ(errorOf(R"({"type": "extrude", "height": 1, "children": [
+                  {"type": "text", "text": "\ue000"}]})"),
+              "test.json: root.children[0].text: the font "
+              "\"/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf\" has no glyph for (U+E000)");
+    EXPECT_EQ(errorOf(R"({"type": "extrude", "height": 1, "children": [
+                  {"type": "text", "text": "   "}]})"),
+              "test.json: root.children[0].text: expected text with something to see, got only "
+              "spaces");
+    EXPECT_EQ(errorOf(R"({"type": "extrude", "height": 1, "children": [
+                  {"type": "text", "text": "a", "font": "/nonexistent.ttf"}]})"),
+              "test.json: root.children[0].font: cannot load font \"/nonexistent.ttf\": no such "
+              "file");
+    EXPECT_EQ(errorOf(R"({"type": "extrude", "height": 1, "children": [{"type": "plane"}]})"),
+              "test.json: root: an extrude needs a bounded child, and its child reaches infinity "
+              "(a plane does)");
+}
+
+// The font's outlines: closed contours, "B" three of them and "o" two, outer ones wound one
+// way and holes the other; extents that hold every point and that the points reach.
+TEST(Profiles, FontOutlinesAreClosedContours) {
+    auto text = detail::textOutline("Bo", detail::defaultFontFile(), 1.0f);
+    ASSERT_TRUE(text) << text.error().str();
+    std::vector<double> areas;
+    double area = 0.0;
+    for (size_t i = 0; i < text->segments.size(); ++i) {
+        const detail::GlyphSegment& s = text->segments[i];
+        area += 0.5 * (double(s.a.x) * s.b.y - double(s.b.x) * s.a.y);
+        if (s.quadratic) // the curve's area beyond its chord: 2/3 of the control triangle's
+            area += (2.0 / 3.0) * 0.5 *
+                    ((s.c.x - s.a.x) * double(s.b.y - s.a.y) - (s.b.x - s.a.x) * double(s.c.y - s.a.y));
+        const bool last = i + 1 == text->segments.size() || text->segments[i + 1].a != s.b;
+        if (last) {
+            areas.push_back(area);
+            area = 0.0;
+        }
+    }
+    ASSERT_EQ(areas.size(), 5u);
+    int positive = 0;
+    for (double a : areas)
+        positive += a > 0;
+    EXPECT_TRUE(positive == 2 || positive == 3) << "outer and inner contours wind apart";
+    for (const auto& s : text->segments)
+        for (glm::vec2 q : {s.a, s.b}) {
+            EXPECT_GE(q.x, text->min.x - 1e-5f);
+            EXPECT_LE(q.y, text->max.y + 1e-5f);
+        }
+    EXPECT_GT(text->advance, text->max.x - 0.2f);
+    EXPECT_GT(text->max.y, 0.5f); // cap height about 0.73 em
+    EXPECT_LT(text->min.y, 0.0f); // the "o" overshoots the baseline
+    // Twice the size: twice every coordinate.
+    auto big = detail::textOutline("Bo", detail::defaultFontFile(), 2.0f);
+    ASSERT_EQ(big->segments.size(), text->segments.size());
+    for (size_t i = 0; i < text->segments.size(); ++i)
+        EXPECT_NEAR(glm::distance(big->segments[i].b, 2.0f * text->segments[i].b), 0.0f, 1e-5f);
+    EXPECT_NEAR(big->advance, 2.0f * text->advance, 1e-5f);
+    // Kerning pulls "AV" together.
+    auto a = detail::textOutline("A", detail::defaultFontFile(), 1.0f);
+    auto v = detail::textOutline("V", detail::defaultFontFile(), 1.0f);
+    auto av = detail::textOutline("AV", detail::defaultFontFile(), 1.0f);
+    EXPECT_LT(av->advance, a->advance + v->advance);
+}
+
+// Text: the field is the exact distance to the glyphs' curves (sampled densely here), negative
+// inside them, and its bounds are the outline's extents, centred.
+TEST(Profiles, TextIsTheExactDistanceToItsGlyphs) {
+    auto text = detail::textOutline("Bo", detail::defaultFontFile(), 1.0f);
+    ASSERT_TRUE(text);
+    const glm::vec2 shift = -0.5f * (text->min + text->max);
+    Brute brute;
+    for (const auto& s : text->segments) {
+        const int n = s.quadratic ? 64 : 1;
+        glm::vec2 prev = s.a + shift;
+        for (int k = 1; k <= n; ++k) {
+            const float t = float(k) / n;
+            const glm::vec2 q = (1 - t) * (1 - t) * s.a + 2 * t * (1 - t) * s.c + t * t * s.b;
+            brute.edges.push_back({prev, q + shift});
+            prev = q + shift;
+        }
+    }
+    Evaluator e(parse(R"({"type": "extrude", "height": 100, "children": [
+        {"type": "text", "text": "Bo"}]})"));
+    const Aabb& box = e.nodes()[1].bounds;
+    const glm::vec2 half = 0.5f * (text->max - text->min);
+    for (int k = 0; k < 2; ++k) { // within the bounds' outward rounding
+        EXPECT_GE(box.max[k], half[k]);
+        EXPECT_LE(box.min[k], -half[k]);
+        EXPECT_NEAR(box.max[k], half[k], 5e-5f);
+        EXPECT_NEAR(box.min[k], -half[k], 5e-5f);
+    }
+    int inside = 0;
+    for (glm::vec3 p : points(4, 4000, 0.8f)) {
+        const float expected = brute.distance({p.x, p.y});
+        const float got = e.distance(glm::vec3(p.x, p.y, 0.0f));
+        ASSERT_NEAR(got, expected, 2e-4f) << p.x << " " << p.y; // the polyline's sag
+        inside += got < 0;
+    }
+    EXPECT_GT(inside, 200);
+}
+
+} // namespace
+} // namespace sdfcsg
