@@ -42,6 +42,16 @@ constexpr std::string_view kRules = R"(## How to build a scene
   them one by one.
 - "camera" is optional: without one the scene is framed automatically. Leave out optional
   keys you do not need (or set them to null).
+- Repeated parts are one node, not many: "repeat" makes a grid of copies of its one child
+  (count and spacing per axis), "polar_repeat" makes count copies around the y axis (the child
+  moved radius along +x first): gear teeth, a ring of pillars, holes on a bolt circle.
+- "mirror" makes a symmetric shape from one half; "shell" hollows its child (cut it open with
+  a difference); "offset" grows or shrinks it; "twist", "bend" and "taper" deform their child.
+- Lathe-turned shapes (vases, chess pieces, bottles) are a "revolve" of a "polygon" profile
+  whose points [x, y] have x >= 0 (x is the distance from the axis). Flat plates and lettering
+  are an "extrude" (thickness along z) of a 2D profile: "circle", "rectangle",
+  "regular_polygon", "polygon" or "text". 2D profiles exist only inside extrude or revolve.
+- "blend" chooses the profile of "smooth": "smooth", "round" (a fillet) or "chamfer" (a bevel).
 - No other keys exist: an unknown key is an error.
 )";
 

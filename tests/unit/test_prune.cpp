@@ -23,7 +23,7 @@ namespace fs = std::filesystem;
 std::vector<glm::vec3> points(const Evaluator& ev, size_t count, uint32_t seed) {
     Aabb box;
     for (const FlatNode& n : ev.nodes())
-        if (n.bounds.finite()) {
+        if (n.bounds.finite() && n.frame == kWorldFrame) { // others are in a domain's space
             box.min = glm::min(box.min, n.bounds.min);
             box.max = glm::max(box.max, n.bounds.max);
         }
