@@ -142,14 +142,16 @@ Result<TextOutline> textOutline(std::string_view utf8, std::string_view fontFile
     if (FT_Init_FreeType(&rawLibrary) != 0) return problem("cannot start FreeType");
     std::unique_ptr<FT_LibraryRec_, LibraryDone> library(rawLibrary);
     const std::string file(fontFile);
-    FT_Face rawFace = nullptr;
-    if (FT_New_Face(library.get(), file.c_str(), 0, &rawFace) != 0) {
-        std::error_code ec;
+    // Only regular files of a font's size: a pipe or a device would block or never end.
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(file, ec))
         return problem("cannot load font \"" + file + "\": " +
-                       (std::filesystem::is_regular_file(file, ec)
-                            ? "not a font FreeType can read"
-                            : "no such file"));
-    }
+                       (std::filesystem::exists(file, ec) ? "not a regular file" : "no such file"));
+    if (std::filesystem::file_size(file, ec) > 64u << 20)
+        return problem("cannot load font \"" + file + "\": larger than 64 MiB");
+    FT_Face rawFace = nullptr;
+    if (FT_New_Face(library.get(), file.c_str(), 0, &rawFace) != 0)
+        return problem("cannot load font \"" + file + "\": not a font FreeType can read");
     std::unique_ptr<FT_FaceRec_, FaceDone> face(rawFace);
     if (!FT_IS_SCALABLE(face.get()) || face->units_per_EM == 0)
         return problem("cannot load font \"" + file + "\": it has no outlines");

@@ -173,6 +173,13 @@ TEST(Profiles, BadProfilesGiveExactMessages) {
                   {"type": "text", "text": "a", "font": "/nonexistent.ttf"}]})"),
               "test.json: root.children[0].font: cannot load font \"/nonexistent.ttf\": no such "
               "file");
+    EXPECT_EQ(errorOf(R"({"type": "extrude", "height": 1, "children": [
+                  {"type": "text", "text": "a", "font": "/dev/zero"}]})"),
+              "test.json: root.children[0].font: cannot load font \"/dev/zero\": not a regular file");
+    EXPECT_EQ(errorOf(R"({"type": "extrude", "height": 1, "children": [
+                  {"type": "text", "text": "a", "font": ")" SDFCSG_SOURCE_DIR R"(/LICENSE"}]})"),
+              "test.json: root.children[0].font: cannot load font \"" SDFCSG_SOURCE_DIR
+              "/LICENSE\": not a font FreeType can read");
     EXPECT_EQ(errorOf(R"({"type": "extrude", "height": 1, "children": [{"type": "plane"}]})"),
               "test.json: root: an extrude needs a bounded child, and its child reaches infinity "
               "(a plane does)");
