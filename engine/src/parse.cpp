@@ -125,6 +125,7 @@ class SceneReader {
 
     const Limits& limits_;
     Problems& problems_;
+    size_t outlineWords_ = 0; // polygon and text outlines so far, in vec4s
 };
 
 Scene SceneReader::read(element top) {
@@ -450,6 +451,11 @@ std::optional<dom::array> SceneReader::readNode(element value, std::string path,
         } else if ((*outline)->empty()) {
             problems_.add(member(p, "text"), "expected text with something to see, got only "
                                              "spaces");
+        } else if ((outlineWords_ += (*outline)->size()) > kMaxOutlineWords) {
+            if (outlineWords_ - (*outline)->size() <= kMaxOutlineWords) // once, where it passes
+                problems_.add(p, "the scene's polygon and text outlines exceed " +
+                                     std::to_string(kMaxOutlineWords / 2) +
+                                     " segments in all, the limit");
         } else {
             node.outline = *outline;
         }

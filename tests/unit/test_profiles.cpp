@@ -185,6 +185,21 @@ TEST(Profiles, BadProfilesGiveExactMessages) {
               "(a plane does)");
 }
 
+// Outlines are bounded per scene, not only per node.
+TEST(Profiles, OutlinesOfAllNodesAreBounded) {
+    std::string kids;
+    for (int i = 0; i < 200; ++i)
+        kids += std::string(i ? ", " : "") + R"({"type": "text", "text": ")" + std::string(256, '@') +
+                "\"}";
+    const std::string error =
+        errorOf(R"({"type": "extrude", "height": 1, "children": [{"type": "union", "children": [)" +
+                kids + "]}]}");
+    EXPECT_NE(error.find("the scene's polygon and text outlines exceed 1048576 segments in all, "
+                         "the limit"),
+              std::string::npos)
+        << error.substr(0, 300);
+}
+
 // The font's outlines: closed contours, "B" three of them and "o" two, outer ones wound one
 // way and holes the other; extents that hold every point and that the points reach.
 TEST(Profiles, FontOutlinesAreClosedContours) {

@@ -108,8 +108,10 @@ inline constexpr bool isProfile(NodeKind kind) {
 inline constexpr bool hasOutline(NodeKind kind) {
     return kind == NodeKind::Polygon || kind == NodeKind::Text;
 }
-// A polygon's points, at most.
+// A polygon's points, at most; and the vec4s of every outline of a scene (segments take two),
+// so that the node buffer stays within 32 MiB.
 inline constexpr size_t kMaxPolygonPoints = 1024;
+inline constexpr size_t kMaxOutlineWords = size_t(1) << 21;
 
 struct KindInfo {
     NodeKind kind;
