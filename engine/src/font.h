@@ -5,6 +5,7 @@
 
 #include <glm/vec2.hpp>
 
+#include <cstddef>
 #include <string_view>
 #include <vector>
 
@@ -19,19 +20,35 @@ struct GlyphSegment {
 
 struct TextOutline {
     std::vector<GlyphSegment> segments; // closed contours, y up, baseline at y = 0, pen from x = 0
-    glm::vec2 min{0.0f}, max{0.0f};     // the glyphs' outline extents, as placed
-    float advance = 0.0f;               // the pen's advance after the last glyph
+    glm::vec2 min{0.0f}, max{0.0f};     // the glyphs' exact outline extents, as placed; 0 if none
+    float advance = 0.0f;               // the pen's advance after the last glyph, kerning applied
 };
 
 inline constexpr size_t kMaxTextCharacters = 256;
 inline constexpr size_t kMaxTextSegments = 65536;
+// How far the quadratics that replace a cubic may stray from it, in ems.
+inline constexpr float kCubicTolerance = 1e-3f;
 
 // DejaVu Sans from Debian's fonts-dejavu-core.
 std::string_view defaultFontFile();
 
 // The outlines of `utf8` set on one line in `fontFile`, the font's em square `size` units tall,
-// with its kerning. Cubic curves (OpenType CFF outlines) become quadratics within 1e-3 em.
-// Errors are messages without a file or path, for the caller to place.
+// with its kerning (the legacy 'kern' table; GPOS is not read). Contours come as the font winds
+// them: TrueType's outer contours clockwise, holes counter-clockwise; inside is non-zero winding.
+// Spaces advance the pen and add no segments. Each call opens its own FreeType library, so calls
+// may run on any threads at once. Errors are messages without a file or path, for the caller to
+// place: "cannot load font \"PATH\": <why>", "the font \"PATH\" has no glyph for 'X' (U+0058)",
+// "text is one line: it may not hold a line break", bad UTF-8, more than kMaxTextCharacters
+// characters or kMaxTextSegments segments.
 Result<TextOutline> textOutline(std::string_view utf8, std::string_view fontFile, float size);
+
+// The cubic Bezier p0, p1, p2, p3 as quadratics appended to `out`, chained from p0 to p3, within
+// `tolerance` of it (units of the points; plus float rounding): n equal parameter pieces, n the
+// least for which sqrt(3) / 36 * |p3 - 3 p2 + 3 p1 - p0| / n^3 <= tolerance. At most 64 pieces,
+// which hold the bound while that third difference is under 5.4 million tolerances (5400 ems
+// for textOutline, which passes kCubicTolerance * size; in a font of 1000 units per em, whose
+// coordinates are 16-bit, it is at most 524 ems).
+void cubicToQuadratics(glm::vec2 p0, glm::vec2 p1, glm::vec2 p2, glm::vec2 p3,
+                       std::vector<GlyphSegment>& out, float tolerance = kCubicTolerance);
 
 } // namespace sdfcsg::detail
