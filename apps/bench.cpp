@@ -41,6 +41,7 @@ std::vector<fs::path> findScenes(const fs::path& dir) {
 }
 
 const char* kHelp = R"(Usage: sdfcsg bench [--scenes DIR] [--width W] [--height H] [--frames N] [--buffer]
+                   [--evaluation E]
        sdfcsg bench --mesh [--scenes DIR] [--resolutions 128,256,512] [--runs N]
 
 For every scene (*.json) in DIR (default assets/scenes), prints the median milliseconds per
@@ -62,6 +63,7 @@ Options:
   --width W      image width (default 1280)
   --height H     image height (default 720)
   --frames N     timed frames per measurement (default 5)
+  --evaluation E auto (default), inlined or tapes, as for render
   --buffer       also time a renderer that reads the values from the node buffer, as the
                  viewer's value edits do (so no recompile): its frame and its build from a
                  parsed scene, with nothing cached (slow to compile on lavapipe)
@@ -96,10 +98,13 @@ bool parseCount(const char* s, uint32_t lo, uint32_t hi, uint32_t& out) {
 
 // JSON text to a renderer with its pipeline built.
 Result<std::unique_ptr<Renderer>> buildFromJson(Context& context, const std::string& json,
-                                                const std::string& file) {
+                                                const std::string& file,
+                                                Evaluation evaluation = Evaluation::Auto) {
     auto scene = parseScene(json, file);
     if (!scene) return scene.error();
-    return Renderer::create(context, *scene);
+    RendererOptions options;
+    options.evaluation = evaluation;
+    return Renderer::create(context, *scene, options);
 }
 
 Result<double> medianFrameMs(Renderer& renderer, const RenderOptions& options, uint32_t frames) {
@@ -286,6 +291,7 @@ int runBench(int argc, char** argv) {
     fs::path dir = "assets/scenes";
     uint32_t width = 1280, height = 720, frames = 5;
     bool buffer = false;
+    Evaluation evaluation = Evaluation::Auto;
     for (int i = 0; i < argc; ++i) {
         std::string_view a = argv[i];
         if (a == "--help" || a == "-h") {
@@ -305,7 +311,13 @@ int runBench(int argc, char** argv) {
             ok = parseCount(argv[++i], 1, 16384, height);
         else if (ok && a == "--frames")
             ok = parseCount(argv[++i], 1, 1000, frames);
-        else
+        else if (ok && a == "--evaluation") {
+            const std::string_view v = argv[++i];
+            ok = v == "auto" || v == "inlined" || v == "tapes";
+            evaluation = v == "inlined" ? Evaluation::Inlined
+                         : v == "tapes" ? Evaluation::Tapes
+                                        : Evaluation::Auto;
+        } else
             ok = false;
         if (!ok) {
             std::fprintf(stderr, "sdfcsg bench: bad argument '%s'\nTry 'sdfcsg bench --help'.\n",
@@ -395,7 +407,7 @@ int runBench(int argc, char** argv) {
             const int column = i % kColdColumns;
             auto build = [&](Context& coldContext) -> Status {
                 auto start = Clock::now();
-                auto built = buildFromJson(coldContext, json, file);
+                auto built = buildFromJson(coldContext, json, file, evaluation);
                 if (!built) return built.error();
                 cold[column].push_back(msSince(start));
                 return Ok{};
@@ -408,7 +420,7 @@ int runBench(int argc, char** argv) {
             for (int i = 0; i <= kPipelineRuns && status == 0; ++i) {
                 detail::clearShaderMemoryCache();
                 auto start = Clock::now();
-                auto built = buildFromJson(**context, json, file);
+                auto built = buildFromJson(**context, json, file, evaluation);
                 if (!built)
                     fail(built.error());
                 else if (i > 0)
@@ -443,6 +455,7 @@ int runBench(int argc, char** argv) {
                 if (!scene) return scene.error();
                 RendererOptions values;
                 values.inlineValues = false;
+                values.evaluation = evaluation;
                 auto start = Clock::now();
                 auto built = Renderer::create(coldContext, *scene, values);
                 if (!built) return built.error();

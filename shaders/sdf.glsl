@@ -195,17 +195,18 @@ SDF_FN float sdRegularPolygon(vec3 p, float r, float an, float cs, float sn) {
     return length(q) * sign(q.x);
 }
 
-SDF_FN float sdSegment2(vec2 p, vec2 a, vec2 b) {
+// The squared distance from p to the segment ab.
+SDF_FN float sqSegment2(vec2 p, vec2 a, vec2 b) {
     vec2 pa = p - a, ba = b - a;
-    return length(pa - ba * clamp(dot(pa, ba) / dot(ba, ba), 0.0f, 1.0f));
+    return dot2(pa - ba * clamp(dot(pa, ba) / dot(ba, ba), 0.0f, 1.0f));
 }
 
 SDF_FN float cubeRoot(float x) { return sign(x) * pow(abs(x), 1.0f / 3.0f); }
 
-// Exact distance to the quadratic Bezier from a through control c to b (IQ's sdBezier: the
-// nearest point's parameter is a root of a cubic). The loader makes nearly straight curves lines,
-// so b - 2c + a is never near zero.
-SDF_FN float sdQuadratic2(vec2 p, vec2 a, vec2 c, vec2 b) {
+// The squared exact distance to the quadratic Bezier from a through control c to b (IQ's
+// sdBezier: the nearest point's parameter is a root of a cubic). The loader makes nearly
+// straight curves lines, so b - 2c + a is never near zero.
+SDF_FN float sqQuadratic2(vec2 p, vec2 a, vec2 c, vec2 b) {
     vec2 ea = c - a, eb = a - 2.0f * c + b, ec = ea * 2.0f, ed = a - p;
     float kk = 1.0f / dot(eb, eb);
     float kx = kk * dot(ea, eb);
@@ -225,55 +226,64 @@ SDF_FN float sdQuadratic2(vec2 p, vec2 a, vec2 c, vec2 b) {
         float t0 = clamp((m + m) * z - kx, 0.0f, 1.0f), t1 = clamp((-n - m) * z - kx, 0.0f, 1.0f);
         res = min(dot2(ed + (ec + eb * t0) * t0), dot2(ed + (ec + eb * t1) * t1));
     }
-    return sqrt(min(res, min(dot2(ed), dot2(b - p))));
+    return min(res, min(dot2(ed), dot2(b - p)));
 }
 
-// How the segment (a line, or a quadratic through c, monotonic in y: the loader splits them)
-// winds around p: +-1 where the ray from p towards +x crosses it, counted half-open in y so a
-// ray through a shared end point counts once.
-SDF_FN float outlineCrossing(vec2 p, vec2 a, vec2 c, vec2 b, bool quadratic) {
+// How a segment winds around p: +-1 where the ray from p towards +x crosses it, counted
+// half-open in y so a ray through a shared end point counts once. A line crosses it where p
+// lies on the left of the line going up (or the right going down), a test without division.
+SDF_FN float lineCrossing(vec2 p, vec2 a, vec2 b) {
     if ((a.y <= p.y) == (b.y <= p.y)) return 0.0f;
-    float x;
-    if (quadratic) {
-        // y(t) = A t^2 + B t + C = p.y has one root in [0, 1]; the stable pair of formulas.
-        float qa = a.y - 2.0f * c.y + b.y, qb = 2.0f * (c.y - a.y), qc = a.y - p.y;
-        float root = sqrt(max(qb * qb - 4.0f * qa * qc, 0.0f));
-        float qq = -0.5f * (qb + (qb >= 0.0f ? root : -root));
-        float t0 = qq / (qa != 0.0f ? qa : 1e-30f), t1 = qc / (qq != 0.0f ? qq : 1e-30f);
-        float t = clamp(abs(t0 - 0.5f) < abs(t1 - 0.5f) ? t0 : t1, 0.0f, 1.0f);
-        x = mix(mix(a.x, c.x, t), mix(c.x, b.x, t), t);
-    } else {
-        x = a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y);
-    }
+    float side = (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x);
+    return b.y > a.y ? (side > 0.0f ? 1.0f : 0.0f) : (side < 0.0f ? -1.0f : 0.0f);
+}
+
+// A quadratic through control point c (monotonic in y: the loader splits them).
+SDF_FN float quadraticCrossing(vec2 p, vec2 a, vec2 c, vec2 b) {
+    if ((a.y <= p.y) == (b.y <= p.y)) return 0.0f;
+    // y(t) = A t^2 + B t + C = p.y has one root in [0, 1]; the stable pair of formulas.
+    float qa = a.y - 2.0f * c.y + b.y, qb = 2.0f * (c.y - a.y), qc = a.y - p.y;
+    float root = sqrt(max(qb * qb - 4.0f * qa * qc, 0.0f));
+    float qq = -0.5f * (qb + (qb >= 0.0f ? root : -root));
+    float t0 = qq / (qa != 0.0f ? qa : 1e-30f), t1 = qc / (qq != 0.0f ? qq : 1e-30f);
+    float t = clamp(abs(t0 - 0.5f) < abs(t1 - 0.5f) ? t0 : t1, 0.0f, 1.0f);
+    float x = mix(mix(a.x, c.x, t), mix(c.x, b.x, t), t);
     return x > p.x ? (b.y > a.y ? 1.0f : -1.0f) : 0.0f;
 }
 
 // Polygon and text: the exact distance to an outline of line and quadratic segments, negative
-// where they wind around p (non-zero rule). The data from `first` on: per glyph (a set of
-// closed contours) its box (min xy, max xy) and (first segment from `first`, segment count);
-// per segment (a, b) and (c, 1 for a quadratic else 0). A glyph whose box is farther than the
-// nearest segment so far is skipped, and one whose box does not hold p cannot wind around it.
-SDF_FN float sdOutline(vec3 p3, float firstAt, float glyphCount SDF_DATA_PARAM) {
+// where they wind around p (non-zero rule). The data from `first` on: per contour its box (min
+// xy, max xy) and (first segment from `first`, line count, -, quadratic count); its lines, a
+// word each (a, b), then its quadratics, two words each ((a, b), (c, -)). Two loops rather than
+// a select per segment: a CPU device computes both sides of a select, and the quadratic's side
+// is several times the line's. A contour whose box is farther than the nearest segment so far
+// is skipped, and one whose box does not hold p cannot wind around it.
+SDF_FN float sdOutline(vec3 p3, float firstAt, float contourCount SDF_DATA_PARAM) {
     vec2 p = vec2(p3.x, p3.y);
-    uint first = uint(firstAt), glyphs = uint(glyphCount);
-    float best = 1e30f, winding = 0.0f;
-    for (uint g = 0u; g < glyphs; ++g) {
+    uint first = uint(firstAt), contours = uint(contourCount);
+    float best = 1e30f, winding = 0.0f; // best: the least squared distance
+    for (uint g = 0u; g < contours; ++g) {
         vec4 box = SDF_DATA(first + 2u * g), range = SDF_DATA(first + 2u * g + 1u);
         vec2 e = max(vec2(box.x - p.x, box.y - p.y), vec2(p.x - box.z, p.y - box.w));
         bool holds = max(e.x, e.y) <= 0.0f;
-        if (!holds && dot2(max(e, 0.0f)) >= best * best) continue;
-        uint s0 = first + uint(range.x), count = uint(range.y);
-        for (uint s = 0u; s < count; ++s) {
-            vec4 ab = SDF_DATA(s0 + 2u * s), cq = SDF_DATA(s0 + 2u * s + 1u);
+        if (!holds && dot2(max(e, 0.0f)) >= best) continue;
+        uint at = first + uint(range.x), lines = uint(range.y), quadratics = uint(range.w);
+        for (uint s = 0u; s < lines; ++s) {
+            vec4 ab = SDF_DATA(at + s);
+            vec2 a = vec2(ab.x, ab.y), b = vec2(ab.z, ab.w);
+            if (holds) winding += lineCrossing(p, a, b);
+            best = min(best, sqSegment2(p, a, b));
+        }
+        at += lines;
+        for (uint s = 0u; s < quadratics; ++s) {
+            vec4 ab = SDF_DATA(at + 2u * s), cq = SDF_DATA(at + 2u * s + 1u);
             vec2 a = vec2(ab.x, ab.y), b = vec2(ab.z, ab.w), c = vec2(cq.x, cq.y);
-            bool quadratic = cq.z > 0.5f;
-            if (holds) winding += outlineCrossing(p, a, c, b, quadratic);
+            if (holds) winding += quadraticCrossing(p, a, c, b);
             vec2 f = max(min(min(a, b), c) - p, p - max(max(a, b), c));
-            if (dot2(max(f, 0.0f)) < best * best)
-                best = min(best, quadratic ? sdQuadratic2(p, a, c, b) : sdSegment2(p, a, b));
+            if (dot2(max(f, 0.0f)) < best) best = min(best, sqQuadratic2(p, a, c, b));
         }
     }
-    return winding != 0.0f ? -best : best;
+    return winding != 0.0f ? -sqrt(best) : sqrt(best);
 }
 
 // CSG operators: IQ's polynomial smooth minimum with blend radius k, and smooth max(a, b) =

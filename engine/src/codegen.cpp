@@ -8,6 +8,7 @@
 
 #include "gpu_nodes.h"
 #include "prune.h"
+#include "sdf.h"
 
 #include <algorithm>
 #include <array>
@@ -23,6 +24,9 @@ namespace {
 // value makes compiling quadratic: 1000 inlined spheres take about 3 s, 2000 more than 5 s.
 // Larger scenes read their values from the node buffer even when inlining is asked for.
 constexpr size_t kInlineLimit = 1024;
+// The most words of a polygon's or text's outline that are written out as code (about 200
+// segments; Emitter::inlinedOutline).
+constexpr size_t kInlineOutlineWords = 256;
 
 // Shortest text that reads back as the same float, always a GLSL float literal.
 void appendFloat(std::string& out, float v) {
@@ -68,10 +72,14 @@ class Emitter {
             bool boundsTests)
         : scene_(scene), out_(out), lit_(literals), tests_(boundsTests) {}
 
-    // The buffer-mode wrappers, e.g. `float boxNode(uint i, vec3 p)`, for the kinds in use (none
-    // with values inlined).
+    // The buffer-mode wrappers, e.g. `float boxNode(uint i, vec3 p)`, for the kinds in use; with
+    // values inlined, the outlines written out as code.
     void helpers() {
-        if (lit_) return;
+        if (lit_) {
+            for (uint32_t i = 0; i < scene_.nodes.size(); ++i)
+                if (inlinedOutline(i)) outlineFunction(i);
+            return;
+        }
         std::array<bool, kNodeKindCount> used{};
         for (const Node& n : scene_.nodes)
             used[size_t(n.kind)] = true;
@@ -107,6 +115,7 @@ class Emitter {
                 const std::vector<uint32_t>& operands = n.children;
                 if (!operands.empty()) {
                     stack.push_back({current, 1, depth});
+                    if (kindInfo(n.kind).role == Role::Domain) depth += openDomain(current, depth);
                     current = operands[0];
                     ++depth;
                     continue;
@@ -129,7 +138,16 @@ class Emitter {
                 const Node& op = scene_.nodes[f.node];
                 const std::vector<uint32_t>& operands = op.children;
                 const uint32_t child = operands[f.next - 1];
-                if (f.next == 1) {
+                const Role role = kindInfo(op.kind).role;
+                if (role == Role::Domain) {
+                    closeDomain(f.node, child, f.depth);
+                } else if (role == Role::Value) {
+                    indent(f.depth);
+                    declare(f.node);
+                    withDistance(child, "valueOp(" + kindConst(f.node) + ", " + distance(child) +
+                                            ", " + param(f.node, 0) + ")");
+                    comment(f.node);
+                } else if (f.next == 1) {
                     indent(f.depth);
                     declare(f.node);
                     var(child);
@@ -150,6 +168,196 @@ class Emitter {
 
   private:
     void indent(uint32_t depth) { out_.append(4 * (depth + 1), ' '); }
+
+    // Whether node i's outline (polygon, text) is written out as code: sdOutline's loop reads
+    // every segment from the node buffer, which costs a CPU device (lavapipe) several times the
+    // arithmetic, while written out they are literals.
+    bool inlinedOutline(uint32_t i) const {
+        const Node& n = scene_.nodes[i];
+        return lit_ && n.outline && n.outline->size() <= kInlineOutlineWords;
+    }
+
+    static std::string vec2Literal(float x, float y) {
+        std::string s;
+        const float v[2] = {x, y};
+        appendVector(s, v, 2);
+        return s;
+    }
+
+    // sdOutline (shaders/sdf.glsl) unrolled over node i's outline: `float outline<i>(vec3 p)`.
+    void outlineFunction(uint32_t i) {
+        const std::vector<glm::vec4>& w = *scene_.nodes[i].outline;
+        out_ += "float outline" + std::to_string(i) +
+                "(vec3 p3) {\n    vec2 p = p3.xy;\n    float best = 1e30, winding = 0.0;\n"
+                "    bool holds;\n";
+        const uint32_t contours = uint32_t(w[1].z);
+        for (uint32_t g = 0; g < contours; ++g) {
+            const glm::vec4 box = w[2 * g], range = w[2 * g + 1];
+            out_ += "    holds = all(greaterThanEqual(p, " + vec2Literal(box.x, box.y) +
+                    ")) && all(lessThanEqual(p, " + vec2Literal(box.z, box.w) + "));\n";
+            uint32_t at = uint32_t(range.x);
+            for (uint32_t s = 0; s < uint32_t(range.y); ++s, ++at) {
+                const std::string a = vec2Literal(w[at].x, w[at].y), b = vec2Literal(w[at].z, w[at].w);
+                out_ += "    if (holds) winding += lineCrossing(p, " + a + ", " + b + ");\n";
+                out_ += "    best = min(best, sqSegment2(p, " + a + ", " + b + "));\n";
+            }
+            for (uint32_t s = 0; s < uint32_t(range.w); ++s, at += 2) {
+                const std::string a = vec2Literal(w[at].x, w[at].y),
+                                  b = vec2Literal(w[at].z, w[at].w),
+                                  c = vec2Literal(w[at + 1].x, w[at + 1].y);
+                out_ += "    if (holds) winding += quadraticCrossing(p, " + a + ", " + c + ", " + b +
+                        ");\n";
+                out_ += "    best = min(best, sqQuadratic2(p, " + a + ", " + c + ", " + b + "));\n";
+            }
+        }
+        out_ += "    return winding != 0.0 ? -sqrt(best) : sqrt(best);\n}\n\n";
+    }
+
+    // The point the code at hand evaluates at: p, or inside domain operations the candidate
+    // point of the innermost one.
+    const std::string& point() const { return points_.back(); }
+
+    std::string kindConst(uint32_t i) const {
+        return std::to_string(uint32_t(scene_.nodes[i].kind)) + "u";
+    }
+
+    // Node i's kernel parameters a (0) or b (1), as literals or read from the node buffer.
+    std::string param(uint32_t i, int which) const {
+        if (!lit_) return "nodes[" + indexExpr(i) + "]." + (which == 0 ? "p0" : "p1");
+        std::string s;
+        const glm::vec4& v = which == 0 ? (*lit_)[i].p0 : (*lit_)[i].p1;
+        appendVector(s, &v.x, 4);
+        return s;
+    }
+
+    // The distance from `at` to node i's bounds.
+    std::string boundsDistanceOf(uint32_t i, const std::string& at) const {
+        if (!lit_) return "nodeBoundsDistance(" + indexExpr(i) + ", " + at + ")";
+        std::string s = "boundsDistance(";
+        appendVector(s, &(*lit_)[i].bmin.x, 3);
+        s += ", ";
+        appendVector(s, &(*lit_)[i].bmax.x, 3);
+        return s + ", " + at + ")";
+    }
+
+    // Node i's bounds' least (max false) or greatest corner.
+    std::string boundsCorner(uint32_t i, bool max) const {
+        if (!lit_) return "nodes[" + indexExpr(i) + "]." + (max ? "bmax" : "bmin") + ".xyz";
+        std::string s;
+        appendVector(s, max ? &(*lit_)[i].bmax.x : &(*lit_)[i].bmin.x, 3);
+        return s;
+    }
+
+    std::string distance(uint32_t i) const {
+        return (sample_ ? "s" : "d") + std::to_string(i) + (sample_ ? ".w" : "");
+    }
+
+    // Node `like`'s value with distance d: d, or its colour and d.
+    void withDistance(uint32_t like, const std::string& d) {
+        if (!sample_) {
+            out_ += d;
+            return;
+        }
+        out_ += "vec4(";
+        var(like);
+        out_ += ".rgb, " + d + ")";
+    }
+
+    // Domain operation i (shaders/sdf.glsl, and tape_run.glsl for the same steps on tapes): its
+    // child's code runs inside a block, in a loop over the candidates for repetitions, at the
+    // candidate point p<level>; a candidate after the first runs only where its bounds could
+    // lower the least value so far, which is why N copies cost about one. Returns the child's
+    // code's extra indentation.
+    uint32_t openDomain(uint32_t i, uint32_t depth) {
+        const Node& n = scene_.nodes[i];
+        const uint32_t kind = uint32_t(n.kind);
+        const std::string level = std::to_string(points_.size());
+        const std::string local = "l" + level, best = "b" + level, c = "c" + level,
+                          q = "q" + level;
+        indent(depth);
+        out_ += sample_ ? "vec4 " : "float ";
+        var(i);
+        comment(i);
+        indent(depth);
+        out_ += "{\n";
+        indent(depth + 1);
+        out_ += "vec3 " + local + " = ";
+        std::string at = point();
+        if (sdf::domainClamps(kind))
+            at = "clamp(" + at + ", " + boundsCorner(i, false) + ", " + boundsCorner(i, true) + ")";
+        localPoint(i, at);
+        out_ += ";\n";
+        indent(depth + 1);
+        out_ += (sample_ ? "vec4 " : "float ") + best +
+                (sample_ ? " = vec4(0.0, 0.0, 0.0, 1e30);\n" : " = 1e30;\n");
+        const std::string a = param(i, 0), b = param(i, 1);
+        std::string count = "domainCount(" + kindConst(i) + ", " + a + ", " + b + ")";
+        if (lit_)
+            count = std::to_string(sdf::domainCount(kind, (*lit_)[i].p0, (*lit_)[i].p1)) + "u";
+        const bool loops =
+            lit_ ? count != "1u" : n.kind == NodeKind::Repeat || n.kind == NodeKind::PolarRepeat;
+        const std::string candidate = "domainPoint(" + kindConst(i) + ", " + local + ", " + a +
+                                      ", " + b + ", " + (loops ? c : std::string("0u")) + ")";
+        points_.push_back("p" + std::to_string(points_.size()));
+        loops_.push_back(loops);
+        if (!loops) {
+            indent(depth + 1);
+            out_ += "vec3 " + point() + " = " + candidate + ".xyz;\n";
+            return 0;
+        }
+        indent(depth + 1);
+        out_ += "for (uint " + c + " = 0u; " + c + " < " + count + "; ++" + c + ") {\n";
+        indent(depth + 2);
+        out_ += "vec4 " + q + " = " + candidate + ";\n";
+        indent(depth + 2);
+        out_ += "if (" + c + " > 0u && (" + q + ".w != 0.0 || " +
+                boundsDistanceOf(n.children[0], q + ".xyz") + " >= " + best +
+                (sample_ ? ".w" : "") + ")) continue;\n";
+        indent(depth + 2);
+        out_ += "vec3 " + point() + " = " + q + ".xyz;\n";
+        return 1;
+    }
+
+    void closeDomain(uint32_t i, uint32_t child, uint32_t depth) {
+        const Node& n = scene_.nodes[i];
+        const uint32_t kind = uint32_t(n.kind);
+        points_.pop_back();
+        const std::string level = std::to_string(points_.size());
+        const std::string local = "l" + level, best = "b" + level;
+        const bool loops = loops_.back();
+        loops_.pop_back();
+        indent(depth + (loops ? 2 : 1));
+        if (sample_) {
+            out_ += "if (" + distance(child) + " < " + best + ".w) " + best + " = ";
+            var(child);
+            out_ += ";\n";
+        } else {
+            out_ += best + " = min(" + best + ", " + distance(child) + ");\n";
+        }
+        if (loops) {
+            indent(depth + 1);
+            out_ += "}\n";
+        }
+        std::string value = "domainFinish(" + kindConst(i) + ", " + local + ", " + best +
+                            (sample_ ? ".w" : "") + ", " + param(i, 0) + ", " + param(i, 1) + ")";
+        if (!lit_)
+            value += " * nodes[" + indexExpr(i) + "].color.w";
+        else if ((*lit_)[i].color.w != 1.0f) {
+            value += " * ";
+            appendFloat(value, (*lit_)[i].color.w);
+        }
+        if (sdf::domainClamps(kind)) value = "max(" + value + ", " + boundsDistanceOf(i, point()) + ")";
+        indent(depth + 1);
+        var(i);
+        out_ += " = ";
+        if (sample_)
+            out_ += "vec4(" + best + ".rgb, " + value + ")";
+        else
+            out_ += value;
+        out_ += ";\n";
+        indent(depth);
+        out_ += "}\n";
+    }
 
     void var(uint32_t i) {
         out_ += sample_ ? 's' : 'd';
@@ -188,7 +396,7 @@ class Emitter {
             const std::string index = indexExpr(i);
             if (sample_) out_ += "withColor(" + index + ", ";
             out_ += kindInfo(scene_.nodes[i].kind).name;
-            out_ += "Node(" + index + ", p)";
+            out_ += "Node(" + index + ", " + point() + ")";
             if (sample_) out_ += ')';
             return;
         }
@@ -199,13 +407,19 @@ class Emitter {
             out_ += ", ";
         }
         const KindInfo& info = kindInfo(scene_.nodes[i].kind);
-        out_ += info.function;
-        out_ += '(';
-        localPoint(g);
-        const float params[8] = {g.p0.x, g.p0.y, g.p0.z, g.p0.w, g.p1.x, g.p1.y, g.p1.z, g.p1.w};
-        for (const KernelArg& arg : info.args) {
-            out_ += ", ";
-            appendVector(out_, params + arg.slot, arg.count);
+        if (inlinedOutline(i)) {
+            out_ += "outline" + std::to_string(i) + "(";
+            localPoint(i, point());
+        } else {
+            out_ += info.function;
+            out_ += '(';
+            localPoint(i, point());
+            const float params[8] = {g.p0.x, g.p0.y, g.p0.z, g.p0.w,
+                                     g.p1.x, g.p1.y, g.p1.z, g.p1.w};
+            for (const KernelArg& arg : info.args) {
+                out_ += ", ";
+                appendVector(out_, params + arg.slot, arg.count);
+            }
         }
         out_ += ')';
         if (g.color.w != 1.0f) { // x * 1 is x: leaving it out changes no bit
@@ -217,15 +431,20 @@ class Emitter {
 
     // The local point as a literal affine map; identities and pure translations are written
     // shorter, which gives the same bits.
-    void localPoint(const detail::GpuNode& g) {
+    void localPoint(uint32_t i, const std::string& at) {
+        if (!lit_) {
+            out_ += "toLocal(" + indexExpr(i) + ", " + at + ")";
+            return;
+        }
+        const detail::GpuNode& g = (*lit_)[i];
         bool linearIdentity = g.row0.x == 1 && g.row0.y == 0 && g.row0.z == 0 && g.row1.x == 0 &&
                               g.row1.y == 1 && g.row1.z == 0 && g.row2.x == 0 && g.row2.y == 0 &&
                               g.row2.z == 1;
         const float offset[3] = {g.row0.w, g.row1.w, g.row2.w};
         if (linearIdentity && offset[0] == 0 && offset[1] == 0 && offset[2] == 0) {
-            out_ += "p";
+            out_ += at;
         } else if (linearIdentity) {
-            out_ += "(p + ";
+            out_ += "(" + at + " + ";
             appendVector(out_, offset, 3);
             out_ += ")";
         } else {
@@ -234,7 +453,7 @@ class Emitter {
                 appendVector(out_, &row->x, 4);
                 out_ += ", ";
             }
-            out_ += "p)";
+            out_ += at + ")";
         }
     }
 
@@ -248,15 +467,7 @@ class Emitter {
         }
         out_ +=
             scene_.nodes[op].kind == NodeKind::Union ? "if (unionNeeds(" : "if (differenceNeeds(";
-        if (lit_) {
-            out_ += "boundsDistance(";
-            appendVector(out_, &(*lit_)[child].bmin.x, 3);
-            out_ += ", ";
-            appendVector(out_, &(*lit_)[child].bmax.x, 3);
-            out_ += ", p)";
-        } else {
-            out_ += "nodeBoundsDistance(" + indexExpr(child) + ", p)";
-        }
+        out_ += boundsDistanceOf(child, point());
         out_ += ", ";
         var(op);
         if (sample_) out_ += ".w";
@@ -298,16 +509,13 @@ class Emitter {
     const std::vector<detail::GpuNode>* lit_; // null: values come from the node buffer
     bool tests_;                                  // CodegenOptions::boundsTests
     bool sample_ = false;
+    std::vector<std::string> points_{"p"}; // see point()
+    std::vector<bool> loops_;              // per open domain operation: whether it loops
 };
 
 } // namespace
 
-// Scenes with value or domain operations (shell, repeat, extrude, ...) always run on tapes,
-// whatever was asked: only the tape machine evaluates those (and the 2D profiles they hold).
 bool usesTapes(const Scene& scene, Evaluation evaluation) {
-    for (const Node& n : scene.nodes)
-        if (const Role role = kindInfo(n.kind).role; role == Role::Value || role == Role::Domain)
-            return true;
     return evaluation == Evaluation::Tapes ||
            (evaluation == Evaluation::Auto && scene.nodes.size() >= kTapeMinNodes);
 }

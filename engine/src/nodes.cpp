@@ -418,13 +418,13 @@ constexpr KindInfo kKinds[] = {
      },
      [](const Params& k, vec3& lo, vec3& hi) { return profile(k[0], k[0], lo, hi); }},
     {NodeKind::Polygon, "polygon", false, kPolygon,
-     "2D profile: a polygon in the xy plane from its corners, exact distance.", "sdOutline", {},
+     "2D profile: a polygon in the xy plane from its corners, exact distance.", "sdOutline", kA0A1,
      nullptr, outlineBounds},
     {NodeKind::Text, "text", false, kText,
      "2D profile: a line of text in the xy plane, set in a TrueType or OpenType font through "
      "FreeType and centred on the origin (the middle of its outlines' extents); exact distance "
      "to the glyphs' outlines.",
-     "sdOutline", {}, nullptr, outlineBounds},
+     "sdOutline", kA0A1, nullptr, outlineBounds},
     {NodeKind::Union, "union", true, kOperation, "All children together.", {}, {}, nullptr,
      nullptr, Role::Boolean},
     {NodeKind::Intersection, "intersection", true, kOperation, "What all children have in common.",

@@ -65,20 +65,23 @@ std::vector<glm::vec4> packOutline(std::span<const GlyphSegment> segments, glm::
     }
     std::erase_if(contours, [](const auto& c) { return c.empty(); });
     std::vector<glm::vec4> out(2 * contours.size());
-    uint32_t at = uint32_t(out.size());
     for (size_t k = 0; k < contours.size(); ++k) {
+        std::vector<GlyphSegment>& contour = contours[k];
+        const auto quadratics = std::stable_partition(
+            contour.begin(), contour.end(), [](const GlyphSegment& s) { return !s.quadratic; });
+        const uint32_t first = uint32_t(out.size());
         glm::vec2 lo(INFINITY), hi(-INFINITY);
-        for (const GlyphSegment& s : contours[k]) {
+        for (const GlyphSegment& s : contour) {
             lo = glm::min(lo, glm::min(glm::min(s.a, s.b), s.c));
             hi = glm::max(hi, glm::max(glm::max(s.a, s.b), s.c));
             out.emplace_back(s.a.x, s.a.y, s.b.x, s.b.y);
-            out.emplace_back(s.c.x, s.c.y, s.quadratic ? 1.0f : 0.0f, 0.0f);
+            if (s.quadratic) out.emplace_back(s.c.x, s.c.y, 0.0f, 0.0f);
         }
         out[2 * k] = glm::vec4(lo, hi);
         // The first record's z holds the number of contours (Evaluator, outlineParams).
-        out[2 * k + 1] = glm::vec4(float(at), float(contours[k].size()),
-                                   k == 0 ? float(contours.size()) : 0.0f, 0.0f);
-        at += 2 * uint32_t(contours[k].size());
+        out[2 * k + 1] = glm::vec4(float(first), float(quadratics - contour.begin()),
+                                   k == 0 ? float(contours.size()) : 0.0f,
+                                   float(contour.end() - quadratics));
     }
     return out;
 }

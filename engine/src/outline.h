@@ -1,6 +1,7 @@
 // The outlines of polygon and text nodes, as shaders/sdf.glsl's sdOutline reads them: per
-// closed contour a box and a range of segments, then the segments (lines, and quadratics split
-// where they turn in y, so that each crosses a horizontal line at most once).
+// closed contour a box and a range of segments, then the segments, the lines of a contour
+// before its quadratics (split where they turn in y, so that each crosses a horizontal line at
+// most once).
 #pragma once
 
 #include "font.h"
