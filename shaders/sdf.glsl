@@ -254,27 +254,35 @@ SDF_FN float quadraticCrossing(vec2 p, vec2 a, vec2 c, vec2 b) {
 // Polygon and text: the exact distance to an outline of line and quadratic segments, negative
 // where they wind around p (non-zero rule). The data from `first` on: per contour its box (min
 // xy, max xy) and (first segment from `first`, line count, -, quadratic count); its lines, a
-// word each (a, b), then its quadratics, two words each ((a, b), (c, -)). Two loops rather than
-// a select per segment: a CPU device computes both sides of a select, and the quadratic's side
-// is several times the line's. A contour whose box is farther than the nearest segment so far
-// is skipped, and one whose box does not hold p cannot wind around it.
+// word each (a, b), then its quadratics, two words each ((a, b), (c, -)). The distance starts
+// from an upper bound, the nearest of the contours' first points; then a contour runs only
+// where its box is nearer than the nearest segment so far (for the distance) or holds p (a
+// contour whose box does not hold p cannot wind around it). The tests set a contour's loop
+// counts rather than skip it, and lines and quadratics have loops of their own rather than a
+// select per segment: a CPU device (lavapipe) runs both sides of every branch, but a loop only
+// as long as one of its lanes needs it.
 SDF_FN float sdOutline(vec3 p3, float firstAt, float contourCount SDF_DATA_PARAM) {
     vec2 p = vec2(p3.x, p3.y);
     uint first = uint(firstAt), contours = uint(contourCount);
     float best = 1e30f, winding = 0.0f; // best: the least squared distance
     for (uint g = 0u; g < contours; ++g) {
+        vec4 start = SDF_DATA(first + uint(SDF_DATA(first + 2u * g + 1u).x));
+        best = min(best, dot2(vec2(start.x, start.y) - p));
+    }
+    for (uint g = 0u; g < contours; ++g) {
         vec4 box = SDF_DATA(first + 2u * g), range = SDF_DATA(first + 2u * g + 1u);
         vec2 e = max(vec2(box.x - p.x, box.y - p.y), vec2(p.x - box.z, p.y - box.w));
         bool holds = max(e.x, e.y) <= 0.0f;
-        if (!holds && dot2(max(e, 0.0f)) >= best) continue;
-        uint at = first + uint(range.x), lines = uint(range.y), quadratics = uint(range.w);
+        bool runs = holds || dot2(max(e, 0.0f)) < best;
+        uint at = first + uint(range.x), lines = runs ? uint(range.y) : 0u;
+        uint quadratics = runs ? uint(range.w) : 0u;
         for (uint s = 0u; s < lines; ++s) {
             vec4 ab = SDF_DATA(at + s);
             vec2 a = vec2(ab.x, ab.y), b = vec2(ab.z, ab.w);
             if (holds) winding += lineCrossing(p, a, b);
             best = min(best, sqSegment2(p, a, b));
         }
-        at += lines;
+        at += uint(range.y);
         for (uint s = 0u; s < quadratics; ++s) {
             vec4 ab = SDF_DATA(at + 2u * s), cq = SDF_DATA(at + 2u * s + 1u);
             vec2 a = vec2(ab.x, ab.y), b = vec2(ab.z, ab.w), c = vec2(cq.x, cq.y);

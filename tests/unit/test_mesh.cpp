@@ -85,6 +85,74 @@ TEST_F(MeshTest, TorusHasEulerCharacteristicZero) {
     EXPECT_EQ(normals.inward, 0u) << normals.str();
 }
 
+// A solid of each new kind meshes closed and manifold with the topology it has: Euler
+// characteristic 2 per component less 2 per hole (a link is a ring; twelve separate copies
+// count twelve; "Bo" in text is two pieces with three holes, B's two and o's one).
+struct KindTopology {
+    const char* name;
+    const char* json; // the root node
+    int64_t euler;
+};
+
+const KindTopology kKindTopologies[] = {
+    {"ellipsoid", R"({"type": "ellipsoid", "radii": [0.9, 0.5, 0.3]})", 2},
+    {"hex_prism", R"({"type": "hex_prism", "radius": 0.6, "height": 0.8})", 2},
+    {"octahedron", R"({"type": "octahedron", "radius": 0.8})", 2},
+    {"pyramid", R"({"type": "pyramid", "width": 1, "height": 0.9})", 2},
+    {"rounded_cylinder", R"({"type": "rounded_cylinder", "radius": 0.6, "height": 0.8,
+        "rounding": 0.1})", 2},
+    {"round_cone", R"({"type": "round_cone", "radius": 0.4, "top_radius": 0.2, "height": 0.8})", 2},
+    {"link", R"({"type": "link", "length": 0.4, "major_radius": 0.3, "minor_radius": 0.1})", 0},
+    {"capped_torus", R"({"type": "capped_torus", "major_radius": 0.6, "minor_radius": 0.15,
+        "angle": 240})", 2},
+    {"polar_repeat", R"({"type": "polar_repeat", "count": 12, "radius": 0.7, "children": [
+        {"type": "sphere", "radius": 0.12}]})", 24},
+    {"repeat", R"({"type": "repeat", "count": [3, 1, 2], "spacing": [0.6, 1, 0.6], "children": [
+        {"type": "box", "size": [0.3, 0.3, 0.3]}]})", 12},
+    {"shell_cut_open", R"({"type": "difference", "children": [
+        {"type": "shell", "thickness": 0.1, "children": [{"type": "sphere", "radius": 0.8}]},
+        {"type": "box", "size": [2, 1, 2], "translate": [0, 0.6, 0]}]})", 2},
+    {"twist", R"({"type": "twist", "angle": 90, "children": [
+        {"type": "box", "size": [0.8, 1.2, 0.3]}]})", 2},
+    {"bend", R"({"type": "bend", "angle": 60, "children": [
+        {"type": "box", "size": [1.4, 0.2, 0.4]}]})", 2},
+    {"taper", R"({"type": "taper", "height": 1.2, "top_scale": 0.4, "children": [
+        {"type": "box", "size": [0.8, 1.2, 0.8]}]})", 2},
+    {"mirror", R"({"type": "mirror", "axes": "x", "children": [
+        {"type": "sphere", "radius": 0.3, "translate": [0.5, 0, 0]}]})", 4},
+    {"elongate", R"({"type": "elongate", "length": [0.3, 0, 0.2], "children": [
+        {"type": "torus", "major_radius": 0.4, "minor_radius": 0.1}]})", 0},
+    {"offset", R"({"type": "offset", "distance": 0.1, "children": [
+        {"type": "box", "size": [0.8, 0.8, 0.8]}]})", 2},
+    {"extrude_polygon", R"({"type": "extrude", "height": 0.3, "rounding": 0.05, "children": [
+        {"type": "polygon", "points": [[-0.5, -0.5], [0.5, -0.5], [0, 0.6]]}]})", 2},
+    {"revolve_circle", R"({"type": "revolve", "offset": 0.5, "children": [
+        {"type": "circle", "radius": 0.2}]})", 0},
+    {"text_Bo", R"({"type": "extrude", "height": 0.2, "children": [
+        {"type": "text", "text": "Bo", "size": 1}]})", -2},
+};
+
+class KindMesh : public GpuTest, public ::testing::WithParamInterface<KindTopology> {};
+
+TEST_P(KindMesh, IsClosedManifoldWithItsTopology) {
+    const Scene scene = sceneFrom(std::string(R"({"version": 1, "root": )") + GetParam().json + "}");
+    MeshOptions options;
+    options.resolution = 64;
+    MeshStats stats;
+    auto mesh = extractMesh(context(), scene, options, &stats);
+    ASSERT_TRUE(mesh) << mesh.error().str();
+    const MeshProperties m = measureMesh(*mesh);
+    SCOPED_TRACE(m.str());
+    EXPECT_FALSE(stats.surfaceCut);
+    EXPECT_TRUE(m.closedManifold());
+    EXPECT_EQ(m.euler, GetParam().euler);
+    EXPECT_GT(m.volume, 0.0);
+    EXPECT_LE(maxSurfaceDistance(*mesh, Evaluator(scene)), stats.voxelSize);
+}
+
+INSTANTIATE_TEST_SUITE_P(Kinds, KindMesh, ::testing::ValuesIn(kKindTopologies),
+                         [](const auto& info) { return std::string(info.param.name); });
+
 // Every bundled scene at the default resolution: closed and manifold where the surface fits the
 // bounds; scenes with a ground plane reach the bounds, say so, and are still manifold.
 class BundledSceneMesh : public GpuTest,

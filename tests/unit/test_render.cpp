@@ -261,8 +261,10 @@ void expectTapesMatchInlined(Context& context, const Scene& scene, uint32_t widt
     EXPECT_LE(double(colourOff), colourShare * double(hits)) << scene.file;
 }
 
+// At 320 x 240 the rims of thin raised parts (the name plate's letters), where the two hits'
+// shift within the hit tolerance turns the normal, are few enough beside the hits.
 TEST_P(SceneRender, PrunedTapesMatchTheInlinedTree) {
-    expectTapesMatchInlined(context(), loadOrDie(GetParam()), 160, 120);
+    expectTapesMatchInlined(context(), loadOrDie(GetParam()), 320, 240);
 }
 
 TEST_P(SceneRender, DefaultCameraIsTheScenesOrTheFramedOne) {
