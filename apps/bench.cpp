@@ -57,6 +57,9 @@ code generation, GLSL compilation, pipeline creation including the driver's comp
               sdfcsg before;
   first       the first build of a new context with nothing cached at all;
   warm        with the SPIR-V and driver disk caches filled but the in-process cache cleared.
+Then the repetition lines, per frame: a repeat of 64 copies and a polar_repeat of 24 against
+one copy alone (framed on itself, so that it fills the picture as the copies do) and against
+the union of the same copies as nodes of their own (the same picture).
 
 Options:
   --scenes DIR   folder of scenes (default assets/scenes)
@@ -116,6 +119,69 @@ Result<double> medianFrameMs(Renderer& renderer, const RenderOptions& options, u
         if (i >= 2) times.push_back(msSince(start));
     }
     return median(times);
+}
+
+// Repetitions against the copies written out: per frame, one copy alone framed on itself (so
+// that it fills the picture about as the N copies do), a repeat or polar_repeat of N copies,
+// and the union of the same N copies as nodes of their own with the same camera.
+struct RepeatCase {
+    const char* name;
+    int copies;
+    std::string repeated, unionOf; // root nodes
+};
+
+const char* const kCopy = R"({"type": "round_box", "size": [0.3, 0.3, 0.3], "radius": 0.05)";
+
+std::string sceneJson(const std::string& root) { return R"({"version": 1, "root": )" + root + "}"; }
+
+std::vector<RepeatCase> repeatCases() {
+    RepeatCase grid{"repeat 8x8", 64, {}, {}};
+    grid.repeated = R"({"type": "repeat", "count": [8, 1, 8], "spacing": [0.5, 1, 0.5], )"
+                    R"("children": [)" + std::string(kCopy) + "}]}";
+    RepeatCase ring{"polar_repeat 24", 24, {}, {}};
+    ring.repeated = R"({"type": "polar_repeat", "count": 24, "radius": 1.5, "children": [)" +
+                    std::string(kCopy) + "}]}";
+    for (RepeatCase* c : {&grid, &ring}) {
+        c->unionOf = R"({"type": "union", "children": [)";
+        for (int i = 0; i < c->copies; ++i) {
+            c->unionOf += i ? ", " : "";
+            if (c == &grid)
+                c->unionOf += kCopy + std::string(R"(, "translate": [)") +
+                              std::to_string(0.5 * (i % 8 - 3.5)) + ", 0, " +
+                              std::to_string(0.5 * (i / 8 - 3.5)) + "]}";
+            else
+                c->unionOf += R"({"type": "union", "rotate": [0, )" + std::to_string(15 * i) +
+                              R"(, 0], "children": [)" + kCopy + R"(, "translate": [1.5, 0, 0]}]})";
+        }
+        c->unionOf += "]}";
+    }
+    return {grid, ring};
+}
+
+// Prints the repetition lines; false after printing an error.
+bool runRepeatBench(Context& context, uint32_t width, uint32_t height, uint32_t frames) {
+    std::printf("\n%-16s %6s %8s %10s %9s %11s\n", "repetition", "copies", "one ms",
+                "repeat ms", "union ms", "repeat/one");
+    for (const RepeatCase& c : repeatCases()) {
+        auto framing = parseScene(sceneJson(c.repeated), c.name);
+        if (!framing) return std::fprintf(stderr, "%s\n", framing.error().str().c_str()), false;
+        RenderOptions options;
+        options.width = width, options.height = height;
+        double ms[3] = {};
+        const std::string roots[3] = {kCopy + std::string("}"), c.repeated, c.unionOf};
+        for (int k = 0; k < 3; ++k) {
+            if (k == 0) options.camera.reset(); // one copy fills the picture as the N do
+            else options.camera = frameCamera(Evaluator(*framing), float(width) / float(height));
+            auto renderer = buildFromJson(context, sceneJson(roots[k]), c.name);
+            auto frame = renderer ? medianFrameMs(**renderer, options, frames)
+                                  : Result<double>(renderer.error());
+            if (!frame) return std::fprintf(stderr, "%s\n", frame.error().str().c_str()), false;
+            ms[k] = *frame;
+        }
+        std::printf("%-16s %6d %8.1f %10.1f %9.1f %10.2fx\n", c.name, c.copies, ms[0], ms[1],
+                    ms[2], ms[1] / std::max(ms[0], 1e-9));
+    }
+    return true;
 }
 
 struct Row {
@@ -496,6 +562,7 @@ int runBench(int argc, char** argv) {
         "warm: SPIR-V and driver disk caches filled, in-process cache cleared.\n"
         "Renders use bounds skipping by default on GPUs and not on CPU devices (lavapipe runs both "
         "sides of every branch, so there the bounds tests only add work).\n");
+    if (status == 0 && !runRepeatBench(**context, width, height, frames)) status = 4;
     return status;
 }
 
