@@ -153,10 +153,10 @@ expect_text "eval after repair" eval/report.txt "validity after repair: 1 of 1 (
 expect_text "eval contact sheet" eval/report.txt "contact sheet: the prompts' renders in order, 1 tile a row, each numbered in its top-left corner; red: no scene"
 # A prompt without a scene shows the problems, not only the line that introduces them; a prompt
 # that repeats an example's request is named.
-printf 'A snowman\nA robot with a square body, two legs\n' >prompts.txt
+printf 'A snowman\nA spur gear: 12 teeth by polar_repeat, a hub\n' >prompts.txt
 check "eval-prompts replay without repairs" 0 "$bin" eval-prompts prompts.txt --out eval-bad $llm --replay "$recording" --max-repairs 0
 expect_text "eval problems" eval-bad/report.txt "           answer: root.children[1].radius: expected a positive number, got -0.6"
-expect_text "eval repeated example" eval-bad/report.txt "note: prompt 2 nearly repeats the request of an example in the system prompt (\"A robot with a square body, two legs, two arms and an antenna.\"), so its first-try validity is inflated"
+expect_text "eval repeated example" eval-bad/report.txt "note: prompt 2 nearly repeats the request of an example in the system prompt (\"A spur gear: 12 teeth by polar_repeat, a hub, and 6 lightening holes by a second polar_repeat.\"), so its first-try validity is inflated"
 
 # Ctrl-C and SIGTERM: long work stops at its next progress check, and work that cannot be
 # cancelled (a kernel build inside the driver) is ended by a watchdog; either way the command
