@@ -1,8 +1,11 @@
 // Scenes built in code for the evaluator and code generator tests: a small tree literal that
-// flattens into Scene's pre-order node array, and a seeded random scene generator.
+// flattens into Scene's pre-order node array, a seeded random scene generator, a scene from its
+// root node's JSON, and seeded random points.
 #pragma once
 
 #include <sdfcsg/scene.h>
+
+#include <gtest/gtest.h>
 
 #include <glm/vec3.hpp>
 
@@ -17,6 +20,24 @@
 #include <vector>
 
 namespace sdfcsg::test {
+
+// The scene whose root node is the JSON text `root`, as "test.json"; a failure, and an empty
+// scene, where it does not parse.
+inline Scene parseRoot(const std::string& root) {
+    auto scene = parseScene(R"({"version": 1, "root": )" + root + "}", "test.json");
+    if (!scene) ADD_FAILURE() << scene.error().str();
+    return scene ? *scene : Scene{};
+}
+
+// `count` points uniform in the cube of half side `reach`, the same for the same seed.
+inline std::vector<glm::vec3> randomPoints(uint32_t seed, int count, float reach) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(-reach, reach);
+    std::vector<glm::vec3> points;
+    for (int i = 0; i < count; ++i)
+        points.push_back({u(rng), u(rng), u(rng)});
+    return points;
+}
 
 // One node and its subtree. Parameters are the table's values (full sizes), by slot.
 struct Tree {

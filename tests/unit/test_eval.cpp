@@ -14,21 +14,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <random>
 
 namespace sdfcsg {
 namespace {
 
 using namespace sdfcsg::test;
-
-std::vector<glm::vec3> randomPoints(uint32_t seed, int count, float reach) {
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> u(-reach, reach);
-    std::vector<glm::vec3> points;
-    for (int i = 0; i < count; ++i)
-        points.push_back({u(rng), u(rng), u(rng)});
-    return points;
-}
 
 // Half again the size of the scene's finite part, and at least 5.
 float reach(const Evaluator& eval) {

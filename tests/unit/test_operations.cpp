@@ -4,6 +4,8 @@
 // the tree walk.
 #include "prune.h"
 
+#include "scene_build_util.h"
+
 #include <sdfcsg/eval.h>
 
 #include <gtest/gtest.h>
@@ -17,29 +19,17 @@
 namespace sdfcsg {
 namespace {
 
-Scene parse(const std::string& root) {
-    auto scene = parseScene(R"({"version": 1, "root": )" + root + "}", "test.json");
-    if (!scene) ADD_FAILURE() << scene.error().str();
-    return scene ? *scene : Scene{};
-}
-
-std::vector<glm::vec3> points(uint32_t seed, int count, float reach) {
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> u(-reach, reach);
-    std::vector<glm::vec3> out;
-    for (int i = 0; i < count; ++i)
-        out.push_back({u(rng), u(rng), u(rng)});
-    return out;
-}
+using test::parseRoot;
+using test::randomPoints;
 
 // `field` and `explicit` agree within 1e-5 wherever the explicit one is within `near` of the
 // surface, and the field is never above it in magnitude nor of another sign elsewhere.
 void expectSameSolid(const std::string& field, const std::string& reference, float reach,
                      float near) {
     SCOPED_TRACE(field);
-    Evaluator a(parse(field)), b(parse(reference));
+    Evaluator a(parseRoot(field)), b(parseRoot(reference));
     int close = 0;
-    for (glm::vec3 p : points(7, 6000, reach)) {
+    for (glm::vec3 p : randomPoints(7, 6000, reach)) {
         const float fa = a.distance(p), fb = b.distance(p);
         if (std::abs(fb) < near) {
             ++close;
@@ -109,7 +99,7 @@ TEST(Operations, ShellAndOffsetOfASphere) {
     expectSameSolid(
         R"({"type": "offset", "distance": 0.1, "children": [{"type": "sphere", "radius": 0.3}]})",
         R"({"type": "sphere", "radius": 0.4})", 2.0f, 10.0f);
-    Evaluator shell(parse(
+    Evaluator shell(parseRoot(
         R"({"type": "shell", "thickness": 0.1, "scale": 2, "children": [{"type": "sphere", "radius": 0.5}]})"));
     EXPECT_NEAR(shell.distance({0, 0, 0}), 0.9f, 1e-6f);   // |-1| - 0.1
     EXPECT_NEAR(shell.distance({1.5f, 0, 0}), 0.4f, 1e-6f); // |0.5| - 0.1
@@ -122,12 +112,12 @@ TEST(Operations, StretchingOperationsStayOneLipschitz) {
     for (const char* op : {R"("type": "twist", "angle": 120)", R"("type": "bend", "angle": 60)",
                            R"("type": "taper", "height": 1, "top_scale": 0.3)"}) {
         SCOPED_TRACE(op);
-        Evaluator e(parse(std::string("{") + op + R"(, "rotate": [5, 10, 0], "children": [
+        Evaluator e(parseRoot(std::string("{") + op + R"(, "rotate": [5, 10, 0], "children": [
             {"type": "box", "size": [0.4, 1.2, 0.3], "translate": [0.1, 0, 0]}]})"));
         std::mt19937 rng(3);
         std::uniform_real_distribution<float> u(-1.0f, 1.0f);
         int inside = 0;
-        for (glm::vec3 p : points(11, 4000, 0.9f)) {
+        for (glm::vec3 p : randomPoints(11, 4000, 0.9f)) {
             const glm::vec3 step = 1e-3f * glm::normalize(glm::vec3(u(rng), u(rng), u(rng)));
             const float slope = std::abs(e.distance(p + step) - e.distance(p)) / 1e-3f;
             ASSERT_LE(slope, 1.0f + 2e-2f) << p.x << " " << p.y << " " << p.z;
@@ -140,12 +130,12 @@ TEST(Operations, StretchingOperationsStayOneLipschitz) {
 // A scale per axis: the box it makes, with the field scaled by the smallest factor, so never
 // above the exact distance and at least smallest/largest of it; the bounds hug the box.
 TEST(Operations, NonUniformScaleIsAConservativeField) {
-    const Scene scaled = parse(R"({"type": "union", "rotate": [0, 30, 0], "children": [
+    const Scene scaled = parseRoot(R"({"type": "union", "rotate": [0, 30, 0], "children": [
         {"type": "box", "size": [1, 1, 1], "scale": [2, 1, 0.5]}]})");
     Evaluator a(scaled);
-    Evaluator b(parse(R"({"type": "union", "rotate": [0, 30, 0], "children": [
+    Evaluator b(parseRoot(R"({"type": "union", "rotate": [0, 30, 0], "children": [
         {"type": "box", "size": [2, 1, 0.5]}]})"));
-    for (glm::vec3 p : points(5, 4000, 2.0f)) {
+    for (glm::vec3 p : randomPoints(5, 4000, 2.0f)) {
         const float fa = a.distance(p), fb = b.distance(p);
         ASSERT_EQ(fa < 0, fb < 0) << p.x << " " << p.y << " " << p.z;
         ASSERT_LE(std::abs(fa), std::abs(fb) + 1e-5f);
@@ -162,7 +152,7 @@ TEST(Operations, NonUniformScaleIsAConservativeField) {
 // The pruned tapes give the tree walk's values near the surface and a bound of the same sign,
 // never larger, elsewhere, with every operation nested in others.
 TEST(Operations, PrunedTapesAgreeWithTheTree) {
-    Scene scene = parse(R"({"type": "union", "smooth": 0.05, "children": [
+    Scene scene = parseRoot(R"({"type": "union", "smooth": 0.05, "children": [
         {"type": "repeat", "count": [4, 1, 3], "spacing": [0.8, 1, 0.8], "children": [
             {"type": "twist", "angle": 90, "children": [
                 {"type": "shell", "thickness": 0.05, "children": [
@@ -178,7 +168,7 @@ TEST(Operations, PrunedTapesAgreeWithTheTree) {
     Evaluator e(scene);
     const detail::PrunedField field = detail::pruneField(e);
     int near = 0;
-    for (glm::vec3 p : points(5, 20000, 3.0f)) {
+    for (glm::vec3 p : randomPoints(5, 20000, 3.0f)) {
         const float full = e.distance(p), pruned = field.distance(e.nodes(), p);
         if (std::abs(full) < field.cell) {
             ++near;

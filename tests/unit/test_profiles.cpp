@@ -4,6 +4,8 @@
 #include "font.h"
 #include "outline.h"
 
+#include "scene_build_util.h"
+
 #include <sdfcsg/eval.h>
 
 #include <gtest/gtest.h>
@@ -11,37 +13,24 @@
 #include <glm/geometric.hpp>
 
 #include <cmath>
-#include <random>
 #include <string>
 
 namespace sdfcsg {
 namespace {
 
-Scene parse(const std::string& root) {
-    auto scene = parseScene(R"({"version": 1, "root": )" + root + "}", "test.json");
-    if (!scene) ADD_FAILURE() << scene.error().str();
-    return scene ? *scene : Scene{};
-}
+using test::parseRoot;
+using test::randomPoints;
 
 std::string errorOf(const std::string& root) {
     auto scene = parseScene(R"({"version": 1, "root": )" + root + "}", "test.json");
     return scene ? "accepted" : scene.error().str();
 }
 
-std::vector<glm::vec3> points(uint32_t seed, int count, float reach) {
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> u(-reach, reach);
-    std::vector<glm::vec3> out;
-    for (int i = 0; i < count; ++i)
-        out.push_back({u(rng), u(rng), u(rng)});
-    return out;
-}
-
 // Both fields agree within `tolerance` everywhere in the cube of half side `reach`.
 void expectSameField(const std::string& a, const std::string& b, float reach, float tolerance) {
     SCOPED_TRACE(a);
-    Evaluator ea(parse(a)), eb(parse(b));
-    for (glm::vec3 p : points(3, 4000, reach))
+    Evaluator ea(parseRoot(a)), eb(parseRoot(b));
+    for (glm::vec3 p : randomPoints(3, 4000, reach))
         ASSERT_NEAR(ea.distance(p), eb.distance(p), tolerance) << p.x << " " << p.y << " " << p.z;
 }
 
@@ -121,9 +110,9 @@ TEST(Profiles, PolygonIsTheExactDistanceToItsEdges) {
                 list += (list.empty() ? "[" : ", [") + std::to_string(pts[i].x) + ", " +
                         std::to_string(pts[i].y) + "]";
         }
-        Evaluator e(parse(R"({"type": "extrude", "height": 100, "children": [
+        Evaluator e(parseRoot(R"({"type": "extrude", "height": 100, "children": [
             {"type": "polygon", "points": [)" + list + "]}]}"));
-        for (glm::vec3 p : points(9, 3000, 0.9f)) {
+        for (glm::vec3 p : randomPoints(9, 3000, 0.9f)) {
             const float expected = brute.distance({p.x, p.y});
             ASSERT_NEAR(e.distance(glm::vec3(p.x, p.y, 0.0f)), expected, 2e-5f)
                 << p.x << " " << p.y << (reversed ? " reversed" : "");
@@ -262,7 +251,7 @@ TEST(Profiles, TextIsTheExactDistanceToItsGlyphs) {
             prev = q + shift;
         }
     }
-    Evaluator e(parse(R"({"type": "extrude", "height": 100, "children": [
+    Evaluator e(parseRoot(R"({"type": "extrude", "height": 100, "children": [
         {"type": "text", "text": "Bo"}]})"));
     const Aabb& box = e.nodes()[1].bounds;
     const glm::vec2 half = 0.5f * (text->max - text->min);
@@ -273,7 +262,7 @@ TEST(Profiles, TextIsTheExactDistanceToItsGlyphs) {
         EXPECT_NEAR(box.min[k], -half[k], 5e-5f);
     }
     int inside = 0;
-    for (glm::vec3 p : points(4, 4000, 0.8f)) {
+    for (glm::vec3 p : randomPoints(4, 4000, 0.8f)) {
         const float expected = brute.distance({p.x, p.y});
         const float got = e.distance(glm::vec3(p.x, p.y, 0.0f));
         ASSERT_NEAR(got, expected, 2e-4f) << p.x << " " << p.y; // the polyline's sag
