@@ -407,19 +407,14 @@ class Emitter {
             out_ += ", ";
         }
         const KindInfo& info = kindInfo(scene_.nodes[i].kind);
-        if (inlinedOutline(i)) {
-            out_ += "outline" + std::to_string(i) + "(";
-            localPoint(i, point());
-        } else {
-            out_ += info.function;
-            out_ += '(';
-            localPoint(i, point());
-            const float params[8] = {g.p0.x, g.p0.y, g.p0.z, g.p0.w,
-                                     g.p1.x, g.p1.y, g.p1.z, g.p1.w};
-            for (const KernelArg& arg : info.args) {
-                out_ += ", ";
-                appendVector(out_, params + arg.slot, arg.count);
-            }
+        const bool outline = inlinedOutline(i); // its data is in the function's code
+        out_ += outline ? "outline" + std::to_string(i) : std::string(info.function);
+        out_ += '(';
+        localPoint(i, point());
+        const float params[8] = {g.p0.x, g.p0.y, g.p0.z, g.p0.w, g.p1.x, g.p1.y, g.p1.z, g.p1.w};
+        for (const KernelArg& arg : outline ? std::span<const KernelArg>{} : info.args) {
+            out_ += ", ";
+            appendVector(out_, params + arg.slot, arg.count);
         }
         out_ += ')';
         if (g.color.w != 1.0f) { // x * 1 is x: leaving it out changes no bit
