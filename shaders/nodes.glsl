@@ -46,6 +46,13 @@ uint nodeIndex(uint page, uint offset) { return page * 256u + offset; }
 
 // Bounds skipping: must operand b of a union (subtrahend b of a difference) be evaluated, given
 // its bounds' signed distance, the running value d and the blend radius k? Written exactly as
-// eval.cpp tests it, so skipping an operand never changes a bit of the result.
-bool unionNeeds(float bounds, float d, float k) { return !kBoundsSkipping || bounds - d < k; }
-bool differenceNeeds(float bounds, float d, float k) { return !kBoundsSkipping || bounds + d < k; }
+// eval.cpp tests it, so skipping an operand never changes a bit of the result. The code tests
+// an operand with a gridded outline even where skipping is off (codegen.cpp: Emitter::guard).
+bool unionChanges(float bounds, float d, float k) { return bounds - d < k; }
+bool differenceChanges(float bounds, float d, float k) { return bounds + d < k; }
+bool unionNeeds(float bounds, float d, float k) {
+    return !kBoundsSkipping || unionChanges(bounds, d, k);
+}
+bool differenceNeeds(float bounds, float d, float k) {
+    return !kBoundsSkipping || differenceChanges(bounds, d, k);
+}

@@ -238,32 +238,48 @@ SDF_FN float lineCrossing(vec2 p, vec2 a, vec2 b) {
     return b.y > a.y ? (side > 0.0f ? 1.0f : 0.0f) : (side < 0.0f ? -1.0f : 0.0f);
 }
 
-// A quadratic through control point c (monotonic in y: the loader splits them).
-SDF_FN float quadraticCrossing(vec2 p, vec2 a, vec2 c, vec2 b) {
-    if ((a.y <= p.y) == (b.y <= p.y)) return 0.0f;
-    // y(t) = A t^2 + B t + C = p.y has one root in [0, 1]; the stable pair of formulas.
-    float qa = a.y - 2.0f * c.y + b.y, qb = 2.0f * (c.y - a.y), qc = a.y - p.y;
+// Where a quadratic through control point c that spans height y in its half-open way (the
+// loader makes them monotonic in y) crosses it: its x there.
+SDF_FN float quadraticAtHeight(float y, vec2 a, vec2 c, vec2 b) {
+    // y(t) = A t^2 + B t + C = y has one root in [0, 1]; the stable pair of formulas.
+    float qa = a.y - 2.0f * c.y + b.y, qb = 2.0f * (c.y - a.y), qc = a.y - y;
     float root = sqrt(max(qb * qb - 4.0f * qa * qc, 0.0f));
     float qq = -0.5f * (qb + (qb >= 0.0f ? root : -root));
     float t0 = qq / (qa != 0.0f ? qa : 1e-30f), t1 = qc / (qq != 0.0f ? qq : 1e-30f);
     float t = clamp(abs(t0 - 0.5f) < abs(t1 - 0.5f) ? t0 : t1, 0.0f, 1.0f);
-    float x = mix(mix(a.x, c.x, t), mix(c.x, b.x, t), t);
-    return x > p.x ? (b.y > a.y ? 1.0f : -1.0f) : 0.0f;
+    return mix(mix(a.x, c.x, t), mix(c.x, b.x, t), t);
 }
 
-// Polygon and text: the exact distance to an outline of line and quadratic segments, negative
-// where they wind around p (non-zero rule). The data from `first` on: per contour its box (min
-// xy, max xy) and (first segment from `first`, line count, -, quadratic count); its lines, a
-// word each (a, b), then its quadratics, two words each ((a, b), (c, -)). The distance starts
+// The crossings of the ray towards +x from (x0, y) less those of the ray from (x1, y).
+SDF_FN float quadraticCrossings(float y, float x0, float x1, vec2 a, vec2 c, vec2 b) {
+    if ((a.y <= y) == (b.y <= y)) return 0.0f;
+    float x = quadraticAtHeight(y, a, c, b);
+    return (b.y > a.y ? 1.0f : -1.0f) * ((x > x0 ? 1.0f : 0.0f) - (x > x1 ? 1.0f : 0.0f));
+}
+
+SDF_FN float quadraticCrossing(vec2 p, vec2 a, vec2 c, vec2 b) {
+    return quadraticCrossings(p.y, p.x, 1e30f, a, c, b);
+}
+
+// The same for rays towards +y, signed so that they count the same winding: -1 where a segment
+// crossing one goes towards +x. (A grid's segments are monotonic in x as well.)
+SDF_FN float lineCrossingUp(vec2 p, vec2 a, vec2 b) {
+    return -lineCrossing(vec2(p.y, p.x), vec2(a.y, a.x), vec2(b.y, b.x));
+}
+SDF_FN float quadraticCrossingsUp(float x, float y0, float y1, vec2 a, vec2 c, vec2 b) {
+    return -quadraticCrossings(x, y0, y1, vec2(a.y, a.x), vec2(c.y, c.x), vec2(b.y, b.x));
+}
+
+// A small polygon or text outline (engine/src/outline.h), listed by contour from `first`: the
+// exact distance to its line and quadratic segments, negative where they wind around p
+// (non-zero rule). The distance starts
 // from an upper bound, the nearest of the contours' first points; then a contour runs only
 // where its box is nearer than the nearest segment so far (for the distance) or holds p (a
 // contour whose box does not hold p cannot wind around it). The tests set a contour's loop
 // counts rather than skip it, and lines and quadratics have loops of their own rather than a
 // select per segment: a CPU device (lavapipe) runs both sides of every branch, but a loop only
 // as long as one of its lanes needs it.
-SDF_FN float sdOutline(vec3 p3, float firstAt, float contourCount SDF_DATA_PARAM) {
-    vec2 p = vec2(p3.x, p3.y);
-    uint first = uint(firstAt), contours = uint(contourCount);
+SDF_FN float sdContours(vec2 p, uint first, uint contours SDF_DATA_PARAM) {
     float best = 1e30f, winding = 0.0f; // best: the least squared distance
     for (uint g = 0u; g < contours; ++g) {
         vec4 start = SDF_DATA(first + uint(SDF_DATA(first + 2u * g + 1u).x));
@@ -292,6 +308,51 @@ SDF_FN float sdOutline(vec3 p3, float firstAt, float contourCount SDF_DATA_PARAM
         }
     }
     return winding != 0.0f ? -sqrt(best) : sqrt(best);
+}
+
+// Polygon and text: the exact distance to an outline (engine/src/outline.h, from `first`, with
+// its box lo, hi) of line and quadratic segments, negative where they wind around p (non-zero
+// rule). A small one is listed by contour (nx = 0). A larger one has a grid of nx by ny cells
+// of `side`, two cells beyond its box: at q, the nearest point of the grid to p, the nearest of
+// the segments that q's cell lists, and the winding at the cell's centre c carried to q along
+// the path from c across to h = (q.x, c.y) and up to q (a segment that crosses it meets the
+// cell, so the cell lists it): the crossings of the ray towards +x from h less those from c,
+// then of the ray towards +y from q less those from h. Beyond the grid, sqrt(|p - q|^2 + d(q)^2)
+// is a lower bound (every segment lies in the grid, on the far side of q from p), 1-Lipschitz
+// and equal to the distance on the grid's edge; and never below the distance to the box. A
+// point's work is its cell's few segments: loads from a buffer in a loop are what costs a CPU
+// device (lavapipe) most.
+SDF_FN float sdOutline(vec3 p3, float firstAt, float nx, vec2 lo, vec2 hi, float ny, float side
+                       SDF_DATA_PARAM) {
+    vec2 p = vec2(p3.x, p3.y);
+    uint first = uint(firstAt);
+    if (nx == 0.0f) return sdContours(p, first + 2u, uint(ny) SDF_DATA_ARG);
+    vec2 corner = lo - 2.0f * side, cells = vec2(nx, ny);
+    vec2 q = clamp(p, corner, corner + cells * side);
+    vec2 g = min(floor((q - corner) / side), cells - 1.0f);
+    vec4 cell = SDF_DATA(first + 2u + uint(g.x + nx * g.y));
+    vec2 c = corner + (g + 0.5f) * side, h = vec2(q.x, c.y);
+    uint at = first + uint(cell.x), lines = uint(cell.y), quadratics = uint(cell.z);
+    float best = 1e30f, winding = cell.w; // best: the least squared distance
+    for (uint s = 0u; s < lines; ++s) {
+        vec4 ab = SDF_DATA(at + s);
+        vec2 a = vec2(ab.x, ab.y), b = vec2(ab.z, ab.w);
+        best = min(best, sqSegment2(q, a, b));
+        winding += lineCrossing(h, a, b) - lineCrossing(c, a, b) + lineCrossingUp(q, a, b) -
+                   lineCrossingUp(h, a, b);
+    }
+    at += lines;
+    for (uint s = 0u; s < quadratics; ++s) {
+        vec4 ab = SDF_DATA(at + 2u * s), kq = SDF_DATA(at + 2u * s + 1u);
+        vec2 a = vec2(ab.x, ab.y), b = vec2(ab.z, ab.w), k = vec2(kq.x, kq.y);
+        best = min(best, sqQuadratic2(q, a, k, b));
+        winding += quadraticCrossings(c.y, h.x, c.x, a, k, b) +
+                   quadraticCrossingsUp(q.x, q.y, h.y, a, k, b);
+    }
+    float d = sqrt(dot2(p - q) + best);
+    vec2 e = max(lo - p, p - hi);
+    float boxDistance = length(max(e, 0.0f)) + min(max(e.x, e.y), 0.0f);
+    return max(winding != 0.0f ? -d : d, boxDistance);
 }
 
 // CSG operators: IQ's polynomial smooth minimum with blend radius k, and smooth max(a, b) =
@@ -422,7 +483,7 @@ SDF_FN float sdPrimitive(uint kind, vec3 q, vec4 a, vec4 b, uint kinds SDF_DATA_
     if (SDF_IS(17u)) return sdCircle(q, a.x);
     if (SDF_IS(18u)) return sdRectangle(q, a.x, a.y, a.z);
     if (SDF_IS(19u)) return sdRegularPolygon(q, a.x, a.y, a.z, a.w);
-    if (SDF_IS(20u) || SDF_IS(21u)) return sdOutline(q, a.x, a.y SDF_DATA_ARG);
+    if (SDF_IS(20u) || SDF_IS(21u)) return sdOutline(q, a.x, a.y, vec2(a.z, a.w), vec2(b.x, b.y), b.z, b.w SDF_DATA_ARG);
     return 1e30f;
 }
 #undef SDF_IS

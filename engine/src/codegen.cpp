@@ -24,9 +24,6 @@ namespace {
 // value makes compiling quadratic: 1000 inlined spheres take about 3 s, 2000 more than 5 s.
 // Larger scenes read their values from the node buffer even when inlining is asked for.
 constexpr size_t kInlineLimit = 1024;
-// The most words of a polygon's or text's outline that are written out as code (about 200
-// segments; Emitter::inlinedOutline).
-constexpr size_t kInlineOutlineWords = 256;
 
 // Shortest text that reads back as the same float, always a GLSL float literal.
 void appendFloat(std::string& out, float v) {
@@ -70,7 +67,13 @@ class Emitter {
   public:
     Emitter(const Scene& scene, std::string& out, const std::vector<detail::GpuNode>* literals,
             bool boundsTests)
-        : scene_(scene), out_(out), lit_(literals), tests_(boundsTests) {}
+        : scene_(scene), out_(out), lit_(literals), tests_(boundsTests),
+          gridded_(scene.nodes.size(), false) {
+        for (uint32_t i = 0; i < scene.nodes.size(); ++i) {
+            const Node& n = scene.nodes[i];
+            if (n.outline && (*n.outline)[0].x != 0.0f) markGridded(i);
+        }
+    }
 
     // The buffer-mode wrappers, e.g. `float boxNode(uint i, vec3 p)`, for the kinds in use; with
     // values inlined, the outlines written out as code.
@@ -169,12 +172,21 @@ class Emitter {
   private:
     void indent(uint32_t depth) { out_.append(4 * (depth + 1), ' '); }
 
-    // Whether node i's outline (polygon, text) is written out as code: sdOutline's loop reads
-    // every segment from the node buffer, which costs a CPU device (lavapipe) several times the
-    // arithmetic, while written out they are literals.
+    // Node i and the operations above it hold a gridded outline (outline.h).
+    void markGridded(uint32_t i) {
+        gridded_[i] = true;
+        for (uint32_t j = 0; j < scene_.nodes.size(); ++j)
+            for (uint32_t child : scene_.nodes[j].children)
+                if (child == i && !gridded_[j]) markGridded(j);
+    }
+
+    // Whether node i's outline (polygon, text) is written out as code: a small one, listed by
+    // contour (outline.h), whose loops would read every segment from the node buffer, which
+    // costs a CPU device (lavapipe) several times the arithmetic, while written out they are
+    // literals. A larger one has a grid, whose cells list few segments.
     bool inlinedOutline(uint32_t i) const {
         const Node& n = scene_.nodes[i];
-        return lit_ && n.outline && n.outline->size() <= kInlineOutlineWords;
+        return lit_ && n.outline && (*n.outline)[0].x == 0.0f;
     }
 
     static std::string vec2Literal(float x, float y) {
@@ -186,7 +198,7 @@ class Emitter {
 
     // sdOutline (shaders/sdf.glsl) unrolled over node i's outline: `float outline<i>(vec3 p)`.
     void outlineFunction(uint32_t i) {
-        const std::vector<glm::vec4>& w = *scene_.nodes[i].outline;
+        const glm::vec4* w = scene_.nodes[i].outline->data() + 2; // the contours
         out_ += "float outline" + std::to_string(i) +
                 "(vec3 p3) {\n    vec2 p = p3.xy;\n    float best = 1e30, winding = 0.0;\n"
                 "    bool holds;\n";
@@ -453,15 +465,18 @@ class Emitter {
     }
 
     // Opens the block of operand `child` of union/difference `op`, entered only when the
-    // operand can change the running value (without bounds tests, a plain block).
+    // operand can change the running value (without bounds tests, a plain block). An operand
+    // with a gridded outline is always tested: its loops cost more than the test, even on a CPU
+    // device that runs both sides of the branch where its lanes disagree.
     void guard(uint32_t op, uint32_t child, uint32_t depth) {
         indent(depth);
-        if (!tests_) {
+        if (!tests_ && !gridded_[child]) {
             out_ += "{\n";
             return;
         }
-        out_ +=
-            scene_.nodes[op].kind == NodeKind::Union ? "if (unionNeeds(" : "if (differenceNeeds(";
+        const bool unionOp = scene_.nodes[op].kind == NodeKind::Union;
+        out_ += gridded_[child] ? (unionOp ? "if (unionChanges(" : "if (differenceChanges(")
+                                : (unionOp ? "if (unionNeeds(" : "if (differenceNeeds(");
         out_ += boundsDistanceOf(child, point());
         out_ += ", ";
         var(op);
@@ -503,6 +518,7 @@ class Emitter {
     std::string& out_;
     const std::vector<detail::GpuNode>* lit_; // null: values come from the node buffer
     bool tests_;                                  // CodegenOptions::boundsTests
+    std::vector<bool> gridded_;                   // markGridded
     bool sample_ = false;
     std::vector<std::string> points_{"p"}; // see point()
     std::vector<bool> loops_;              // per open domain operation: whether it loops

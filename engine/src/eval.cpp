@@ -120,18 +120,13 @@ template <class V> float dist(const V& v) {
         return v.w;
 }
 
-// Polygon and text: the first record (0 here; the node buffer rebases it), the glyph count and
-// the extents of the glyphs' boxes.
+// Polygon and text: sdOutline's parameters (outline.h): the outline's first word (0 here; the
+// node buffer rebases it), its grid's cells per row (0 for an outline listed by contour), its
+// box, and the grid's rows and cell side (or the number of contours).
 Params outlineParams(const std::vector<glm::vec4>* outline) {
-    Params k{};
-    if (!outline || outline->empty()) return k;
-    const float glyphs = (*outline)[1].z; // the first glyph record holds the count
-    glm::vec2 lo(INFINITY), hi(-INFINITY);
-    for (uint32_t g = 0; g < uint32_t(glyphs); ++g) {
-        const glm::vec4 box = (*outline)[2 * g];
-        lo = glm::min(lo, glm::vec2(box.x, box.y)), hi = glm::max(hi, glm::vec2(box.z, box.w));
-    }
-    return {0.0f, glyphs, lo.x, lo.y, hi.x, hi.y};
+    if (!outline || outline->size() < 2) return Params{};
+    const glm::vec4 layout = (*outline)[0], box = (*outline)[1];
+    return {0.0f, layout.x, box.x, box.y, box.z, box.w, layout.y, layout.z};
 }
 
 Role roleOf(NodeKind kind) {

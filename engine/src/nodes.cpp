@@ -261,6 +261,7 @@ constexpr KernelArg kA0[] = {{0, 1}};
 constexpr KernelArg kA3[] = {{0, 3}};
 constexpr KernelArg kA3A1[] = {{0, 3}, {3, 1}};
 constexpr KernelArg kA0A1[] = {{0, 1}, {1, 1}};
+constexpr KernelArg kOutlineArgs[] = {{0, 1}, {1, 1}, {2, 2}, {4, 2}, {6, 1}, {7, 1}};
 constexpr KernelArg kA0A1A2[] = {{0, 1}, {1, 1}, {2, 1}};
 constexpr KernelArg kA0A1A2A3[] = {{0, 1}, {1, 1}, {2, 1}, {3, 1}};
 constexpr KernelArg kCapsuleArgs[] = {{0, 3}, {4, 3}, {3, 1}};
@@ -418,13 +419,13 @@ constexpr KindInfo kKinds[] = {
      },
      [](const Params& k, vec3& lo, vec3& hi) { return profile(k[0], k[0], lo, hi); }},
     {NodeKind::Polygon, "polygon", false, kPolygon,
-     "2D profile: a polygon in the xy plane from its corners, exact distance.", "sdOutline", kA0A1,
-     nullptr, outlineBounds},
+     "2D profile: a polygon in the xy plane from its corners, exact distance.", "sdOutline",
+     kOutlineArgs, nullptr, outlineBounds},
     {NodeKind::Text, "text", false, kText,
      "2D profile: a line of text in the xy plane, set in a TrueType or OpenType font through "
      "FreeType and centred on the origin (the middle of its outlines' extents); exact distance "
      "to the glyphs' outlines.",
-     "sdOutline", kA0A1, nullptr, outlineBounds},
+     "sdOutline", kOutlineArgs, nullptr, outlineBounds},
     {NodeKind::Union, "union", true, kOperation, "All children together.", {}, {}, nullptr,
      nullptr, Role::Boolean},
     {NodeKind::Intersection, "intersection", true, kOperation, "What all children have in common.",

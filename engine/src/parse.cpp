@@ -441,7 +441,8 @@ std::optional<dom::array> SceneReader::readNode(element value, std::string path,
             problems_.add(member(p, "points"), why);
         paramsOk = paramsOk && polygonProblem(node.points).empty();
     }
-    if (hasOutline(kind->kind) && paramsOk) {
+    // Past the limit, the outline that passed it has said so: no more are built.
+    if (hasOutline(kind->kind) && paramsOk && outlineWords_ <= kMaxOutlineWords) {
         auto outline = buildOutline(node);
         if (!outline) {
             const bool fontProblem =
@@ -454,8 +455,8 @@ std::optional<dom::array> SceneReader::readNode(element value, std::string path,
         } else if ((outlineWords_ += (*outline)->size()) > kMaxOutlineWords) {
             if (outlineWords_ - (*outline)->size() <= kMaxOutlineWords) // once, where it passes
                 problems_.add(p, "the scene's polygon and text outlines exceed " +
-                                     std::to_string(kMaxOutlineWords / 2) +
-                                     " segments in all, the limit");
+                                     std::to_string(kMaxOutlineWords * 16 >> 20) +
+                                     " MiB in all, the limit");
         } else {
             node.outline = *outline;
         }

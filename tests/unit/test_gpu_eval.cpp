@@ -223,7 +223,8 @@ const std::map<std::string, std::string>& profileExamples() {
         {"rectangle", R"("width": 0.9, "height": 0.6, "rounding": 0.1)"},
         {"regular_polygon", R"("radius": 0.6, "sides": 5)"},
         {"polygon", R"("points": [[-0.5, -0.4], [0.6, -0.4], [0.1, 0.0], [0.3, 0.5], [-0.4, 0.3]])"},
-        {"text", R"("text": "Bo", "size": 0.8)"},
+        // Large enough for a grid (engine/src/outline.h); the polygon is listed by contour.
+        {"text", R"("text": "Bo sdfg", "size": 0.5)"},
     };
     return examples;
 }

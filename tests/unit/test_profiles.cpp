@@ -183,8 +183,7 @@ TEST(Profiles, OutlinesOfAllNodesAreBounded) {
     const std::string error =
         errorOf(R"({"type": "extrude", "height": 1, "children": [{"type": "union", "children": [)" +
                 kids + "]}]}");
-    EXPECT_NE(error.find("the scene's polygon and text outlines exceed 1048576 segments in all, "
-                         "the limit"),
+    EXPECT_NE(error.find("the scene's polygon and text outlines exceed 64 MiB in all, the limit"),
               std::string::npos)
         << error.substr(0, 300);
 }
@@ -234,14 +233,11 @@ TEST(Profiles, FontOutlinesAreClosedContours) {
     EXPECT_LT(av->advance, a->advance + v->advance);
 }
 
-// Text: the field is the exact distance to the glyphs' curves (sampled densely here), negative
-// inside them, and its bounds are the outline's extents, centred.
-TEST(Profiles, TextIsTheExactDistanceToItsGlyphs) {
-    auto text = detail::textOutline("Bo", detail::defaultFontFile(), 1.0f);
-    ASSERT_TRUE(text);
-    const glm::vec2 shift = -0.5f * (text->min + text->max);
+// A text's outline as a dense polyline (64 lines to a curve), centred as the text node centres it.
+Brute textBrute(const detail::TextOutline& text) {
+    const glm::vec2 shift = -0.5f * (text.min + text.max);
     Brute brute;
-    for (const auto& s : text->segments) {
+    for (const auto& s : text.segments) {
         const int n = s.quadratic ? 64 : 1;
         glm::vec2 prev = s.a + shift;
         for (int k = 1; k <= n; ++k) {
@@ -251,6 +247,52 @@ TEST(Profiles, TextIsTheExactDistanceToItsGlyphs) {
             prev = q + shift;
         }
     }
+    return brute;
+}
+
+// A gridded outline (outline.h) against `brute` in the rectangle of half sides `reach`: exact
+// within `tolerance` on the grid; beyond it a lower bound, positive and never below the
+// distance to the outline's box; and 1-Lipschitz everywhere, across cells and the grid's edge.
+void expectGridField(const std::string& root, const Brute& brute, glm::vec2 reach,
+                     float tolerance) {
+    SCOPED_TRACE(root);
+    Evaluator e(parseRoot(root));
+    const Params& k = e.nodes()[1].params;
+    ASSERT_GT(k[1], 0.0f) << "not gridded";
+    const glm::vec2 lo(k[2], k[3]), hi(k[4], k[5]), corner = lo - 2.0f * k[7];
+    const glm::vec2 far = corner + glm::vec2(k[1], k[6]) * k[7];
+    auto field = [&](glm::vec2 p) { return e.distance(glm::vec3(p, 0.0f)); };
+    int on = 0, beyond = 0, inside = 0;
+    const std::vector<glm::vec3> at = randomPoints(5, 4000, 1.0f), steps = randomPoints(6, 4000, 1.0f);
+    for (size_t i = 0; i < at.size(); ++i) {
+        const glm::vec2 p = reach * glm::vec2(at[i]);
+        SCOPED_TRACE(std::to_string(p.x) + " " + std::to_string(p.y));
+        const float got = field(p), exact = brute.distance(p);
+        if (glm::all(glm::greaterThanEqual(p, corner)) && glm::all(glm::lessThanEqual(p, far))) {
+            ASSERT_NEAR(got, exact, tolerance);
+            ++on;
+            inside += got < 0;
+        } else {
+            ASSERT_LE(got, exact + tolerance);
+            const glm::vec2 out = glm::max(glm::max(lo - p, p - hi), 0.0f);
+            ASSERT_GE(got, glm::length(out) * (1.0f - 1e-6f));
+            ++beyond;
+        }
+        // A step of up to a tenth of the reach.
+        const glm::vec2 q = p + 0.1f * reach * glm::vec2(steps[i]);
+        ASSERT_LE(std::abs(field(q) - got), glm::length(q - p) * 1.0001f + 1e-6f) << "step";
+    }
+    EXPECT_GT(on, 500);
+    EXPECT_GT(beyond, 500);
+    EXPECT_GT(inside, 50);
+}
+
+// Text: the field is the exact distance to the glyphs' curves (sampled densely here), negative
+// inside them, and its bounds are the outline's extents, centred.
+TEST(Profiles, TextIsTheExactDistanceToItsGlyphs) {
+    auto text = detail::textOutline("Bo", detail::defaultFontFile(), 1.0f);
+    ASSERT_TRUE(text);
+    const Brute brute = textBrute(*text);
     Evaluator e(parseRoot(R"({"type": "extrude", "height": 100, "children": [
         {"type": "text", "text": "Bo"}]})"));
     const Aabb& box = e.nodes()[1].bounds;
@@ -269,6 +311,37 @@ TEST(Profiles, TextIsTheExactDistanceToItsGlyphs) {
         inside += got < 0;
     }
     EXPECT_GT(inside, 200);
+}
+
+// Outlines too large to write into a kernel carry a grid of cells, each listing the segments
+// that can be nearest in it.
+TEST(Profiles, GriddedTextIsExactOnItsGrid) {
+    auto text = detail::textOutline("sdfcsg gear", detail::defaultFontFile(), 0.6f);
+    ASSERT_TRUE(text);
+    expectGridField(R"({"type": "extrude", "height": 100, "children": [
+        {"type": "text", "text": "sdfcsg gear", "size": 0.6}]})",
+                    textBrute(*text), {2.5f, 0.6f}, 2e-4f);
+}
+
+TEST(Profiles, GriddedPolygonIsExactOnItsGrid) {
+    // A star of 300 points, 150 spikes.
+    std::string list;
+    Brute brute;
+    std::vector<glm::vec2> pts;
+    for (int i = 0; i < 300; ++i) {
+        const float angle = 6.2831853f * float(i) / 300.0f, r = i % 2 ? 0.5f : 0.8f;
+        pts.push_back({r * std::cos(angle), r * std::sin(angle)});
+        list += (i ? ", [" : "[") + std::to_string(pts.back().x) + ", " +
+                std::to_string(pts.back().y) + "]";
+    }
+    // The points as the parser reads them back from their text.
+    for (glm::vec2& p : pts)
+        p = {std::stof(std::to_string(p.x)), std::stof(std::to_string(p.y))};
+    for (size_t i = 0; i < pts.size(); ++i)
+        brute.edges.push_back({pts[i], pts[(i + 1) % pts.size()]});
+    expectGridField(R"({"type": "extrude", "height": 100, "children": [
+        {"type": "polygon", "points": [)" + list + "]}]}",
+                    brute, {1.2f, 1.2f}, 2e-5f);
 }
 
 } // namespace

@@ -108,10 +108,10 @@ inline constexpr bool isProfile(NodeKind kind) {
 inline constexpr bool hasOutline(NodeKind kind) {
     return kind == NodeKind::Polygon || kind == NodeKind::Text;
 }
-// A polygon's points, at most; and the vec4s of every outline of a scene (segments take two),
-// so that the node buffer stays within 32 MiB.
+// A polygon's points, at most; and the vec4s of every outline of a scene (a large one lists its
+// segments per cell of a grid), so that they stay within 64 MiB of the node buffer.
 inline constexpr size_t kMaxPolygonPoints = 1024;
-inline constexpr size_t kMaxOutlineWords = size_t(1) << 21;
+inline constexpr size_t kMaxOutlineWords = size_t(1) << 22;
 
 struct KindInfo {
     NodeKind kind;
