@@ -272,13 +272,12 @@ SDF_FN float quadraticCrossingsUp(float x, float y0, float y1, vec2 a, vec2 c, v
 
 // A small polygon or text outline (engine/src/outline.h), listed by contour from `first`: the
 // exact distance to its line and quadratic segments, negative where they wind around p
-// (non-zero rule). The distance starts
-// from an upper bound, the nearest of the contours' first points; then a contour runs only
-// where its box is nearer than the nearest segment so far (for the distance) or holds p (a
-// contour whose box does not hold p cannot wind around it). The tests set a contour's loop
-// counts rather than skip it, and lines and quadratics have loops of their own rather than a
-// select per segment: a CPU device (lavapipe) runs both sides of every branch, but a loop only
-// as long as one of its lanes needs it.
+// (non-zero rule). The distance starts from an upper bound, the nearest of the contours' first
+// points; then a contour runs only where its box is nearer than the nearest segment so far (for
+// the distance) or holds p (a contour whose box does not hold p cannot wind around it). The
+// tests set a contour's loop counts rather than skip it, and lines and quadratics have loops of
+// their own rather than a select per segment: a CPU device (lavapipe) runs both sides of every
+// branch, but a loop only as long as one of its lanes needs it.
 SDF_FN float sdContours(vec2 p, uint first, uint contours SDF_DATA_PARAM) {
     float best = 1e30f, winding = 0.0f; // best: the least squared distance
     for (uint g = 0u; g < contours; ++g) {

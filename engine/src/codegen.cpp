@@ -69,9 +69,14 @@ class Emitter {
             bool boundsTests)
         : scene_(scene), out_(out), lit_(literals), tests_(boundsTests),
           gridded_(scene.nodes.size(), false) {
-        for (uint32_t i = 0; i < scene.nodes.size(); ++i) {
+        // Whether node i's subtree holds a gridded outline (outline.h): children come after
+        // their operation.
+        for (size_t i = scene.nodes.size(); i-- > 0;) {
             const Node& n = scene.nodes[i];
-            if (n.outline && (*n.outline)[0].x != 0.0f) markGridded(i);
+            bool gridded = n.outline && (*n.outline)[0].x != 0.0f;
+            for (uint32_t child : n.children)
+                gridded = gridded || gridded_[child];
+            gridded_[i] = gridded;
         }
     }
 
@@ -171,14 +176,6 @@ class Emitter {
 
   private:
     void indent(uint32_t depth) { out_.append(4 * (depth + 1), ' '); }
-
-    // Node i and the operations above it hold a gridded outline (outline.h).
-    void markGridded(uint32_t i) {
-        gridded_[i] = true;
-        for (uint32_t j = 0; j < scene_.nodes.size(); ++j)
-            for (uint32_t child : scene_.nodes[j].children)
-                if (child == i && !gridded_[j]) markGridded(j);
-    }
 
     // Whether node i's outline (polygon, text) is written out as code: a small one, listed by
     // contour (outline.h), whose loops would read every segment from the node buffer, which
@@ -518,7 +515,7 @@ class Emitter {
     std::string& out_;
     const std::vector<detail::GpuNode>* lit_; // null: values come from the node buffer
     bool tests_;                                  // CodegenOptions::boundsTests
-    std::vector<bool> gridded_;                   // markGridded
+    std::vector<bool> gridded_;                   // per node, see the constructor
     bool sample_ = false;
     std::vector<std::string> points_{"p"}; // see point()
     std::vector<bool> loops_;              // per open domain operation: whether it loops
