@@ -272,16 +272,18 @@ int cmdRender(int argc, char** argv) {
     return kOk;
 }
 
-const char* kMeshHelp = R"(Usage: sdfcsg mesh SCENE -o OUT.(ply|obj|stl|glb) [options]
+const char* kMeshHelp = R"(Usage: sdfcsg mesh SCENE -o OUT.(ply|obj|stl|glb|3mf) [options]
 
 Extracts a triangle mesh of SCENE by marching cubes in Vulkan compute passes and writes it
 (atomically) in the format that OUT's extension names: binary PLY with normals and colours,
-OBJ with normals and colours ("v x y z r g b"), binary STL for printing, or glTF 2.0 binary.
+OBJ with normals and colours ("v x y z r g b"), binary STL for printing, glTF 2.0 binary, or
+3MF with colours for slicers (z up: the scene's y axis becomes the build direction).
 The mesh is indexed, and closed and manifold wherever the surface lies inside the bounds;
 where the bounds cut the surface it is open, and a note says so.
 
 Options:
-  -o, --output FILE      output mesh (required): .ply, .obj, .stl or .glb
+  -o, --output FILE      output mesh (required): .ply, .obj, .stl, .glb or .3mf
+  --unit U               3MF only: what one scene unit is, mm (default), cm, m or inch
   --resolution N         cells along the longest axis of the bounds (default 128)
   --voxel-size H         cell edge length in scene units, instead of --resolution
   --bounds X0,Y0,Z0,X1,Y1,Z1
@@ -351,17 +353,25 @@ int cmdMesh(int argc, char** argv) {
     };
     Args args("mesh", argc, argv,
               {"-o", "--output", "--resolution", "--voxel-size", "--bounds", "--device",
-               "--evaluation"},
+               "--evaluation", "--unit"},
               {"--stats", "--validation", "--help", "-h"});
     if (args.has("--help") || args.has("-h")) return std::fputs(kMeshHelp, stdout), kOk;
     if (!args.error.empty()) return usageError("mesh", args.error);
     if (args.positional.size() != 1) return usageError("mesh", "expected one SCENE file");
     std::string out = args.get("-o", args.get("--output"));
-    if (out.empty()) return usageError("mesh", "missing -o OUT.(ply|obj|stl|glb)");
+    if (out.empty()) return usageError("mesh", "missing -o OUT.(ply|obj|stl|glb|3mf)");
     auto format = sdfcsg::meshFormatFromPath(out);
     if (!format)
-        return usageError("mesh",
-                          "the output must end in .ply, .obj, .stl or .glb, got '" + out + "'");
+        return usageError("mesh", "the output must end in .ply, .obj, .stl, .glb or .3mf, got '" +
+                                      out + "'");
+    sdfcsg::LengthUnit unit = sdfcsg::LengthUnit::Millimeter;
+    if (args.has("--unit")) {
+        auto named = sdfcsg::lengthUnitFromName(args.get("--unit"));
+        if (!named) return usageError("mesh", "--unit expects mm, cm, m or inch");
+        if (*format != sdfcsg::MeshFormat::ThreeMf)
+            return usageError("mesh", "--unit applies to .3mf output only");
+        unit = *named;
+    }
 
     sdfcsg::MeshOptions options;
     if (args.has("--resolution") && args.has("--voxel-size"))
@@ -407,7 +417,7 @@ int cmdMesh(int argc, char** argv) {
     }();
     if (!mesh) return fail(mesh.error());
     t0 = Clock::now();
-    if (auto written = writeOutput([&] { return sdfcsg::writeMesh(*mesh, out, *format); });
+    if (auto written = writeOutput([&] { return sdfcsg::writeMesh(*mesh, out, *format, unit); });
         !written)
         return fail(written.error());
     const double writeSeconds = secondsSince(t0);

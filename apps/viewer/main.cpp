@@ -772,7 +772,7 @@ void fileBrowser(Viewer& v) {
 std::optional<std::string> startExport(Viewer& v, const fs::path& path) {
     auto format = meshFormatFromPath(path);
     if (!format)
-        return path.string() + ": the extension names no mesh format (.ply, .obj, .stl, .glb)";
+        return path.string() + ": the extension names no mesh format (.ply, .obj, .stl, .glb, .3mf)";
     if (!v.exporter->start(v.mesh, path, *format)) return "a mesh is being written";
     v.exporting = path;
     v.meshMessage = "writing " + path.string() + "...";

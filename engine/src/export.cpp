@@ -1,14 +1,16 @@
-// Mesh exporters: binary PLY, OBJ, binary STL and glTF 2.0 binary, encoded in memory and
+// Mesh exporters: binary PLY, OBJ, binary STL, glTF 2.0 binary and 3MF, encoded in memory and
 // written atomically. Binary formats are little-endian by specification; values are written
 // byte by byte so the output does not depend on the host's byte order.
 //
 // References: PLY (Greg Turk, "The PLY Polygon File Format"); binary STL (3D Systems,
 // "StereoLithography Interface Specification", 1989); glTF 2.0 (Khronos, "glTF 2.0
-// Specification": the chapters on accessors and on the GLB file format).
+// Specification": the chapters on accessors and on the GLB file format); 3MF (3MF Consortium,
+// "3MF Core Specification" 1.3 and "Materials and Properties Extension" 1.2).
 #include "sdfcsg/export.h"
 #include "sdfcsg/io.h"
 
 #include "json_writer.h"
+#include "zip.h"
 
 #include <glm/geometric.hpp>
 
@@ -18,9 +20,11 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <initializer_list>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace sdfcsg {
 namespace {
@@ -267,6 +271,111 @@ std::string encodeGlb(const Mesh& mesh) {
 }
 
 // What the encoders rely on; a mesh that breaks it would give files that readers reject.
+
+const char* unitName(LengthUnit unit) {
+    switch (unit) {
+    case LengthUnit::Millimeter:
+        return "millimeter";
+    case LengthUnit::Centimeter:
+        return "centimeter";
+    case LengthUnit::Meter:
+        return "meter";
+    case LengthUnit::Inch:
+        return "inch";
+    }
+    return "millimeter";
+}
+
+// The model part of a 3MF package: vertices turned z up ((x, y, z) -> (x, -z, y), a rotation,
+// so the winding stays outward), triangles with their corners' colours, and one build item.
+// The specification forbids a triangle that names a vertex twice; such a triangle has no area
+// and is left out.
+std::string threeMfModel(const Mesh& mesh, LengthUnit unit) {
+    const bool colors = hasColors(mesh);
+    std::string out = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<model unit=\"";
+    out += unitName(unit);
+    out += "\" xml:lang=\"en-US\" "
+           "xmlns=\"http://schemas.microsoft.com/3dmanufacturing/core/2015/02\" "
+           "xmlns:m=\"http://schemas.microsoft.com/3dmanufacturing/material/2015/02\">\n"
+           "<metadata name=\"Application\">sdfcsg</metadata>\n<resources>\n";
+    // The distinct colours, each once, and each vertex's place among them.
+    std::vector<uint32_t> colorOf;
+    if (colors) {
+        std::vector<uint32_t> rgb(mesh.vertexCount());
+        for (size_t i = 0; i < rgb.size(); ++i) {
+            const glm::vec3 c = mesh.colors[i];
+            rgb[i] = uint32_t(toByte(c.r)) << 16 | uint32_t(toByte(c.g)) << 8 | toByte(c.b);
+        }
+        std::vector<uint32_t> distinct = rgb;
+        std::sort(distinct.begin(), distinct.end());
+        distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+        out += " <m:colorgroup id=\"1\">\n";
+        for (uint32_t c : distinct) {
+            char text[8];
+            std::snprintf(text, sizeof text, "%06X", c);
+            out += "  <m:color color=\"#";
+            out += text;
+            out += "\"/>\n";
+        }
+        out += " </m:colorgroup>\n";
+        colorOf.resize(rgb.size());
+        for (size_t i = 0; i < rgb.size(); ++i)
+            colorOf[i] = uint32_t(std::lower_bound(distinct.begin(), distinct.end(), rgb[i]) -
+                                  distinct.begin());
+    }
+    out += colors ? " <object id=\"2\" type=\"model\" pid=\"1\" pindex=\"0\">\n"
+                  : " <object id=\"2\" type=\"model\">\n";
+    out += "  <mesh>\n   <vertices>\n";
+    out.reserve(out.size() + mesh.vertexCount() * 48 + mesh.triangleCount() * 64);
+    for (const glm::vec3& v : mesh.positions) {
+        const float turned[3] = {v.x, -v.z, v.y};
+        out += "    <vertex";
+        for (int k = 0; k < 3; ++k) {
+            out += k == 0 ? " x=\"" : k == 1 ? "\" y=\"" : "\" z=\"";
+            appendFloat(out, turned[k] == 0.0f ? 0.0f : turned[k]); // no "-0"
+        }
+        out += "\"/>\n";
+    }
+    out += "   </vertices>\n   <triangles>\n";
+    for (size_t t = 0; t < mesh.triangleCount(); ++t) {
+        const uint32_t* v = &mesh.indices[3 * t];
+        if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2]) continue;
+        out += "    <triangle";
+        for (int k = 0; k < 3; ++k)
+            out += " v" + std::to_string(k + 1) + "=\"" + std::to_string(v[k]) + "\"";
+        if (colors)
+            for (int k = 0; k < 3; ++k)
+                out += " p" + std::to_string(k + 1) + "=\"" + std::to_string(colorOf[v[k]]) + "\"";
+        out += "/>\n";
+    }
+    out += "   </triangles>\n  </mesh>\n </object>\n</resources>\n"
+           "<build>\n <item objectid=\"2\"/>\n</build>\n</model>\n";
+    return out;
+}
+
+// The package: the content types, the relationship that names the model, and the model.
+std::string encodeThreeMf(const Mesh& mesh, LengthUnit unit) {
+    static constexpr std::string_view kContentTypes =
+        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+        "<Types xmlns=\"http://schemas.openxmlformats.org/package/2006/content-types\">\n"
+        " <Default Extension=\"rels\" "
+        "ContentType=\"application/vnd.openxmlformats-package.relationships+xml\"/>\n"
+        " <Default Extension=\"model\" "
+        "ContentType=\"application/vnd.ms-package.3dmanufacturing-3dmodel+xml\"/>\n"
+        "</Types>\n";
+    static constexpr std::string_view kRelationships =
+        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+        "<Relationships xmlns=\"http://schemas.openxmlformats.org/package/2006/relationships\">\n"
+        " <Relationship Target=\"/3D/3dmodel.model\" Id=\"rel0\" "
+        "Type=\"http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel\"/>\n"
+        "</Relationships>\n";
+    const std::string model = threeMfModel(mesh, unit);
+    const detail::ZipEntry entries[] = {{"[Content_Types].xml", kContentTypes},
+                                        {"_rels/.rels", kRelationships},
+                                        {"3D/3dmodel.model", model}};
+    return detail::zipArchive(entries).value_or(std::string());
+}
+
 std::optional<std::string> meshProblem(const Mesh& mesh) {
     const size_t n = mesh.vertexCount();
     if (mesh.indices.size() % 3 != 0)
@@ -294,6 +403,15 @@ std::optional<MeshFormat> meshFormatFromPath(const std::filesystem::path& path) 
     if (ext == ".obj") return MeshFormat::Obj;
     if (ext == ".stl") return MeshFormat::Stl;
     if (ext == ".glb") return MeshFormat::Glb;
+    if (ext == ".3mf") return MeshFormat::ThreeMf;
+    return std::nullopt;
+}
+
+std::optional<LengthUnit> lengthUnitFromName(std::string_view name) {
+    if (name == "mm") return LengthUnit::Millimeter;
+    if (name == "cm") return LengthUnit::Centimeter;
+    if (name == "m") return LengthUnit::Meter;
+    if (name == "inch") return LengthUnit::Inch;
     return std::nullopt;
 }
 
@@ -307,11 +425,13 @@ std::string_view meshFormatName(MeshFormat format) {
         return "stl";
     case MeshFormat::Glb:
         return "glb";
+    case MeshFormat::ThreeMf:
+        return "3mf";
     }
     return "?";
 }
 
-std::string encodeMesh(const Mesh& mesh, MeshFormat format) {
+std::string encodeMesh(const Mesh& mesh, MeshFormat format, LengthUnit unit) {
     switch (format) {
     case MeshFormat::Ply:
         return encodePly(mesh);
@@ -321,15 +441,23 @@ std::string encodeMesh(const Mesh& mesh, MeshFormat format) {
         return encodeStl(mesh);
     case MeshFormat::Glb:
         return encodeGlb(mesh);
+    case MeshFormat::ThreeMf:
+        return encodeThreeMf(mesh, unit);
     }
     return {};
 }
 
-Status writeMesh(const Mesh& mesh, const std::filesystem::path& path, MeshFormat format) {
+Status writeMesh(const Mesh& mesh, const std::filesystem::path& path, MeshFormat format,
+                 LengthUnit unit) {
     if (auto problem = meshProblem(mesh))
         return Error::message(ErrorKind::Usage, path.string(),
                               "cannot write an inconsistent mesh: " + *problem);
-    return writeFileAtomic(path, encodeMesh(mesh, format));
+    const std::string bytes = encodeMesh(mesh, format, unit);
+    if (bytes.empty())
+        return Error::message(ErrorKind::Limit, path.string(),
+                              "the mesh is too large for a 3MF file (its ZIP container holds "
+                              "4 GiB); write .ply, or mesh at a lower resolution");
+    return writeFileAtomic(path, bytes);
 }
 
 } // namespace sdfcsg

@@ -87,7 +87,20 @@ check "mesh nothing in the bounds" 0 "$bin" mesh "$mesh_a" -o empty.glb --resolu
 check "mesh voxel size" 0 "$bin" mesh "$mesh_a" -o voxel.ply --voxel-size 0.1
 check "mesh usage" 2 "$bin" mesh "$mesh_a"
 check "mesh bad extension" 2 "$bin" mesh "$mesh_a" -o part.txt
-expect_text "mesh bad extension message" err.txt "sdfcsg mesh: the output must end in .ply, .obj, .stl or .glb, got 'part.txt'"
+expect_text "mesh bad extension message" err.txt "sdfcsg mesh: the output must end in .ply, .obj, .stl, .glb or .3mf, got 'part.txt'"
+# 3MF, read back by Python's own ZIP and XML readers against the PLY of the same mesh.
+check "mesh 3mf" 0 "$bin" mesh "$mesh_a" -o part.3mf --resolution 24 --bounds $box --unit cm
+if command -v python3 >/dev/null 2>&1; then
+    python3 "$src/tests/cli/read_3mf.py" part.3mf part.ply centimeter >out.txt 2>&1 &&
+        grep -q "^3mf: $vertices vertices, $triangles triangles, 2 colours" out.txt ||
+        { echo "FAIL part.3mf:"; cat out.txt; failures=$((failures + 1)); }
+else
+    echo "skipped reading part.3mf back: python3 not found"
+fi
+check "mesh unit for another format" 2 "$bin" mesh "$mesh_a" -o bad.ply --unit cm
+expect_text "mesh unit for another format message" err.txt "sdfcsg mesh: --unit applies to .3mf output only"
+check "mesh bad unit" 2 "$bin" mesh "$mesh_a" -o bad.3mf --unit furlong
+expect_text "mesh bad unit message" err.txt "sdfcsg mesh: --unit expects mm, cm, m or inch"
 check "mesh bad bounds" 2 "$bin" mesh "$mesh_a" -o bad.ply --bounds 1,1,1,0,0,0
 check "mesh short bounds" 2 "$bin" mesh "$mesh_a" -o bad.ply --bounds 0,0,0,1,1
 check "mesh resolution and voxel size" 2 "$bin" mesh "$mesh_a" -o bad.ply --resolution 8 --voxel-size 0.1

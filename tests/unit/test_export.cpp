@@ -83,11 +83,29 @@ TEST(Export, FormatFromPath) {
     EXPECT_EQ(meshFormatFromPath("b.OBJ"), MeshFormat::Obj);
     EXPECT_EQ(meshFormatFromPath("b.Stl"), MeshFormat::Stl);
     EXPECT_EQ(meshFormatFromPath("b.glb"), MeshFormat::Glb);
+    EXPECT_EQ(meshFormatFromPath("b.3MF"), MeshFormat::ThreeMf);
     EXPECT_EQ(meshFormatFromPath("b.gltf"), std::nullopt);
     EXPECT_EQ(meshFormatFromPath("ply"), std::nullopt);
     EXPECT_EQ(meshFormatFromPath("b.ply.txt"), std::nullopt);
-    for (MeshFormat f : {MeshFormat::Ply, MeshFormat::Obj, MeshFormat::Stl, MeshFormat::Glb})
+    for (MeshFormat f : {MeshFormat::Ply, MeshFormat::Obj, MeshFormat::Stl, MeshFormat::Glb,
+                         MeshFormat::ThreeMf})
         EXPECT_EQ(meshFormatFromPath("x." + std::string(meshFormatName(f))), f);
+}
+
+// 3MF's reading back is tests/cli/read_3mf.py, by Python's ZIP and XML readers; here, what the
+// package holds in plain text: its parts' names and a ZIP end record that counts 3.
+TEST(Export, ThreeMfIsAZipOfThreeParts) {
+    EXPECT_EQ(lengthUnitFromName("mm"), LengthUnit::Millimeter);
+    EXPECT_EQ(lengthUnitFromName("inch"), LengthUnit::Inch);
+    EXPECT_EQ(lengthUnitFromName("in"), std::nullopt);
+    const std::string bytes = encodeMesh(boxMesh(), MeshFormat::ThreeMf, LengthUnit::Inch);
+    ASSERT_GT(bytes.size(), 22u);
+    EXPECT_EQ(bytes.substr(0, 4), std::string("PK\x03\x04", 4));
+    for (const char* name : {"[Content_Types].xml", "_rels/.rels", "3D/3dmodel.model"})
+        EXPECT_NE(bytes.find(name), std::string::npos) << name;
+    const std::string end = bytes.substr(bytes.size() - 22);
+    EXPECT_EQ(end.substr(0, 4), std::string("PK\x05\x06", 4));
+    EXPECT_EQ(uint8_t(end[10]), 3u); // entries
 }
 
 TEST(Export, PlyRoundTrips) {

@@ -16,16 +16,28 @@ enum class MeshFormat {
     Obj, // Wavefront OBJ: "v x y z r g b" (the common colour extension), "vn", "f a//a b//b c//c"
     Stl, // binary STL: facet normals from the triangle winding, no colours (for printing)
     Glb, // glTF 2.0 binary: POSITION, NORMAL, COLOR_0 (linear), indices, one mesh and node
+    // 3MF (3D Manufacturing Format, core and materials specifications), as slicers read it: one
+    // object, z up (the scene's y becomes z), per-vertex sRGB colours as a colour group, in a
+    // unit (one scene unit is one of it)
+    ThreeMf,
 };
+
+// The length that one scene unit stands for, where the format says (3MF).
+enum class LengthUnit { Millimeter, Centimeter, Meter, Inch };
 
 // The format named by a path's extension (case-insensitive), or nullopt.
 std::optional<MeshFormat> meshFormatFromPath(const std::filesystem::path& path);
-std::string_view meshFormatName(MeshFormat format); // "ply", "obj", "stl", "glb"
+std::string_view meshFormatName(MeshFormat format); // "ply", "obj", "stl", "glb", "3mf"
 
-// The file's bytes.
-std::string encodeMesh(const Mesh& mesh, MeshFormat format);
+// A unit from its short name ("mm", "cm", "m", "inch"), or nullopt.
+std::optional<LengthUnit> lengthUnitFromName(std::string_view name);
+
+// The file's bytes; empty for a 3MF past what its ZIP container holds (4 GiB).
+std::string encodeMesh(const Mesh& mesh, MeshFormat format,
+                       LengthUnit unit = LengthUnit::Millimeter);
 
 // Encodes and writes atomically (see io.h).
-Status writeMesh(const Mesh& mesh, const std::filesystem::path& path, MeshFormat format);
+Status writeMesh(const Mesh& mesh, const std::filesystem::path& path, MeshFormat format,
+                 LengthUnit unit = LengthUnit::Millimeter);
 
 } // namespace sdfcsg
