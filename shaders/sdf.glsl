@@ -482,7 +482,8 @@ SDF_FN float sdPrimitive(uint kind, vec3 q, vec4 a, vec4 b, uint kinds SDF_DATA_
     if (SDF_IS(17u)) return sdCircle(q, a.x);
     if (SDF_IS(18u)) return sdRectangle(q, a.x, a.y, a.z);
     if (SDF_IS(19u)) return sdRegularPolygon(q, a.x, a.y, a.z, a.w);
-    if (SDF_IS(20u) || SDF_IS(21u)) return sdOutline(q, a.x, a.y, vec2(a.z, a.w), vec2(b.x, b.y), b.z, b.w SDF_DATA_ARG);
+    if (SDF_IS(20u) || SDF_IS(21u))
+        return sdOutline(q, a.x, a.y, vec2(a.z, a.w), vec2(b.x, b.y), b.z, b.w SDF_DATA_ARG);
     return 1e30f;
 }
 #undef SDF_IS

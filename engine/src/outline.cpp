@@ -1,9 +1,8 @@
 #include "outline.h"
+#include "sdf.h"
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
-
-#include "sdf.h"
 
 #include <algorithm>
 #include <cmath>
@@ -46,7 +45,8 @@ void appendMonotonic(const GlyphSegment& s, std::vector<GlyphSegment>& out, bool
     }
     const glm::vec2 ac = glm::mix(s.a, s.c, t), cb = glm::mix(s.c, s.b, t);
     const glm::vec2 m = glm::mix(ac, cb, t);
-    for (const GlyphSegment& piece : {GlyphSegment{s.a, m, ac, true}, GlyphSegment{m, s.b, cb, true}}) {
+    for (const GlyphSegment& piece :
+         {GlyphSegment{s.a, m, ac, true}, GlyphSegment{m, s.b, cb, true}}) {
         if (last) out.push_back(piece);
         else appendMonotonic(piece, out, inX, 0);
     }
@@ -109,9 +109,14 @@ glm::vec2 at(const GlyphSegment& s, float t) {
 
 constexpr int kCurvePieces = 8;
 
+// The distance between two boxes.
+float gap(const Box2& a, const Box2& b) {
+    return glm::length(glm::max(glm::max(a.lo - b.hi, b.lo - a.hi), 0.0f));
+}
+
 // The distance from the box to the box of segment s's control points: a quick lower bound.
 float hullDistance(const GlyphSegment& s, const Box2& box) {
-    return glm::length(glm::max(glm::max(box.lo - segmentMax(s), segmentMin(s) - box.hi), 0.0f));
+    return gap(box, {segmentMin(s), segmentMax(s)});
 }
 
 // The least distance from the box to segment s: exact for a line (apart, the nearest pair has a
@@ -124,9 +129,8 @@ float lowerDistance(const GlyphSegment& s, const Box2& box) {
             // The piece's control point: where the tangents at its ends meet.
             const glm::vec2 a = at(s, t0), b = at(s, t1);
             const glm::vec2 c = glm::mix(glm::mix(s.a, s.c, t0), glm::mix(s.c, s.b, t0), t1);
-            const Box2 hull{glm::min(glm::min(a, b), c), glm::max(glm::max(a, b), c)};
-            least = std::min(least, glm::length(glm::max(
-                                        glm::max(box.lo - hull.hi, hull.lo - box.hi), 0.0f)));
+            least = std::min(least, gap(box, {glm::min(glm::min(a, b), c),
+                                              glm::max(glm::max(a, b), c)}));
         }
         return least;
     }
@@ -235,7 +239,8 @@ class GridBuilder {
         std::vector<float> hull(candidates.size());
         for (size_t k = 0; k < candidates.size(); ++k) {
             hull[k] = hullDistance(segments_[candidates[k]], box);
-            if (hull[k] < least) least = std::min(least, upperDistance(segments_[candidates[k]], box));
+            if (hull[k] < least)
+                least = std::min(least, upperDistance(segments_[candidates[k]], box));
         }
         std::vector<uint32_t> kept;
         for (size_t k = 0; k < candidates.size(); ++k)
