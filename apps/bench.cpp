@@ -18,6 +18,7 @@
 #include <sstream>
 #include <string>
 #include <string_view>
+#include <tuple>
 #include <vector>
 
 namespace sdfcsg::app {
@@ -43,6 +44,7 @@ std::vector<fs::path> findScenes(const fs::path& dir) {
 const char* kHelp = R"(Usage: sdfcsg bench [--scenes DIR] [--width W] [--height H] [--frames N] [--buffer]
                    [--evaluation E]
        sdfcsg bench --mesh [--scenes DIR] [--resolutions 128,256,512] [--runs N]
+                   [--method dc|mc] [--error]
 
 For every scene (*.json) in DIR (default assets/scenes), prints the median milliseconds per
 frame in shaded mode with and without bounding-box skipping (after two warm-up frames; a frame
@@ -76,7 +78,9 @@ extraction and of the whole (from a compiled scene to an indexed mesh in host me
 --runs extractions (default 3) after one warm-up per scene. The resolution is the number of
 cells along the longest axis of the bounds: the scene's finite bounds plus a margin, except
 for the reference scenes mesh_a and mesh_b, which are meshed in the bounds their benchmark
-defines.
+defines. --method picks dual contouring (default) or marching cubes. --error adds the
+distance from the surface of points spread over every triangle (not only its vertices),
+by the CPU evaluator, in cells: the largest and the 99th percentile.
 )";
 
 using Clock = std::chrono::steady_clock;
@@ -221,19 +225,49 @@ struct MeshRow {
     uint32_t resolution = 0;
     glm::uvec3 cells{0};
     uint64_t triangles = 0;
+    float maxError = NAN, p99Error = NAN; // cells
     std::vector<double> stages; // median seconds, in the order of the stage names
     double total = 0;
 };
+
+// The distance from the surface, in cells of edge h, of seven points on every triangle: its
+// centre, the middles of its sides and the points halfway from the centre to each corner.
+std::pair<float, float> surfaceError(const Mesh& mesh, const Evaluator& evaluator, float h) {
+    std::vector<float> errors;
+    errors.reserve(mesh.indices.size() / 3 * 7);
+    const glm::vec3 weights[7] = {glm::vec3(1.0f / 3),          glm::vec3(0.5f, 0.5f, 0.0f),
+                                  glm::vec3(0.0f, 0.5f, 0.5f),  glm::vec3(0.5f, 0.0f, 0.5f),
+                                  glm::vec3(2, 0.5f, 0.5f) / 3.0f, glm::vec3(0.5f, 2, 0.5f) / 3.0f,
+                                  glm::vec3(0.5f, 0.5f, 2) / 3.0f};
+    for (size_t t = 0; t + 3 <= mesh.indices.size(); t += 3) {
+        const glm::vec3 a = mesh.positions[mesh.indices[t]], b = mesh.positions[mesh.indices[t + 1]],
+                        c = mesh.positions[mesh.indices[t + 2]];
+        for (const glm::vec3& w : weights)
+            errors.push_back(std::abs(evaluator.distance(w.x * a + w.y * b + w.z * c)) / h);
+    }
+    if (errors.empty()) return {0.0f, 0.0f};
+    const size_t p99 = errors.size() * 99 / 100;
+    std::nth_element(errors.begin(), errors.begin() + p99, errors.end());
+    return {*std::max_element(errors.begin(), errors.end()), errors[p99]};
+}
 
 int runMeshBench(int argc, char** argv) {
     fs::path dir = "assets/scenes";
     std::vector<uint32_t> resolutions = {128, 256, 512};
     uint32_t runs = 3;
+    MeshMethod method = MeshMethod::DualContouring;
+    bool measureError = false;
     for (int i = 0; i < argc; ++i) {
         std::string_view a = argv[i];
         bool ok = true;
         if (a == "--mesh")
             continue;
+        else if (a == "--error")
+            measureError = true;
+        else if (i + 1 < argc && a == "--method" && std::string_view(argv[i + 1]) == "dc")
+            method = MeshMethod::DualContouring, ++i;
+        else if (i + 1 < argc && a == "--method" && std::string_view(argv[i + 1]) == "mc")
+            method = MeshMethod::MarchingCubes, ++i;
         else if (i + 1 < argc && a == "--scenes")
             dir = argv[++i];
         else if (i + 1 < argc && a == "--resolutions")
@@ -277,7 +311,9 @@ int runMeshBench(int argc, char** argv) {
             failed(mesher.error());
             break;
         }
+        Evaluator evaluator(*scene);
         MeshOptions options;
+        options.method = method;
         for (const ReferenceBounds& r : kReferenceBounds)
             if (name == r.scene) options.bounds = r.bounds;
         options.resolution = resolutions.front();
@@ -299,6 +335,9 @@ int runMeshBench(int argc, char** argv) {
                     failed(mesh.error());
                     break;
                 }
+                if (measureError && run == 0)
+                    std::tie(row.maxError, row.p99Error) =
+                        surfaceError(*mesh, evaluator, stats.voxelSize);
                 row.cells = stats.cells;
                 row.triangles = stats.triangles;
                 totals.push_back(stats.totalSeconds);
@@ -323,7 +362,9 @@ int runMeshBench(int argc, char** argv) {
     std::printf("\n%-16s %5s %16s %10s", "scene", "res", "cells", "triangles");
     for (const std::string& stage : stageNames)
         std::printf(" %*s", int(std::max<size_t>(stage.size(), 8)), stage.c_str());
-    std::printf(" %8s\n", "total s");
+    std::printf(" %8s", "total s");
+    if (measureError) std::printf(" %9s %9s", "max err", "p99 err");
+    std::printf("\n");
     for (const MeshRow& r : rows) {
         const std::string cells = std::to_string(r.cells.x) + "x" + std::to_string(r.cells.y) +
                                   "x" + std::to_string(r.cells.z);
@@ -336,7 +377,9 @@ int runMeshBench(int argc, char** argv) {
             else
                 std::printf(" %*s", width, "-");
         }
-        std::printf(" %8.3f\n", r.total);
+        std::printf(" %8.3f", r.total);
+        if (measureError) std::printf(" %9.3f %9.3f", r.maxError, r.p99Error);
+        std::printf("\n");
     }
     std::printf(
         "\nSeconds, median per stage and in total, from a compiled scene to an indexed mesh "

@@ -274,7 +274,8 @@ int cmdRender(int argc, char** argv) {
 
 const char* kMeshHelp = R"(Usage: sdfcsg mesh SCENE -o OUT.(ply|obj|stl|glb|3mf) [options]
 
-Extracts a triangle mesh of SCENE by marching cubes in Vulkan compute passes and writes it
+Extracts a triangle mesh of SCENE in Vulkan compute passes, by dual contouring (sharp edges
+and corners of the solid stay sharp) or marching cubes, and writes it
 (atomically) in the format that OUT's extension names: binary PLY with normals and colours,
 OBJ with normals and colours ("v x y z r g b"), binary STL for printing, glTF 2.0 binary, or
 3MF with colours for slicers (z up: the scene's y axis becomes the build direction).
@@ -284,6 +285,7 @@ where the bounds cut the surface it is open, and a note says so.
 Options:
   -o, --output FILE      output mesh (required): .ply, .obj, .stl, .glb or .3mf
   --unit U               3MF only: what one scene unit is, mm (default), cm, m or inch
+  --method M             dc (dual contouring, the default) or mc (marching cubes)
   --resolution N         cells along the longest axis of the bounds (default 128)
   --voxel-size H         cell edge length in scene units, instead of --resolution
   --bounds X0,Y0,Z0,X1,Y1,Z1
@@ -332,12 +334,12 @@ void printMeshStats(const sdfcsg::MeshStats& stats, double compileSeconds, doubl
                 static_cast<unsigned long long>(stats.triangles));
     std::printf("surface:   %s\n", stats.surfaceCut ? "cut by the bounds (the mesh is open there)"
                                                     : "inside the bounds (the mesh is closed)");
-    std::printf("time:      %-12s %8.3f s\n", "compile", compileSeconds);
+    std::printf("time:      %-13s %8.3f s\n", "compile", compileSeconds);
     for (const auto& stage : stats.stages)
-        std::printf("           %-12s %8.3f s\n", stage.name.c_str(), stage.seconds);
-    std::printf("           %-12s %8.3f s (compiled scene to mesh in memory)\n", "extraction",
+        std::printf("           %-13s %8.3f s\n", stage.name.c_str(), stage.seconds);
+    std::printf("           %-13s %8.3f s (compiled scene to mesh in memory)\n", "extraction",
                 stats.totalSeconds);
-    std::printf("           %-12s %8.3f s\n", "write", writeSeconds);
+    std::printf("           %-13s %8.3f s\n", "write", writeSeconds);
     // ru_maxrss is in KiB on Linux.
     rusage usage{};
     ::getrusage(RUSAGE_SELF, &usage);
@@ -353,7 +355,7 @@ int cmdMesh(int argc, char** argv) {
     };
     Args args("mesh", argc, argv,
               {"-o", "--output", "--resolution", "--voxel-size", "--bounds", "--device",
-               "--evaluation", "--unit"},
+               "--evaluation", "--unit", "--method"},
               {"--stats", "--validation", "--help", "-h"});
     if (args.has("--help") || args.has("-h")) return std::fputs(kMeshHelp, stdout), kOk;
     if (!args.error.empty()) return usageError("mesh", args.error);
@@ -374,6 +376,13 @@ int cmdMesh(int argc, char** argv) {
     }
 
     sdfcsg::MeshOptions options;
+    if (args.has("--method")) {
+        const std::string method = args.get("--method");
+        if (method != "dc" && method != "mc")
+            return usageError("mesh", "--method expects dc or mc, got '" + method + "'");
+        options.method = method == "mc" ? sdfcsg::MeshMethod::MarchingCubes
+                                        : sdfcsg::MeshMethod::DualContouring;
+    }
     if (args.has("--resolution") && args.has("--voxel-size"))
         return usageError("mesh", "give --resolution or --voxel-size, not both");
     if (args.has("--resolution") &&

@@ -7,8 +7,15 @@ layout(std140, set = 0, binding = SDFCSG_BINDING_MESH_GRID) uniform MeshGrid {
     vec4 origin; // xyz: position of sample 0; w: cell edge length
     uvec4 cells; // xyz: cells per axis; w: root-finding steps per vertex
     uvec4 bricks; // xyz: bricks per axis
-    vec4 cull;   // x: a brick whose centre value exceeds this in magnitude holds no surface
+    // x: a brick whose centre value exceeds this in magnitude holds no surface; y: for dual
+    // contouring, how far (in cells, along kNormalOffset) two more centres of the taps of an
+    // edge point's normal lie off it, 0 for marching cubes; z: the taps' size, in cells
+    vec4 cull;
 } grid;
+
+// A direction away from the planes x = +-y, y = +-z, z = +-x and the axis planes (by 0.15 or
+// more), where sharp edges of CSG solids often lie, exactly on grid edges of a symmetric grid.
+const vec3 kNormalOffset = vec3(0.218218, 0.436436, 0.872872); // (1, 2, 4) / sqrt(21)
 
 layout(push_constant) uniform MeshPush {
     uint first;         // cull: first brick; others: slot of the batch's first brick

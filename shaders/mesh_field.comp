@@ -9,7 +9,8 @@
 //             vertex and its crossed edges, then the block's signs, for the triangle pass.
 //   vertices: one workgroup per brick of the batch, one invocation per crossed edge; places the
 //             vertex on the edge (linear estimate, then regula falsi on the field), and gives it
-//             the field's normal (four-tap tetrahedral differences) and the scene's colour.
+//             the field's normal (four-tap tetrahedral differences) and the scene's colour; for
+//             dual contouring, also a second normal where the point lies on a sharp edge.
 #extension GL_GOOGLE_include_directive : require
 
 #include "shared.h"
@@ -34,7 +35,7 @@ layout(std430, set = 0, binding = SDFCSG_BINDING_MESH_SAMPLES) buffer MeshSample
 };
 
 layout(std430, set = 0, binding = SDFCSG_BINDING_MESH_COUNTS) buffer MeshCounts {
-    uvec2 counts[];
+    uvec4 counts[];
 };
 
 layout(std430, set = 0, binding = SDFCSG_BINDING_MESH_RECORDS) writeonly buffer MeshRecords {
@@ -42,15 +43,16 @@ layout(std430, set = 0, binding = SDFCSG_BINDING_MESH_RECORDS) writeonly buffer 
 };
 
 layout(std430, set = 0, binding = SDFCSG_BINDING_MESH_BASES) readonly buffer MeshBases {
-    uvec2 bases[];
+    uvec4 bases[];
 };
 
 layout(std430, set = 0, binding = SDFCSG_BINDING_MESH_EDGES) buffer MeshEdges {
     uint edges[];
 };
 
+// Per edge point: (position, colour.r), (normal, colour.g), (second normal, colour.b).
 layout(std430, set = 0, binding = SDFCSG_BINDING_MESH_VERTICES) writeonly buffer MeshVertices {
-    float vertices[];
+    vec4 vertices[];
 };
 
 void cull() {
@@ -108,26 +110,37 @@ void classify() {
     }
     barrier();
 
-    // First walk: counts. Second walk: vertex numbers, records and the edge list.
-    uint planeTotal = 0u; // vertices | triangles << 16
+    // First walk: counts (edge vertices | marching-cubes triangles << 16, dual vertices | dual
+    // triangles << 16). Second walk: vertex numbers, records and the edge list.
+    uvec2 planeTotal = uvec2(0u);
     bool cut = false;
     for (uint y = 0u; y < SDFCSG_MESH_BRICK; ++y) {
         uvec3 s0 = brick + uvec3(0u, y, plane);
         Row row = rowAt(s0, y, plane);
-        planeTotal += bitCount(row.crossed.x) + bitCount(row.crossed.y) + bitCount(row.crossed.z);
-        for (uint cells = row.cells; cells != 0u; cells &= cells - 1u)
-            planeTotal += triangleCountOf(cellCase(findLSB(cells), y, plane)) << 16;
+        planeTotal.x +=
+            bitCount(row.crossed.x) + bitCount(row.crossed.y) + bitCount(row.crossed.z);
+        for (uint cells = row.cells; cells != 0u; cells &= cells - 1u) {
+            uint c = cellCase(findLSB(cells), y, plane);
+            planeTotal += uvec2(triangleCountOf(c) << 16, patchCountOf(c));
+        }
+        uvec3 quads = quadEdges(row, s0);
+        planeTotal.y += (bitCount(quads.x) + bitCount(quads.y) + bitCount(quads.z)) << 17;
         cut = cut || (insideRows[y + kSide * plane] & boundarySamples(s0)) != 0u;
     }
     if (cut) status[0] = 1u;
 
-    uint total;
-    uint next = planePrefix(planeTotal, total) & 0xffffu; // brick-local number of the next vertex
+    uvec2 total;
+    uvec2 before = planePrefix(planeTotal, total);
+    uint next = before.x & 0xffffu; // brick-local number of the next edge vertex
+    uint nextDual = before.y & 0xffffu;
     for (uint y = 0u; y < SDFCSG_MESH_BRICK; ++y) {
         Row row = rowAt(brick + uvec3(0u, y, plane), y, plane);
         uint r = y + SDFCSG_MESH_BRICK * plane;
         records[record + 2u * r] = next;
         records[record + 2u * r + 1u] = row.crossed.x | row.crossed.y << 8 | row.crossed.z << 16;
+        records[record + kRecordDual + r] = nextDual;
+        for (uint cells = row.cells; cells != 0u; cells &= cells - 1u)
+            nextDual += patchCountOf(cellCase(findLSB(cells), y, plane));
         for (uint any = row.crossed.x | row.crossed.y | row.crossed.z; any != 0u;
              any &= any - 1u) {
             uint x = findLSB(any);
@@ -137,7 +150,8 @@ void classify() {
                         ownedIndex(uvec3(x, y, plane)) * 3u + axis;
         }
     }
-    if (plane == 0u) counts[slot] = uvec2(total & 0xffffu, total >> 16);
+    if (plane == 0u)
+        counts[slot] = uvec4(total.x & 0xffffu, total.x >> 16, total.y & 0xffffu, total.y >> 16);
 }
 
 void placeVertices() {
@@ -159,46 +173,74 @@ void placeVertices() {
         vec3 pa = samplePosition(b + l);
         vec3 pb = samplePosition(b + l + step);
 
-        // Regula falsi on the field (grid.cells.w steps from the linear estimate), then the
+        // Regula falsi on the field (grid.cells.w steps from the linear estimate; for dual
+        // contouring, after each step the value at the end that stays is halved, as in the
+        // Illinois variant, so that it closes in from both sides where the field bends, as at a
+        // sharp edge: the planes through these points place the vertex there), then the
         // normal's four tetrahedral taps around the vertex, all through one call of the scene
         // in one loop: lavapipe's compiler inlines every call site, each a copy of the scene to
-        // compile (six of them took the house's kernel three times as long).
+        // compile (six of them took the house's kernel three times as long). Dual contouring
+        // also takes the taps around two centres a little off the point either way along
+        // kNormalOffset: where the point lies on a sharp edge of the solid, the taps around it
+        // straddle the edge and see a blend of both faces' normals, a plane of neither that
+        // would cut the edge off, while those off it see one face each.
         const uint steps = grid.cells.w;
-        const float e = 0.05 * grid.origin.w;
+        const bool dual = grid.cull.y > 0.0;
+        const uint taps = dual ? 12u : 4u;
+        const float keep = dual ? 0.5 : 1.0; // the factor on the value of the end that stays
+        const float e = grid.cull.z * grid.origin.w;
+        const vec3 offset = grid.cull.y * grid.origin.w * kNormalOffset;
         float t = da / (da - db);
         float lo = 0.0, hi = 1.0, dlo = da, dhi = db;
         vec3 p = pa + (pb - pa) * t;
-        vec3 g = vec3(0.0);
-        for (uint k = 0u; k < steps + 4u; ++k) {
-            vec3 tap = k < steps ? vec3(0.0) : tetraTap(int(k - steps));
-            float d = sceneDistance(p + tap * e);
+        vec3 g = vec3(0.0), gradients[3];
+        for (uint k = 0u; k < steps + taps; ++k) {
+            uint tap = k - steps;
+            vec3 at = p;
+            if (k >= steps) {
+                uint centre = tap / 4u;
+                at += tetraTap(int(tap % 4u)) * e +
+                      (centre == 0u ? vec3(0.0) : centre == 1u ? offset : -offset);
+            }
+            float d = sceneDistance(at);
             if (k < steps) {
                 if ((d < 0.0) == (dlo < 0.0)) {
                     lo = t;
                     dlo = d;
+                    dhi *= keep;
                 } else {
                     hi = t;
                     dhi = d;
+                    dlo *= keep;
                 }
                 t = lo + (hi - lo) * (dlo / (dlo - dhi));
                 p = pa + (pb - pa) * t;
             } else {
-                g += tap * d;
+                g += tetraTap(int(tap % 4u)) * d;
+                if (tap % 4u == 3u) {
+                    gradients[tap / 4u] = g;
+                    g = vec3(0.0);
+                }
             }
         }
-        vec3 n = length(g) > 1e-20 ? normalize(g) : vec3(step) * (db > da ? 1.0 : -1.0);
+        // Dual contouring: where the gradients off the point either way disagree, the point lies
+        // on a sharp edge, and they are the normals of its two faces.
+        vec3 g0 = gradients[0], other = g0;
+        if (taps > 4u) {
+            vec3 a = normalize(gradients[1]), b = normalize(gradients[2]);
+            if (dot(a, b) < 0.98) {
+                g0 = a;
+                other = b;
+            }
+        }
+        vec3 n = length(g0) > 1e-20 ? normalize(g0) : vec3(step) * (db > da ? 1.0 : -1.0);
+        other = length(other) > 1e-20 ? normalize(other) : n;
         vec3 c = sceneSample(p).rgb;
 
-        uint o = (first + v) * 9u;
-        vertices[o + 0u] = p.x;
-        vertices[o + 1u] = p.y;
-        vertices[o + 2u] = p.z;
-        vertices[o + 3u] = n.x;
-        vertices[o + 4u] = n.y;
-        vertices[o + 5u] = n.z;
-        vertices[o + 6u] = c.r;
-        vertices[o + 7u] = c.g;
-        vertices[o + 8u] = c.b;
+        uint o = (first + v) * 3u;
+        vertices[o] = vec4(p, c.r);
+        vertices[o + 1u] = vec4(n, c.g);
+        vertices[o + 2u] = vec4(other, c.b);
     }
 }
 

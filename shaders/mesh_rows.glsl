@@ -7,20 +7,21 @@
 
 const uint kSide = SDFCSG_MESH_BRICK_SAMPLES;
 const uint kSignRows = kSide * kSide;
-const uint kRecordSigns = 2u * SDFCSG_MESH_BRICK * SDFCSG_MESH_BRICK; // offset in a record
+const uint kRecordDual = 2u * SDFCSG_MESH_BRICK * SDFCSG_MESH_BRICK;  // offsets in a record
+const uint kRecordSigns = 3u * SDFCSG_MESH_BRICK * SDFCSG_MESH_BRICK;
 
 // Bit x of insideRows[y + kSide * z] is set when sample (x, y, z) of the block is inside.
 shared uint insideRows[kSignRows];
-shared uint planeTotals[SDFCSG_MESH_BRICK];
+shared uvec2 planeTotals[SDFCSG_MESH_BRICK];
 
 // Returns the sum of `planeTotal` over the planes before this invocation's; `total` gets the
 // sum over all planes. Every invocation of the workgroup must call it.
-uint planePrefix(uint planeTotal, out uint total) {
+uvec2 planePrefix(uvec2 planeTotal, out uvec2 total) {
     uint plane = gl_LocalInvocationID.x;
     planeTotals[plane] = planeTotal;
     barrier();
-    uint before = 0u;
-    total = 0u;
+    uvec2 before = uvec2(0u);
+    total = uvec2(0u);
     for (uint k = 0u; k < SDFCSG_MESH_BRICK; ++k) {
         if (k < plane) before += planeTotals[k];
         total += planeTotals[k];
@@ -70,4 +71,15 @@ uint cellCase(uint x, uint y, uint z) {
     uint r01 = insideRows[y + kSide * (z + 1u)] >> x;
     uint r11 = insideRows[y + 1u + kSide * (z + 1u)] >> x;
     return (r00 & 3u) | (r10 & 3u) << 2 | (r01 & 3u) << 4 | (r11 & 3u) << 6;
+}
+
+// Dual contouring: the crossed edges of a row that get a quad, over x per axis: those whose four
+// cells all lie in the grid (the others are on its boundary, where the surface is cut).
+uvec3 quadEdges(Row row, uvec3 s0) {
+    uvec3 c = grid.cells.xyz;
+    bvec3 rowInner = bvec3(true, s0.y >= 1u && s0.y < c.y, s0.z >= 1u && s0.z < c.z);
+    uint xInner = (s0.x < c.x ? lowBits(c.x - s0.x) : 0u) & (s0.x == 0u ? ~1u : ~0u);
+    return uvec3(rowInner.y && rowInner.z ? row.crossed.x : 0u,
+                 rowInner.z ? row.crossed.y & xInner : 0u,
+                 rowInner.y ? row.crossed.z & xInner : 0u);
 }

@@ -45,7 +45,7 @@
 #define SDFCSG_MESH_BRICK_BLOCK 729      // SDFCSG_MESH_BRICK_SAMPLES^3
 #define SDFCSG_MESH_BRICK_EDGES 1536     // 3 edges per owned sample
 #define SDFCSG_MESH_GROUP_X 64           // cull and vertex passes
-#define SDFCSG_MESH_RECORD 209           // 2 * 8 * 8 + 9 * 9
+#define SDFCSG_MESH_RECORD 273           // 3 * 8 * 8 + 9 * 9
 #define SDFCSG_MESH_NO_BRICK 0xffffffffu // brick map entry of a skipped brick
 
 #define SDFCSG_BINDING_MESH_GRID 0     // uniform MeshGrid: origin, cell size, counts
@@ -55,14 +55,18 @@
                                        // then its slot or SDFCSG_MESH_NO_BRICK (host writes)
 #define SDFCSG_BINDING_MESH_SAMPLES 5  // float[]: the block of each brick of the batch
 #define SDFCSG_BINDING_MESH_RECORDS 6  // uint[]: per active brick, SDFCSG_MESH_RECORD words:
-                                       // per owned row, first vertex and crossed edges; then
-                                       // the signs of the block, a word per row
-#define SDFCSG_BINDING_MESH_COUNTS 7   // uvec2[]: per active brick, vertices and triangles
-#define SDFCSG_BINDING_MESH_BASES 8    // uvec2[]: per active brick, first vertex and triangle
+                                       // per owned row, first edge vertex and crossed edges;
+                                       // per owned row, first dual vertex; then the signs of
+                                       // the block, a word per row
+#define SDFCSG_BINDING_MESH_COUNTS 7   // uvec4[]: per active brick, edge vertices, triangles
+                                       // of marching cubes, dual vertices, dual triangles
+#define SDFCSG_BINDING_MESH_BASES 8    // uvec4[]: per active brick, the first of each
 #define SDFCSG_BINDING_MESH_EDGES 9    // uint[]: crossed edges of each brick of the batch
-#define SDFCSG_BINDING_MESH_VERTICES 10 // float[]: 9 per vertex: position, normal, colour
+#define SDFCSG_BINDING_MESH_VERTICES 10 // float[]: per vertex: position, normal, colour (and
+                                        // from the vertices pass, a second normal: 12 floats)
 #define SDFCSG_BINDING_MESH_INDICES 11  // uint[]: 3 per triangle
 #define SDFCSG_BINDING_MESH_STATUS 12   // uint[2]: surface cut, brick skipped wrongly
+#define SDFCSG_BINDING_MESH_HERMITE 13  // float[]: dual contouring: every edge vertex, 12 each
 
 #define SDFCSG_MAX_LIGHTS 4
 #define SDFCSG_MAX_CLIP_BOXES 8 // boxes that hold every surface; rays skip the space outside them
@@ -101,5 +105,9 @@
 #define SDFCSG_MESH_PASS_CULL 0
 #define SDFCSG_MESH_PASS_CLASSIFY 1
 #define SDFCSG_MESH_PASS_VERTICES 2
+// mesh_triangles.comp
+#define SDFCSG_MESH_PASS_TRIANGLES 0
+#define SDFCSG_MESH_PASS_DUAL_VERTICES 1
+#define SDFCSG_MESH_PASS_QUADS 2
 
 #endif

@@ -1,6 +1,8 @@
 // The marching-cubes triangle table (see mc_tables.h for the numbering and the rules it follows).
 #include "mc_tables.h"
 
+#include <algorithm>
+
 namespace sdfcsg::detail {
 
 // Row c: the triangles of case c (bit k set when corner k is inside), three edge indices each,
@@ -274,5 +276,34 @@ const uint8_t kTriCount[256] = {
     2, 3, 3, 4, 3, 4, 4, 5, 3, 4, 4, 5, 2, 3, 3, 2, 3, 4, 4, 5, 4, 5, 5, 2, 4, 3, 5, 4, 3, 2, 4, 1,
     3, 4, 4, 5, 4, 5, 3, 4, 4, 5, 5, 2, 3, 4, 2, 1, 2, 3, 3, 2, 3, 4, 2, 1, 3, 2, 4, 1, 2, 1, 1, 0,
 };
+
+CellPatches cellPatches(unsigned cellCase) {
+    int root[12];
+    for (int e = 0; e < 12; ++e)
+        root[e] = e;
+    auto find = [&](int e) {
+        while (root[e] != e)
+            e = root[e];
+        return e;
+    };
+    bool crossed[12] = {};
+    for (int t = 0; t < kTriCount[cellCase]; ++t) {
+        const int8_t* tri = &kTriTable[cellCase][3 * t];
+        for (int k = 0; k < 3; ++k) {
+            crossed[tri[k]] = true;
+            int a = find(tri[k]), b = find(tri[(k + 1) % 3]);
+            root[std::max(a, b)] = std::min(a, b);
+        }
+    }
+    CellPatches out;
+    int8_t pieceOfRoot[12];
+    for (int e = 0; e < 12; ++e) {
+        if (!crossed[e]) continue;
+        const int r = find(e);
+        if (r == e) pieceOfRoot[e] = int8_t(out.count++);
+        out.patch[e] = pieceOfRoot[r];
+    }
+    return out;
+}
 
 } // namespace sdfcsg::detail

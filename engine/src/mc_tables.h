@@ -41,4 +41,13 @@ inline constexpr int kEdgeAxis[12] = {0, 1, 0, 1, 0, 1, 0, 1, 2, 2, 2, 2};
 extern const int8_t kTriTable[256][16];
 extern const uint8_t kTriCount[256];
 
+// The separate pieces of surface in a cell of one case, for dual contouring (one vertex per
+// piece): triangles that share an edge belong to one piece. Pieces are numbered in the order of
+// their lowest edge; patch[e] is the piece of crossed edge e, or -1 when e is not crossed.
+struct CellPatches {
+    int count = 0; // 0..4
+    int8_t patch[12] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1};
+};
+CellPatches cellPatches(unsigned cellCase);
+
 } // namespace sdfcsg::detail

@@ -1,4 +1,5 @@
-// Mesh extraction: marching cubes over the scene's generated field, in Vulkan compute passes.
+// Mesh extraction: marching cubes or dual contouring over the scene's generated field, in Vulkan
+// compute passes.
 //
 // Per extraction:
 //   cull       one value per brick of the grid (shaders/mesh_field.comp); the host compacts the
@@ -6,15 +7,20 @@
 //   classify   per batch of active bricks, the brick's block of field values, its crossed
 //              edges and brick-local vertex numbers, and its counts; the host turns the counts
 //              into each brick's first vertex and triangle;
-//   vertices   one vertex per crossed edge, on the surface, with normal and colour;
+//   vertices   one point per crossed edge, on the surface, with normal and colour: marching
+//              cubes' vertices, dual contouring's edge data;
 //   triangles  after every batch is classified (a cell's edges may belong to a later brick),
-//              the index triples, from the marching-cubes table.
+//              marching cubes' index triples, from its table. Dual contouring instead places
+//              its vertices, one per piece of surface in a cell, from the edge data of every
+//              batch, then joins them by a quad per crossed edge (both in mesh_triangles.comp);
+//              the host turns each quad into the two triangles that fold it least.
 // Vertices and triangles come out in brick order, so the mesh is the same on every run.
 #include "sdfcsg/mesh.h"
 
 #include "camera.h"
 #include "gpu_nodes.h"
 #include "mc_tables.h"
+#include "mesh_dual.h"
 #include "shader_compile.h"
 #include "vk.h"
 
@@ -45,11 +51,16 @@ constexpr uint32_t kBatchBricks = 4096;      // bricks sampled and classified pe
 constexpr uint32_t kMaxGroups = 65535;       // the minimum maxComputeWorkGroupCount[0]
 constexpr uint64_t kMaxActive = 1u << 22; // slots * SDFCSG_MESH_RECORD fits a uint32_t index
 // Bytes each active brick holds for the whole extraction: slot, record, counts, bases.
-constexpr uint64_t kBytesPerActive = 4 + SDFCSG_MESH_RECORD * 4 + 8 + 8;
+constexpr uint64_t kBytesPerActive = 4 + SDFCSG_MESH_RECORD * 4 + 16 + 16;
 // Bytes of the per-batch working buffers: samples and crossed edges.
 constexpr uint64_t kBytesPerBatchBrick = 4 * (SDFCSG_MESH_BRICK_BLOCK + SDFCSG_MESH_BRICK_EDGES);
-constexpr uint64_t kBytesPerVertex = 9 * 4 * 2; // GPU output and host mesh
+constexpr uint64_t kBytesPerVertex = 12 * 4 * 2; // GPU output and host mesh (or edge data)
 constexpr uint64_t kBytesPerTriangle = 3 * 4 * 2;
+// The normal at an edge point, from four taps this many cells from its centre; for dual
+// contouring also around centres kDualNormalOffset cells off the point either way (see
+// placeVertices() in shaders/mesh_field.comp), whose taps must keep clear of the planes that
+// the offset's direction avoids by 0.15 of it.
+constexpr float kNormalTaps = 0.05f, kDualNormalTaps = 0.02f, kDualNormalOffset = 0.25f;
 
 // Mirrors MeshGrid in shaders/mesh_common.glsl (std140).
 struct MeshGrid {
@@ -79,6 +90,7 @@ constexpr detail::Binding kBindings[] = {
     {SDFCSG_BINDING_MESH_INDICES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
     {SDFCSG_BINDING_MESH_STATUS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
     {SDFCSG_BINDING_FIELD, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+    {SDFCSG_BINDING_MESH_HERMITE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
 };
 constexpr size_t kBindingCount = std::size(kBindings);
 
@@ -90,7 +102,7 @@ std::vector<uint32_t> packTables() {
     uint32_t cornerAt[8]; // table corner at each canonical position
     for (uint32_t c = 0; c < 8; ++c)
         cornerAt[bits(detail::kCornerOffset[c])] = c;
-    std::vector<uint32_t> t(1292, 0);
+    std::vector<uint32_t> t(2596, 0);
     for (uint32_t canonical = 0; canonical < 256; ++canonical) {
         uint32_t c = 0;
         for (uint32_t k = 0; k < 8; ++k)
@@ -103,6 +115,21 @@ std::vector<uint32_t> packTables() {
     for (int e = 0; e < 12; ++e)
         t[1280 + e] =
             bits(detail::kCornerOffset[detail::kEdgeCorners[e][0]]) | detail::kEdgeAxis[e] << 3;
+    for (uint32_t canonical = 0; canonical < 256; ++canonical) {
+        uint32_t c = 0;
+        for (uint32_t k = 0; k < 8; ++k)
+            if (canonical & (1u << k)) c |= 1u << cornerAt[k];
+        const detail::CellPatches pieces = detail::cellPatches(c);
+        t[1292 + canonical] = uint32_t(pieces.count);
+        for (int e = 0; e < 12; ++e)
+            if (pieces.patch[e] >= 0) {
+                t[1292 + canonical] |= uint32_t(pieces.patch[e]) << (3 + 2 * e);
+                t[1572 + 4 * canonical + uint32_t(pieces.patch[e])] |= 1u << e;
+            }
+    }
+    for (int e = 0; e < 12; ++e)
+        t[1548 + 8 * detail::kEdgeAxis[e] + bits(detail::kCornerOffset[detail::kEdgeCorners[e][0]])] =
+            uint32_t(e);
     return t;
 }
 
@@ -193,11 +220,12 @@ struct Mesher::Impl {
     Context::Impl& ctx;
     std::unique_ptr<Evaluator> evaluator;
 
-    VkShaderModule modules[2] = {}; // field (cull, classify, vertices), triangles
+    VkShaderModule modules[2] = {}; // field (cull, classify, vertices); triangles, dual passes
     VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
     VkPipelineLayout pipelineLayout = VK_NULL_HANDLE;
     VkPipeline cull = VK_NULL_HANDLE, classify = VK_NULL_HANDLE, vertices = VK_NULL_HANDLE,
-               triangles = VK_NULL_HANDLE;
+               triangles = VK_NULL_HANDLE, dualVertices = VK_NULL_HANDLE,
+               quads = VK_NULL_HANDLE;
     VkDescriptorPool pool = VK_NULL_HANDLE;
     VkDescriptorSet set = VK_NULL_HANDLE;
 
@@ -211,7 +239,7 @@ struct Mesher::Impl {
     ~Impl() {
         for (Buffer& b : buffers)
             detail::destroyBuffer(ctx, b);
-        for (VkPipeline p : {cull, classify, vertices, triangles})
+        for (VkPipeline p : {cull, classify, vertices, triangles, dualVertices, quads})
             if (p) vkDestroyPipeline(ctx.device, p, nullptr);
         for (VkShaderModule m : modules)
             if (m) vkDestroyShaderModule(ctx.device, m, nullptr);
@@ -233,6 +261,7 @@ struct Mesher::Impl {
         case SDFCSG_BINDING_MESH_TABLES:
         case SDFCSG_BINDING_MESH_ACTIVE:
         case SDFCSG_BINDING_MESH_BASES:
+        case SDFCSG_BINDING_MESH_HERMITE:
         case SDFCSG_BINDING_FIELD: return MemoryUse::Upload;
         case SDFCSG_BINDING_MESH_MAP: // written by the cull pass, read and rewritten by the host
         case SDFCSG_BINDING_MESH_COUNTS:
@@ -252,6 +281,21 @@ struct Mesher::Impl {
                                        : VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
         auto made = detail::createBuffer(ctx, bytes, usage, memoryUse(binding));
         if (!made) return made.error();
+        detail::destroyBuffer(ctx, b);
+        b = *made;
+        writeDescriptors();
+        return Ok{};
+    }
+
+    // Makes the host-visible buffer of `binding` hold at least `bytes`, keeping its contents.
+    Status grow(uint32_t binding, uint64_t bytes) {
+        Buffer& b = buffer(binding);
+        if (b.buffer && b.size >= bytes) return Ok{};
+        auto made = detail::createBuffer(ctx, std::max<uint64_t>(bytes, b.size + b.size / 2),
+                                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, memoryUse(binding));
+        if (!made) return made.error();
+        detail::invalidateBuffer(ctx, b);
+        if (b.size > 4) std::memcpy(made->data, b.data, b.size);
         detail::destroyBuffer(ctx, b);
         b = *made;
         writeDescriptors();
@@ -380,7 +424,18 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
     m.cull = detail::createComputePipeline(m.ctx, m.modules[0], m.pipelineLayout, cullSpec);
     m.classify = detail::createComputePipeline(m.ctx, m.modules[0], m.pipelineLayout, classifySpec);
     m.vertices = detail::createComputePipeline(m.ctx, m.modules[0], m.pipelineLayout, verticesSpec);
-    m.triangles = detail::createComputePipeline(m.ctx, m.modules[1], m.pipelineLayout, {});
+    using PassSpec = std::array<detail::SpecConstant, 2>;
+    auto passSpec = [](uint32_t pass, uint32_t group) {
+        return PassSpec{{{SDFCSG_SPEC_MESH_PASS, pass}, {SDFCSG_SPEC_MESH_GROUP, group}}};
+    };
+    const PassSpec trianglesSpec = passSpec(SDFCSG_MESH_PASS_TRIANGLES, SDFCSG_MESH_BRICK);
+    m.triangles =
+        detail::createComputePipeline(m.ctx, m.modules[1], m.pipelineLayout, trianglesSpec);
+    m.dualVertices = detail::createComputePipeline(
+        m.ctx, m.modules[1], m.pipelineLayout,
+        passSpec(SDFCSG_MESH_PASS_DUAL_VERTICES, SDFCSG_MESH_GROUP_X));
+    m.quads = detail::createComputePipeline(m.ctx, m.modules[1], m.pipelineLayout,
+                                            passSpec(SDFCSG_MESH_PASS_QUADS, SDFCSG_MESH_GROUP_X));
 
     std::vector<detail::GpuNode> nodes = detail::packNodes(*m.evaluator);
     std::vector<uint32_t> tables = packTables();
@@ -418,7 +473,7 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
     std::thread other([&] {
         std::vector<detail::Precompile> jobs;
         if (fresh[0]) jobs.push_back({spirv[0], verticesSpec});
-        if (fresh[1]) jobs.push_back({spirv[1], {}});
+        if (fresh[1]) jobs.push_back({spirv[1], trianglesSpec});
         const double ms = detail::precompileElsewhere(m.ctx, jobs, kBindings, sizeof(MeshPush));
         if (fresh[0]) helperMs = ms;
     });
@@ -431,6 +486,8 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
         std::chrono::steady_clock::now() - start;
     if (helperMs > 0.0 && verticesMs.count() > 0.25 * helperMs) detail::compileHelperMissed(m.ctx);
     m.warmUp(m.triangles);
+    m.warmUp(m.dualVertices);
+    m.warmUp(m.quads);
     auto words = fieldWords.get();
     if (!words) return words.error();
     auto made = detail::uploadField(m.ctx, m.buffer(SDFCSG_BINDING_FIELD), *words);
@@ -495,7 +552,10 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
     gridUniform.cells = glm::uvec4(g.cells, options.refineSteps);
     gridUniform.bricks = glm::uvec4(g.bricks, 0);
     const float halfDiagonal = 0.5f * std::sqrt(3.0f) * float(kBrick) * g.h;
-    gridUniform.cull = glm::vec4(cullBricks ? halfDiagonal * 1.001f : INFINITY, 0, 0, 0);
+    const bool dual = options.method == MeshMethod::DualContouring;
+    gridUniform.cull = glm::vec4(cullBricks ? halfDiagonal * 1.001f : INFINITY,
+                                 dual ? kDualNormalOffset : 0.0f,
+                                 dual ? kDualNormalTaps : kNormalTaps, 0);
     detail::uploadBuffer(ctx, buffer(SDFCSG_BINDING_MESH_GRID), &gridUniform, sizeof gridUniform);
     const uint32_t zero[2] = {0, 0};
     detail::uploadBuffer(ctx, buffer(SDFCSG_BINDING_MESH_STATUS), zero, sizeof zero);
@@ -527,7 +587,7 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
     const uint32_t activeCount = uint32_t(active.size());
     const uint32_t batches = (activeCount + kBatchBricks - 1) / kBatchBricks;
     const uint32_t batchBricks = std::min(activeCount, kBatchBricks);
-    progressTotal += 3.0 * batches;
+    progressTotal += (options.method == MeshMethod::DualContouring ? 4.0 : 3.0) * batches;
     if (!progress(1)) return cancelled;
 
     // Known once the bricks are culled: what the bricks hold for the whole extraction.
@@ -539,8 +599,8 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
     detail::uploadBuffer(ctx, buffer(SDFCSG_BINDING_MESH_MAP), map.data(), map.size() * 4);
     for (auto [binding, bytes] : {std::pair{SDFCSG_BINDING_MESH_ACTIVE, activeCount * 4ull},
                                   {SDFCSG_BINDING_MESH_RECORDS, activeCount * uint64_t(SDFCSG_MESH_RECORD) * 4},
-                                  {SDFCSG_BINDING_MESH_COUNTS, activeCount * 8ull},
-                                  {SDFCSG_BINDING_MESH_BASES, activeCount * 8ull},
+                                  {SDFCSG_BINDING_MESH_COUNTS, activeCount * 16ull},
+                                  {SDFCSG_BINDING_MESH_BASES, activeCount * 16ull},
                                   {SDFCSG_BINDING_MESH_SAMPLES,
                                    batchBricks * uint64_t(SDFCSG_MESH_BRICK_BLOCK) * 4},
                                   {SDFCSG_BINDING_MESH_EDGES,
@@ -550,39 +610,56 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
                                           active.size() * 4);
     notePeak(map.size() * 4);
 
-    Mesh mesh;
-    std::vector<glm::uvec2> bases(activeCount);
-    uint64_t vertexTotal = 0, triangleTotal = 0;
-    for (uint32_t batch = 0; batch < batches; ++batch) {
+    // Per active brick: the first edge point, marching-cubes triangle, dual vertex and dual
+    // triangle it makes.
+    std::vector<glm::uvec4> bases(activeCount);
+    glm::u64vec4 totals(0);
+    auto batchOf = [&](uint32_t batch) {
         MeshPush push;
         push.first = batch * kBatchBricks;
         push.count = std::min(kBatchBricks, activeCount - push.first);
-
+        return push;
+    };
+    // The [first, end) range of bases[.][k] over the batch of `push`.
+    auto batchRange = [&](const MeshPush& push, int k) {
+        const uint64_t end = push.first + push.count < activeCount
+                                 ? bases[push.first + push.count][k]
+                                 : totals[k];
+        return std::pair<uint32_t, uint64_t>(bases[push.first][k], end);
+    };
+    Mesh mesh;
+    for (uint32_t batch = 0; batch < batches; ++batch) {
+        MeshPush push = batchOf(batch);
         t0 = Clock::now();
         VkCommandBuffer cmd = begin(classify);
         dispatch(cmd, push, push.count);
         finish(cmd);
-        const glm::uvec2* counts = mapped<glm::uvec2>(SDFCSG_BINDING_MESH_COUNTS);
-        push.vertexBase = uint32_t(vertexTotal);
-        push.triangleBase = uint32_t(triangleTotal);
+        const glm::uvec4* counts = mapped<glm::uvec4>(SDFCSG_BINDING_MESH_COUNTS);
         for (uint32_t i = push.first; i < push.first + push.count; ++i) {
-            bases[i] = glm::uvec2(uint32_t(vertexTotal), uint32_t(triangleTotal));
-            vertexTotal += counts[i].x;
-            triangleTotal += counts[i].y;
+            bases[i] = glm::uvec4(totals);
+            totals += glm::u64vec4(counts[i]);
         }
+        push.vertexBase = bases[push.first].x;
         stage("classify", t0);
         if (!progress(1)) return cancelled;
 
-        const uint64_t batchVertices = vertexTotal - push.vertexBase;
+        const uint64_t batchVertices = totals.x - push.vertexBase;
         const uint64_t meshBytes =
-            vertexTotal * kBytesPerVertex + triangleTotal * kBytesPerTriangle;
-        if (vertexTotal > UINT32_MAX || fixedBytes + meshBytes > options.memoryBudget)
+            dual ? totals.x * kBytesPerVertex + totals.z * kBytesPerVertex +
+                       totals.w * kBytesPerTriangle
+                 : totals.x * kBytesPerVertex + totals.y * kBytesPerTriangle;
+        if (totals.x > UINT32_MAX || totals.z > UINT32_MAX ||
+            fixedBytes + meshBytes > options.memoryBudget)
             return overBudget(g, "the mesh", fixedBytes + meshBytes, options.memoryBudget);
 
         t0 = Clock::now();
         detail::uploadBuffer(ctx, buffer(SDFCSG_BINDING_MESH_BASES), bases.data(),
-                             bases.size() * 8);
-        if (auto ok = reserve(SDFCSG_BINDING_MESH_VERTICES, batchVertices * 36); !ok)
+                             bases.size() * 16);
+        // Marching cubes takes the batch's vertices; dual contouring keeps every edge point.
+        if (dual) push.vertexBase = 0;
+        if (auto ok = dual ? grow(SDFCSG_BINDING_MESH_VERTICES, totals.x * 48)
+                           : reserve(SDFCSG_BINDING_MESH_VERTICES, batchVertices * 48);
+            !ok)
             return ok.error();
         cmd = begin(vertices);
         dispatch(cmd, push, push.count);
@@ -590,42 +667,68 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
         stage("vertices", t0);
 
         t0 = Clock::now();
-        const float* v = mapped<float>(SDFCSG_BINDING_MESH_VERTICES);
-        mesh.positions.resize(vertexTotal);
-        mesh.normals.resize(vertexTotal);
-        mesh.colors.resize(vertexTotal);
-        for (uint64_t i = 0; i < batchVertices; ++i, v += 9) {
-            uint64_t o = push.vertexBase + i;
-            mesh.positions[o] = glm::vec3(v[0], v[1], v[2]);
-            mesh.normals[o] = glm::vec3(v[3], v[4], v[5]);
-            mesh.colors[o] = glm::vec3(v[6], v[7], v[8]);
+        if (!dual) {
+            const float* v = mapped<float>(SDFCSG_BINDING_MESH_VERTICES);
+            mesh.positions.resize(totals.x);
+            mesh.normals.resize(totals.x);
+            mesh.colors.resize(totals.x);
+            for (uint64_t i = 0; i < batchVertices; ++i, v += 12) { // as in mesh_field.comp
+                uint64_t o = push.vertexBase + i;
+                mesh.positions[o] = glm::vec3(v[0], v[1], v[2]);
+                mesh.normals[o] = glm::vec3(v[4], v[5], v[6]);
+                mesh.colors[o] = glm::vec3(v[3], v[7], v[11]);
+            }
         }
         stage("download", t0);
         notePeak(map.size() * 4 + mesh.positions.capacity() * 36);
         if (!progress(1)) return cancelled;
     }
 
-    mesh.indices.resize(triangleTotal * 3);
+    if (dual) {
+        t0 = Clock::now();
+        std::swap(buffer(SDFCSG_BINDING_MESH_VERTICES), buffer(SDFCSG_BINDING_MESH_HERMITE));
+        writeDescriptors();
+        mesh.positions.resize(totals.z);
+        mesh.normals.resize(totals.z);
+        mesh.colors.resize(totals.z);
+        for (uint32_t batch = 0; batch < batches; ++batch) {
+            MeshPush push = batchOf(batch);
+            auto [first, end] = batchRange(push, 2);
+            push.vertexBase = first;
+            if (auto ok = reserve(SDFCSG_BINDING_MESH_VERTICES, (end - first) * 36); !ok)
+                return ok.error();
+            VkCommandBuffer cmd = begin(dualVertices);
+            dispatch(cmd, push, push.count);
+            finish(cmd);
+            const float* v = mapped<float>(SDFCSG_BINDING_MESH_VERTICES);
+            for (uint64_t o = first; o < end; ++o, v += 9) {
+                mesh.positions[o] = glm::vec3(v[0], v[1], v[2]);
+                mesh.normals[o] = glm::vec3(v[3], v[4], v[5]);
+                mesh.colors[o] = glm::vec3(v[6], v[7], v[8]);
+            }
+            if (!progress(1)) return cancelled;
+        }
+        stage("dual vertices", t0);
+    }
+
+    const int triangleKind = dual ? 3 : 1;
+    mesh.indices.resize(totals[triangleKind] * 3);
     for (uint32_t batch = 0; batch < batches; ++batch) {
-        MeshPush push;
-        push.first = batch * kBatchBricks;
-        push.count = std::min(kBatchBricks, activeCount - push.first);
-        push.triangleBase = bases[push.first].y;
-        const uint64_t end = push.first + push.count < activeCount
-                                 ? bases[push.first + push.count].y
-                                 : triangleTotal;
-        const uint64_t batchTriangles = end - push.triangleBase;
+        MeshPush push = batchOf(batch);
+        auto [first, end] = batchRange(push, triangleKind);
+        push.triangleBase = first;
+        const uint64_t batchTriangles = end - first;
 
         t0 = Clock::now();
         if (auto ok = reserve(SDFCSG_BINDING_MESH_INDICES, batchTriangles * 12); !ok)
             return ok.error();
-        VkCommandBuffer cmd = begin(triangles);
+        VkCommandBuffer cmd = begin(dual ? quads : triangles);
         dispatch(cmd, push, push.count);
         finish(cmd);
         stage("triangles", t0);
 
         t0 = Clock::now();
-        std::memcpy(mesh.indices.data() + uint64_t(push.triangleBase) * 3,
+        std::memcpy(mesh.indices.data() + uint64_t(first) * 3,
                     mapped<uint32_t>(SDFCSG_BINDING_MESH_INDICES), batchTriangles * 12);
         stage("download", t0);
         notePeak(map.size() * 4 + mesh.positions.capacity() * 36 + mesh.indices.capacity() * 4);
@@ -634,6 +737,11 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
 
     const uint32_t* status = mapped<uint32_t>(SDFCSG_BINDING_MESH_STATUS);
     skippedSurface = status[1] != 0;
+    if (dual && !skippedSurface) {
+        t0 = Clock::now();
+        detail::foldQuads(mesh);
+        stage("quads", t0);
+    }
     stats.surfaceCut = status[0] != 0;
     stats.vertices = mesh.vertexCount();
     stats.triangles = mesh.triangleCount();

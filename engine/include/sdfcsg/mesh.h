@@ -1,10 +1,19 @@
-// sdfcsg: polygon meshes of a scene, extracted by marching cubes in Vulkan compute passes.
+// sdfcsg: polygon meshes of a scene, extracted in Vulkan compute passes by dual contouring
+// (the default) or marching cubes.
 //
-// The field is sampled on a grid of cubic cells covering the bounds. One vertex is made per grid
-// edge whose end samples differ in sign (inside is d < 0), so the mesh is indexed and welded by
-// construction; triangles come from the standard marching-cubes table. Wherever the surface lies
-// inside the bounds the mesh is closed and manifold, with triangles wound counter-clockwise seen
-// from outside.
+// The field is sampled on a grid of cubic cells covering the bounds. A grid edge whose end
+// samples differ in sign (inside is d < 0) is crossed by the surface; it gets a point on the
+// surface and the field's normal there.
+// - Marching cubes makes those points the vertices, and the triangles of each cell come from the
+//   marching-cubes table. Sharp edges of the solid come out bevelled, up to half a cell wide.
+// - Dual contouring makes one vertex per piece of surface in a cell (the pieces of its
+//   marching-cubes case; a cell where two sheets pass gets two), placed where the planes through
+//   the piece's edge points meet best (a quadratic error function, solved by eigenvectors and
+//   kept in the cell), and one quad per crossed edge, joining the vertices of its four cells.
+//   Flat faces stay flat, and the sharp edges and corners of the solid stay sharp.
+// Either way the mesh is indexed and welded by construction and, wherever the surface lies
+// inside the bounds, closed and manifold, with triangles wound counter-clockwise seen from
+// outside.
 //
 // The grid is processed in bricks of SDFCSG_MESH_BRICK^3 cells (shaders/shared.h). A brick whose
 // centre lies farther from the surface than its half-diagonal cannot contain surface (the field
@@ -41,7 +50,13 @@ struct Mesh {
     size_t triangleCount() const { return indices.size() / 3; }
 };
 
+enum class MeshMethod {
+    DualContouring, // sharp edges and corners kept (see above)
+    MarchingCubes,
+};
+
 struct MeshOptions {
+    MeshMethod method = MeshMethod::DualContouring;
     // The region to mesh. Unset: the scene's finite bounds plus a margin of a few voxels (the
     // finite part only, for scenes with planes).
     std::optional<Aabb> bounds;
@@ -49,8 +64,8 @@ struct MeshOptions {
     // size as they need. Ignored when voxelSize is set.
     uint32_t resolution = 128;
     std::optional<float> voxelSize; // edge length of a cell, in scene units
-    // Root-finding steps that move each vertex from the linear estimate onto the surface.
-    uint32_t refineSteps = 2;
+    // Root-finding steps that move each edge point from the linear estimate onto the surface.
+    uint32_t refineSteps = 3;
     // Host memory the extraction may use for its working buffers, in bytes; a request that
     // needs more fails with ErrorKind::Limit before the heavy work starts.
     size_t memoryBudget = size_t(4) << 30;
