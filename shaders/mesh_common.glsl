@@ -16,6 +16,10 @@ layout(std140, set = 0, binding = SDFCSG_BINDING_MESH_GRID) uniform MeshGrid {
 // A direction away from the planes x = +-y, y = +-z, z = +-x and the axis planes (by 0.15 or
 // more), where sharp edges of CSG solids often lie, exactly on grid edges of a symmetric grid.
 const vec3 kNormalOffset = vec3(0.218218, 0.436436, 0.872872); // (1, 2, 4) / sqrt(21)
+// Where the field's gradient has length 1 on every face, taps whose gradient is longer or
+// shorter than that by more than this fraction straddle a sharp edge (or lie in a blend, or on a
+// field that is not a distance, where extra taps cost time but no accuracy).
+const float kBlendedGradient = 0.001;
 
 layout(push_constant) uniform MeshPush {
     uint first;         // cull: first brick; others: slot of the batch's first brick

@@ -181,12 +181,14 @@ void placeVertices() {
         // in one loop: lavapipe's compiler inlines every call site, each a copy of the scene to
         // compile (six of them took the house's kernel three times as long). Dual contouring
         // also takes the taps around two centres a little off the point either way along
-        // kNormalOffset: where the point lies on a sharp edge of the solid, the taps around it
-        // straddle the edge and see a blend of both faces' normals, a plane of neither that
-        // would cut the edge off, while those off it see one face each.
+        // kNormalOffset where the point lies on a sharp edge of the solid: there the taps around
+        // it straddle the edge and see a blend of both faces' normals, a plane of neither that
+        // would cut the edge off, while those off it see one face each. The blend is shorter
+        // than the gradient of either face, which tells those points; elsewhere (most of them)
+        // four taps are all it takes.
         const uint steps = grid.cells.w;
         const bool dual = grid.cull.y > 0.0;
-        const uint taps = dual ? 12u : 4u;
+        uint taps = 4u;
         const float keep = dual ? 0.5 : 1.0; // the factor on the value of the end that stays
         const float e = grid.cull.z * grid.origin.w;
         const vec3 offset = grid.cull.y * grid.origin.w * kNormalOffset;
@@ -219,6 +221,9 @@ void placeVertices() {
                 g += tetraTap(int(tap % 4u)) * d;
                 if (tap % 4u == 3u) {
                     gradients[tap / 4u] = g;
+                    // The taps sum to 4 e times the gradient, whose length is 1 on a face.
+                    if (dual && tap == 3u && abs(length(g) - 4.0 * e) > kBlendedGradient * 4.0 * e)
+                        taps = 12u;
                     g = vec3(0.0);
                 }
             }

@@ -114,7 +114,12 @@ template <class Distance, class Color> struct ReferenceSamples {
         // (placeVertices() in shaders/mesh_field.comp).
         std::vector<glm::vec3> gradients;
         for (float side : {0.0f, 1.0f, -1.0f}) {
-            if (side != 0.0f && tapOffset == 0.0f) break;
+            // Only where the gradient is a blend of two faces (kBlendedGradient in
+            // shaders/mesh_common.glsl).
+            if (side != 0.0f &&
+                (tapOffset == 0.0f ||
+                 std::abs(glm::length(gradients[0]) - 4.0f * e) <= 0.001f * 4.0f * e))
+                break;
             const glm::vec3 c = p + side * offset;
             gradients.push_back(xyy * distance(c + xyy * e) + yyx * distance(c + yyx * e) +
                                 yxy * distance(c + yxy * e) + xxx * distance(c + xxx * e));
