@@ -7,11 +7,12 @@
 //                   edge's lower sample (this one or a neighbour): that brick's first vertex, plus
 //                   the number of its row's first vertex, plus the crossed edges before it in the
 //                   row (see the classify pass in mesh_field.comp).
-//   dual vertices:  dual contouring: one vertex per piece of surface in each cell (the pieces of
+//   dual:           dual contouring: one vertex per piece of surface in each cell (the pieces of
 //                   its marching-cubes case), where the planes through the piece's edge vertices
-//                   along their normals meet best (a quadratic error function), kept in the cell.
-//   quads:          dual contouring: for each crossed edge, the quad that joins the vertices of
-//                   the four cells around it, as two triangles.
+//                   along their normals meet best (a quadratic error function), kept in the cell;
+//                   then for each crossed edge, the quad that joins the vertices of the four
+//                   cells around it, as two triangles. One pass for both: they share the loads
+//                   of the brick's rows, and a dispatch and its wait.
 #extension GL_GOOGLE_include_directive : require
 
 #include "shared.h"
@@ -409,15 +410,14 @@ void main() {
     uint slot = push.first + gl_WorkGroupID.x;
     uvec3 b = brickCoords(activeBricks[slot]);
     uvec3 brick = b * SDFCSG_MESH_BRICK;
-    if (kPass == SDFCSG_MESH_PASS_QUADS) {
-        for (uint r = gl_LocalInvocationID.x; r < kSignRows; r += gl_WorkGroupSize.x)
-            insideRows[r] = records[slot * SDFCSG_MESH_RECORD + kRecordSigns + r];
-        loadDualCells(slot, b);
-        barrier();
-        emitQuads(slot, brick);
+    if (kPass == SDFCSG_MESH_PASS_TRIANGLES) {
+        loadBrick(slot, b);
+        emitTriangles(slot, brick);
         return;
     }
+    loadDualCells(slot, b);
     loadBrick(slot, b);
-    if (kPass == SDFCSG_MESH_PASS_TRIANGLES) emitTriangles(slot, brick);
-    else emitDualVertices(slot, brick);
+    emitDualVertices(slot, brick);
+    barrier(); // the quads reuse the work list
+    emitQuads(slot, brick);
 }

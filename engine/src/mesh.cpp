@@ -12,8 +12,9 @@
 //   triangles  after every batch is classified (a cell's edges may belong to a later brick),
 //              marching cubes' index triples, from its table. Dual contouring instead places
 //              its vertices, one per piece of surface in a cell, from the edge data of every
-//              batch, then joins them by a quad per crossed edge (both in mesh_triangles.comp);
-//              the host turns each quad into the two triangles that fold it least.
+//              batch, and joins them by a quad per crossed edge, in one pass
+//              (mesh_triangles.comp); the host turns each quad into the two triangles that fold
+//              it least.
 // Vertices and triangles come out in brick order, so the mesh is the same on every run.
 #include "sdfcsg/mesh.h"
 
@@ -224,8 +225,7 @@ struct Mesher::Impl {
     VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
     VkPipelineLayout pipelineLayout = VK_NULL_HANDLE;
     VkPipeline cull = VK_NULL_HANDLE, classify = VK_NULL_HANDLE, vertices = VK_NULL_HANDLE,
-               triangles = VK_NULL_HANDLE, dualVertices = VK_NULL_HANDLE,
-               quads = VK_NULL_HANDLE;
+               triangles = VK_NULL_HANDLE, dualPass = VK_NULL_HANDLE;
     VkDescriptorPool pool = VK_NULL_HANDLE;
     VkDescriptorSet set = VK_NULL_HANDLE;
 
@@ -239,7 +239,7 @@ struct Mesher::Impl {
     ~Impl() {
         for (Buffer& b : buffers)
             detail::destroyBuffer(ctx, b);
-        for (VkPipeline p : {cull, classify, vertices, triangles, dualVertices, quads})
+        for (VkPipeline p : {cull, classify, vertices, triangles, dualPass})
             if (p) vkDestroyPipeline(ctx.device, p, nullptr);
         for (VkShaderModule m : modules)
             if (m) vkDestroyShaderModule(ctx.device, m, nullptr);
@@ -431,11 +431,8 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
     const PassSpec trianglesSpec = passSpec(SDFCSG_MESH_PASS_TRIANGLES, SDFCSG_MESH_BRICK);
     m.triangles =
         detail::createComputePipeline(m.ctx, m.modules[1], m.pipelineLayout, trianglesSpec);
-    m.dualVertices = detail::createComputePipeline(
-        m.ctx, m.modules[1], m.pipelineLayout,
-        passSpec(SDFCSG_MESH_PASS_DUAL_VERTICES, SDFCSG_MESH_GROUP_X));
-    m.quads = detail::createComputePipeline(m.ctx, m.modules[1], m.pipelineLayout,
-                                            passSpec(SDFCSG_MESH_PASS_QUADS, SDFCSG_MESH_GROUP_X));
+    m.dualPass = detail::createComputePipeline(m.ctx, m.modules[1], m.pipelineLayout,
+                                               passSpec(SDFCSG_MESH_PASS_DUAL, SDFCSG_MESH_GROUP_X));
 
     std::vector<detail::GpuNode> nodes = detail::packNodes(*m.evaluator);
     std::vector<uint32_t> tables = packTables();
@@ -486,8 +483,7 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
         std::chrono::steady_clock::now() - start;
     if (helperMs > 0.0 && verticesMs.count() > 0.25 * helperMs) detail::compileHelperMissed(m.ctx);
     m.warmUp(m.triangles);
-    m.warmUp(m.dualVertices);
-    m.warmUp(m.quads);
+    m.warmUp(m.dualPass);
     auto words = fieldWords.get();
     if (!words) return words.error();
     auto made = detail::uploadField(m.ctx, m.buffer(SDFCSG_BINDING_FIELD), *words);
@@ -587,7 +583,7 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
     const uint32_t activeCount = uint32_t(active.size());
     const uint32_t batches = (activeCount + kBatchBricks - 1) / kBatchBricks;
     const uint32_t batchBricks = std::min(activeCount, kBatchBricks);
-    progressTotal += (options.method == MeshMethod::DualContouring ? 4.0 : 3.0) * batches;
+    progressTotal += 3.0 * batches;
     if (!progress(1)) return cancelled;
 
     // Known once the bricks are culled: what the bricks hold for the whole extraction.
@@ -684,50 +680,44 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
         if (!progress(1)) return cancelled;
     }
 
+    const int triangleKind = dual ? 3 : 1;
+    mesh.indices.resize(totals[triangleKind] * 3);
     if (dual) {
-        t0 = Clock::now();
         std::swap(buffer(SDFCSG_BINDING_MESH_VERTICES), buffer(SDFCSG_BINDING_MESH_HERMITE));
         writeDescriptors();
         mesh.positions.resize(totals.z);
         mesh.normals.resize(totals.z);
         mesh.colors.resize(totals.z);
-        for (uint32_t batch = 0; batch < batches; ++batch) {
-            MeshPush push = batchOf(batch);
-            auto [first, end] = batchRange(push, 2);
-            push.vertexBase = first;
-            if (auto ok = reserve(SDFCSG_BINDING_MESH_VERTICES, (end - first) * 36); !ok)
-                return ok.error();
-            VkCommandBuffer cmd = begin(dualVertices);
-            dispatch(cmd, push, push.count);
-            finish(cmd);
-            const float* v = mapped<float>(SDFCSG_BINDING_MESH_VERTICES);
-            for (uint64_t o = first; o < end; ++o, v += 9) {
-                mesh.positions[o] = glm::vec3(v[0], v[1], v[2]);
-                mesh.normals[o] = glm::vec3(v[3], v[4], v[5]);
-                mesh.colors[o] = glm::vec3(v[6], v[7], v[8]);
-            }
-            if (!progress(1)) return cancelled;
-        }
-        stage("dual vertices", t0);
     }
-
-    const int triangleKind = dual ? 3 : 1;
-    mesh.indices.resize(totals[triangleKind] * 3);
     for (uint32_t batch = 0; batch < batches; ++batch) {
         MeshPush push = batchOf(batch);
         auto [first, end] = batchRange(push, triangleKind);
         push.triangleBase = first;
         const uint64_t batchTriangles = end - first;
+        auto [firstVertex, endVertex] = batchRange(push, 2);
+        push.vertexBase = firstVertex;
 
         t0 = Clock::now();
         if (auto ok = reserve(SDFCSG_BINDING_MESH_INDICES, batchTriangles * 12); !ok)
             return ok.error();
-        VkCommandBuffer cmd = begin(dual ? quads : triangles);
+        if (dual) {
+            if (auto ok = reserve(SDFCSG_BINDING_MESH_VERTICES, (endVertex - firstVertex) * 36); !ok)
+                return ok.error();
+        }
+        VkCommandBuffer cmd = begin(dual ? dualPass : triangles);
         dispatch(cmd, push, push.count);
         finish(cmd);
-        stage("triangles", t0);
+        stage(dual ? "dual" : "triangles", t0);
 
         t0 = Clock::now();
+        if (dual) {
+            const float* v = mapped<float>(SDFCSG_BINDING_MESH_VERTICES);
+            for (uint64_t o = firstVertex; o < endVertex; ++o, v += 9) {
+                mesh.positions[o] = glm::vec3(v[0], v[1], v[2]);
+                mesh.normals[o] = glm::vec3(v[3], v[4], v[5]);
+                mesh.colors[o] = glm::vec3(v[6], v[7], v[8]);
+            }
+        }
         std::memcpy(mesh.indices.data() + uint64_t(first) * 3,
                     mapped<uint32_t>(SDFCSG_BINDING_MESH_INDICES), batchTriangles * 12);
         stage("download", t0);

@@ -206,7 +206,9 @@ INSTANTIATE_TEST_SUITE_P(Scenes, BundledSceneMesh, ::testing::ValuesIn(bundledSc
                          sceneTestName);
 
 // The benchmark scenes (assets/bench, meshed from pruned tapes) at a reduced resolution: closed,
-// manifold, and every vertex within a voxel of the surface, by the CPU evaluator's pruned field
+// manifold, and every vertex within its cell's diagonal of the surface (a dual vertex lies in a
+// cell that the surface crosses; where a part is thinner than a cell, the planes of its two sides
+// may place it that far off), by the CPU evaluator's pruned field
 // (which the prune tests hold to the whole tree near the surface; the whole tree at half a
 // million vertices would take minutes).
 TEST_F(MeshTest, BenchmarkScenesAreClosedWithVerticesOnTheSurface) {
@@ -228,7 +230,7 @@ TEST_F(MeshTest, BenchmarkScenesAreClosedWithVerticesOnTheSurface) {
         float worst = 0.0f;
         for (const glm::vec3& p : mesh.positions)
             worst = std::max(worst, std::abs(evaluator.prunedDistance(p)));
-        EXPECT_LE(worst, stats.voxelSize);
+        EXPECT_LE(worst, std::sqrt(3.0f) * stats.voxelSize);
     }
 }
 
