@@ -8,7 +8,7 @@
 
 namespace sdfcsg::app {
 
-// Exit codes, documented in the README.
+// Exit codes, documented in docs/cli.md.
 enum Exit : int {
     kOk = 0,
     kInvalidScene = 1, // the scene failed to parse or validate, or a limit was exceeded

@@ -520,7 +520,7 @@ int cmdConvert(int argc, char** argv) {
 const char* kSchemaHelp = R"(Usage: sdfcsg schema [-o FILE] [--markdown]
 
 Prints the JSON Schema (draft 2020-12) of the scene format, generated from the node table.
-  --markdown  print the field reference in Markdown instead (as in the README)
+  --markdown  print the field reference in Markdown instead (as in docs/scene-format.md)
 )";
 
 int cmdSchema(int argc, char** argv) {

@@ -1,4 +1,4 @@
-// The README's field reference is generated from the node table; keep the copy in step.
+// docs/scene-format.md's field reference is generated from the node table; keep the copy in step.
 #include <sdfcsg/scene.h>
 
 #include <gtest/gtest.h>
@@ -15,17 +15,17 @@ std::string readFile(const std::string& path) {
     return s.str();
 }
 
-TEST(Reference, ReadmeEmbedsTheGeneratedReference) {
-    const std::string readme = readFile(SDFCSG_SOURCE_DIR "/README.md");
+TEST(Reference, DocsEmbedTheGeneratedReference) {
+    const std::string page = readFile(SDFCSG_SOURCE_DIR "/docs/scene-format.md");
     const std::string begin = "<!-- BEGIN scene-format-reference -->\n";
     const std::string end = "<!-- END scene-format-reference -->";
-    size_t b = readme.find(begin), e = readme.find(end);
+    size_t b = page.find(begin), e = page.find(end);
     ASSERT_NE(b, std::string::npos);
     ASSERT_NE(e, std::string::npos);
-    std::string embedded = readme.substr(b + begin.size(), e - b - begin.size());
+    std::string embedded = page.substr(b + begin.size(), e - b - begin.size());
     EXPECT_EQ(embedded, "\n" + sdfcsg::sceneFormatReference() + "\n")
-        << "README.md is out of date: replace the block between the markers with the output of "
-           "'sdfcsg schema --markdown' (and a blank line on each side).";
+        << "docs/scene-format.md is out of date: replace the block between the markers with the "
+           "output of 'sdfcsg schema --markdown' (and a blank line on each side).";
 }
 
 TEST(Reference, MentionsEveryKindAndParameter) {

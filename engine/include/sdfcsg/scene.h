@@ -1,6 +1,6 @@
 // sdfcsg: scenes, their JSON format, and loading with strict validation.
 //
-// The format is documented in README.md ("Scene format") and assets/scene.schema.json.
+// The format is documented in docs/scene-format.md and assets/scene.schema.json.
 // Lengths are in scene units (metres by convention), angles in degrees, colours in 0..1.
 #pragma once
 
@@ -96,7 +96,7 @@ std::vector<Light> defaultLights();
 std::string sceneJsonSchema();
 
 // The Markdown reference of every node kind and field (units, defaults, meaning), generated from
-// the same table; README.md embeds it and a test keeps the two equal.
+// the same table; docs/scene-format.md embeds it and a test keeps the two equal.
 std::string sceneFormatReference();
 
 } // namespace sdfcsg
