@@ -3,8 +3,8 @@
 // times per stage at several resolutions instead.
 #include "bench.h"
 
-#include "scoped_env.h"
-#include "shader_compile.h"
+#include "gpu/scoped_env.h"
+#include "codegen/shader_compile.h"
 
 #include <sdfcsg/sdfcsg.h>
 

@@ -1,8 +1,8 @@
-// Declarations shared by the mesh-extraction kernels (engine/src/mesh.cpp drives them). The grid
+// Declarations shared by the mesh-extraction kernels (engine/src/mesh/mesh.cpp drives them). The grid
 // has cells.xyz cells of edge origin.w; sample s (0 <= s <= cells) lies at origin.xyz + s * w.
 // Inside is d < 0. See engine/include/sdfcsg/mesh.h for the algorithm.
 
-// Mirrors MeshGrid in engine/src/mesh.cpp (std140).
+// Mirrors MeshGrid in engine/src/mesh/mesh.cpp (std140).
 layout(std140, set = 0, binding = SDFCSG_BINDING_MESH_GRID) uniform MeshGrid {
     vec4 origin; // xyz: position of sample 0; w: cell edge length
     uvec4 cells; // xyz: cells per axis; w: root-finding steps per vertex

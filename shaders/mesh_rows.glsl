@@ -64,7 +64,7 @@ Row rowAt(uvec3 s0, uint y, uint z) {
 }
 
 // The marching-cubes case of the cell at sample x of row (y, z), with corners in canonical
-// order (bit ox + 2 oy + 4 oz for the corner at offset (ox, oy, oz)); engine/src/mesh.cpp packs
+// order (bit ox + 2 oy + 4 oz for the corner at offset (ox, oy, oz)); engine/src/mesh/mesh.cpp packs
 // the tables in that order.
 uint cellCase(uint x, uint y, uint z) {
     uint r00 = insideRows[y + kSide * z] >> x, r10 = insideRows[y + 1u + kSide * z] >> x;

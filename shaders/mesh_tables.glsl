@@ -1,4 +1,4 @@
-// The marching-cubes tables (engine/src/mc_tables.cpp), as packed by engine/src/mesh.cpp.
+// The marching-cubes tables (engine/src/mesh/mc_tables.cpp), as packed by engine/src/mesh/mesh.cpp.
 layout(std430, set = 0, binding = SDFCSG_BINDING_MESH_TABLES) readonly buffer MeshTables {
     // Cases have corners in canonical order (see cellCase() in mesh_rows.glsl).
     // [0, 256): triangles per case; [256, 1280): per case, 4 words of edge numbers, one byte

@@ -1,5 +1,5 @@
 // The node buffer that generated scene code reads. Layout (std430, 128 bytes a node) mirrors
-// GpuNode in engine/src/gpu_nodes.h; node i is scene node i.
+// GpuNode in engine/src/codegen/gpu_nodes.h; node i is scene node i.
 struct Node {
     vec4 row0, row1, row2; // world -> local affine: local = vec3(dot(row0, vec4(p, 1)), ...)
     vec4 p0, p1;           // kernel parameters (half extents etc.), see kernelParams() in sdf.h
@@ -24,7 +24,7 @@ vec3 toLocal(uint i, vec3 p) { return affine(nodes[i].row0, nodes[i].row1, nodes
 
 // Signed distance to a box: a lower bound of the value of every node inside it (outside, the
 // solid is no nearer than its box; inside, its boundary is no farther than the box's). Same
-// formula as Aabb::signedDistance in engine/src/eval.cpp.
+// formula as Aabb::signedDistance in engine/src/field/eval.cpp.
 float boundsDistance(vec3 bmin, vec3 bmax, vec3 p) {
     vec3 q = max(bmin - p, p - bmax);
     return length(max(q, 0.0)) + min(max(q.x, max(q.y, q.z)), 0.0);
@@ -34,7 +34,7 @@ float nodeBoundsDistance(uint i, vec3 p) {
     return boundsDistance(nodes[i].bmin.xyz, nodes[i].bmax.xyz, p);
 }
 
-// Helpers for the generated scene code (engine/src/codegen.cpp), which also defines one
+// Helpers for the generated scene code (engine/src/codegen/codegen.cpp), which also defines one
 // `float <kind>Node(uint i, vec3 p)` per primitive kind it uses.
 float nodeSmooth(uint i) { return nodes[i].bmin.w; }
 uint nodeBlend(uint i) { return uint(nodes[i].bmax.w); }

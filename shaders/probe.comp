@@ -1,6 +1,6 @@
 #version 450
 // Evaluates the scene at given points: output i = sceneSample(points[i].xyz) (rgb colour,
-// distance in w). The GPU tests compare it with the CPU evaluator (engine/src/eval.cpp).
+// distance in w). The GPU tests compare it with the CPU evaluator (engine/src/field/eval.cpp).
 #extension GL_GOOGLE_include_directive : require
 
 #include "shared.h"

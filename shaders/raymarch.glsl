@@ -28,7 +28,7 @@
 // the house's; the shadow-ray ends and the lighting a quarter of the shade kernel's), so the
 // scene kernels hold nothing that can live elsewhere.
 //
-// Rays are generated and clipped exactly as engine/src/camera.h does on the CPU (the tests trace
+// Rays are generated and clipped exactly as engine/src/render/camera.h does on the CPU (the tests trace
 // the same rays with the reference evaluator). Normals use the four-tap tetrahedral difference
 // of the original system; soft shadows are IQ's improved technique
 // (https://iquilezles.org/articles/rmshadows/); ambient occlusion samples along the normal.
@@ -41,7 +41,7 @@ struct FrameLight {
     vec4 color;     // rgb: colour times intensity
 };
 
-// Mirrors FrameUniform in engine/src/render.cpp (std140): the frame's values. No branch or loop
+// Mirrors FrameUniform in engine/src/render/render.cpp (std140): the frame's values. No branch or loop
 // may depend on these alone (see Control).
 layout(std140, set = 0, binding = SDFCSG_BINDING_FRAME) uniform Frame {
     vec4 eye;        // xyz; w: tan(fov / 2)
@@ -60,7 +60,7 @@ layout(std140, set = 0, binding = SDFCSG_BINDING_FRAME) uniform Frame {
     vec4 grid; // ground grid: xy: centre (x, z); z: height of its plane; w: line spacing
 } frame;
 
-// Mirrors FrameControl in engine/src/render.cpp: the frame's values that branches and loops
+// Mirrors FrameControl in engine/src/render/render.cpp: the frame's values that branches and loops
 // read. A storage buffer, not a uniform block: lavapipe (Mesa 22.3) may specialise a kernel on
 // the uniform-block values that decide its branches, and then compiles it again whenever the
 // block or the push constants change, which they do at every band's dispatch. Whether it does
@@ -74,7 +74,7 @@ layout(std430, set = 0, binding = SDFCSG_BINDING_CONTROL) readonly buffer Contro
     uvec4 parts;  // x: surface parts in Frame.surfaceBoxes (0: the clip box alone)
 } control;
 
-// The band this dispatch computes (engine/src/render.cpp): its first pixel row, and where its
+// The band this dispatch computes (engine/src/render/render.cpp): its first pixel row, and where its
 // first sample's colour goes in Colors.
 layout(push_constant) uniform Band {
     uint firstRow;

@@ -1,11 +1,11 @@
 // The SDF function library, one source for both languages: the kernels include it as GLSL and
-// engine/src/sdf.h includes it as C++ with GLM standing in for GLSL, so the CPU evaluator and the
+// engine/src/field/sdf.h includes it as C++ with GLM standing in for GLSL, so the CPU evaluator and the
 // GPU evaluate the same formulas. It is written in the dialect the two share: float literals with
 // an f suffix, no swizzles (vec2(p.x, p.z), vec3(v)), no out parameters, functions marked SDF_FN.
 //
 // Exact distance functions after Inigo Quilez (https://iquilezles.org/articles/distfunctions/,
 // .../smin/). Every primitive is centred at the origin of its local frame and takes the kernel
-// parameters that its table entry's kernel() derives (engine/src/nodes.cpp: half extents, half
+// parameters that its table entry's kernel() derives (engine/src/scene/nodes.cpp: half extents, half
 // heights), not the JSON values. Adding a primitive: its table entry, its formula here and its
 // line in sdPrimitive() below (docs/vocabulary.md).
 
@@ -14,8 +14,8 @@
 #endif
 
 // Polygon and text read their outlines from data beside the nodes: in GLSL the node buffer seen
-// as vec4s (their records follow the nodes, engine/src/gpu_nodes.cpp), in C++ the node's own
-// array (engine/src/sdf.h). SDF_DATA_PARAM is the extra parameter that carries it, SDF_DATA_ARG
+// as vec4s (their records follow the nodes, engine/src/codegen/gpu_nodes.cpp), in C++ the node's own
+// array (engine/src/field/sdf.h). SDF_DATA_PARAM is the extra parameter that carries it, SDF_DATA_ARG
 // passes it on.
 #ifndef SDF_DATA
 #define SDF_DATA(i) nodeWords[i]
@@ -270,7 +270,7 @@ SDF_FN float quadraticCrossingsUp(float x, float y0, float y1, vec2 a, vec2 c, v
     return -quadraticCrossings(x, y0, y1, vec2(a.y, a.x), vec2(c.y, c.x), vec2(b.y, b.x));
 }
 
-// A small polygon or text outline (engine/src/outline.h), listed by contour from `first`: the
+// A small polygon or text outline (engine/src/scene/outline.h), listed by contour from `first`: the
 // exact distance to its line and quadratic segments, negative where they wind around p
 // (non-zero rule). The distance starts from an upper bound, the nearest of the contours' first
 // points; then a contour runs only where its box is nearer than the nearest segment so far (for
@@ -309,7 +309,7 @@ SDF_FN float sdContours(vec2 p, uint first, uint contours SDF_DATA_PARAM) {
     return winding != 0.0f ? -sqrt(best) : sqrt(best);
 }
 
-// Polygon and text: the exact distance to an outline (engine/src/outline.h, from `first`, with
+// Polygon and text: the exact distance to an outline (engine/src/scene/outline.h, from `first`, with
 // its box lo, hi) of line and quadratic segments, negative where they wind around p (non-zero
 // rule). A small one is listed by contour (nx = 0). A larger one has a grid of nx by ny cells
 // of `side`, two cells beyond its box: at q, the nearest point of the grid to p, the nearest of
@@ -411,7 +411,7 @@ SDF_FN vec4 sharpDifference(vec4 a, vec4 b) { return a.w >= -b.w ? a : vec4(vec3
 // radius k where the surfaces meet at a right angle; chamfer (2) cuts the corner along
 // a + b = k, as hg_sdf's does, with half its slope so that the field stays 1-Lipschitz. Both
 // pass at most half of a change in either operand on, are exact once |a - b| >= k and never
-// dip more than k below min(a, b), which pruning and the bounds rely on (engine/src/prune.cpp).
+// dip more than k below min(a, b), which pruning and the bounds rely on (engine/src/field/prune.cpp).
 SDF_FN float blendDip(float h, uint style) {
     return style == 2u ? 0.5f * h : 0.5f * (1.0f + h - sqrt(max(1.0f + 2.0f * h - h * h, 0.0f)));
 }
@@ -491,7 +491,7 @@ SDF_FN float sdPrimitive(uint kind, vec3 q, vec4 a, vec4 b, uint kinds SDF_DATA_
 // ---- Value and domain operations (NodeKind's numbering; kernel parameters from their table
 // entries' kernelAround) ----
 
-// NodeKind's numbers of the operations (engine/src/sdf.h checks them).
+// NodeKind's numbers of the operations (engine/src/field/sdf.h checks them).
 const uint kKindShell = 25u, kKindOffset = 26u, kKindRepeat = 27u, kKindPolarRepeat = 28u;
 const uint kKindMirror = 29u, kKindElongate = 30u, kKindTwist = 31u, kKindBend = 32u;
 const uint kKindTaper = 33u, kKindExtrude = 34u, kKindRevolve = 35u;
@@ -506,7 +506,7 @@ SDF_FN float valueOp(uint kind, float d, vec4 a) {
 // p here is in the node's local space. Repeat: a: spacing, G; b: count, M packed a byte per
 // axis. Along each axis the candidates are the nearest copy, then in turn M more either side,
 // then one more towards p, or every copy when that is as many: the nearest copy to any point of
-// a child that reaches M copies either side is among them (engine/src/nodes.cpp, repeatKernel).
+// a child that reaches M copies either side is among them (engine/src/scene/nodes.cpp, repeatKernel).
 SDF_FN uint repeatAxisCount(float n, float m) {
     return n <= 1.0f ? 1u : (2.0f * m + 2.0f >= n ? uint(n) : uint(2.0f * m + 2.0f));
 }

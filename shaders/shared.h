@@ -19,13 +19,13 @@
 #define SDFCSG_BINDING_CONTROL 9 // raymarch.glsl: buffer Control: the values that branches read
 #define SDFCSG_BINDING_SURFACES 10 // raymarch.glsl: per listed hit, what the shade pass hands over
 #define SDFCSG_BINDING_RANGES 11   // raymarch.glsl: per sample, the part of its ray to march
-#define SDFCSG_BINDING_FIELD 15   // tape.glsl: per-region pruned tapes (engine/src/prune.h)
+#define SDFCSG_BINDING_FIELD 15   // tape.glsl: per-region pruned tapes (engine/src/field/prune.h)
 #define SDFCSG_BINDING_PROBE_IN 4  // probe.comp: readonly buffer of vec4 points (xyz used)
 #define SDFCSG_BINDING_PROBE_OUT 5 // probe.comp: buffer of vec4 sceneSample() results
 
 #define SDFCSG_PROBE_GROUP_X 64
 
-// A tape instruction (engine/src/prune.h, shaders/tape.glsl): the node's index in the low bits
+// A tape instruction (engine/src/field/prune.h, shaders/tape.glsl): the node's index in the low bits
 // and its kind (NodeKind) above them. In the packed tapes, a primitive whose operation follows at
 // once also carries that operation (its kind less SDFCSG_TAPE_FIRST_OPERATION, plus 1) and its
 // blend profile, and the next word holds the blend radius.
@@ -36,7 +36,7 @@
 #define SDFCSG_TAPE_FIRST_OPERATION 22 // NodeKind::Union; then intersection, difference
 #define SDFCSG_TAPE_DOMAIN_END 63     // the kind of the instruction that ends a domain's child
 
-// Mesh extraction (engine/src/mesh.cpp, shaders/mesh_*.comp). The grid's samples are split into
+// Mesh extraction (engine/src/mesh/mesh.cpp, shaders/mesh_*.comp). The grid's samples are split into
 // bricks of SDFCSG_MESH_BRICK^3; a brick also reads the samples one step past its far faces, so
 // it holds SDFCSG_MESH_BRICK_SAMPLES^3 values and owns the cells and edges that start at its own
 // samples.

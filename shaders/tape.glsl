@@ -1,13 +1,13 @@
-// The scene as data: the stack machine that runs a cell's pruned tape (engine/src/prune.h), the
+// The scene as data: the stack machine that runs a cell's pruned tape (engine/src/field/prune.h), the
 // scene code of scenes too large to inline. Kernels built this way are the same for every such
 // scene; the tapes, the cells and the node buffer carry everything that is the scene's own.
-// PrunedField::distance and sample in engine/src/prune.cpp are this file in C++.
+// PrunedField::distance and sample in engine/src/field/prune.cpp are this file in C++.
 //
 // The generated scene code defines SDFCSG_TAPE_STACK (the most values a tape holds at once,
 // rounded up), SDFCSG_TAPE_KINDS (a bit for each kind the scene holds) and SDFCSG_TAPE_DOMAINS
 // (the most domain operations nested in one another, 0 for none) before it includes this file.
 
-// Mirrors packField() in engine/src/prune.cpp: a header of 12 words (origin xyz and leaf cell
+// Mirrors packField() in engine/src/field/prune.cpp: a header of 12 words (origin xyz and leaf cell
 // side as float bits, levels, leaf cells per axis xyz, 1 when bounded, whole-tape length, first
 // tape word), two words per leaf cell, then the tape.
 layout(std430, set = 0, binding = SDFCSG_BINDING_FIELD) readonly buffer Field {

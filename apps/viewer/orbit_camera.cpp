@@ -1,6 +1,6 @@
 #include "orbit_camera.h"
 
-#include "camera.h" // finiteSceneBounds(), as the mesher uses
+#include "render/camera.h" // finiteSceneBounds(), as the mesher uses
 
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>

@@ -1,6 +1,6 @@
 #include "picking.h"
 
-#include "camera.h" // the renderer's own ray formulas, so picks match the pixels
+#include "render/camera.h" // the renderer's own ray formulas, so picks match the pixels
 
 #include <algorithm>
 #include <cmath>

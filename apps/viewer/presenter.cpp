@@ -1,6 +1,6 @@
 #include "presenter.h"
 
-#include "camera.h"
+#include "render/camera.h"
 
 #include <GLFW/glfw3.h>
 #include <imgui.h>

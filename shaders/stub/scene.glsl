@@ -1,5 +1,5 @@
 // Stand-in for the generated scene, used only to syntax-check the kernels at build time: the
-// output of engine/src/codegen.cpp (buffer mode) for a small scene. Keep it in step.
+// output of engine/src/codegen/codegen.cpp (buffer mode) for a small scene. Keep it in step.
 
 float sphereNode(uint i, vec3 p) {
     return sdSphere(toLocal(i, p), nodes[i].p0.x) * nodes[i].color.w;

@@ -9,7 +9,7 @@
 // mutator retries until the scene still loads: most executions then compile a scene. The SPIR-V
 // cache stays in memory only (the same GLSL text twice is compiled once); the counts printed at
 // exit say how many scenes glslang compiled.
-#include "shader_compile.h"
+#include "codegen/shader_compile.h"
 
 #include <sdfcsg/compile.h>
 #include <sdfcsg/scene.h>

@@ -1,9 +1,9 @@
 // Mesa's disk cache of machine code, for the tests that look at what lavapipe compiled.
 #pragma once
 
-#include "scoped_env.h"
-#include "shader_compile.h"
-#include "vk.h"
+#include "gpu/scoped_env.h"
+#include "codegen/shader_compile.h"
+#include "gpu/vk.h"
 
 #include <sdfcsg/sdfcsg.h>
 

@@ -3,7 +3,7 @@
 // keeps what it received. Used by the generation tests and the viewer's worker tests.
 #pragma once
 
-#include "json_writer.h"
+#include "scene/json_writer.h"
 
 #include <httplib.h>
 

@@ -1,11 +1,11 @@
 // The mesh extraction algorithms on the CPU, written plainly, as the reference the GPU mesher is
 // held to: the same grid, sign test, edge points, refinement, normals, colours and table
-// (engine/src/mc_tables.h), and for dual contouring the same pieces, vertex placement and
+// (engine/src/mesh/mc_tables.h), and for dual contouring the same pieces, vertex placement and
 // quads. Only the order of vertices and triangles differs from the GPU's.
 #pragma once
 
-#include "mc_tables.h"
-#include "mesh_dual.h"
+#include "mesh/mc_tables.h"
+#include "mesh/mesh_dual.h"
 
 #include <sdfcsg/eval.h>
 #include <sdfcsg/mesh.h>

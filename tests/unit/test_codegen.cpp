@@ -2,8 +2,8 @@
 // pasted twice, linear size), that it compiles in both modes through compileKernel, compile
 // errors as values, and the SPIR-V cache in memory and on disk.
 #include "scene_build_util.h"
-#include "scoped_env.h"
-#include "shader_compile.h"
+#include "gpu/scoped_env.h"
+#include "codegen/shader_compile.h"
 
 #include <sdfcsg/compile.h>
 

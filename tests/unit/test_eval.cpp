@@ -1,5 +1,5 @@
 // The CPU reference evaluator: transforms, colours, smooth blending, bounds and bounds skipping.
-#include "gpu_nodes.h"
+#include "codegen/gpu_nodes.h"
 #include "scene_build_util.h"
 #include "shared.h"
 

@@ -3,7 +3,7 @@
 // rasterizer covers, with FreeType's bounding boxes and advances (kerning included); linear in
 // the size; the exact error messages; and the cubic-to-quadratic split within its bound (no
 // installed font has cubic outlines, so the split is tested on its own).
-#include "font.h"
+#include "scene/font.h"
 
 #include <gtest/gtest.h>
 

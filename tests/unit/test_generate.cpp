@@ -5,7 +5,7 @@
 #include <sdfcsg/generate.h>
 
 #include "fake_llm_server.h"
-#include "json_writer.h"
+#include "scene/json_writer.h"
 
 #include <gtest/gtest.h>
 

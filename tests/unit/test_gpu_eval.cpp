@@ -1,11 +1,11 @@
 // The generated GLSL against the CPU reference evaluator: shaders/probe.comp evaluates
 // sceneSample at thousands of points, for every primitive kind, the operations, and every bundled
 // scene, with bounds skipping on and off, and with the bounds tests left out of the code.
-#include "gpu_nodes.h"
+#include "codegen/gpu_nodes.h"
 #include "gpu_test.h"
-#include "prune.h"
+#include "field/prune.h"
 #include "shared.h"
-#include "vk.h"
+#include "gpu/vk.h"
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
@@ -27,7 +27,7 @@ struct Probe {
     // The result is read back through a staging copy, as on GPUs whose storage memory is not
     // mappable (lavapipe's always is), so that path runs under validation too.
     bool viaStaging;
-    // Pruned tapes (shaders/tape.glsl), held to the CPU's pruned field (engine/src/prune.cpp).
+    // Pruned tapes (shaders/tape.glsl), held to the CPU's pruned field (engine/src/field/prune.cpp).
     bool tapes = false;
 };
 
@@ -223,7 +223,7 @@ const std::map<std::string, std::string>& profileExamples() {
         {"rectangle", R"("width": 0.9, "height": 0.6, "rounding": 0.1)"},
         {"regular_polygon", R"("radius": 0.6, "sides": 5)"},
         {"polygon", R"("points": [[-0.5, -0.4], [0.6, -0.4], [0.1, 0.0], [0.3, 0.5], [-0.4, 0.3]])"},
-        // Large enough for a grid (engine/src/outline.h); the polygon is listed by contour.
+        // Large enough for a grid (engine/src/scene/outline.h); the polygon is listed by contour.
         {"text", R"("text": "Bo sdfg", "size": 0.5)"},
     };
     return examples;

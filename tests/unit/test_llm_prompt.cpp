@@ -3,7 +3,7 @@
 // of JSON from an answer, the repair message, and the geometric sanity warnings.
 #include <sdfcsg/generate.h>
 
-#include "embedded_shaders.h"
+#include "codegen/embedded_shaders.h"
 #include "shared.h"
 
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// The GPU mesher (engine/src/mesh.cpp) by the properties of its meshes: analytic volume and area,
+// The GPU mesher (engine/src/mesh/mesh.cpp) by the properties of its meshes: analytic volume and area,
 // topology, vertices on the surface, outward normals, closed and manifold meshes of the bundled
 // scenes, equality with the CPU reference (mesh_reference.h), repeatability, and its errors.
 #include "driver_cache.h"

@@ -1,8 +1,8 @@
-// The marching-cubes tables (engine/src/mc_tables.h) and the CPU reference mesher
+// The marching-cubes tables (engine/src/mesh/mc_tables.h) and the CPU reference mesher
 // (mesh_reference.h) on their own, without a GPU: every table case is checked against the rule
 // that makes meshes closed and manifold, and meshes of known solids have the right volume, area,
 // topology and orientation.
-#include "mc_tables.h"
+#include "mesh/mc_tables.h"
 #include "mesh_checks.h"
 #include "mesh_reference.h"
 #include "scene_build_util.h"

@@ -2,7 +2,7 @@
 // for (a repeat against the union of its copies, an elongated sphere against a capsule, ...),
 // the stretching ones as 1-Lipschitz fields with the right sign, and the pruned tapes against
 // the tree walk.
-#include "prune.h"
+#include "field/prune.h"
 
 #include "scene_build_util.h"
 

@@ -1,8 +1,8 @@
-// Every primitive's CPU distance (engine/src/sdf.h, fed through the table -> kernel parameter
+// Every primitive's CPU distance (engine/src/field/sdf.h, fed through the table -> kernel parameter
 // mapping) against a true distance computed independently in double precision: convex polytopes
 // by point-to-triangle distances, solids of revolution by 2D distances to their profile in the
 // meridian half-plane, torus and capsule by minimising over their core curve.
-#include "sdf.h"
+#include "field/sdf.h"
 
 #include <gtest/gtest.h>
 

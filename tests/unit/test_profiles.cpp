@@ -1,8 +1,8 @@
 // 2D profiles, extrude and revolve on the CPU: each against the 3D primitive it makes (an
 // extruded circle is a cylinder, a revolved circle a torus), polygons and text against brute
 // force over their outlines, and the font's outlines against their own geometry.
-#include "font.h"
-#include "outline.h"
+#include "scene/font.h"
+#include "scene/outline.h"
 
 #include "scene_build_util.h"
 

@@ -1,7 +1,7 @@
-// Per-region pruning (engine/src/prune.h) on the CPU: in every cell that may hold surface the
+// Per-region pruning (engine/src/field/prune.h) on the CPU: in every cell that may hold surface the
 // pruned tape gives the whole tree's value; elsewhere the bound never exceeds the field in
 // magnitude and keeps its sign; the tapes are short; smooth unions' bounds stay tight.
-#include "prune.h"
+#include "field/prune.h"
 #include "scene_build_util.h"
 
 #include <sdfcsg/sdfcsg.h>

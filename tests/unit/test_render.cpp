@@ -1,12 +1,12 @@
 // The GPU ray march against CPU sphere tracing with the reference evaluator: same rays (camera.h),
 // same clipping, same epsilon rule. Plus modes, bounds skipping, value updates and PNG output.
-#include "camera.h"
+#include "render/camera.h"
 #include "driver_cache.h"
 #include "gpu_test.h"
-#include "scoped_env.h"
-#include "shader_compile.h"
+#include "gpu/scoped_env.h"
+#include "codegen/shader_compile.h"
 #include "shared.h"
-#include "vk.h"
+#include "gpu/vk.h"
 
 #include <glm/common.hpp>
 #include <glm/exponential.hpp>

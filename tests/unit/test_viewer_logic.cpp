@@ -10,7 +10,7 @@
 #include "script.h"
 #include "workers.h"
 
-#include "camera.h" // the renderer's rays, to trace depths as it does
+#include "render/camera.h" // the renderer's rays, to trace depths as it does
 
 #include <sdfcsg/generate.h>
 #include <sdfcsg/io.h>

@@ -11,7 +11,7 @@ layout(push_constant) uniform MeshConstants {
     vec4 grid;    // ground grid: xy: centre (x, z); z: height of its plane; w: line spacing
 } pc;
 
-// The ray marcher's camera (engine/src/camera.h), so the mesh lies on the ray-marched surface
+// The ray marcher's camera (engine/src/render/camera.h), so the mesh lies on the ray-marched surface
 // pixel for pixel. Vulkan's y points down the image as the ray marcher's pixel rows do, hence
 // -up. Depth is reversed (near / distance: 1 at the near plane, towards 0 far away), which keeps
 // float depth precise at every distance and needs no far plane.

@@ -21,7 +21,7 @@ namespace sdfcsg {
 // How the generated scene code evaluates the tree. Inlined: every node becomes a line of code
 // (fastest for small scenes, and what a user reads in `sdfcsg glsl`). Tapes: the code is the
 // same for every scene, a stack machine (shaders/tape.glsl) that runs, per cell of an octree
-// around the solid, the nodes that can change the field there (engine/src/prune.h), read from
+// around the solid, the nodes that can change the field there (engine/src/field/prune.h), read from
 // buffers; its size and build time do not grow with the scene. Auto: tapes above
 // kTapeMinNodes nodes.
 enum class Evaluation : uint8_t { Auto, Inlined, Tapes };

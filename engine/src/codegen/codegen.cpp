@@ -1,0 +1,595 @@
+// Scene -> GLSL. Both functions, sceneDistance (float) and sceneSample (vec4: colour, distance),
+// come from the same walk, which is the evaluator's walk in eval.cpp written out as code: every
+// node is evaluated once into a local, operands fold left to right, and union operands i > 0
+// and difference subtrahends sit in a block that is skipped when their bounds say they cannot
+// change the value. Output size and glslang's time are linear in the node count (see
+// nodeIndex() in nodes.glsl and kInlineLimit); the walk uses an explicit stack.
+#include "sdfcsg/compile.h"
+
+#include "codegen/gpu_nodes.h"
+#include "field/prune.h"
+#include "field/sdf.h"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <charconv>
+#include <string>
+#include <vector>
+
+namespace sdfcsg {
+namespace {
+
+// glslang finds each literal by a linear search through all earlier ones, so inlining every
+// value makes compiling quadratic: 1000 inlined spheres take about 3 s, 2000 more than 5 s.
+// Larger scenes read their values from the node buffer even when inlining is asked for.
+constexpr size_t kInlineLimit = 1024;
+
+// Shortest text that reads back as the same float, always a GLSL float literal.
+void appendFloat(std::string& out, float v) {
+    char buf[32];
+    auto [end, ec] = std::to_chars(buf, buf + sizeof(buf), v);
+    std::string_view s(buf, size_t(end - buf));
+    out += s;
+    if (s.find_first_of(".e") == std::string_view::npos) out += ".0";
+}
+
+// Comments must stay on one line and pure ASCII (a trailing backslash would splice lines).
+void appendCommentText(std::string& out, std::string_view text) {
+    for (char c : text.substr(0, 120))
+        out += (c >= 0x20 && c < 0x7f && c != '\\') ? c : '?';
+}
+
+// Node i as a uint expression (see nodeIndex in nodes.glsl).
+std::string indexExpr(uint32_t i) {
+    if (i < 256) return std::to_string(i) + "u";
+    return "nodeIndex(" + std::to_string(i / 256) + "u, " + std::to_string(i % 256) + "u)";
+}
+
+// Where the value of kernel-parameter slot `first` lives: p0/p1 and the component letters.
+std::string_view paramVector(int first) {
+    return first < 4 ? "p0" : "p1";
+}
+std::string_view swizzle(int first, int count) {
+    return std::string_view("xyzw").substr(size_t(first % 4), size_t(count));
+}
+
+void appendVector(std::string& out, const float* v, int count) {
+    if (count > 1) out += "vec" + std::to_string(count) + "(";
+    for (int c = 0; c < count; ++c) {
+        if (c) out += ", ";
+        appendFloat(out, v[c]);
+    }
+    if (count > 1) out += ")";
+}
+
+class Emitter {
+  public:
+    Emitter(const Scene& scene, std::string& out, const std::vector<detail::GpuNode>* literals,
+            bool boundsTests)
+        : scene_(scene), out_(out), lit_(literals), tests_(boundsTests),
+          gridded_(scene.nodes.size(), false) {
+        // Whether node i's subtree holds a gridded outline (outline.h): children come after
+        // their operation.
+        for (size_t i = scene.nodes.size(); i-- > 0;) {
+            const Node& n = scene.nodes[i];
+            bool gridded = n.outline && (*n.outline)[0].x != 0.0f;
+            for (uint32_t child : n.children)
+                gridded = gridded || gridded_[child];
+            gridded_[i] = gridded;
+        }
+    }
+
+    // The buffer-mode wrappers, e.g. `float boxNode(uint i, vec3 p)`, for the kinds in use; with
+    // values inlined, the outlines written out as code.
+    void helpers() {
+        if (lit_) {
+            for (uint32_t i = 0; i < scene_.nodes.size(); ++i)
+                if (inlinedOutline(i)) outlineFunction(i);
+            return;
+        }
+        std::array<bool, kNodeKindCount> used{};
+        for (const Node& n : scene_.nodes)
+            used[size_t(n.kind)] = true;
+        for (const KindInfo& info : nodeKinds()) {
+            if (info.operation || !used[size_t(info.kind)]) continue;
+            out_ += "float ";
+            out_ += info.name;
+            out_ += "Node(uint i, vec3 p) {\n    return ";
+            out_ += info.function;
+            out_ += "(toLocal(i, p)";
+            for (const KernelArg& arg : info.args) {
+                out_ += ", nodes[i].";
+                out_ += paramVector(arg.slot);
+                out_ += '.';
+                out_ += swizzle(arg.slot, arg.count);
+            }
+            out_ += ") * nodes[i].color.w;\n}\n";
+        }
+        out_ += '\n';
+    }
+
+    void function(bool sample) {
+        sample_ = sample;
+        out_ += sample ? "vec4 sceneSample(vec3 p) {\n" : "float sceneDistance(vec3 p) {\n";
+        struct Frame {
+            uint32_t node, next, depth;
+        };
+        std::vector<Frame> stack;
+        uint32_t current = 0, depth = 0;
+        for (;;) {
+            const Node& n = scene_.nodes[current];
+            if (kindInfo(n.kind).operation) {
+                const std::vector<uint32_t>& operands = n.children;
+                if (!operands.empty()) {
+                    stack.push_back({current, 1, depth});
+                    if (kindInfo(n.kind).role == Role::Domain) depth += openDomain(current, depth);
+                    current = operands[0];
+                    ++depth;
+                    continue;
+                }
+            } else {
+                indent(depth);
+                declare(current);
+                leaf(current);
+                comment(current);
+            }
+            // Fold the finished value into the enclosing operations; descend into the next child.
+            for (;;) {
+                if (stack.empty()) {
+                    out_ += "    return ";
+                    var(0);
+                    out_ += ";\n}\n";
+                    return;
+                }
+                Frame& f = stack.back();
+                const Node& op = scene_.nodes[f.node];
+                const std::vector<uint32_t>& operands = op.children;
+                const uint32_t child = operands[f.next - 1];
+                const Role role = kindInfo(op.kind).role;
+                if (role == Role::Domain) {
+                    closeDomain(f.node, child, f.depth);
+                } else if (role == Role::Value) {
+                    indent(f.depth);
+                    declare(f.node);
+                    withDistance(child, "valueOp(" + kindConst(f.node) + ", " + distance(child) +
+                                            ", " + param(f.node, 0) + ")");
+                    comment(f.node);
+                } else if (f.next == 1) {
+                    indent(f.depth);
+                    declare(f.node);
+                    var(child);
+                    comment(f.node);
+                } else {
+                    fold(f.node, child, f.depth);
+                }
+                if (f.next < operands.size()) {
+                    current = operands[f.next++];
+                    depth = f.depth + 1;
+                    if (op.kind != NodeKind::Intersection) guard(f.node, current, f.depth);
+                    break;
+                }
+                stack.pop_back();
+            }
+        }
+    }
+
+  private:
+    void indent(uint32_t depth) { out_.append(4 * (depth + 1), ' '); }
+
+    // Whether node i's outline (polygon, text) is written out as code: a small one, listed by
+    // contour (outline.h), whose loops would read every segment from the node buffer, which
+    // costs a CPU device (lavapipe) several times the arithmetic, while written out they are
+    // literals. A larger one has a grid, whose cells list few segments.
+    bool inlinedOutline(uint32_t i) const {
+        const Node& n = scene_.nodes[i];
+        return lit_ && n.outline && (*n.outline)[0].x == 0.0f;
+    }
+
+    static std::string vec2Literal(float x, float y) {
+        std::string s;
+        const float v[2] = {x, y};
+        appendVector(s, v, 2);
+        return s;
+    }
+
+    // sdOutline (shaders/sdf.glsl) unrolled over node i's outline: `float outline<i>(vec3 p)`.
+    void outlineFunction(uint32_t i) {
+        const glm::vec4* w = scene_.nodes[i].outline->data() + 2; // the contours
+        out_ += "float outline" + std::to_string(i) +
+                "(vec3 p3) {\n    vec2 p = p3.xy;\n    float best = 1e30, winding = 0.0;\n"
+                "    bool holds;\n";
+        const uint32_t contours = uint32_t(w[1].z);
+        for (uint32_t g = 0; g < contours; ++g) {
+            const glm::vec4 box = w[2 * g], range = w[2 * g + 1];
+            out_ += "    holds = all(greaterThanEqual(p, " + vec2Literal(box.x, box.y) +
+                    ")) && all(lessThanEqual(p, " + vec2Literal(box.z, box.w) + "));\n";
+            uint32_t at = uint32_t(range.x);
+            for (uint32_t s = 0; s < uint32_t(range.y); ++s, ++at) {
+                const std::string a = vec2Literal(w[at].x, w[at].y), b = vec2Literal(w[at].z, w[at].w);
+                out_ += "    if (holds) winding += lineCrossing(p, " + a + ", " + b + ");\n";
+                out_ += "    best = min(best, sqSegment2(p, " + a + ", " + b + "));\n";
+            }
+            for (uint32_t s = 0; s < uint32_t(range.w); ++s, at += 2) {
+                const std::string a = vec2Literal(w[at].x, w[at].y),
+                                  b = vec2Literal(w[at].z, w[at].w),
+                                  c = vec2Literal(w[at + 1].x, w[at + 1].y);
+                out_ += "    if (holds) winding += quadraticCrossing(p, " + a + ", " + c + ", " + b +
+                        ");\n";
+                out_ += "    best = min(best, sqQuadratic2(p, " + a + ", " + c + ", " + b + "));\n";
+            }
+        }
+        out_ += "    return winding != 0.0 ? -sqrt(best) : sqrt(best);\n}\n\n";
+    }
+
+    // The point the code at hand evaluates at: p, or inside domain operations the candidate
+    // point of the innermost one.
+    const std::string& point() const { return points_.back(); }
+
+    std::string kindConst(uint32_t i) const {
+        return std::to_string(uint32_t(scene_.nodes[i].kind)) + "u";
+    }
+
+    // Node i's kernel parameters a (0) or b (1), as literals or read from the node buffer.
+    std::string param(uint32_t i, int which) const {
+        if (!lit_) return "nodes[" + indexExpr(i) + "]." + (which == 0 ? "p0" : "p1");
+        std::string s;
+        const glm::vec4& v = which == 0 ? (*lit_)[i].p0 : (*lit_)[i].p1;
+        appendVector(s, &v.x, 4);
+        return s;
+    }
+
+    // The distance from `at` to node i's bounds.
+    std::string boundsDistanceOf(uint32_t i, const std::string& at) const {
+        if (!lit_) return "nodeBoundsDistance(" + indexExpr(i) + ", " + at + ")";
+        std::string s = "boundsDistance(";
+        appendVector(s, &(*lit_)[i].bmin.x, 3);
+        s += ", ";
+        appendVector(s, &(*lit_)[i].bmax.x, 3);
+        return s + ", " + at + ")";
+    }
+
+    // Node i's bounds' least (max false) or greatest corner.
+    std::string boundsCorner(uint32_t i, bool max) const {
+        if (!lit_) return "nodes[" + indexExpr(i) + "]." + (max ? "bmax" : "bmin") + ".xyz";
+        std::string s;
+        appendVector(s, max ? &(*lit_)[i].bmax.x : &(*lit_)[i].bmin.x, 3);
+        return s;
+    }
+
+    std::string distance(uint32_t i) const {
+        return (sample_ ? "s" : "d") + std::to_string(i) + (sample_ ? ".w" : "");
+    }
+
+    // Node `like`'s value with distance d: d, or its colour and d.
+    void withDistance(uint32_t like, const std::string& d) {
+        if (!sample_) {
+            out_ += d;
+            return;
+        }
+        out_ += "vec4(";
+        var(like);
+        out_ += ".rgb, " + d + ")";
+    }
+
+    // Domain operation i (shaders/sdf.glsl, and tape_run.glsl for the same steps on tapes): its
+    // child's code runs inside a block, in a loop over the candidates for repetitions, at the
+    // candidate point p<level>; a candidate after the first runs only where its bounds could
+    // lower the least value so far, which is why N copies cost about one. Returns the child's
+    // code's extra indentation.
+    uint32_t openDomain(uint32_t i, uint32_t depth) {
+        const Node& n = scene_.nodes[i];
+        const uint32_t kind = uint32_t(n.kind);
+        const std::string level = std::to_string(points_.size());
+        const std::string local = "l" + level, best = "b" + level, c = "c" + level,
+                          q = "q" + level;
+        indent(depth);
+        out_ += sample_ ? "vec4 " : "float ";
+        var(i);
+        comment(i);
+        indent(depth);
+        out_ += "{\n";
+        indent(depth + 1);
+        out_ += "vec3 " + local + " = ";
+        std::string at = point();
+        if (sdf::domainClamps(kind))
+            at = "clamp(" + at + ", " + boundsCorner(i, false) + ", " + boundsCorner(i, true) + ")";
+        localPoint(i, at);
+        out_ += ";\n";
+        indent(depth + 1);
+        out_ += (sample_ ? "vec4 " : "float ") + best +
+                (sample_ ? " = vec4(0.0, 0.0, 0.0, 1e30);\n" : " = 1e30;\n");
+        const std::string a = param(i, 0), b = param(i, 1);
+        std::string count = "domainCount(" + kindConst(i) + ", " + a + ", " + b + ")";
+        if (lit_)
+            count = std::to_string(sdf::domainCount(kind, (*lit_)[i].p0, (*lit_)[i].p1)) + "u";
+        const bool loops =
+            lit_ ? count != "1u" : n.kind == NodeKind::Repeat || n.kind == NodeKind::PolarRepeat;
+        const std::string candidate = "domainPoint(" + kindConst(i) + ", " + local + ", " + a +
+                                      ", " + b + ", " + (loops ? c : std::string("0u")) + ")";
+        points_.push_back("p" + std::to_string(points_.size()));
+        loops_.push_back(loops);
+        if (!loops) {
+            indent(depth + 1);
+            out_ += "vec3 " + point() + " = " + candidate + ".xyz;\n";
+            return 0;
+        }
+        indent(depth + 1);
+        out_ += "for (uint " + c + " = 0u; " + c + " < " + count + "; ++" + c + ") {\n";
+        indent(depth + 2);
+        out_ += "vec4 " + q + " = " + candidate + ";\n";
+        indent(depth + 2);
+        out_ += "if (" + c + " > 0u && (" + q + ".w != 0.0 || " +
+                boundsDistanceOf(n.children[0], q + ".xyz") + " >= " + best +
+                (sample_ ? ".w" : "") + ")) continue;\n";
+        indent(depth + 2);
+        out_ += "vec3 " + point() + " = " + q + ".xyz;\n";
+        return 1;
+    }
+
+    void closeDomain(uint32_t i, uint32_t child, uint32_t depth) {
+        const Node& n = scene_.nodes[i];
+        const uint32_t kind = uint32_t(n.kind);
+        points_.pop_back();
+        const std::string level = std::to_string(points_.size());
+        const std::string local = "l" + level, best = "b" + level;
+        const bool loops = loops_.back();
+        loops_.pop_back();
+        indent(depth + (loops ? 2 : 1));
+        if (sample_) {
+            out_ += "if (" + distance(child) + " < " + best + ".w) " + best + " = ";
+            var(child);
+            out_ += ";\n";
+        } else {
+            out_ += best + " = min(" + best + ", " + distance(child) + ");\n";
+        }
+        if (loops) {
+            indent(depth + 1);
+            out_ += "}\n";
+        }
+        std::string value = "domainFinish(" + kindConst(i) + ", " + local + ", " + best +
+                            (sample_ ? ".w" : "") + ", " + param(i, 0) + ", " + param(i, 1) + ")";
+        if (!lit_)
+            value += " * nodes[" + indexExpr(i) + "].color.w";
+        else if ((*lit_)[i].color.w != 1.0f) {
+            value += " * ";
+            appendFloat(value, (*lit_)[i].color.w);
+        }
+        if (sdf::domainClamps(kind)) value = "max(" + value + ", " + boundsDistanceOf(i, point()) + ")";
+        indent(depth + 1);
+        var(i);
+        out_ += " = ";
+        if (sample_)
+            out_ += "vec4(" + best + ".rgb, " + value + ")";
+        else
+            out_ += value;
+        out_ += ";\n";
+        indent(depth);
+        out_ += "}\n";
+    }
+
+    void var(uint32_t i) {
+        out_ += sample_ ? 's' : 'd';
+        out_ += std::to_string(i);
+    }
+
+    void declare(uint32_t i) {
+        out_ += sample_ ? "vec4 " : "float ";
+        var(i);
+        out_ += " = ";
+    }
+
+    void comment(uint32_t i) {
+        const Node& n = scene_.nodes[i];
+        out_ += "; // ";
+        if (!n.name.empty())
+            appendCommentText(out_, n.name);
+        else if (!n.path.empty())
+            appendCommentText(out_, n.path);
+        else
+            out_ += "node " + std::to_string(i);
+        out_ += " (";
+        out_ += kindInfo(n.kind).name;
+        out_ += ")\n";
+    }
+
+    void smooth(uint32_t op) {
+        if (lit_)
+            appendFloat(out_, (*lit_)[op].bmin.w);
+        else
+            out_ += "nodeSmooth(" + indexExpr(op) + ")";
+    }
+
+    void leaf(uint32_t i) {
+        if (!lit_) {
+            const std::string index = indexExpr(i);
+            if (sample_) out_ += "withColor(" + index + ", ";
+            out_ += kindInfo(scene_.nodes[i].kind).name;
+            out_ += "Node(" + index + ", " + point() + ")";
+            if (sample_) out_ += ')';
+            return;
+        }
+        const detail::GpuNode& g = (*lit_)[i];
+        if (sample_) {
+            out_ += "vec4(";
+            appendVector(out_, &g.color.x, 3);
+            out_ += ", ";
+        }
+        const KindInfo& info = kindInfo(scene_.nodes[i].kind);
+        const bool outline = inlinedOutline(i); // its data is in the function's code
+        out_ += outline ? "outline" + std::to_string(i) : std::string(info.function);
+        out_ += '(';
+        localPoint(i, point());
+        const float params[8] = {g.p0.x, g.p0.y, g.p0.z, g.p0.w, g.p1.x, g.p1.y, g.p1.z, g.p1.w};
+        for (const KernelArg& arg : outline ? std::span<const KernelArg>{} : info.args) {
+            out_ += ", ";
+            appendVector(out_, params + arg.slot, arg.count);
+        }
+        out_ += ')';
+        if (g.color.w != 1.0f) { // x * 1 is x: leaving it out changes no bit
+            out_ += " * ";
+            appendFloat(out_, g.color.w);
+        }
+        if (sample_) out_ += ')';
+    }
+
+    // The local point as a literal affine map; identities and pure translations are written
+    // shorter, which gives the same bits.
+    void localPoint(uint32_t i, const std::string& at) {
+        if (!lit_) {
+            out_ += "toLocal(" + indexExpr(i) + ", " + at + ")";
+            return;
+        }
+        const detail::GpuNode& g = (*lit_)[i];
+        bool linearIdentity = g.row0.x == 1 && g.row0.y == 0 && g.row0.z == 0 && g.row1.x == 0 &&
+                              g.row1.y == 1 && g.row1.z == 0 && g.row2.x == 0 && g.row2.y == 0 &&
+                              g.row2.z == 1;
+        const float offset[3] = {g.row0.w, g.row1.w, g.row2.w};
+        if (linearIdentity && offset[0] == 0 && offset[1] == 0 && offset[2] == 0) {
+            out_ += at;
+        } else if (linearIdentity) {
+            out_ += "(" + at + " + ";
+            appendVector(out_, offset, 3);
+            out_ += ")";
+        } else {
+            out_ += "affine(";
+            for (const glm::vec4* row : {&g.row0, &g.row1, &g.row2}) {
+                appendVector(out_, &row->x, 4);
+                out_ += ", ";
+            }
+            out_ += at + ")";
+        }
+    }
+
+    // Opens the block of operand `child` of union/difference `op`, entered only when the
+    // operand can change the running value (without bounds tests, a plain block). An operand
+    // with a gridded outline is always tested: its loops cost more than the test, even on a CPU
+    // device that runs both sides of the branch where its lanes disagree.
+    void guard(uint32_t op, uint32_t child, uint32_t depth) {
+        indent(depth);
+        if (!tests_ && !gridded_[child]) {
+            out_ += "{\n";
+            return;
+        }
+        const bool unionOp = scene_.nodes[op].kind == NodeKind::Union;
+        out_ += gridded_[child] ? (unionOp ? "if (unionChanges(" : "if (differenceChanges(")
+                                : (unionOp ? "if (unionNeeds(" : "if (differenceNeeds(");
+        out_ += boundsDistanceOf(child, point());
+        out_ += ", ";
+        var(op);
+        if (sample_) out_ += ".w";
+        out_ += ", ";
+        smooth(op);
+        out_ += ")) {\n";
+    }
+
+    void fold(uint32_t op, uint32_t child, uint32_t depth) {
+        const NodeKind kind = scene_.nodes[op].kind;
+        const bool guarded = kind != NodeKind::Intersection;
+        // A literal blend radius of 0 takes the sharp form: the same bits, much less code.
+        const bool sharp = lit_ && (*lit_)[op].bmin.w == 0.0f;
+        indent(depth + (guarded ? 1 : 0));
+        var(op);
+        out_ += sharp ? " = sharp" : " = op";
+        out_ += kind == NodeKind::Union          ? "Union("
+                : kind == NodeKind::Intersection ? "Intersection("
+                                                 : "Difference(";
+        var(op);
+        out_ += ", ";
+        var(child);
+        if (!sharp) {
+            out_ += ", ";
+            smooth(op);
+            // The profile is part of the code, as the kind is: a plain blend keeps its short call.
+            if (const uint32_t blend = uint32_t(scene_.nodes[op].params[1]); blend != 0)
+                out_ += ", " + std::to_string(blend) + "u";
+        }
+        out_ += ");\n";
+        if (guarded) {
+            indent(depth);
+            out_ += "}\n";
+        }
+    }
+
+    const Scene& scene_;
+    std::string& out_;
+    const std::vector<detail::GpuNode>* lit_; // null: values come from the node buffer
+    bool tests_;                                  // CodegenOptions::boundsTests
+    std::vector<bool> gridded_;                   // per node, see the constructor
+    bool sample_ = false;
+    std::vector<std::string> points_{"p"}; // see point()
+    std::vector<bool> loops_;              // per open domain operation: whether it loops
+};
+
+} // namespace
+
+bool usesTapes(const Scene& scene, Evaluation evaluation) {
+    return evaluation == Evaluation::Tapes ||
+           (evaluation == Evaluation::Auto && scene.nodes.size() >= kTapeMinNodes);
+}
+
+namespace {
+
+// The most domain operations nested in one another on any path from the root.
+uint32_t domainNesting(const Scene& scene) {
+    std::vector<uint32_t> depth(scene.nodes.size(), 0);
+    uint32_t most = 0;
+    for (size_t i = 0; i < scene.nodes.size(); ++i) { // parents come first
+        const Node& n = scene.nodes[i];
+        const uint32_t own = depth[i] + (kindInfo(n.kind).role == Role::Domain ? 1 : 0);
+        most = std::max(most, own);
+        for (uint32_t c : n.children)
+            depth[c] = own;
+    }
+    return most;
+}
+
+} // namespace
+
+std::string generateSceneGlsl(const Scene& scene, const CodegenOptions& options) {
+    if (!scene.nodes.empty() && usesTapes(scene, options.evaluation)) {
+        uint32_t depth = 0;
+        detail::fullTape(Evaluator(scene).nodes(), depth);
+        // Stacks in powers of two: scenes of similar depth share their kernels.
+        const uint32_t stack = std::max(4u, std::bit_ceil(depth));
+        uint32_t kinds = 0;
+        for (const Node& n : scene.nodes)
+            if (!kindInfo(n.kind).operation) kinds |= 1u << uint32_t(n.kind);
+        std::string out = "// Generated by sdfcsg from ";
+        appendCommentText(out, scene.file.empty() ? std::string_view("<scene>") : scene.file);
+        out += " (" + std::to_string(scene.nodes.size()) +
+               " nodes, evaluated per region from pruned tapes: shaders/tape.glsl).\n"
+               "#define SDFCSG_TAPE_STACK " + std::to_string(stack) +
+               "\n#define SDFCSG_TAPE_KINDS " + std::to_string(kinds) +
+               "u\n#define SDFCSG_TAPE_DOMAINS " + std::to_string(domainNesting(scene)) +
+               "\n#include \"tape.glsl\"\n"
+               "float sceneDistance(vec3 p) { return tapeDistance(p); }\n"
+               "vec4 sceneSample(vec3 p) { return tapeSample(p); }\n";
+        return out;
+    }
+    const bool inlined = options.inlineParams && scene.nodes.size() <= kInlineLimit;
+    std::string out = "// Generated by sdfcsg from ";
+    appendCommentText(out, scene.file.empty() ? std::string_view("<scene>") : scene.file);
+    out += " (" + std::to_string(scene.nodes.size()) + " nodes, ";
+    out += inlined ? "values inlined" : "values read from the node buffer";
+    out += ").\n// One line per node, named by its name or JSON path. Children are indented one\n"
+           "// level deeper than their operation, whose line follows its first child; later\n"
+           "// children fold in left to right. Do not edit.\n\n";
+    if (scene.nodes.empty()) {
+        out += "float sceneDistance(vec3 p) { return 1e30; }\n"
+               "vec4 sceneSample(vec3 p) { return vec4(0.0, 0.0, 0.0, 1e30); }\n";
+        return out;
+    }
+    Evaluator evaluator(scene);
+    std::vector<detail::GpuNode> literals;
+    if (inlined) literals = detail::packNodes(evaluator);
+    out.reserve(out.size() + scene.nodes.size() * (inlined ? 500 : 200));
+    Emitter emitter(scene, out, inlined ? &literals : nullptr, options.boundsTests);
+    emitter.helpers();
+    emitter.function(false);
+    out += '\n';
+    emitter.function(true);
+    return out;
+}
+
+} // namespace sdfcsg

@@ -1,0 +1,469 @@
+// The CPU reference evaluator. Flattening resolves transforms, colours, smooth radii and bounds
+// to world space once; evaluation then walks the pre-order node array with an explicit stack,
+// in exactly the order (and with exactly the skipping rules) of the code that codegen.cpp
+// generates, so the CPU and GPU fields agree to rounding.
+#include "sdfcsg/eval.h"
+
+#include "field/prune.h"
+#include "field/sdf.h"
+
+#include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
+#include <glm/trigonometric.hpp>
+#include <glm/vec4.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+#include <numbers>
+#include <type_traits>
+
+namespace sdfcsg {
+
+bool Aabb::finite() const {
+    for (int i = 0; i < 3; ++i)
+        if (!std::isfinite(min[i]) || !std::isfinite(max[i])) return false;
+    return true;
+}
+
+float Aabb::distance(glm::vec3 p) const {
+    return glm::length(glm::max(glm::max(min - p, p - max), glm::vec3(0.0f)));
+}
+
+// Same formula as boundsDistance() in shaders/nodes.glsl. A node's value is never below it:
+// outside, the solid is no nearer than its box; inside, the solid's boundary is no farther than
+// the box's. (The unsigned distance would not do: 0 inside the box says nothing about a value
+// that may be negative there.)
+float Aabb::signedDistance(glm::vec3 p) const {
+    glm::vec3 q = glm::max(min - p, p - max);
+    return glm::length(glm::max(q, 0.0f)) + std::min(std::max(q.x, std::max(q.y, q.z)), 0.0f);
+}
+
+namespace {
+
+constexpr glm::vec3 kDefaultColor{0.8f, 0.8f, 0.8f};
+
+bool isOperation(NodeKind kind) {
+    return kindInfo(kind).operation;
+}
+
+// cos and sin of an angle in degrees, exact for multiples of 90 so that quarter turns keep
+// boxes axis-aligned to the last bit.
+glm::dvec2 cosSin(double degrees) {
+    double r = std::fmod(degrees, 360.0);
+    if (r < 0) r += 360.0;
+    if (r == 0.0) return {1, 0};
+    if (r == 90.0) return {0, 1};
+    if (r == 180.0) return {-1, 0};
+    if (r == 270.0) return {0, -1};
+    double a = r * std::numbers::pi / 180.0;
+    return {std::cos(a), std::sin(a)};
+}
+
+// R = Rz * Ry * Rx: rotate about x first, then y, then z.
+glm::dmat3 rotation(glm::vec3 degrees) {
+    glm::dvec2 x = cosSin(degrees.x), y = cosSin(degrees.y), z = cosSin(degrees.z);
+    glm::dmat3 rx(1, 0, 0, 0, x[0], x[1], 0, -x[1], x[0]); // columns
+    glm::dmat3 ry(y[0], 0, -y[1], 0, 1, 0, y[1], 0, y[0]);
+    glm::dmat3 rz(z[0], z[1], 0, -z[1], z[0], 0, 0, 0, 1);
+    return rz * ry * rx;
+}
+
+// Float bounds that contain the double ones: round outwards, then pad a little so that the
+// single-precision fields evaluated against them still never undercut them.
+Aabb outwardBox(glm::dvec3 lo, glm::dvec3 hi) {
+    // Sizes from the axes a 2D profile's prism does not reach along (nodes.cpp, kProfileReach):
+    // its 1e30 would pad the others by 1e25.
+    glm::dvec3 l = lo, h = hi;
+    for (int i = 0; i < 3; ++i)
+        if (std::max(std::abs(l[i]), std::abs(h[i])) >= 1e29) l[i] = h[i] = 0.0;
+    double pad = 1e-5 * (glm::length(h - l) + glm::length(h + l) * 0.5) + 1e-6;
+    Aabb box;
+    for (int i = 0; i < 3; ++i) {
+        box.min[i] = std::nextafter(float(lo[i] - pad), -INFINITY);
+        box.max[i] = std::nextafter(float(hi[i] + pad), INFINITY);
+    }
+    return box;
+}
+
+Aabb infiniteBox() {
+    return Aabb{glm::vec3(-INFINITY), glm::vec3(INFINITY)};
+}
+
+float volume(const Aabb& b) {
+    glm::vec3 e = b.max - b.min;
+    return e.x * e.y * e.z;
+}
+
+// local = toLocal * p + offset, associated as dot(row, vec4(p, 1)) in nodes.glsl.
+glm::vec3 localPoint(const FlatNode& n, glm::vec3 p) {
+    const glm::mat3& m = n.toLocal;
+    return {m[0][0] * p.x + m[1][0] * p.y + m[2][0] * p.z + n.offset.x,
+            m[0][1] * p.x + m[1][1] * p.y + m[2][1] * p.z + n.offset.y,
+            m[0][2] * p.x + m[1][2] * p.y + m[2][2] * p.z + n.offset.z};
+}
+
+// The value types of sceneDistance (float) and sceneSample (vec4: colour, distance in w).
+template <class V> V leaf(const FlatNode& n, glm::vec3 p) {
+    float d = sdf::evalPrimitive(n.kind, localPoint(n, p), n.params,
+                                 n.outline ? n.outline->data() : nullptr) *
+              n.scale;
+    if constexpr (std::is_same_v<V, float>)
+        return d;
+    else
+        return glm::vec4(n.color, d);
+}
+template <class V> float dist(const V& v) {
+    if constexpr (std::is_same_v<V, float>)
+        return v;
+    else
+        return v.w;
+}
+
+// Polygon and text: sdOutline's parameters (outline.h): the outline's first word (0 here; the
+// node buffer rebases it), its grid's cells per row (0 for an outline listed by contour), its
+// box, and the grid's rows and cell side (or the number of contours).
+Params outlineParams(const std::vector<glm::vec4>* outline) {
+    if (!outline || outline->size() < 2) return Params{};
+    const glm::vec4 layout = (*outline)[0], box = (*outline)[1];
+    return {0.0f, layout.x, box.x, box.y, box.z, box.w, layout.y, layout.z};
+}
+
+Role roleOf(NodeKind kind) {
+    return kindInfo(kind).role;
+}
+
+glm::vec4 kernelA(const FlatNode& n) {
+    return {n.params[0], n.params[1], n.params[2], n.params[3]};
+}
+glm::vec4 kernelB(const FlatNode& n) {
+    return {n.params[4], n.params[5], n.params[6], n.params[7]};
+}
+
+template <class V> V withDistance(V v, float d) {
+    if constexpr (std::is_same_v<V, float>)
+        return d;
+    else
+        return glm::vec4(glm::vec3(v), d);
+}
+
+// The generated code's walk, iteratively: a frame per open operation holds the running fold
+// and the next child to visit. Operand i > 0 of a union is skipped when its bounds lie at least
+// k beyond the running value, a subtrahend when they lie at least k beyond its negation; with
+// sdf.glsl's exact operator ends, the skipped operand could not have changed the result. A
+// domain operation evaluates its child at each of its candidate points (sdf.glsl, domainPoint)
+// whose bounds could lower the least value so far, as shaders/tape.glsl does.
+template <class V>
+V evaluate(const std::vector<FlatNode>& nodes, uint32_t root, glm::vec3 p, bool skipping) {
+    struct Frame {
+        uint32_t node, next;
+        V acc;
+        glm::vec3 outer{0.0f}, local{0.0f}; // domain operations: the point outside, and local
+        uint32_t candidate = 0, count = 0;
+    };
+    thread_local std::vector<Frame> stack;
+    stack.clear();
+    uint32_t current = root;
+    for (;;) {
+        const FlatNode& n = nodes[current];
+        if (isOperation(n.kind)) {
+            Frame f{current, 1, V{}};
+            if (roleOf(n.kind) == Role::Domain) {
+                const uint32_t kind = uint32_t(n.kind);
+                f.outer = p;
+                f.local = localPoint(
+                    n, sdf::domainClamps(kind) ? glm::clamp(p, n.bounds.min, n.bounds.max) : p);
+                f.count = sdf::domainCount(kind, kernelA(n), kernelB(n));
+                f.acc = withDistance(V{}, INFINITY);
+                p = glm::vec3(sdf::domainPoint(kind, f.local, kernelA(n), kernelB(n), 0));
+            }
+            stack.push_back(f);
+            current = n.children[0];
+            continue;
+        }
+        V value = leaf<V>(n, p);
+        // Deliver the value to the enclosing operations until one has another child to visit.
+        for (;;) {
+            if (stack.empty()) return value;
+            Frame& f = stack.back();
+            const FlatNode& op = nodes[f.node];
+            const Role role = roleOf(op.kind);
+            if (role == Role::Value) {
+                value = withDistance(value, sdf::valueOp(uint32_t(op.kind), dist(value), kernelA(op)));
+                stack.pop_back();
+                continue;
+            }
+            if (role == Role::Domain) {
+                const uint32_t kind = uint32_t(op.kind);
+                if (dist(value) < dist(f.acc)) f.acc = value;
+                const FlatNode& child = nodes[op.children[0]];
+                bool again = false;
+                while (!again && ++f.candidate < f.count) {
+                    const glm::vec4 q =
+                        sdf::domainPoint(kind, f.local, kernelA(op), kernelB(op), f.candidate);
+                    again = q.w == 0.0f && (!skipping || child.bounds.signedDistance(glm::vec3(q)) <
+                                                             dist(f.acc));
+                    if (again) p = glm::vec3(q);
+                }
+                if (again) {
+                    current = op.children[0];
+                    break;
+                }
+                float d = sdf::domainFinish(kind, f.local, dist(f.acc), kernelA(op), kernelB(op)) *
+                          op.scale;
+                if (sdf::domainClamps(kind)) d = std::max(d, op.bounds.signedDistance(f.outer));
+                value = withDistance(f.acc, d);
+                p = f.outer;
+                stack.pop_back();
+                continue;
+            }
+            if (f.next == 1) {
+                f.acc = value;
+            } else if (op.kind == NodeKind::Union) {
+                f.acc = sdf::opUnion(f.acc, value, op.smooth, op.blend);
+            } else if (op.kind == NodeKind::Intersection) {
+                f.acc = sdf::opIntersection(f.acc, value, op.smooth, op.blend);
+            } else {
+                f.acc = sdf::opDifference(f.acc, value, op.smooth, op.blend);
+            }
+            while (f.next < op.children.size() && skipping && op.kind != NodeKind::Intersection) {
+                float bd = nodes[op.children[f.next]].bounds.signedDistance(p);
+                float d = dist(f.acc);
+                bool skip = op.kind == NodeKind::Union ? bd - d >= op.smooth : bd + d >= op.smooth;
+                if (!skip) break;
+                ++f.next;
+            }
+            if (f.next < op.children.size()) {
+                current = op.children[f.next++];
+                break;
+            }
+            value = f.acc;
+            stack.pop_back();
+        }
+    }
+}
+
+} // namespace
+
+namespace detail {
+
+float primitiveValue(const FlatNode& node, glm::vec3 p) {
+    return leaf<float>(node, p);
+}
+
+glm::vec3 nodeLocalPoint(const FlatNode& node, glm::vec3 p) {
+    return localPoint(node, p);
+}
+
+} // namespace detail
+
+struct Evaluator::Pruned {
+    std::once_flag once;
+    detail::PrunedField field;
+};
+
+Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
+    const size_t count = scene.nodes.size();
+    nodes_.resize(count);
+    if (count == 0) return;
+
+    // Pass 1, parents first: transforms (accumulated in double), colours, parameters.
+    struct Acc {
+        glm::dmat3 toLocal{1.0}, toWorld{1.0};
+        glm::dvec3 offset{0.0},
+            origin{0.0}; // local = toLocal*p + offset; world = toWorld*l + origin
+        double scale = 1.0;
+    };
+    const Acc identity;
+    std::vector<Acc> acc(count);
+    std::vector<uint32_t> parent(count, UINT32_MAX);
+    for (size_t i = 0; i < count; ++i) {
+        const Node& src = scene.nodes[i];
+        for (uint32_t c : src.children)
+            parent[c] = uint32_t(i);
+        const bool hasParent = parent[i] != UINT32_MAX;
+        const FlatNode* upNode = hasParent ? &nodes_[parent[i]] : nullptr;
+        // A domain operation's child starts a frame: its transforms act in the child space.
+        const bool opensFrame = upNode && roleOf(upNode->kind) == Role::Domain;
+        const Acc& up = hasParent && !opensFrame ? acc[parent[i]] : identity;
+
+        glm::dmat3 r = rotation(src.transform.rotate);
+        // p = R S l + t. Where S differs per axis the distance in the parent is at least the
+        // local one times the smallest factor (S's least singular value; a product's is at
+        // least the product of its factors'), which is exact for uniform scales.
+        const glm::dvec3 s(src.transform.scale);
+        glm::dvec3 t(src.transform.translate);
+        const glm::dmat3 scaling(glm::dvec3(s.x, 0, 0), glm::dvec3(0, s.y, 0), glm::dvec3(0, 0, s.z));
+        const glm::dmat3 unscaling(glm::dvec3(1 / s.x, 0, 0), glm::dvec3(0, 1 / s.y, 0),
+                                   glm::dvec3(0, 0, 1 / s.z));
+        glm::dmat3 inv = unscaling * glm::transpose(r);
+        Acc& a = acc[i];
+        a.toLocal = inv * up.toLocal;
+        a.offset = inv * (up.offset - t);
+        a.toWorld = up.toWorld * (r * scaling);
+        a.origin = up.toWorld * t + up.origin;
+        a.scale = up.scale * std::min({s.x, s.y, s.z});
+
+        FlatNode& n = nodes_[i];
+        n.kind = src.kind;
+        n.frame = !upNode ? kWorldFrame : opensFrame ? parent[i] : upNode->frame;
+        n.toLocal = glm::mat3(a.toLocal);
+        n.offset = glm::vec3(a.offset);
+        n.scale = float(a.scale);
+        n.color = src.color ? *src.color : upNode ? upNode->color : kDefaultColor;
+        n.params = sdf::kernelParams(src.kind, src.params);
+        if (hasOutline(src.kind)) {
+            n.outline = src.outline;
+            n.params = outlineParams(src.outline.get());
+        }
+        const bool boolean = roleOf(src.kind) == Role::Boolean;
+        n.smooth = boolean ? float(double(src.params[0]) * a.scale) : 0.0f;
+        n.blend = boolean ? uint32_t(src.params[1]) : 0u;
+        n.children = src.children;
+    }
+
+    // Pass 2, children first: bounds, and the kernel parameters of the operations that take
+    // their child's bounds.
+    auto toFrame = [&](size_t i, glm::vec3 lo, glm::vec3 hi) {
+        glm::dvec3 wlo(INFINITY), whi(-INFINITY);
+        for (int c = 0; c < 8; ++c) {
+            glm::dvec3 corner(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z);
+            glm::dvec3 w = acc[i].toWorld * corner + acc[i].origin;
+            wlo = glm::min(wlo, w);
+            whi = glm::max(whi, w);
+        }
+        return outwardBox(wlo, whi);
+    };
+    for (size_t i = count; i-- > 0;) {
+        FlatNode& n = nodes_[i];
+        const KindInfo& info = kindInfo(n.kind);
+        if (!isOperation(n.kind)) {
+            glm::vec3 lo, hi;
+            n.bounds = sdf::localBounds(n.kind, n.params, lo, hi) ? toFrame(i, lo, hi)
+                                                                 : infiniteBox();
+        } else if (info.role == Role::Value) {
+            // Lengths in the frame's units, as the child's values are.
+            Params values = scene.nodes[i].params;
+            values[0] = float(double(values[0]) * acc[i].scale);
+            const Aabb& child = nodes_[n.children[0]].bounds;
+            n.params = info.kernelAround(values, child.min, child.max);
+            n.bounds = child;
+            if (child.finite()) info.boundsAround(n.params, child.min, child.max, n.bounds.min,
+                                                  n.bounds.max);
+        } else if (info.role == Role::Domain) {
+            const Aabb& child = nodes_[n.children[0]].bounds;
+            if (!child.finite()) { // refused by the parser, but for mirror and elongate
+                n.params = info.kernelAround(scene.nodes[i].params, glm::vec3(0), glm::vec3(0));
+                n.bounds = infiniteBox();
+                continue;
+            }
+            n.params = info.kernelAround(scene.nodes[i].params, child.min, child.max);
+            glm::vec3 lo, hi;
+            info.boundsAround(n.params, child.min, child.max, lo, hi);
+            n.bounds = toFrame(i, lo, hi);
+            if (info.lipschitz) {
+                // Over the node's bounds (which the child's points are clamped to) in local space.
+                glm::vec3 llo(INFINITY), lhi(-INFINITY);
+                for (int c = 0; c < 8; ++c) {
+                    const glm::vec3 corner(c & 1 ? n.bounds.max.x : n.bounds.min.x,
+                                           c & 2 ? n.bounds.max.y : n.bounds.min.y,
+                                           c & 4 ? n.bounds.max.z : n.bounds.min.z);
+                    const glm::vec3 l = localPoint(n, corner);
+                    llo = glm::min(llo, l), lhi = glm::max(lhi, l);
+                }
+                n.params[7] = 1.0f / info.lipschitz(n.params, llo, lhi);
+            }
+        } else if (n.kind == NodeKind::Union) {
+            Aabb box;
+            for (uint32_t c : n.children) {
+                box.min = glm::min(box.min, nodes_[c].bounds.min);
+                box.max = glm::max(box.max, nodes_[c].bounds.max);
+            }
+            // Each fold goes at most k/4 below the smaller operand (k/2 chamfered, k (1 - 1/sqrt 2)
+            // round), and however many operands, the fold never goes more than k below their
+            // minimum: every blend grows with each operand, and blends m - k and m to m - k, so
+            // from operands >= m every fold stays >= m - k. Boxes widened by the lesser of the
+            // two then bound it.
+            if (n.smooth > 0.0f) {
+                const float folds = float(n.children.size() - 1);
+                const float dip = n.blend == 2 ? 0.5f : n.blend == 1 ? 0.29289322f : 0.25f;
+                float grow = n.smooth * std::min(1.0f, dip * folds) * (1.0f + 1e-5f);
+                box.min -= grow;
+                box.max += grow;
+            }
+            n.bounds = box;
+        } else if (n.kind == NodeKind::Intersection) {
+            // A smooth maximum is never below the sharp one, so any operand's box bounds it.
+            const Aabb* best = &nodes_[n.children[0]].bounds;
+            for (uint32_t c : n.children)
+                if (volume(nodes_[c].bounds) < volume(*best)) best = &nodes_[c].bounds;
+            n.bounds = *best;
+        } else {
+            n.bounds = nodes_[n.children[0]].bounds;
+        }
+    }
+}
+
+float Evaluator::distance(glm::vec3 p) const {
+    return distance(p, 0);
+}
+
+Sample Evaluator::sample(glm::vec3 p) const {
+    return sample(p, 0);
+}
+
+namespace {
+
+// The node itself, or the outermost domain operation it lies in: the subtree that takes world
+// points.
+uint32_t worldSubtree(const std::vector<FlatNode>& nodes, uint32_t node) {
+    while (nodes[node].frame != kWorldFrame)
+        node = nodes[node].frame;
+    return node;
+}
+
+} // namespace
+
+float Evaluator::distance(glm::vec3 p, uint32_t node) const {
+    if (node >= nodes_.size()) return INFINITY; // an empty scene is empty space
+    return evaluate<float>(nodes_, worldSubtree(nodes_, node), p, skipping_);
+}
+
+Sample Evaluator::sample(glm::vec3 p, uint32_t node) const {
+    if (node >= nodes_.size()) return {INFINITY, kDefaultColor};
+    glm::vec4 v = evaluate<glm::vec4>(nodes_, worldSubtree(nodes_, node), p, skipping_);
+    return {v.w, glm::vec3(v)};
+}
+
+float Evaluator::prunedDistance(glm::vec3 p) const {
+    if (nodes_.empty()) return INFINITY;
+    std::call_once(pruned_->once, [&] { pruned_->field = detail::pruneField(*this); });
+    return pruned_->field.distance(nodes_, p);
+}
+
+Camera frameCamera(const Evaluator& evaluator, float aspect, float fov) {
+    Camera camera;
+    camera.fov = fov;
+    Aabb box = evaluator.bounds();
+    if (!box.finite()) {
+        box = Aabb{};
+        for (const FlatNode& n : evaluator.nodes()) {
+            if (isOperation(n.kind) || !n.bounds.finite() || n.frame != kWorldFrame) continue;
+            box.min = glm::min(box.min, n.bounds.min);
+            box.max = glm::max(box.max, n.bounds.max);
+        }
+    }
+    if (box.empty()) box = Aabb{glm::vec3(-1.0f), glm::vec3(1.0f)};
+
+    glm::vec3 centre = 0.5f * (box.min + box.max);
+    float radius = std::max(0.5f * glm::length(box.max - box.min), 1e-3f);
+    float halfV = 0.5f * glm::radians(fov);
+    float halfH = std::atan(std::tan(halfV) * std::max(aspect, 1e-3f));
+    float distance = 1.1f * radius / std::sin(std::min(halfV, halfH));
+    glm::vec3 direction = glm::normalize(glm::vec3(0.0f, 0.35f, 1.0f)); // front, ~20 deg up
+    camera.eye = centre + direction * distance;
+    camera.target = centre;
+    return camera;
+}
+
+} // namespace sdfcsg

@@ -1,0 +1,581 @@
+// Per-region pruning (see prune.h): the tape, the octree walk that prunes it per cell, and the
+// stack machine that runs it on the CPU, instruction for instruction as shaders/tape.glsl does.
+#include "field/prune.h"
+
+#include "field/sdf.h"
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <thread>
+
+namespace sdfcsg::detail {
+namespace {
+
+bool isOperation(NodeKind kind) {
+    return kindInfo(kind).operation;
+}
+
+uint32_t instruction(uint32_t node, NodeKind kind) {
+    return node | uint32_t(kind) << kTapeKindShift;
+}
+
+NodeKind opcode(uint32_t instruction) {
+    return NodeKind(instruction >> kTapeKindShift);
+}
+
+template <class V> V opValue(const FlatNode& op, V a, V b) {
+    return op.kind == NodeKind::Union ? sdf::opUnion(a, b, op.smooth, op.blend)
+           : op.kind == NodeKind::Intersection
+               ? sdf::opIntersection(a, b, op.smooth, op.blend)
+               : sdf::opDifference(a, b, op.smooth, op.blend);
+}
+
+Role roleOf(NodeKind kind) {
+    return kindInfo(kind).role;
+}
+
+bool isDomainEnd(uint32_t ins) {
+    return (ins >> kTapeKindShift) == kTapeDomainEnd;
+}
+
+glm::vec4 kernelA(const FlatNode& n) {
+    return {n.params[0], n.params[1], n.params[2], n.params[3]};
+}
+glm::vec4 kernelB(const FlatNode& n) {
+    return {n.params[4], n.params[5], n.params[6], n.params[7]};
+}
+
+float distanceOf(float v) { return v; }
+float distanceOf(glm::vec4 v) { return v.w; }
+float withDistance(float, float d) { return d; }
+glm::vec4 withDistance(glm::vec4 v, float d) { return {glm::vec3(v), d}; }
+
+// Runs tape[begin, end) at p. V: float (distance) or vec4 (colour, distance in w).
+template <class V>
+V run(const std::vector<FlatNode>& nodes, const uint32_t* tape, uint32_t length, glm::vec3 p) {
+    struct Domain {
+        glm::vec3 outer, local;
+        V best;
+        uint32_t candidate, count, body;
+    };
+    thread_local std::vector<V> stack;
+    thread_local std::vector<Domain> domains;
+    stack.clear();
+    domains.clear();
+    for (uint32_t i = 0; i < length; ++i) {
+        const uint32_t ins = tape[i];
+        const FlatNode& n = nodes[ins & kTapeNodeMask];
+        if (isDomainEnd(ins)) {
+            Domain& d = domains.back();
+            const uint32_t kind = uint32_t(n.kind);
+            const V v = stack.back();
+            stack.pop_back();
+            if (distanceOf(v) < distanceOf(d.best)) d.best = v;
+            const FlatNode& child = nodes[n.children[0]];
+            bool again = false;
+            while (!again && ++d.candidate < d.count) {
+                const glm::vec4 q = sdf::domainPoint(kind, d.local, kernelA(n), kernelB(n),
+                                                     d.candidate);
+                again = q.w == 0.0f &&
+                        child.bounds.signedDistance(glm::vec3(q)) < distanceOf(d.best);
+                if (again) p = glm::vec3(q);
+            }
+            if (again) {
+                i = d.body - 1;
+                continue;
+            }
+            float value =
+                sdf::domainFinish(kind, d.local, distanceOf(d.best), kernelA(n), kernelB(n)) *
+                n.scale;
+            if (sdf::domainClamps(kind)) value = std::max(value, n.bounds.signedDistance(d.outer));
+            stack.push_back(withDistance(d.best, value));
+            p = d.outer;
+            domains.pop_back();
+            continue;
+        }
+        const NodeKind kind = opcode(ins);
+        const Role role = roleOf(kind);
+        if (role == Role::Primitive) {
+            float d = primitiveValue(n, p);
+            if constexpr (std::is_same_v<V, float>)
+                stack.push_back(d);
+            else
+                stack.push_back(glm::vec4(n.color, d));
+        } else if (role == Role::Domain) {
+            const uint32_t k = uint32_t(kind);
+            const glm::vec3 local =
+                nodeLocalPoint(n, sdf::domainClamps(k) ? glm::clamp(p, n.bounds.min, n.bounds.max) : p);
+            domains.push_back({p, local, withDistance(V{}, INFINITY), 0,
+                               sdf::domainCount(k, kernelA(n), kernelB(n)), i + 1});
+            p = glm::vec3(sdf::domainPoint(k, local, kernelA(n), kernelB(n), 0));
+        } else if (role == Role::Value) {
+            stack.back() = withDistance(
+                stack.back(), sdf::valueOp(uint32_t(kind), distanceOf(stack.back()), kernelA(n)));
+        } else {
+            V b = stack.back();
+            stack.pop_back();
+            stack.back() = opValue(n, stack.back(), b);
+        }
+    }
+    return stack.back();
+}
+
+// Prunes `in` for a cell of centre c and radius r (see prune.h), appending the cell's tape to
+// `out`; returns the root value at c. The first pass runs the tape at c and notes, per
+// operation, the least (union) or greatest (intersection) value of its operands. The second
+// drops the operands that cannot matter anywhere in the cell, where each value lies within
+// v +- r, widened by `slack` for the rounding of single precision (at c here, at p on the GPU):
+//  - of a union, an operand whose lower bound is at least 2k above the least upper bound (k:
+//    the blend radius); of an intersection, the mirror image. Sharp (k = 0), the result is the
+//    same bits. Smooth, an operand 2k above the least one changes the left-to-right fold only
+//    through a chain of blends each of which passes on at most half of a change, well under
+//    1e-5 of k (the tests check 1e-5 absolute near the surface);
+//  - a subtrahend b of a difference where a + b >= k over the cell (max(a, -b) is a), and the
+//    running union a or operand b where they lie k apart (opUnion returns the other).
+// A domain operation's instructions (its own, its child's and the end) stay whole: the pruner
+// takes its value at c like a primitive's and keeps or drops it as one.
+struct Pruner {
+    const std::vector<FlatNode>& nodes;
+    const std::vector<uint32_t>& spans; // per domain node: its instructions, the end included
+    float slack;
+    std::vector<float> value;    // per instruction of `in`: the value of the subtree it ends
+    std::vector<float> extreme;  // per node: least (union) / greatest operand value
+    std::vector<uint32_t> touched;
+    std::vector<uint32_t> ends;  // first pass: the stack, as the instructions that end its values
+    struct Segment {
+        uint32_t start; // in out
+        uint32_t end;   // its last instruction in `in` (value[end] is its value at c)
+        bool empty;     // all of it dropped
+    };
+    std::vector<Segment> stack;
+
+    // Whether the fold at `in[i]` of operation u is its first (its left operand is operand 0).
+    static bool firstFold(const uint32_t* in, uint32_t leftEnd, uint32_t instructionAt) {
+        return in[leftEnd] != in[instructionAt];
+    }
+
+    // A cell whose root value exceeds `far` in magnitude needs no tape: pass 2 is skipped.
+    float prune(const uint32_t* in, uint32_t length, glm::vec3 c, float r, float far,
+                std::vector<uint32_t>& out) {
+        if (value.size() < length) value.resize(length);
+        if (extreme.size() < nodes.size()) extreme.assign(nodes.size(), NAN);
+        ends.clear();
+        for (uint32_t i = 0; i < length; ++i) {
+            const uint32_t node = in[i] & kTapeNodeMask;
+            const FlatNode& n = nodes[node];
+            const NodeKind kind = opcode(in[i]);
+            const Role role = roleOf(kind);
+            if (role == Role::Primitive) {
+                value[i] = primitiveValue(n, c);
+                ends.push_back(i);
+                continue;
+            }
+            if (role == Role::Domain) {
+                const uint32_t end = i + spans[node] - 1;
+                value[end] = run<float>(nodes, in + i, spans[node], c);
+                ends.push_back(end);
+                i = end;
+                continue;
+            }
+            if (role == Role::Value) {
+                value[i] = sdf::valueOp(uint32_t(kind), value[ends.back()], kernelA(n));
+                ends.back() = i;
+                continue;
+            }
+            const uint32_t b = ends.back();
+            ends.pop_back();
+            const uint32_t a = ends.back();
+            const uint32_t u = in[i] & kTapeNodeMask;
+            if (kind != NodeKind::Difference) {
+                float& e = extreme[u];
+                if (std::isnan(e)) touched.push_back(u), e = value[a];
+                const bool least = kind == NodeKind::Union;
+                if (firstFold(in, a, i)) e = least ? std::min(e, value[a]) : std::max(e, value[a]);
+                e = least ? std::min(e, value[b]) : std::max(e, value[b]);
+            }
+            value[i] = opValue(n, value[a], value[b]);
+            ends.back() = i;
+        }
+        const float root = value[length - 1];
+        if (std::abs(root) > far) return resetExtremes(), root;
+
+        stack.clear();
+        for (uint32_t i = 0; i < length; ++i) {
+            const uint32_t ins = in[i];
+            const NodeKind kind = opcode(ins);
+            const Role role = roleOf(kind);
+            if (role == Role::Primitive || role == Role::Domain) {
+                const uint32_t span = role == Role::Domain ? spans[ins & kTapeNodeMask] : 1;
+                stack.push_back({uint32_t(out.size()), i + span - 1, false});
+                out.insert(out.end(), in + i, in + i + span);
+                i += span - 1;
+                continue;
+            }
+            if (role == Role::Value) {
+                if (!stack.back().empty) out.push_back(ins);
+                stack.back().end = i;
+                continue;
+            }
+            const uint32_t u = ins & kTapeNodeMask;
+            const float k = nodes[u].smooth;
+            Segment b = stack.back();
+            stack.pop_back();
+            Segment& a = stack.back();
+            const float va = value[a.end], vb = value[b.end];
+            const float gap = 2.0f * r + slack + 1e-5f * (std::abs(va) + std::abs(vb));
+            bool dropA = false, dropB = false;
+            if (kind == NodeKind::Difference) {
+                dropB = va + vb >= gap + k;
+            } else {
+                const float sign = kind == NodeKind::Union ? 1.0f : -1.0f;
+                // Far from the operation's extreme operand; or k beyond the running value.
+                const float e = sign * extreme[u] + 2.0f * k + gap;
+                dropB = sign * vb >= e || sign * (vb - va) >= gap + k;
+                dropA = (firstFold(in, a.end, i) && sign * va >= e) || sign * (va - vb) >= gap + k;
+                if (dropA && dropB) dropA = false; // keep one (only rounding could ask for both)
+            }
+            const bool keepA = !a.empty && !dropA, keepB = !b.empty && !dropB;
+            if (!keepB && !b.empty) out.resize(b.start); // b's instructions are the last ones
+            if (!keepA && !a.empty)
+                out.erase(out.begin() + a.start,
+                          keepB ? out.begin() + b.start : out.end()); // b then starts at a.start
+            if (keepA && keepB) out.push_back(ins);
+            a.empty = !keepA && !keepB;
+            if (a.empty) a.start = uint32_t(out.size());
+            a.end = i;
+        }
+        if (stack.back().empty) { // cannot happen but through rounding: keep everything
+            out.resize(stack.back().start);
+            out.insert(out.end(), in, in + length);
+        }
+        resetExtremes();
+        return root;
+    }
+
+    void resetExtremes() {
+        for (uint32_t u : touched)
+            extreme[u] = NAN;
+        touched.clear();
+    }
+};
+
+// A cell is far from every surface when its centre value exceeds its radius and this many leaf
+// radii less one: its bound is then at least a leaf cell's radius everywhere in it, which keeps
+// the soft shadows' ratio of distance to travel (and so the shading) what the whole tree gives
+// (at 1.25 leaf radii, shadow rays crossing cell corners darkened lit surfaces in blotches). A
+// coarse cell needs no more than that, so it stops refining as soon as it holds no surface
+// (forest_10k: a third less pruning time, the same leaf tapes).
+constexpr float kFarRadii = 2.0f;
+
+// The grid that the octrees divide: the finite part of the bounds (all finite leaves' boxes where
+// a plane makes the root unbounded) and a leaf cell more on every side, so that outside it a
+// bounded field is at least half a cell more than the distance to it. Leaf cells are cubes sized
+// so that the box holds about options.cells of them; the top level is a grid of cubes of
+// 2^levels leaf cells, each the root of an octree.
+bool fieldGrid(const Evaluator& evaluator, const PruneOptions& options, PrunedField& f) {
+    Aabb box = evaluator.bounds();
+    f.bounded = box.finite();
+    if (!f.bounded) {
+        box = Aabb{};
+        for (const FlatNode& n : evaluator.nodes())
+            if (!isOperation(n.kind) && n.bounds.finite() && n.frame == kWorldFrame) {
+                box.min = glm::min(box.min, n.bounds.min);
+                box.max = glm::max(box.max, n.bounds.max);
+            }
+    }
+    if (box.empty()) return false;
+    const glm::vec3 extent = box.max - box.min;
+    const float largest = std::max(std::max(extent.x, extent.y), std::max(extent.z, 1e-6f));
+    // Thin boxes: at least a 64th of the largest extent on every axis, so the cells stay few.
+    const glm::vec3 padded = glm::max(extent, glm::vec3(largest / 64.0f));
+    f.cell = std::cbrt(padded.x * padded.y * padded.z / float(options.cells));
+    const float top = f.cell * float(1u << options.levels);
+    const glm::uvec3 tops = glm::uvec3(glm::ceil((extent + 2.0f * f.cell) / top));
+    f.levels = options.levels;
+    f.dims = tops * (1u << f.levels);
+    f.origin = 0.5f * (box.min + box.max) - 0.5f * glm::vec3(f.dims) * f.cell;
+    return true;
+}
+
+} // namespace
+
+std::vector<uint32_t> fullTape(const std::vector<FlatNode>& nodes, uint32_t& stackDepth) {
+    std::vector<uint32_t> tape;
+    stackDepth = 0;
+    if (nodes.empty()) return tape;
+    tape.reserve(2 * nodes.size());
+    // Explicit stack of (node, next child); depth of the value stack alongside.
+    struct Frame {
+        uint32_t node, next;
+    };
+    std::vector<Frame> frames{{0, 0}};
+    uint32_t depth = 0;
+    while (!frames.empty()) {
+        Frame& f = frames.back();
+        const FlatNode& n = nodes[f.node];
+        const Role role = roleOf(n.kind);
+        if (role == Role::Primitive) {
+            tape.push_back(instruction(f.node, n.kind));
+            stackDepth = std::max(stackDepth, ++depth);
+            frames.pop_back();
+        } else if (f.next < n.children.size()) {
+            if (role == Role::Domain) tape.push_back(instruction(f.node, n.kind));
+            if (f.next >= 2) tape.push_back(instruction(f.node, n.kind)), --depth;
+            const uint32_t child = n.children[f.next++];
+            frames.push_back({child, 0});
+        } else {
+            if (role == Role::Domain) tape.push_back(f.node | kTapeDomainEnd << kTapeKindShift);
+            if (role == Role::Value) tape.push_back(instruction(f.node, n.kind));
+            if (n.children.size() >= 2) tape.push_back(instruction(f.node, n.kind)), --depth;
+            frames.pop_back();
+        }
+    }
+    return tape;
+}
+
+PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) {
+    const std::vector<FlatNode>& nodes = evaluator.nodes();
+    PrunedField field;
+    field.tape = fullTape(nodes, field.stackDepth);
+    field.fullLength = uint32_t(field.tape.size());
+    std::vector<uint32_t> spans(nodes.size(), 0), begins;
+    for (uint32_t i = 0; i < field.fullLength; ++i) {
+        const uint32_t ins = field.tape[i];
+        if (isDomainEnd(ins))
+            spans[ins & kTapeNodeMask] = i + 1 - begins.back(), begins.pop_back();
+        else if (roleOf(opcode(ins)) == Role::Domain)
+            begins.push_back(i);
+    }
+    if (nodes.empty() || options.levels < 1 || !fieldGrid(evaluator, options, field)) {
+        field.levels = 0;
+        field.bounded = false;
+        field.cells.assign(1, glm::uvec2(0, field.fullLength));
+        return field;
+    }
+    const glm::uvec3 dims = field.dims;
+    field.cells.assign(size_t(dims.x) * dims.y * dims.z, glm::uvec2(0));
+    const float slack = 1e-5f * (field.cell * float(dims.x + dims.y + dims.z) +
+                                 glm::length(field.origin));
+
+    // Sets every leaf entry under the cell `at` of `level` (in cells of its level).
+    auto fillLeaves = [&](glm::uvec3 at, uint32_t level, glm::uvec2 entry) {
+        const uint32_t span = 1u << (field.levels - level);
+        for (uint32_t z = 0; z < span; ++z)
+            for (uint32_t y = 0; y < span; ++y) {
+                const glm::uvec3 l = at * span + glm::uvec3(0, y, z);
+                std::fill_n(field.cells.begin() + (l.x + dims.x * (l.y + dims.y * l.z)), span,
+                            entry);
+            }
+    };
+    // Level by level: the cells that may hold surface, each with its tape in `tapes`.
+    struct Cell {
+        glm::uvec3 at; // in cells of its level
+        uint32_t begin, length;
+    };
+    std::vector<Cell> cells;
+    const glm::uvec3 tops = dims >> field.levels;
+    for (uint32_t z = 0; z < tops.z; ++z)
+        for (uint32_t y = 0; y < tops.y; ++y)
+            for (uint32_t x = 0; x < tops.x; ++x)
+                cells.push_back({glm::uvec3(x, y, z), 0, field.fullLength});
+    std::vector<uint32_t> tapes = field.tape;
+    const unsigned threads = std::max(1u, std::min(8u, std::thread::hardware_concurrency()));
+    for (uint32_t level = 0; level <= field.levels; ++level) {
+        const float size = field.cell * float(1u << (field.levels - level));
+        const float r = 0.5f * std::sqrt(3.0f) * size;
+        const float leafR = 0.5f * std::sqrt(3.0f) * field.cell;
+        const bool leaf = level == field.levels;
+        // The children of this level's cells (the cells themselves at the root).
+        const uint32_t fan = level == 0 ? 1 : 8; // the top cells themselves at level 0
+        const size_t jobs = cells.size() * fan;
+        struct Out {
+            std::vector<Cell> cells;
+            std::vector<uint32_t> tapes;
+        };
+        const unsigned used = jobs > 64 ? threads : 1;
+        std::vector<Out> outs(used);
+        std::atomic<bool> overBudget{false};
+        auto work = [&](unsigned t) {
+            Pruner pruner{nodes, spans, slack, {}};
+            Out& out = outs[t];
+            for (size_t j = t; j < jobs && !overBudget; j += used) {
+                const Cell& parent = cells[j / fan];
+                const uint32_t octant = uint32_t(j % fan);
+                const glm::uvec3 at =
+                    level == 0 ? parent.at
+                               : parent.at * 2u +
+                                     glm::uvec3(octant & 1, octant >> 1 & 1, octant >> 2);
+                const glm::vec3 c = field.origin + (glm::vec3(at) + 0.5f) * size;
+                const uint32_t begin = uint32_t(out.tapes.size());
+                const float far = r + (kFarRadii - 1.0f) * leafR + slack;
+                const float v =
+                    pruner.prune(tapes.data() + parent.begin, parent.length, c, r, far, out.tapes);
+                if (std::abs(v) > far) { // no surface: fill its leaf cells
+                    fillLeaves(at, level,
+                               glm::uvec2(std::bit_cast<uint32_t>(v), kFarCell | level));
+                    continue;
+                }
+                out.cells.push_back({at, begin, uint32_t(out.tapes.size()) - begin});
+                if (out.tapes.size() > options.maxWords / used) overBudget = true;
+            }
+        };
+        std::vector<std::thread> pool;
+        for (unsigned t = 1; t < used; ++t)
+            pool.emplace_back(work, t);
+        work(0);
+        for (std::thread& t : pool)
+            t.join();
+        if (overBudget) {
+            // Tapes that prune this little would exceed the budget: the parents' tapes serve
+            // their leaf cells (the top cells': the whole tape). Every bound written so far
+            // holds; the parents' cells only run longer tapes.
+            const uint32_t base = uint32_t(field.tape.size());
+            if (level > 0) field.tape.insert(field.tape.end(), tapes.begin(), tapes.end());
+            for (const Cell& c : cells)
+                fillLeaves(c.at, level == 0 ? 0 : level - 1,
+                           level > 0 ? glm::uvec2(base + c.begin, c.length)
+                                     : glm::uvec2(0, field.fullLength));
+            return field;
+        }
+        // Gather.
+        std::vector<Cell> next;
+        std::vector<uint32_t> nextTapes;
+        for (Out& out : outs) {
+            const uint32_t base = uint32_t(nextTapes.size());
+            nextTapes.insert(nextTapes.end(), out.tapes.begin(), out.tapes.end());
+            for (Cell c : out.cells) {
+                c.begin += base;
+                next.push_back(c);
+            }
+        }
+        if (leaf) {
+            const uint32_t base = field.fullLength;
+            field.tape.insert(field.tape.end(), nextTapes.begin(), nextTapes.end());
+            for (const Cell& c : next)
+                field.cells[c.at.x + dims.x * (c.at.y + dims.y * c.at.z)] =
+                    glm::uvec2(base + c.begin, c.length);
+        }
+        cells = std::move(next);
+        tapes = std::move(nextTapes);
+    }
+    return field;
+}
+
+double PrunedField::meanActiveLength() const {
+    double sum = 0.0;
+    size_t near = 0;
+    for (const glm::uvec2& c : cells)
+        if (!(c.y & kFarCell)) sum += c.y, ++near;
+    return near ? sum / double(near) : 0.0;
+}
+
+namespace {
+
+// The leaf cell of p, or nullptr outside the cube.
+const glm::uvec2* cellAt(const PrunedField& f, glm::vec3 p, glm::uvec3& at) {
+    const glm::vec3 q = glm::floor((p - f.origin) / f.cell);
+    const glm::vec3 n(f.dims);
+    if (f.levels == 0 || !(q.x >= 0 && q.y >= 0 && q.z >= 0 && q.x < n.x && q.y < n.y && q.z < n.z))
+        return nullptr;
+    at = glm::uvec3(q);
+    return &f.cells[at.x + f.dims.x * (at.y + f.dims.y * at.z)];
+}
+
+// The bound of a far cell at p.
+float farBound(const PrunedField& f, glm::uvec2 e, glm::uvec3 at, glm::vec3 p) {
+    const uint32_t shift = f.levels - (e.y & 0xffu);
+    const float size = f.cell * float(1u << shift);
+    const glm::vec3 c = f.origin + (glm::vec3(at >> shift) + 0.5f) * size;
+    const float v = std::bit_cast<float>(e.x);
+    const float away = glm::length(p - c);
+    return v > 0.0f ? v - away : v + away;
+}
+
+// Outside the cube of a bounded field.
+float outsideBound(const PrunedField& f, glm::vec3 p) {
+    Aabb cube{f.origin, f.origin + f.cell * glm::vec3(f.dims)};
+    return cube.signedDistance(p) + 0.5f * f.cell;
+}
+
+} // namespace
+
+float PrunedField::distance(const std::vector<FlatNode>& nodes, glm::vec3 p) const {
+    glm::uvec3 at;
+    const glm::uvec2* e = cellAt(*this, p, at);
+    if (!e) {
+        if (bounded) return outsideBound(*this, p);
+        return run<float>(nodes, tape.data(), fullLength, p);
+    }
+    if (e->y & kFarCell) return farBound(*this, *e, at, p);
+    return run<float>(nodes, tape.data() + e->x, e->y, p);
+}
+
+Sample PrunedField::sample(const std::vector<FlatNode>& nodes, glm::vec3 p) const {
+    glm::uvec3 at;
+    const glm::uvec2* e = cellAt(*this, p, at);
+    glm::vec4 v;
+    if (!e && bounded)
+        v = glm::vec4(-1.0f, -1.0f, -1.0f, outsideBound(*this, p));
+    else if (!e)
+        v = run<glm::vec4>(nodes, tape.data(), fullLength, p);
+    else if (e->y & kFarCell)
+        v = glm::vec4(-1.0f, -1.0f, -1.0f, farBound(*this, *e, at, p));
+    else
+        v = run<glm::vec4>(nodes, tape.data() + e->x, e->y, p);
+    return {v.w, glm::vec3(v)};
+}
+
+uint32_t PrunedField::activeLength(glm::vec3 p) const {
+    glm::uvec3 at;
+    const glm::uvec2* e = cellAt(*this, p, at);
+    if (!e) return bounded ? 0 : fullLength;
+    return e->y & kFarCell ? 0 : e->y;
+}
+
+std::vector<uint32_t> packField(const PrunedField& f, const std::vector<FlatNode>& nodes) {
+    std::vector<uint32_t> out(kFieldHeaderWords + 2 * f.cells.size() + f.tape.size());
+    auto put = [&](size_t at, float v) { out[at] = std::bit_cast<uint32_t>(v); };
+    put(0, f.origin.x);
+    put(1, f.origin.y);
+    put(2, f.origin.z);
+    put(3, f.cell);
+    out[4] = f.levels;
+    out[5] = f.levels ? f.dims.x : 0;
+    out[6] = f.dims.y;
+    out[7] = f.dims.z;
+    out[8] = f.bounded ? 1u : 0u;
+    out[9] = f.fullLength;
+    const uint32_t tapeStart = uint32_t(kFieldHeaderWords + 2 * f.cells.size());
+    out[10] = tapeStart;
+    std::memcpy(out.data() + kFieldHeaderWords, f.cells.data(), f.cells.size() * 8);
+    uint32_t* tape = out.data() + tapeStart;
+    std::copy(f.tape.begin(), f.tape.end(), tape);
+    // Within each tape, a primitive whose operation follows at once carries the operation, so
+    // that the shader folds it into the running value without the stack (shaders/tape.glsl).
+    std::vector<bool> marked(f.tape.size() + 1, false); // by first word: cells share tapes
+    auto mark = [&](uint32_t begin, uint32_t length) {
+        if (marked[begin]) return;
+        marked[begin] = true;
+        for (uint32_t t = begin; t + 1 < begin + length; ++t)
+            if (!isDomainEnd(f.tape[t]) && !isDomainEnd(f.tape[t + 1]) &&
+                roleOf(opcode(f.tape[t])) == Role::Primitive &&
+                roleOf(opcode(f.tape[t + 1])) == Role::Boolean) {
+                const FlatNode& op = nodes[f.tape[t + 1] & kTapeNodeMask];
+                tape[t] |= (uint32_t(op.kind) - uint32_t(NodeKind::Union) + 1u) << kTapeFoldShift |
+                           op.blend << SDFCSG_TAPE_BLEND_SHIFT;
+                tape[t + 1] = std::bit_cast<uint32_t>(op.smooth);
+            }
+    };
+    mark(0, f.fullLength);
+    for (const glm::uvec2& c : f.cells)
+        if (!(c.y & kFarCell)) mark(c.x, c.y);
+    return out;
+}
+
+} // namespace sdfcsg::detail

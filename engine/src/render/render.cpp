@@ -1,0 +1,825 @@
+// The ray march: per band of rows, the clip, march, ends, shade and light passes and, with several
+// samples per pixel or overlays, the resolve and overlay passes (shaders/clip.comp, march.comp,
+// light.comp, shade.comp and finish.comp, around raymarch.glsl), read back to RGBA8 and
+// per-pixel info.
+#include "sdfcsg/render.h"
+
+#include "render/camera.h"
+#include "codegen/gpu_nodes.h"
+#include "codegen/shader_compile.h"
+#include "gpu/vk.h"
+
+#include "sdfcsg/compile.h"
+#include "sdfcsg/eval.h"
+
+#include "shared.h"
+
+#include <glm/vec4.hpp>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <future>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <utility>
+
+namespace sdfcsg {
+namespace {
+
+using detail::Buffer;
+
+struct FrameLight {
+    glm::vec4 direction; // towards the light
+    glm::vec4 inverse;   // 1 / direction, finite
+    glm::vec4 color;
+};
+
+// Mirrors the Frame uniform block in shaders/raymarch.glsl (std140: every member is 16 bytes).
+struct FrameUniform {
+    glm::vec4 eye, right, up, forward;
+    glm::vec4 clipMin, clipMax;
+    glm::vec4 background, sky;
+    glm::vec4 distances; // depth near, depth far, occlusion scale, shadow reach
+    FrameLight lights[SDFCSG_MAX_LIGHTS];
+    glm::vec4 surfaceBoxes[2 * SDFCSG_MAX_CLIP_BOXES]; // surface parts, as in raymarch.glsl
+    glm::vec4 grid; // centre x, z; plane height; spacing
+};
+static_assert(sizeof(FrameUniform) ==
+              10 * 16 + SDFCSG_MAX_LIGHTS * 48 + SDFCSG_MAX_CLIP_BOXES * 32);
+
+// Mirrors the Control buffer in shaders/raymarch.glsl: the values that branches read.
+struct FrameControl {
+    glm::uvec4 size;   // width, height, mode, flags
+    glm::uvec4 counts; // aa, lights, nodes, selected
+    glm::uvec4 parts;  // x: surface parts in FrameUniform::surfaceBoxes
+};
+static_assert(SDFCSG_MAX_LIGHTS == 4, "shade.comp reads the lights into four locals");
+static_assert(GroundGrid{}.halfLines == SDFCSG_GRID_HALF_LINES);
+
+constexpr detail::Binding kBindings[] = {
+    {SDFCSG_BINDING_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
+    {SDFCSG_BINDING_NODES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+    {SDFCSG_BINDING_PIXELS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+    {SDFCSG_BINDING_INFO, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+    {SDFCSG_BINDING_SAMPLES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+    {SDFCSG_BINDING_HITS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+    {SDFCSG_BINDING_TILES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+    {SDFCSG_BINDING_CONTROL, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+    {SDFCSG_BINDING_SURFACES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+    {SDFCSG_BINDING_RANGES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+    {SDFCSG_BINDING_FIELD, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+};
+
+// What the renderers of a context share: the layout of the kernels' bindings, and the pipelines
+// of the passes that do not evaluate the scene (clip.comp, light.comp, finish.comp), each made
+// once per context, at its first use. A new scene compiles only its own kernels.
+struct SharedPasses {
+    Context::Impl& ctx;
+    VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+    VkShaderModule clip = VK_NULL_HANDLE, light = VK_NULL_HANDLE, finish = VK_NULL_HANDLE;
+    // The SPIR-V of clip.comp and light.comp where glslang made it (none was cached): then the
+    // driver has most likely not compiled them either, and the compile helper may.
+    std::vector<uint32_t> freshClip, freshLight;
+    std::mutex mutex; // guards pipelines and warm
+    VkPipeline pipelines[SDFCSG_RAYMARCH_PASSES] = {};
+    bool warm[SDFCSG_RAYMARCH_PASSES] = {}; // the pipeline has run (Renderer::Impl::warmUp)
+
+    explicit SharedPasses(Context::Impl& c) : ctx(c) {}
+
+    // The pipeline of a pass, created on first use. Under mutex.
+    VkPipeline created(uint32_t pass);
+
+    ~SharedPasses() {
+        for (VkPipeline p : pipelines)
+            if (p) vkDestroyPipeline(ctx.device, p, nullptr);
+        for (VkShaderModule m : {clip, light, finish})
+            if (m) vkDestroyShaderModule(ctx.device, m, nullptr);
+        if (layout) vkDestroyPipelineLayout(ctx.device, layout, nullptr);
+        if (setLayout) vkDestroyDescriptorSetLayout(ctx.device, setLayout, nullptr);
+    }
+};
+
+// Mirrors the Band push constants of shaders/raymarch.glsl.
+struct BandConstants {
+    uint32_t firstRow;
+    uint32_t colorOffset;
+};
+
+constexpr uint32_t kGroupSize = SDFCSG_RAYMARCH_GROUP_X * SDFCSG_RAYMARCH_GROUP_Y;
+constexpr VkDeviceSize kHitsHeader = 16; // count, then the shade pass's dispatch
+constexpr VkDeviceSize kSurfaceBytes = 64; // per listed hit: four vec4 (raymarch.glsl)
+constexpr VkDeviceSize kRangeBytes = 32;   // per sample: two vec4 (raymarch.glsl)
+
+Error usage(std::string text) {
+    return Error::message(ErrorKind::Usage, "<render>", std::move(text));
+}
+
+// Samples per submission (see Renderer::render).
+constexpr uint32_t kBandSamples = 1u << 16;
+
+Result<std::shared_ptr<SharedPasses>> sharedPasses(Context::Impl& ctx) {
+    std::lock_guard lock(ctx.rendererSharedMutex);
+    if (ctx.rendererShared) return std::static_pointer_cast<SharedPasses>(ctx.rendererShared);
+    auto shared = std::make_shared<SharedPasses>(ctx);
+    const char* kernels[] = {"clip.comp", "light.comp", "finish.comp"};
+    VkShaderModule* modules[] = {&shared->clip, &shared->light, &shared->finish};
+    std::vector<uint32_t>* fresh[] = {&shared->freshClip, &shared->freshLight, nullptr};
+    for (int i = 0; i < 3; ++i) {
+        bool ranGlslang = false;
+        auto spirv = detail::compileKernel(kernels[i], "", ranGlslang);
+        if (!spirv) return spirv.error();
+        *modules[i] = detail::createShaderModule(ctx, *spirv);
+        if (ranGlslang && fresh[i]) *fresh[i] = std::move(*spirv);
+    }
+    shared->setLayout = detail::createDescriptorSetLayout(ctx, kBindings);
+    shared->layout = detail::createPipelineLayout(ctx, shared->setLayout, sizeof(BandConstants));
+    ctx.rendererShared = shared;
+    return shared;
+}
+
+} // namespace
+
+// Polygon and text outlines follow the nodes in their buffer: a new size is a new buffer.
+static size_t outlineSize(const Node& n) { return n.outline ? n.outline->size() : 0; }
+
+bool sameStructure(const Scene& a, const Scene& b) {
+    if (a.nodes.size() != b.nodes.size()) return false;
+    for (size_t i = 0; i < a.nodes.size(); ++i)
+        if (a.nodes[i].kind != b.nodes[i].kind || a.nodes[i].children != b.nodes[i].children ||
+            outlineSize(a.nodes[i]) != outlineSize(b.nodes[i]))
+            return false;
+    return true;
+}
+
+struct Renderer::Impl {
+    Context::Impl& ctx;
+    RendererOptions options;
+    Scene scene; // the values last uploaded; structure fixed at creation
+    std::unique_ptr<Evaluator> evaluator;
+    uint32_t nodeCount = 0;
+
+    std::shared_ptr<SharedPasses> shared;
+    VkPipelineLayout pipelineLayout = VK_NULL_HANDLE; // shared->layout
+    // The scene's kernels, march.comp and shade.comp, and their pipelines: [pass][bounds
+    // skipping]. The generated code differs with skipping (CodegenOptions::boundsTests).
+    // buildKernels() makes the default ones, kernels() and pipeline() the others on first use.
+    VkShaderModule modules[2][2] = {};
+    VkPipeline pipelines[2][2] = {};
+    static_assert(SDFCSG_RAYMARCH_PASS_MARCH == 0 && SDFCSG_RAYMARCH_PASS_SHADE == 1);
+    VkDescriptorPool pool = VK_NULL_HANDLE;
+    VkDescriptorSet set = VK_NULL_HANDLE;
+
+    // The image (pixels, info), and per band: the samples' colours (with several per pixel),
+    // the workgroups to march and the hits to shade.
+    Buffer frame, control, nodes, pixels, info, pixelsStaging, infoStaging, samples, hits, tiles,
+        surfaces, ranges, field;
+    uint32_t capacity = 0;       // pixels the image buffers hold
+    uint32_t sampleCapacity = 0; // samples the band buffers hold
+    uint32_t tileCapacity = 0;   // workgroups the tile list holds
+    bool samplesArePixels = false; // what the SAMPLES binding points at
+    std::vector<PixelInfo> lastInfo;
+
+    explicit Impl(Context::Impl& c) : ctx(c) {}
+    // No work of this renderer is pending between calls (submitAndWait() waits for it), and the
+    // device may be busy with other threads' work: nothing to wait for.
+    ~Impl() {
+        VkDevice device = ctx.device;
+        for (Buffer* b : {&frame, &control, &nodes, &pixels, &info, &pixelsStaging, &infoStaging,
+                          &samples, &hits, &tiles, &surfaces, &ranges, &field})
+            detail::destroyBuffer(ctx, *b);
+        destroyKernel();
+        if (pool) vkDestroyDescriptorPool(device, pool, nullptr);
+    }
+
+    // Generates and compiles the scene's kernels, replacing the previous ones, and makes the
+    // march and shade pipelines that render() uses by default, ready to run. The two kernels are
+    // compiled side by side. On llvmpipe, which makes machine code at a pipeline's first dispatch
+    // and one pipeline at a time, a new march kernel is compiled on the context's helper device
+    // (precompileElsewhere()) while this device compiles the shade kernel. On failure the
+    // previous kernels stay.
+    Status buildKernels() {
+        const bool skipping = defaultSkipping();
+        const std::string glsl = sceneGlsl(skipping);
+        struct Built {
+            std::optional<Error> error;
+            VkShaderModule module = VK_NULL_HANDLE;
+            VkPipeline pipeline = VK_NULL_HANDLE;
+        };
+        auto build = [&](const Result<std::vector<uint32_t>>& spirv, uint32_t pass) {
+            Built b;
+            if (!spirv) {
+                b.error = spirv.error();
+                return b;
+            }
+            b.module = detail::createShaderModule(ctx, *spirv);
+            b.pipeline = createPipeline(b.module, pass, skipping);
+            return b;
+        };
+        // While this device compiles the shade kernel, the other thread makes the march kernel:
+        // on llvmpipe, its machine code on the helper device (if it is a new kernel), and this
+        // device's pipeline beside that, which at its first dispatch loads the helper's work.
+        // In a context's first build the passes that do not depend on the scene are most likely
+        // new too: the helper then compiles the clip and ends passes after the march kernel, and
+        // this device the light pass after the shade kernel (about as long on either side).
+        std::vector<uint32_t> clipSpirv, endsSpirv;
+        {
+            std::lock_guard lock(shared->mutex);
+            if (!shared->pipelines[SDFCSG_RAYMARCH_PASS_CLIP])
+                clipSpirv = std::exchange(shared->freshClip, {});
+            if (!shared->pipelines[SDFCSG_RAYMARCH_PASS_ENDS])
+                endsSpirv = std::exchange(shared->freshLight, {});
+        }
+        Built march;
+        double helperMs = 0.0; // the helper's compile of the march kernel
+        std::thread other([&] {
+            detail::makeCompileHelper(ctx); // the last build used it up
+            bool fresh = false;
+            auto spirv = detail::compileKernel("march.comp", glsl, fresh);
+            const auto marchSpec = specConstants(SDFCSG_RAYMARCH_PASS_MARCH, skipping);
+            const auto clipSpec = specConstants(SDFCSG_RAYMARCH_PASS_CLIP, false);
+            const auto endsSpec = specConstants(SDFCSG_RAYMARCH_PASS_ENDS, false);
+            std::vector<detail::Precompile> jobs;
+            if (spirv && fresh) jobs.push_back({*spirv, marchSpec});
+            if (!clipSpirv.empty()) jobs.push_back({clipSpirv, clipSpec});
+            if (!endsSpirv.empty()) jobs.push_back({endsSpirv, endsSpec});
+            // This device's pipeline translates the kernel (SPIR-V to the driver's IR, a tenth of
+            // the compile). Beside the helper's compile of the march kernel alone, which ends
+            // before the shade kernel's, that would take the shade kernel's core from it: after
+            // it. Beside a first build's longer list, which ends later.
+            auto translate = [&] { march = build(spirv, SDFCSG_RAYMARCH_PASS_MARCH); };
+            std::thread beside;
+            if (jobs.size() > 1) beside = std::thread(translate);
+            const double ms =
+                detail::precompileElsewhere(ctx, jobs, kBindings, sizeof(BandConstants));
+            if (spirv && fresh) helperMs = ms;
+            if (beside.joinable())
+                beside.join();
+            else
+                translate();
+            // The first renderer of a context makes the passes that do not depend on the scene
+            // (their machine code, in a first build, from the helper): their translations too,
+            // beside the shade kernel's compile. Their warm-ups follow (pipeline()).
+            for (uint32_t pass : {SDFCSG_RAYMARCH_PASS_CLIP, SDFCSG_RAYMARCH_PASS_ENDS}) {
+                std::lock_guard lock(shared->mutex);
+                shared->created(pass);
+            }
+        });
+        Built shade = build(compileKernel("shade.comp", glsl), SDFCSG_RAYMARCH_PASS_SHADE);
+        if (!shade.error) {
+            warmUp(shade.pipeline);
+            pipeline(SDFCSG_RAYMARCH_PASS_LIGHT, false); // made once per context
+        }
+        other.join();
+        if (march.error || shade.error) {
+            for (Built* b : {&march, &shade}) {
+                if (b->pipeline) vkDestroyPipeline(ctx.device, b->pipeline, nullptr);
+                if (b->module) vkDestroyShaderModule(ctx.device, b->module, nullptr);
+            }
+            return shade.error ? *shade.error : *march.error;
+        }
+        destroyKernel();
+        modules[SDFCSG_RAYMARCH_PASS_MARCH][skipping ? 1 : 0] = march.module;
+        modules[SDFCSG_RAYMARCH_PASS_SHADE][skipping ? 1 : 0] = shade.module;
+        pipelines[SDFCSG_RAYMARCH_PASS_MARCH][skipping ? 1 : 0] = march.pipeline;
+        pipelines[SDFCSG_RAYMARCH_PASS_SHADE][skipping ? 1 : 0] = shade.pipeline;
+        const auto start = std::chrono::steady_clock::now();
+        warmUp(march.pipeline);
+        const std::chrono::duration<double, std::milli> marchMs =
+            std::chrono::steady_clock::now() - start;
+        // Loading the helper's machine code takes a few milliseconds, a tenth of its compile or
+        // less; compiling it again takes about as long as the helper did.
+        if (helperMs > 0.0 && marchMs.count() > 0.25 * helperMs) detail::compileHelperMissed(ctx);
+        return Ok{};
+    }
+
+    // The scene's kernels and their pipelines.
+    void destroyKernel() {
+        for (int pass : {SDFCSG_RAYMARCH_PASS_MARCH, SDFCSG_RAYMARCH_PASS_SHADE})
+            for (int skipping : {0, 1}) {
+                VkPipeline& p = pipelines[pass][skipping];
+                if (p) vkDestroyPipeline(ctx.device, p, nullptr);
+                p = VK_NULL_HANDLE;
+                VkShaderModule& m = modules[pass][skipping];
+                if (m) vkDestroyShaderModule(ctx.device, m, nullptr);
+                m = VK_NULL_HANDLE;
+            }
+    }
+
+    std::string sceneGlsl(bool skipping) const {
+        CodegenOptions codegen;
+        codegen.inlineParams = options.inlineValues;
+        codegen.evaluation = options.evaluation;
+        codegen.boundsTests = skipping;
+        return generateSceneGlsl(scene, codegen);
+    }
+
+    // The scene's kernels for a skipping choice, compiled on first use.
+    Status kernels(bool skipping) {
+        VkShaderModule* made[] = {&modules[SDFCSG_RAYMARCH_PASS_MARCH][skipping ? 1 : 0],
+                                  &modules[SDFCSG_RAYMARCH_PASS_SHADE][skipping ? 1 : 0]};
+        if (*made[0] && *made[1]) return Ok{};
+        const std::string glsl = sceneGlsl(skipping);
+        const char* names[] = {"march.comp", "shade.comp"};
+        for (int i = 0; i < 2; ++i) {
+            if (*made[i]) continue;
+            auto spirv = compileKernel(names[i], glsl);
+            if (!spirv) return spirv.error();
+            *made[i] = detail::createShaderModule(ctx, *spirv);
+        }
+        return Ok{};
+    }
+
+    bool defaultSkipping() const {
+        return ctx.properties.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU;
+    }
+
+    static std::array<detail::SpecConstant, 2> specConstants(uint32_t pass, bool skipping) {
+        return {{{SDFCSG_SPEC_BOUNDS_SKIPPING, skipping ? 1u : 0u},
+                 {SDFCSG_SPEC_RAYMARCH_PASS, pass}}};
+    }
+
+    VkPipeline createPipeline(VkShaderModule module, uint32_t pass, bool skipping) const {
+        return detail::createComputePipeline(ctx, module, pipelineLayout,
+                                             specConstants(pass, skipping));
+    }
+
+    // The pipeline of a pass and skipping choice, created and warmed up on first use.
+    VkPipeline pipeline(uint32_t pass, bool skipping) {
+        if (pass != SDFCSG_RAYMARCH_PASS_MARCH && pass != SDFCSG_RAYMARCH_PASS_SHADE) {
+            std::lock_guard lock(shared->mutex);
+            VkPipeline p = shared->created(pass);
+            if (!shared->warm[pass]) warmUp(p);
+            shared->warm[pass] = true;
+            return p;
+        }
+        VkPipeline& p = pipelines[pass][skipping ? 1 : 0];
+        if (!p) {
+            p = createPipeline(modules[pass][skipping ? 1 : 0], pass, skipping); // see kernels()
+            warmUp(p);
+        }
+        return p;
+    }
+
+    // Some drivers (llvmpipe among them) compile a compute pipeline to machine code only at its
+    // first dispatch. An empty dispatch (image size 0 and no hits: every invocation returns at
+    // once) moves that cost here, so a created pipeline is ready and the first frame costs what
+    // later ones do.
+    void warmUp(VkPipeline p) {
+        FrameControl empty = {};
+        detail::uploadBuffer(ctx, control, &empty, sizeof(empty));
+        VkCommandBuffer cmd = detail::beginCommands(ctx);
+        vkCmdFillBuffer(cmd, hits.buffer, 0, kHitsHeader, 0);
+        detail::recordComputeBarrier(cmd);
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p);
+        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipelineLayout, 0, 1, &set, 0,
+                                nullptr);
+        const BandConstants band = {};
+        vkCmdPushConstants(cmd, pipelineLayout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof band, &band);
+        vkCmdDispatch(cmd, 1, 1, 1);
+        detail::submitAndWait(ctx);
+    }
+
+    // The node buffer, and the field (detail::fieldWords()).
+    Status uploadNodes(std::span<const uint32_t> fieldWords) {
+        std::vector<detail::GpuNode> packed = detail::packNodes(*evaluator);
+        detail::uploadBuffer(ctx, nodes, packed.data(), packed.size() * sizeof(detail::GpuNode));
+        auto made = detail::uploadField(ctx, field, fieldWords);
+        if (!made) return made.error();
+        if (*made) writeDescriptors();
+        return Ok{};
+    }
+
+    // Once the image and band buffers exist (create() reserves both).
+    void writeDescriptors() {
+        if (!pixels.buffer || !samples.buffer) return;
+        const Buffer* colors = samplesArePixels ? &pixels : &samples;
+        const Buffer* buffers[] = {&frame, &nodes,   &pixels,   &info,   colors, &hits,
+                                   &tiles, &control, &surfaces, &ranges, &field};
+        detail::writeDescriptorSet(ctx, set, kBindings, buffers);
+    }
+
+    // Grows the band buffers to hold `count` samples in `tileCount` workgroups; never shrinks
+    // them. On failure the old buffers stay.
+    Status reserveSamples(uint32_t count, uint32_t tileCount) {
+        if (count <= sampleCapacity && tileCount <= tileCapacity) return Ok{};
+        count = std::max(count, sampleCapacity);
+        tileCount = std::max(tileCount, tileCapacity);
+        constexpr VkBufferUsageFlags kStorage =
+            VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+        constexpr int kBuffers = 5;
+        const VkDeviceSize sizes[kBuffers] = {
+            VkDeviceSize(count) * 4, kHitsHeader + VkDeviceSize(count) * 8,
+            VkDeviceSize(tileCount) * 4, VkDeviceSize(count) * kSurfaceBytes,
+            VkDeviceSize(count) * kRangeBytes};
+        const VkBufferUsageFlags usages[kBuffers] = {
+            kStorage, kStorage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT,
+            VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+            VK_BUFFER_USAGE_STORAGE_BUFFER_BIT};
+        const detail::MemoryUse uses[kBuffers] = {
+            detail::MemoryUse::Device, detail::MemoryUse::Device, detail::MemoryUse::Upload,
+            detail::MemoryUse::Device, detail::MemoryUse::Device};
+        Buffer made[kBuffers];
+        for (int i = 0; i < kBuffers; ++i) {
+            auto buffer = detail::createBuffer(ctx, sizes[i], usages[i], uses[i]);
+            if (!buffer) {
+                for (Buffer& b : made)
+                    detail::destroyBuffer(ctx, b);
+                return buffer.error();
+            }
+            made[i] = *buffer;
+        }
+        Buffer* current[kBuffers] = {&samples, &hits, &tiles, &surfaces, &ranges};
+        for (int i = 0; i < kBuffers; ++i) {
+            detail::destroyBuffer(ctx, *current[i]);
+            *current[i] = made[i];
+        }
+        sampleCapacity = count;
+        tileCapacity = tileCount;
+        writeDescriptors();
+        return Ok{};
+    }
+
+    // Grows the image buffers to hold `count` pixels; never shrinks them. On failure the old
+    // buffers stay.
+    Status reserve(uint32_t count) {
+        if (count <= capacity) return Ok{};
+        constexpr VkBufferUsageFlags kOutput = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                               VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                                               VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+        const VkDeviceSize sizes[] = {VkDeviceSize(count) * 4, VkDeviceSize(count) * 8};
+        Buffer made[4]; // pixels, info, and their staging copies when those are not mappable
+        auto create = [&](int i, VkDeviceSize size, VkBufferUsageFlags usage,
+                          detail::MemoryUse use) -> Status {
+            auto buffer = detail::createBuffer(ctx, size, usage, use);
+            if (!buffer) {
+                for (Buffer& b : made)
+                    detail::destroyBuffer(ctx, b);
+                return buffer.error();
+            }
+            made[i] = *buffer;
+            return Ok{};
+        };
+        for (int i = 0; i < 2; ++i)
+            if (auto ok = create(i, sizes[i], kOutput, detail::MemoryUse::Readback); !ok) return ok;
+        if (!made[0].data || !made[1].data)
+            for (int i = 0; i < 2; ++i)
+                if (auto ok = create(2 + i, sizes[i], VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                     detail::MemoryUse::Staging);
+                    !ok)
+                    return ok;
+        Buffer* current[] = {&pixels, &info, &pixelsStaging, &infoStaging};
+        for (int i = 0; i < 4; ++i) {
+            detail::destroyBuffer(ctx, *current[i]);
+            *current[i] = made[i];
+        }
+        capacity = count;
+        writeDescriptors();
+        return Ok{};
+    }
+
+    // The frame's values (f) and those that its branches read (fc).
+    void frameValues(const RenderOptions& render, const detail::RayCamera& rc,
+                     const detail::ClipVolume& clip, FrameUniform& f, FrameControl& fc) const {
+        Aabb finite = detail::finitePrimitiveBounds(*evaluator);
+
+        f = {};
+        fc = {};
+        f.eye = glm::vec4(rc.eye, rc.tanHalfFov);
+        f.right = glm::vec4(rc.right, rc.aspect);
+        f.up = glm::vec4(rc.up, rc.footprint);
+        f.forward = glm::vec4(rc.forward, detail::kMinHitEpsilon);
+        f.clipMin = glm::vec4(clip.box.min, clip.far);
+        // Supersampling resolves detail finer than a pixel: the hit epsilon follows the sample.
+        f.clipMax = glm::vec4(clip.box.max, rc.footprint / float(std::max(render.aa, 1u)));
+        fc.parts.x = uint32_t(clip.parts.size());
+        for (size_t i = 0; i < clip.parts.size(); ++i) {
+            const detail::SurfacePart& part = clip.parts[i];
+            f.surfaceBoxes[2 * i] = part.halfSpace ? glm::vec4(part.normal, 1.0f)
+                                                   : glm::vec4(part.box.min, 0.0f);
+            f.surfaceBoxes[2 * i + 1] = part.halfSpace ? glm::vec4(part.offset, 0.0f, 0.0f, 0.0f)
+                                                       : glm::vec4(part.box.max, 0.0f);
+        }
+        f.background = glm::vec4(scene.background, 0.0f);
+        f.sky = glm::vec4(scene.background * scene.background, 0.0f); // gamma 2, as the kernel
+        const float size = std::max(glm::length(finite.max - finite.min), 1e-3f);
+        float nearest = finite.distance(rc.eye), farthest = 0.0f;
+        for (int c = 0; c < 8; ++c) {
+            glm::vec3 corner((c & 1) ? finite.max.x : finite.min.x,
+                             (c & 2) ? finite.max.y : finite.min.y,
+                             (c & 4) ? finite.max.z : finite.min.z);
+            farthest = std::max(farthest, glm::length(corner - rc.eye));
+        }
+        f.distances = glm::vec4(nearest, farthest, 0.2f * size, size);
+
+        uint32_t flags = 0;
+        if (render.shadows) flags |= SDFCSG_FLAG_SHADOWS;
+        if (render.ambientOcclusion) flags |= SDFCSG_FLAG_AO;
+        if (render.boxes == BoxOverlay::All) flags |= SDFCSG_FLAG_BOXES_ALL;
+        if (render.boxes == BoxOverlay::Selected) flags |= SDFCSG_FLAG_BOXES_SELECTED;
+        if (render.grid) {
+            flags |= SDFCSG_FLAG_GRID;
+            const GroundGrid g = groundGrid(*evaluator);
+            f.grid = glm::vec4(g.centreX, g.centreZ, g.height, g.spacing);
+        }
+        fc.size = glm::uvec4(render.width, render.height, uint32_t(render.mode), flags);
+
+        std::vector<Light> lights = scene.lights.empty() ? defaultLights() : scene.lights;
+        uint32_t lightCount = uint32_t(std::min<size_t>(lights.size(), SDFCSG_MAX_LIGHTS));
+        for (uint32_t i = 0; i < lightCount; ++i) {
+            glm::vec3 l = -glm::normalize(lights[i].direction);
+            f.lights[i].direction = glm::vec4(l, 0.0f);
+            for (int c = 0; c < 3; ++c) // as safeInverse() in the kernel
+                f.lights[i].inverse[c] =
+                    1.0f / (std::abs(l[c]) < 1e-20f ? (l[c] >= 0.0f ? 1e-20f : -1e-20f) : l[c]);
+            f.lights[i].color = glm::vec4(lights[i].color * lights[i].intensity, 0.0f);
+        }
+        uint32_t selected = render.selectedNode >= 0 ? uint32_t(render.selectedNode) : nodeCount;
+        fc.counts = glm::uvec4(render.aa, lightCount, nodeCount, selected);
+    }
+};
+
+GroundGrid groundGrid(const Evaluator& evaluator) {
+    const Aabb box = detail::finiteSceneBounds(evaluator);
+    const float width = std::max(box.max.x - box.min.x, box.max.z - box.min.z);
+    GroundGrid g;
+    g.spacing = std::pow(10.0f, std::floor(std::log10(std::max(width, 1e-3f) / 2.0f)));
+    g.centreX = std::round(0.5f * (box.min.x + box.max.x) / g.spacing) * g.spacing;
+    g.centreZ = std::round(0.5f * (box.min.z + box.max.z) / g.spacing) * g.spacing;
+    g.height = box.min.y;
+    return g;
+}
+
+std::optional<RenderMode> parseRenderMode(std::string_view name) {
+    if (name == "shaded") return RenderMode::Shaded;
+    if (name == "normals") return RenderMode::Normals;
+    if (name == "depth") return RenderMode::Depth;
+    if (name == "steps") return RenderMode::Steps;
+    return std::nullopt;
+}
+
+Renderer::Renderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Renderer::~Renderer() = default;
+
+VkPipeline SharedPasses::created(uint32_t pass) {
+    VkPipeline& p = pipelines[pass];
+    if (p) return p;
+    const bool perHit = pass == SDFCSG_RAYMARCH_PASS_ENDS || pass == SDFCSG_RAYMARCH_PASS_LIGHT;
+    VkShaderModule module = pass == SDFCSG_RAYMARCH_PASS_CLIP ? clip : perHit ? light : finish;
+    p = detail::createComputePipeline(ctx, module, layout,
+                                      Renderer::Impl::specConstants(pass, false));
+    return p;
+}
+
+Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene& scene,
+                                                   const RendererOptions& options) {
+    if (scene.nodes.empty()) return usage("the scene has no nodes");
+    auto impl = std::make_unique<Impl>(context.impl());
+    Impl& r = *impl;
+    r.options = options;
+    r.scene = scene;
+    r.evaluator = std::make_unique<Evaluator>(scene);
+    r.nodeCount = uint32_t(scene.nodes.size());
+    // Pruned on the host while the kernels build (with tapes, they are the same for every
+    // scene): on the forest benchmark scene, most of the prune's time.
+    auto fieldWords = std::async(std::launch::async, [&] {
+        return detail::fieldWords(scene, *r.evaluator, options.evaluation);
+    });
+
+    auto shared = sharedPasses(r.ctx);
+    if (!shared) return shared.error();
+    r.shared = *shared;
+    r.pipelineLayout = r.shared->layout;
+    r.pool = detail::createDescriptorPool(r.ctx, kBindings);
+    r.set = detail::allocateDescriptorSet(r.ctx, r.pool, r.shared->setLayout);
+
+    auto frame = detail::createBuffer(
+        r.ctx, sizeof(FrameUniform), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, detail::MemoryUse::Upload);
+    if (!frame) return frame.error();
+    r.frame = *frame;
+    auto control = detail::createBuffer(
+        r.ctx, sizeof(FrameControl), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, detail::MemoryUse::Upload);
+    if (!control) return control.error();
+    r.control = *control;
+    auto nodes =
+        detail::createBuffer(r.ctx, detail::packNodes(*r.evaluator).size() * sizeof(detail::GpuNode),
+                             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, detail::MemoryUse::Upload);
+    if (!nodes) return nodes.error();
+    r.nodes = *nodes;
+    if (auto uploaded = r.uploadNodes(detail::emptyField()); !uploaded) return uploaded.error();
+    if (auto reserved = r.reserve(64 * 64); !reserved) return reserved.error();
+    if (auto reserved = r.reserveSamples(64 * 64, 64); !reserved) return reserved.error();
+    if (auto built = r.buildKernels(); !built) return built.error();
+    // The passes around the march and shade passes run in every shaded frame (the first
+    // renderer of the context makes them; buildKernels() has made the light pass, and on
+    // lavapipe compiled the others on the helper).
+    r.pipeline(SDFCSG_RAYMARCH_PASS_CLIP, false);
+    r.pipeline(SDFCSG_RAYMARCH_PASS_ENDS, false);
+    r.pipeline(SDFCSG_RAYMARCH_PASS_LIGHT, false);
+    auto words = fieldWords.get();
+    if (!words) return words.error();
+    if (auto uploaded = r.uploadNodes(*words); !uploaded) return uploaded.error();
+    return std::unique_ptr<Renderer>(new Renderer(std::move(impl)));
+}
+
+Status Renderer::updateValues(const Scene& scene) {
+    if (!sameStructure(impl_->scene, scene))
+        return usage("updateValues: the scene's structure (node kinds or children) differs from "
+                     "the compiled one; create a new Renderer instead");
+    Impl& r = *impl_;
+    Scene previous = std::move(r.scene);
+    r.scene = scene;
+    if (r.options.inlineValues && !usesTapes(scene, r.options.evaluation)) {
+        if (auto built = r.buildKernels(); !built) {
+            r.scene = std::move(previous);
+            return built.error();
+        }
+    }
+    r.evaluator = std::make_unique<Evaluator>(scene);
+    auto words = detail::fieldWords(scene, *r.evaluator, r.options.evaluation);
+    if (!words) {
+        r.scene = std::move(previous);
+        r.evaluator = std::make_unique<Evaluator>(r.scene);
+        return words.error();
+    }
+    return r.uploadNodes(*words); // no render is in flight: render() waits for its fence
+}
+
+Result<Image> Renderer::render(const RenderOptions& options) {
+    Impl& r = *impl_;
+    const VkPhysicalDeviceLimits& limits = r.ctx.properties.limits;
+    if (options.width == 0 || options.height == 0)
+        return usage("the image must be at least 1 x 1 pixels");
+    if (options.aa == 0 || options.aa > 16) return usage("aa must be in 1..16");
+    if (options.boxes == BoxOverlay::Selected &&
+        (options.selectedNode < 0 || uint32_t(options.selectedNode) >= r.nodeCount))
+        return usage("selectedNode " + std::to_string(options.selectedNode) +
+                     " is not a node of the scene (it has " + std::to_string(r.nodeCount) + ")");
+    // Bands of whole workgroup rows, about kBandSamples samples each: a heavy scene or a huge
+    // image never becomes one long dispatch (GPU drivers reset a device whose work runs for
+    // seconds), and the caller can follow progress and stop between bands.
+    const uint64_t count = uint64_t(options.width) * options.height;
+    const uint32_t aa = options.aa;
+    const uint64_t rowGroupSamples =
+        uint64_t(options.width) * aa * aa * SDFCSG_RAYMARCH_GROUP_Y;
+    const uint32_t bandGroups = uint32_t(std::max<uint64_t>(1, kBandSamples / rowGroupSamples));
+    const uint64_t bandSamples = rowGroupSamples * bandGroups;
+    const uint64_t sampleColumns = uint64_t(options.width) * aa;
+    const uint32_t groupsY = detail::groupCount(options.height, SDFCSG_RAYMARCH_GROUP_Y);
+    const uint64_t groupsX = (sampleColumns + SDFCSG_RAYMARCH_GROUP_X - 1) / SDFCSG_RAYMARCH_GROUP_X;
+    if (count * 8 > limits.maxStorageBufferRange ||
+        kHitsHeader + bandSamples * 8 > limits.maxStorageBufferRange ||
+        groupsX > limits.maxComputeWorkGroupCount[0] || groupsX > 0xffff ||
+        uint64_t(bandGroups) * aa > 0xffff || // the tile list packs x | y << 16
+        uint64_t(bandGroups) * aa > limits.maxComputeWorkGroupCount[1] ||
+        bandSamples / kGroupSize > limits.maxComputeWorkGroupCount[0])
+        return Error::message(ErrorKind::Limit, "<render>",
+                              "an image of " + std::to_string(options.width) + " x " +
+                                  std::to_string(options.height) + " pixels" +
+                                  (aa > 1 ? " at aa " + std::to_string(aa) : std::string()) +
+                                  " is too large for " + r.ctx.properties.deviceName);
+    if (auto reserved = r.reserve(uint32_t(count)); !reserved) return reserved.error();
+    if (auto reserved = r.reserveSamples(uint32_t(bandSamples), uint32_t(groupsX) * bandGroups * aa);
+        !reserved)
+        return reserved.error();
+    // One sample per pixel: the passes write the image directly and no resolve runs.
+    if (r.samplesArePixels != (aa == 1)) {
+        r.samplesArePixels = aa == 1;
+        r.writeDescriptors();
+    }
+
+    float aspect = float(options.width) / float(options.height);
+    Camera camera = options.camera   ? *options.camera
+                    : r.scene.camera ? *r.scene.camera
+                                     : frameCamera(*r.evaluator, aspect);
+    const bool skipping = options.boundsSkipping.value_or(r.defaultSkipping());
+    if (auto made = r.kernels(skipping); !made) return made.error();
+    const bool shading = options.mode == RenderMode::Shaded || options.mode == RenderMode::Normals;
+    VkPipeline clipRays = r.pipeline(SDFCSG_RAYMARCH_PASS_CLIP, false);
+    VkPipeline march = r.pipeline(SDFCSG_RAYMARCH_PASS_MARCH, skipping);
+    VkPipeline shade = shading ? r.pipeline(SDFCSG_RAYMARCH_PASS_SHADE, skipping) : VK_NULL_HANDLE;
+    VkPipeline light = shading ? r.pipeline(SDFCSG_RAYMARCH_PASS_LIGHT, false) : VK_NULL_HANDLE;
+    VkPipeline ends = shading && options.mode == RenderMode::Shaded && options.shadows
+                          ? r.pipeline(SDFCSG_RAYMARCH_PASS_ENDS, false)
+                          : VK_NULL_HANDLE;
+    VkPipeline resolve = aa > 1 ? r.pipeline(SDFCSG_RAYMARCH_PASS_RESOLVE, false) : VK_NULL_HANDLE;
+    const bool overlays = options.grid || options.boxes != BoxOverlay::None;
+    VkPipeline overlay =
+        overlays ? r.pipeline(SDFCSG_RAYMARCH_PASS_OVERLAY, false) : VK_NULL_HANDLE;
+    const detail::RayCamera rc = detail::makeRayCamera(camera, options.width, options.height);
+    const detail::ClipVolume clip = detail::makeClipVolume(*r.evaluator, rc.eye);
+    FrameUniform f;
+    FrameControl control;
+    r.frameValues(options, rc, clip, f, control);
+    detail::uploadBuffer(r.ctx, r.frame, &f, sizeof(f));
+    detail::uploadBuffer(r.ctx, r.control, &control, sizeof(control));
+
+    // Workgroups whose rays cannot meet a surface are not marched; the band is filled with the
+    // colour and info of a miss first (t = -1; the steps word too, read back as 0). The steps
+    // mode colours misses by their steps, so it traces every ray.
+    std::vector<detail::ScreenRect> rects;
+    const bool culling = options.mode != RenderMode::Steps &&
+                         detail::surfaceRects(rc, clip, options.width, options.height, rects);
+    auto packed = [](glm::vec3 c) {
+        glm::uvec3 u(glm::clamp(c, 0.0f, 1.0f) * 255.0f + 0.5f);
+        return u.r | (u.g << 8) | (u.b << 16) | (255u << 24);
+    };
+    const uint32_t missColor = packed(options.mode == RenderMode::Shaded ? r.scene.background
+                                                                          : glm::vec3(0.0f));
+    const float missInfo = -1.0f;
+    uint32_t missInfoBits;
+    std::memcpy(&missInfoBits, &missInfo, sizeof missInfoBits);
+    std::vector<uint32_t> tiles;
+
+    for (uint32_t firstGroup = 0; firstGroup < groupsY; firstGroup += bandGroups) {
+        const uint32_t groups = std::min(bandGroups, groupsY - firstGroup);
+        const uint32_t firstRow = firstGroup * SDFCSG_RAYMARCH_GROUP_Y;
+        const BandConstants band = {firstRow, aa == 1 ? firstRow * options.width : 0u};
+        const uint32_t rows = std::min(groups * SDFCSG_RAYMARCH_GROUP_Y, options.height - firstRow);
+        tiles.clear();
+        for (uint32_t ty = 0; ty < groups * aa; ++ty) {
+            const float y0 = float(firstRow) + float(ty * SDFCSG_RAYMARCH_GROUP_Y) / float(aa);
+            const float y1 = y0 + float(SDFCSG_RAYMARCH_GROUP_Y) / float(aa);
+            for (uint32_t tx = 0; tx < groupsX; ++tx) {
+                const float x0 = float(tx * SDFCSG_RAYMARCH_GROUP_X) / float(aa);
+                const float x1 = x0 + float(SDFCSG_RAYMARCH_GROUP_X) / float(aa);
+                bool visible = !culling;
+                for (const detail::ScreenRect& q : rects)
+                    visible = visible || (x0 < q.x1 && x1 > q.x0 && y0 < q.y1 && y1 > q.y0);
+                if (visible) tiles.push_back(tx | ty << 16);
+            }
+        }
+        if (!tiles.empty())
+            detail::uploadBuffer(r.ctx, r.tiles, tiles.data(), tiles.size() * sizeof(uint32_t));
+
+        VkCommandBuffer cmd = detail::beginCommands(r.ctx);
+        if (culling) {
+            const VkDeviceSize first = VkDeviceSize(firstRow) * options.width;
+            const VkDeviceSize pixelsInBand = VkDeviceSize(rows) * options.width;
+            if (aa == 1)
+                vkCmdFillBuffer(cmd, r.pixels.buffer, first * 4, pixelsInBand * 4, missColor);
+            else
+                vkCmdFillBuffer(cmd, r.samples.buffer, 0, pixelsInBand * aa * aa * 4, missColor);
+            vkCmdFillBuffer(cmd, r.info.buffer, first * 8, pixelsInBand * 8, missInfoBits);
+        }
+        vkCmdFillBuffer(cmd, r.hits.buffer, 0, 8, 0); // count, and the shade dispatch's x
+        vkCmdFillBuffer(cmd, r.hits.buffer, 8, 8, 1); // its y and z
+        detail::recordComputeBarrier(cmd);
+        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r.pipelineLayout, 0, 1,
+                                &r.set, 0, nullptr);
+        vkCmdPushConstants(cmd, r.pipelineLayout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof band,
+                           &band);
+        if (!tiles.empty()) { // the listed workgroups' samples
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, clipRays);
+            vkCmdDispatch(cmd, uint32_t(tiles.size()), 1, 1);
+            detail::recordComputeBarrier(cmd);
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, march);
+            vkCmdDispatch(cmd, uint32_t(tiles.size()), 1, 1);
+        }
+        for (VkPipeline perHit : {ends, shade, light}) { // one invocation per listed hit
+            if (!perHit) continue;
+            detail::recordComputeBarrier(cmd);
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, perHit);
+            vkCmdDispatchIndirect(cmd, r.hits.buffer, 4);
+        }
+        for (VkPipeline perPixel : {resolve, overlay}) {
+            if (!perPixel) continue;
+            detail::recordComputeBarrier(cmd);
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, perPixel);
+            vkCmdDispatch(cmd, detail::groupCount(options.width, SDFCSG_RAYMARCH_GROUP_X), groups,
+                          1);
+        }
+        const bool last = firstGroup + groups == groupsY;
+        if (last) {
+            detail::recordReadback(cmd, r.pixels, &r.pixelsStaging);
+            detail::recordReadback(cmd, r.info, &r.infoStaging);
+        }
+        detail::submitAndWait(r.ctx);
+        const float done = float(firstGroup + groups) / float(groupsY);
+        if (options.progress && !options.progress(done) && !last)
+            return Error::message(ErrorKind::Cancelled, "<render>", "cancelled");
+    }
+
+    Image image;
+    image.width = options.width;
+    image.height = options.height;
+    image.rgba.resize(count * 4);
+    std::memcpy(image.rgba.data(), detail::readback(r.ctx, r.pixels, &r.pixelsStaging), count * 4);
+    const auto* info = static_cast<const float*>(detail::readback(r.ctx, r.info, &r.infoStaging));
+    r.lastInfo.resize(count);
+    for (uint64_t i = 0; i < count; ++i)
+        r.lastInfo[i] = PixelInfo{info[2 * i], info[2 * i + 1] > 0.0f ? uint32_t(info[2 * i + 1]) : 0u};
+    return image;
+}
+
+const std::vector<PixelInfo>& Renderer::lastPixelInfo() const {
+    return impl_->lastInfo;
+}
+
+} // namespace sdfcsg
