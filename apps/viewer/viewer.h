@@ -6,7 +6,7 @@
 //   input.cpp       mouse and keyboard
 //   panels.cpp      the ImGui panels
 //   automation.cpp  the commands of --script
-//   presenter.cpp   the window's Vulkan device (presenter.h)
+//   presenter.cpp, mesh_view.cpp  the window's Vulkan device (presenter.h)
 #pragma once
 
 #include "document.h"

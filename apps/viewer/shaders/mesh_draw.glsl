@@ -1,5 +1,5 @@
 // What the viewer's mesh-view shaders share: the push constants, set by drawMesh() in
-// presenter.cpp (MeshConstants there has the same layout).
+// mesh_view.cpp (MeshConstants there has the same layout).
 
 layout(push_constant) uniform MeshConstants {
     vec4 eye;     // xyz: the camera; w: distance of the near plane
