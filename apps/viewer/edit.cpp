@@ -65,9 +65,10 @@ void defaultParams(Node& node) {
 
 // Whether the node is an extrude or a revolve or lies inside one (where 2D profiles may go).
 bool cutsProfiles(const Scene& scene, int node) {
-    for (; node >= 0; node = parentOf(scene, uint32_t(node)))
-        if (scene.nodes[node].kind == NodeKind::Extrude || scene.nodes[node].kind == NodeKind::Revolve)
-            return true;
+    for (; node >= 0; node = parentOf(scene, uint32_t(node))) {
+        const NodeKind kind = scene.nodes[node].kind;
+        if (kind == NodeKind::Extrude || kind == NodeKind::Revolve) return true;
+    }
     return false;
 }
 
