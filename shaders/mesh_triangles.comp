@@ -203,6 +203,11 @@ vec3 solveQef(mat3 ata, vec3 atb, vec3 mass, vec3 lo, float h) {
 // normal direction would be dropped anyway.
 const float kFlat = 0.995;
 
+// Vertices keep this fraction of a cell from the faces of their cell: vertices of neighbouring
+// cells then never coincide (a pinch in the surface), and seen along its edge the four of each
+// quad lie strictly around it.
+const float kInset = 0.005;
+
 // The dual passes' work items, listed by the first SDFCSG_MESH_BRICK invocations: the dual
 // vertices (owned cell | piece << 9 | case << 11) or the quads (owned sample | axis << 9 |
 // 1 << 11 when its lower end is inside).
@@ -264,6 +269,7 @@ void emitDualVertices(uint slot, uvec3 brick) {
         } else {
             p = lo + solveQef(ata, atb, mass, vec3(0.0), grid.origin.w);
         }
+        p = clamp(p, lo + kInset * grid.origin.w, lo + (1.0 - kInset) * grid.origin.w);
         // Where the normals of a piece nearly cancel (a sheet thinner than a cell), the first one.
         normal = length(normal) > 0.1 ? normalize(normal) : first0;
         // The colour of the nearest edge point: a mean would blend the colours of two operands

@@ -302,8 +302,11 @@ ReferenceMesh referenceDualMeshOf(const Distance& distance, const Color& color,
                         normal += field.points.normals[k];
                         colours.push_back(field.points.colors[k]);
                     }
-                    const glm::vec3 p = referenceQef(points, normals, others,
-                                                     field.position(cell), grid.voxelSize);
+                    // kInset in shaders/mesh_triangles.comp: off the cell's faces.
+                    const glm::vec3 lo = field.position(cell);
+                    const glm::vec3 p = glm::clamp(
+                        referenceQef(points, normals, others, lo, grid.voxelSize),
+                        lo + 0.005f * grid.voxelSize, lo + (1.0f - 0.005f) * grid.voxelSize);
                     size_t nearest = 0; // its colour is the vertex's
                     for (size_t k = 1; k < points.size(); ++k)
                         if (glm::dot(points[k] - p, points[k] - p) <
