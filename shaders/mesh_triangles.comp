@@ -205,7 +205,8 @@ const float kFlat = 0.995;
 
 // Vertices keep this fraction of a cell from the faces of their cell: vertices of neighbouring
 // cells then never coincide (a pinch in the surface), and seen along its edge the four of each
-// quad lie strictly around it.
+// quad lie strictly around it, so that foldQuads() on the host finds a diagonal whose triangles
+// both wind around the edge.
 const float kInset = 0.005;
 
 // The dual passes' work items, listed by the first SDFCSG_MESH_BRICK invocations: the dual
@@ -397,9 +398,11 @@ void emitQuads(uint slot, uvec3 brick) {
         uint q2 = dualVertex(l, uvec3(0u), axis);
         uint q3 = dualVertex(l - u, uvec3(u), axis);
         // Outward (towards d > 0) is along the axis when the lower end is inside. As (a, b, c),
-        // (a, c, d): the host may split it along b-d instead.
+        // (a, c, d), the second starting at its axis'th corner: the host reads the edge's axis
+        // from it and may split the quad along b-d instead (foldQuads in mesh_dual.cpp).
         uvec3 t0 = inside ? uvec3(q0, q1, q2) : uvec3(q0, q3, q2);
         uvec3 t1 = inside ? uvec3(q0, q2, q3) : uvec3(q0, q2, q1);
+        t1 = axis == 0u ? t1 : axis == 1u ? t1.yzx : t1.zxy;
         uint o = (first + 2u * i) * 3u;
         indices[o + 0u] = t0.x;
         indices[o + 1u] = t0.y;

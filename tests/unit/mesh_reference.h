@@ -347,9 +347,10 @@ ReferenceMesh referenceDualMeshOf(const Distance& distance, const Color& color,
                     uint32_t q[4];
                     for (int k = 0; k < 4; ++k)
                         q[k] = vertexOf(cells[k], s - cells[k], axis);
-                    const uint32_t quad[2][6] = {{q[0], q[3], q[2], q[0], q[2], q[1]},
-                                                 {q[0], q[1], q[2], q[0], q[2], q[3]}};
-                    const uint32_t* t = quad[field.inside(s) ? 1 : 0];
+                    uint32_t quad[2][6] = {{q[0], q[3], q[2], q[0], q[2], q[1]},
+                                           {q[0], q[1], q[2], q[0], q[2], q[3]}};
+                    uint32_t* t = quad[field.inside(s) ? 1 : 0];
+                    std::rotate(t + 3, t + 3 + axis, t + 6); // names the axis (foldQuads)
                     mesh.indices.insert(mesh.indices.end(), t, t + 6);
                 }
     detail::foldQuads(mesh);
