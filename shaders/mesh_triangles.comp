@@ -161,8 +161,9 @@ void eigenSymmetric(inout mat3 a, out mat3 v) {
 // (eigenvalues under a hundredth of the largest) keep the mass point's coordinate, so flat and
 // curved pieces stay where their points are. Where the best point lies outside the cell, it
 // moves along the least constrained direction into the cell if it can, so that a vertex meant
-// for a sharp edge that only clips the cell stays on that edge; otherwise it is clamped.
-vec3 solveQef(mat3 ata, vec3 atb, vec3 mass, vec3 lo, float h) {
+// for a sharp edge that only clips the cell stays on that edge; otherwise it is clamped, or for
+// a slab (normals that face nearly opposite ways) it is the mass point.
+vec3 solveQef(mat3 ata, vec3 atb, vec3 mass, vec3 lo, float h, bool slab) {
     mat3 v;
     eigenSymmetric(ata, v);
     vec3 lambda = vec3(ata[0][0], ata[1][1], ata[2][2]);
@@ -194,6 +195,11 @@ vec3 solveQef(mat3 ata, vec3 atb, vec3 mass, vec3 lo, float h) {
         float wanted = rank == 3 ? dot(v[weakest], atb) / lambda[weakest] : 0.0;
         if (s0 <= s1) return clamp(base + dir * clamp(wanted, s0, s1), lo, hi);
     }
+    // Sheets that face nearly opposite ways and meet outside the cell bound a slab thinner than
+    // the cell: no point of the cell lies on both, and clamping would pull the vertex to the
+    // cell's side nearest their meeting line, folding the quads of the two sheets over each
+    // other. The mass point lies between them.
+    if (slab) return mass;
     return clamp(best, lo, hi);
 }
 
@@ -202,6 +208,9 @@ vec3 solveQef(mat3 ata, vec3 atb, vec3 mass, vec3 lo, float h) {
 // eigenvectors: with a hundredth of the largest eigenvalue as the cut (solveQef), all but the
 // normal direction would be dropped anyway.
 const float kFlat = 0.995;
+
+// Pieces with two normals further apart than this cosine (143 degrees) are slabs for solveQef().
+const float kSlab = -0.8;
 
 // Vertices keep this fraction of a cell from the faces of their cell: vertices of neighbouring
 // cells then never coincide (a pinch in the surface), and seen along its edge the four of each
@@ -268,7 +277,7 @@ void emitDualVertices(uint slot, uvec3 brick) {
             p = lo + clamp(mass + mean * (dot(mean, atb) / dot(mean, ata * mean)), vec3(0.0),
                            vec3(grid.origin.w));
         } else {
-            p = lo + solveQef(ata, atb, mass, vec3(0.0), grid.origin.w);
+            p = lo + solveQef(ata, atb, mass, vec3(0.0), grid.origin.w, leastCos < kSlab);
         }
         p = clamp(p, lo + kInset * grid.origin.w, lo + (1.0 - kInset) * grid.origin.w);
         // Where the normals of a piece nearly cancel (a sheet thinner than a cell), the first one.

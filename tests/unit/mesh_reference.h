@@ -173,8 +173,8 @@ ReferenceMesh referenceMeshOf(const Distance& distance, const Color& color,
 // others[k] (the same, or the other face's at a sharp edge), kept in the
 // cell [lo, lo + h]: the mass point plus the least-squares step along the eigenvectors of
 // sum n n^T whose eigenvalues reach a hundredth of the largest; outside the cell, moved along
-// the weakest of them into it where it can be, else clamped (solveQef() in
-// shaders/mesh_triangles.comp).
+// the weakest of them into it where it can be, else clamped, or for a slab (two normals more
+// than 143 degrees apart) the mass point (solveQef() in shaders/mesh_triangles.comp).
 inline glm::vec3 referenceQef(const std::vector<glm::vec3>& points,
                               const std::vector<glm::vec3>& normals,
                               const std::vector<glm::vec3>& others, glm::vec3 lo, float h) {
@@ -268,6 +268,7 @@ inline glm::vec3 referenceQef(const std::vector<glm::vec3>& points,
             return glm::clamp(glm::vec3(base + dir * std::clamp(wanted, s0, s1)), lo,
                               lo + glm::vec3(h));
     }
+    if (leastCos < -0.8f) return glm::vec3(mass); // kSlab
     return glm::clamp(glm::vec3(best), lo, lo + glm::vec3(h));
 }
 
