@@ -162,8 +162,9 @@ void eigenSymmetric(inout mat3 a, out mat3 v) {
 // (eigenvalues under a hundredth of the largest) keep the mass point's coordinate, so flat and
 // curved pieces stay where their points are. Where the best point lies outside the cell, it
 // moves along the least constrained direction into the cell if it can, so that a vertex meant
-// for a sharp edge that only clips the cell stays on that edge; otherwise it is clamped.
-vec3 solveQef(mat3 ata, vec3 atb, vec3 mass, vec3 lo, float h) {
+// for a sharp edge that only clips the cell stays on that edge; otherwise it is clamped, or for
+// a slab (normals that face nearly opposite ways) it is the mass point.
+vec3 solveQef(mat3 ata, vec3 atb, vec3 mass, vec3 lo, float h, bool slab) {
     mat3 v;
     eigenSymmetric(ata, v);
     vec3 lambda = vec3(ata[0][0], ata[1][1], ata[2][2]);
@@ -195,6 +196,11 @@ vec3 solveQef(mat3 ata, vec3 atb, vec3 mass, vec3 lo, float h) {
         float wanted = rank == 3 ? dot(v[weakest], atb) / lambda[weakest] : 0.0;
         if (s0 <= s1) return clamp(base + dir * clamp(wanted, s0, s1), lo, hi);
     }
+    // Sheets that face nearly opposite ways and meet outside the cell bound a slab thinner than
+    // the cell: no point of the cell lies on both, and clamping would pull the vertex to the
+    // cell's side nearest their meeting line, folding the quads of the two sheets over each
+    // other. The mass point lies between them.
+    if (slab) return mass;
     return clamp(best, lo, hi);
 }
 
@@ -203,6 +209,15 @@ vec3 solveQef(mat3 ata, vec3 atb, vec3 mass, vec3 lo, float h) {
 // eigenvectors: with a hundredth of the largest eigenvalue as the cut (solveQef), all but the
 // normal direction would be dropped anyway.
 const float kFlat = 0.995;
+
+// Pieces with two normals further apart than this cosine (143 degrees) are slabs for solveQef().
+const float kSlab = -0.8;
+
+// Vertices keep this fraction of a cell from the faces of their cell: vertices of neighbouring
+// cells then never coincide (a pinch in the surface), and seen along its edge the four of each
+// quad lie strictly around it, so that foldQuads() on the host finds a diagonal whose triangles
+// both wind around the edge.
+const float kInset = 0.005;
 
 // The dual passes' work items, listed by the first SDFCSG_MESH_BRICK invocations: the dual
 // vertices (owned cell | piece << 9 | case << 11) or the quads (owned sample | axis << 9 |
@@ -263,8 +278,9 @@ void emitDualVertices(uint slot, uvec3 brick) {
             p = lo + clamp(mass + mean * (dot(mean, atb) / dot(mean, ata * mean)), vec3(0.0),
                            vec3(grid.origin.w));
         } else {
-            p = lo + solveQef(ata, atb, mass, vec3(0.0), grid.origin.w);
+            p = lo + solveQef(ata, atb, mass, vec3(0.0), grid.origin.w, leastCos < kSlab);
         }
+        p = clamp(p, lo + kInset * grid.origin.w, lo + (1.0 - kInset) * grid.origin.w);
         // Where the normals of a piece nearly cancel (a sheet thinner than a cell), the first one.
         normal = length(normal) > 0.1 ? normalize(normal) : first0;
         // The colour of the nearest edge point: a mean would blend the colours of two operands
@@ -392,9 +408,11 @@ void emitQuads(uint slot, uvec3 brick) {
         uint q2 = dualVertex(l, uvec3(0u), axis);
         uint q3 = dualVertex(l - u, uvec3(u), axis);
         // Outward (towards d > 0) is along the axis when the lower end is inside. As (a, b, c),
-        // (a, c, d): the host may split it along b-d instead.
+        // (a, c, d), the second starting at its axis'th corner: the host reads the edge's axis
+        // from it and may split the quad along b-d instead (foldQuads in mesh_dual.cpp).
         uvec3 t0 = inside ? uvec3(q0, q1, q2) : uvec3(q0, q3, q2);
         uvec3 t1 = inside ? uvec3(q0, q2, q3) : uvec3(q0, q2, q1);
+        t1 = axis == 0u ? t1 : axis == 1u ? t1.yzx : t1.zxy;
         uint o = (first + 2u * i) * 3u;
         indices[o + 0u] = t0.x;
         indices[o + 1u] = t0.y;

@@ -1,6 +1,8 @@
 // Properties of a triangle mesh that tests assert on: closed and manifold (every edge shared by two
 // triangles in opposite directions), Euler characteristic, signed volume, area, distance of the
-// vertices from the surface, outward normals, and an order-independent comparison of two meshes.
+// vertices and of points across the triangles from the surface, outward normals, triangles that
+// intersect each other or face against the field, and an order-independent comparison of two
+// meshes.
 #pragma once
 
 #include <sdfcsg/eval.h>
@@ -11,12 +13,14 @@
 #include <glm/vec3.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <iterator>
 #include <sstream>
 #include <string>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 namespace sdfcsg::test {
@@ -95,6 +99,351 @@ inline float maxSurfaceDistance(const Mesh& mesh, const Evaluator& evaluator) {
     for (const glm::vec3& p : mesh.positions)
         worst = std::max(worst, std::abs(evaluator.distance(p)));
     return worst;
+}
+
+// The largest |distance| from the surface, by the CPU evaluator, of seven points on every
+// triangle: its centre, the middles of its sides and the points halfway from the centre to each
+// corner (the points of surfaceError() in apps/bench.cpp). Unlike maxSurfaceDistance(), this
+// sees a triangle that cuts across a sharp edge or corner of the solid.
+inline float maxSampledSurfaceDistance(const Mesh& mesh, const Evaluator& evaluator) {
+    const glm::vec3 weights[7] = {glm::vec3(1.0f / 3),
+                                  glm::vec3(0.5f, 0.5f, 0.0f),
+                                  glm::vec3(0.0f, 0.5f, 0.5f),
+                                  glm::vec3(0.5f, 0.0f, 0.5f),
+                                  glm::vec3(2, 0.5f, 0.5f) / 3.0f,
+                                  glm::vec3(0.5f, 2, 0.5f) / 3.0f,
+                                  glm::vec3(0.5f, 0.5f, 2) / 3.0f};
+    float worst = 0.0f;
+    for (size_t t = 0; t + 3 <= mesh.indices.size(); t += 3) {
+        const glm::vec3 a = mesh.positions[mesh.indices[t]];
+        const glm::vec3 b = mesh.positions[mesh.indices[t + 1]];
+        const glm::vec3 c = mesh.positions[mesh.indices[t + 2]];
+        for (const glm::vec3& w : weights)
+            worst = std::max(worst, std::abs(evaluator.distance(w.x * a + w.y * b + w.z * c)));
+    }
+    return worst;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Triangles that intersect each other.
+
+namespace geometry {
+
+using glm::dvec3;
+
+inline double pointSegmentDistance(dvec3 p, dvec3 a, dvec3 b) {
+    const dvec3 ab = b - a;
+    const double length2 = glm::dot(ab, ab);
+    const double t = length2 > 0.0 ? std::clamp(glm::dot(p - a, ab) / length2, 0.0, 1.0) : 0.0;
+    return glm::length(p - (a + t * ab));
+}
+
+// Ericson, Real-Time Collision Detection (2005), 5.1.9: the closest points of two segments.
+inline double segmentSegmentDistance(dvec3 p1, dvec3 q1, dvec3 p2, dvec3 q2) {
+    const dvec3 d1 = q1 - p1, d2 = q2 - p2, r = p1 - p2;
+    const double a = glm::dot(d1, d1), e = glm::dot(d2, d2), f = glm::dot(d2, r);
+    if (a <= 0.0 && e <= 0.0) return glm::length(r);
+    double s = 0.0, t = 0.0;
+    if (a <= 0.0) {
+        t = std::clamp(f / e, 0.0, 1.0);
+    } else {
+        const double c = glm::dot(d1, r);
+        if (e <= 0.0) {
+            s = std::clamp(-c / a, 0.0, 1.0);
+        } else {
+            const double b = glm::dot(d1, d2), denominator = a * e - b * b;
+            s = denominator > 0.0 ? std::clamp((b * f - c * e) / denominator, 0.0, 1.0) : 0.0;
+            t = (b * s + f) / e;
+            if (t < 0.0) {
+                t = 0.0;
+                s = std::clamp(-c / a, 0.0, 1.0);
+            } else if (t > 1.0) {
+                t = 1.0;
+                s = std::clamp((b - c) / a, 0.0, 1.0);
+            }
+        }
+    }
+    return glm::length(p1 + d1 * s - (p2 + d2 * t));
+}
+
+// A triangle in double precision. One whose height over its longest side is at most the
+// tolerance of the test (a needle or a point) gets no plane: within that tolerance it is the
+// union of its sides, and a plane through it would only be rounding noise.
+struct Triangle {
+    std::array<dvec3, 3> v;
+    dvec3 normal{0.0}; // unit, or zero without a plane
+    dvec3 lo{0.0}, hi{0.0};
+
+    Triangle(glm::vec3 a, glm::vec3 b, glm::vec3 c, double tolerance)
+        : v{dvec3(a), dvec3(b), dvec3(c)} {
+        const dvec3 n = glm::cross(v[1] - v[0], v[2] - v[0]);
+        const double longest = std::max(
+            {glm::length(v[1] - v[0]), glm::length(v[2] - v[1]), glm::length(v[0] - v[2])});
+        if (glm::length(n) > tolerance * longest) normal = glm::normalize(n);
+        lo = glm::min(v[0], glm::min(v[1], v[2]));
+        hi = glm::max(v[0], glm::max(v[1], v[2]));
+    }
+    bool hasPlane() const { return normal != dvec3(0.0); }
+    // Whether x, taken as lying in the plane, is within the triangle (the prism over it).
+    bool overTriangle(dvec3 x) const {
+        for (int i = 0; i < 3; ++i)
+            if (glm::dot(glm::cross(v[(i + 1) % 3] - v[i], x - v[i]), normal) < 0.0) return false;
+        return true;
+    }
+    double distance(dvec3 p) const {
+        if (hasPlane() && overTriangle(p)) return std::abs(glm::dot(p - v[0], normal));
+        double d = pointSegmentDistance(p, v[0], v[1]);
+        d = std::min(d, pointSegmentDistance(p, v[1], v[2]));
+        return std::min(d, pointSegmentDistance(p, v[2], v[0]));
+    }
+};
+
+// Whether segment pq comes within `tolerance` of the triangle: it crosses the triangle's plane
+// over the triangle, or else the nearest points are an end of the segment and the triangle or
+// the segment and a side.
+inline bool segmentMeetsTriangle(dvec3 p, dvec3 q, const Triangle& t, double tolerance) {
+    if (t.hasPlane()) {
+        const double sp = glm::dot(p - t.v[0], t.normal), sq = glm::dot(q - t.v[0], t.normal);
+        if ((sp > tolerance && sq > tolerance) || (sp < -tolerance && sq < -tolerance))
+            return false;
+        if ((sp < 0.0) != (sq < 0.0) && t.overTriangle(p + (q - p) * (sp / (sp - sq)))) return true;
+    }
+    if (t.distance(p) <= tolerance || t.distance(q) <= tolerance) return true;
+    for (int i = 0; i < 3; ++i)
+        if (segmentSegmentDistance(p, q, t.v[i], t.v[(i + 1) % 3]) <= tolerance) return true;
+    return false;
+}
+
+// Two triangles come within `tolerance` of each other exactly when a side of one comes within it
+// of the other: where they cross, the ends of the crossing lie on sides; where they are apart,
+// the nearest points can be chosen with one of them on a side.
+inline bool trianglesMeet(const Triangle& a, const Triangle& b, double tolerance) {
+    for (int i = 0; i < 3; ++i)
+        if (segmentMeetsTriangle(a.v[i], a.v[(i + 1) % 3], b, tolerance) ||
+            segmentMeetsTriangle(b.v[i], b.v[(i + 1) % 3], a, tolerance))
+            return true;
+    return false;
+}
+
+} // namespace geometry
+
+struct SelfIntersections {
+    size_t crossing = 0;    // pairs with no vertex in common that meet
+    size_t overlapping = 0; // pairs with one vertex in common that also meet away from it
+    size_t folded = 0;      // pairs with a side in common that lie folded onto each other
+    size_t duplicates = 0;  // pairs with all three vertices in common
+    std::string first;      // the first pair found
+
+    size_t total() const { return crossing + overlapping + folded + duplicates; }
+    std::string str() const {
+        std::ostringstream s;
+        s << crossing << " pairs of triangles crossing, " << overlapping
+          << " overlapping beyond a common vertex, " << folded << " folded onto a common side, "
+          << duplicates << " duplicated";
+        if (!first.empty()) s << "; first: " << first;
+        return s.str();
+    }
+};
+
+// Pairs of triangles that meet where a surface embedded without self-intersections would not let
+// them: by vertex numbers, triangles with no vertex in common must not come within `tolerance` of
+// each other (distinct vertices at one position count: the surface is pinched there). Two with
+// one vertex v in common meet at v; they meet elsewhere as well exactly when the side opposite v
+// in one comes within the tolerance of the other (their intersection is convex and holds v, so
+// it is v alone or reaches from v to a point on such a side). Two with a side in common meet
+// beyond it only when they lie in one plane on the same side of it, folded onto each other: when
+// the angle between them at the side is under `foldAngle` radians. Triangles without a plane
+// (see geometry::Triangle) are judged by their sides alone, and pairs with a side in common of
+// which one has no plane not at all: checkTriangleFacing() reports them as degenerate.
+// `tolerance` defaults to 1e-6 of the diagonal of the mesh's bounds, above the rounding of float
+// positions and far below any feature a mesher should make. `pairs`, if given, receives every
+// pair found (triangle numbers).
+inline SelfIntersections
+findSelfIntersections(const Mesh& mesh, double tolerance = -1.0, double foldAngle = 1e-3,
+                      std::vector<std::pair<uint32_t, uint32_t>>* pairs = nullptr) {
+    using geometry::Triangle;
+    using glm::dvec3;
+    SelfIntersections r;
+    const size_t n = mesh.triangleCount();
+    if (n == 0) return r;
+    dvec3 lo(1e300), hi(-1e300);
+    for (const glm::vec3& p : mesh.positions) {
+        lo = glm::min(lo, dvec3(p));
+        hi = glm::max(hi, dvec3(p));
+    }
+    if (tolerance < 0.0) tolerance = 1e-6 * glm::length(hi - lo);
+    std::vector<Triangle> triangles;
+    std::vector<uint32_t> valid; // triangles with three distinct vertices in range
+    triangles.reserve(n);
+    double extent = 0.0;
+    for (size_t t = 0; t < n; ++t) {
+        const uint32_t* v = &mesh.indices[3 * t];
+        const bool ok = v[0] < mesh.vertexCount() && v[1] < mesh.vertexCount() &&
+                        v[2] < mesh.vertexCount() && v[0] != v[1] && v[1] != v[2] && v[2] != v[0];
+        triangles.emplace_back(mesh.positions[ok ? v[0] : 0], mesh.positions[ok ? v[1] : 0],
+                               mesh.positions[ok ? v[2] : 0], tolerance);
+        if (!ok) continue;
+        valid.push_back(uint32_t(t));
+        const dvec3 size = triangles.back().hi - triangles.back().lo;
+        extent += std::max(size.x, std::max(size.y, size.z));
+    }
+    if (valid.empty()) return r;
+
+    // A uniform grid of cells about twice the mean triangle's size; each triangle is listed in
+    // every cell its bounds (grown by the tolerance) reach, and each pair is tested only in the
+    // cell that holds the low corner of the overlap of their grown bounds.
+    const double cell = std::max(2.0 * extent / double(valid.size()), 1e-30);
+    auto cellOf = [&](dvec3 p) { return glm::ivec3(glm::floor((p - lo) / cell)); };
+    auto key = [](glm::ivec3 c) {
+        return (uint64_t(uint32_t(c.x) & 0x1fffff) << 42) |
+               (uint64_t(uint32_t(c.y) & 0x1fffff) << 21) | uint64_t(uint32_t(c.z) & 0x1fffff);
+    };
+    std::vector<std::pair<uint64_t, uint32_t>> listed;
+    for (uint32_t t : valid) {
+        const glm::ivec3 c0 = cellOf(triangles[t].lo - tolerance);
+        const glm::ivec3 c1 = cellOf(triangles[t].hi + tolerance);
+        for (int z = c0.z; z <= c1.z; ++z)
+            for (int y = c0.y; y <= c1.y; ++y)
+                for (int x = c0.x; x <= c1.x; ++x)
+                    listed.push_back({key({x, y, z}), t});
+    }
+    std::sort(listed.begin(), listed.end());
+
+    auto describe = [&](uint32_t t) {
+        std::ostringstream s;
+        s.precision(7);
+        s << "triangle " << t;
+        for (int i = 0; i < 3; ++i) {
+            const glm::vec3 p = mesh.positions[mesh.indices[3 * t + i]];
+            s << (i ? ", " : " (") << mesh.indices[3 * t + i] << " at " << p.x << " " << p.y << " "
+              << p.z;
+        }
+        return s.str() + ")";
+    };
+    auto found = [&](size_t& count, uint32_t a, uint32_t b, const char* what) {
+        ++count;
+        if (pairs) pairs->push_back({a, b});
+        if (r.first.empty()) r.first = describe(a) + " and " + describe(b) + " " + what;
+    };
+    for (size_t i = 0; i < listed.size();) {
+        size_t end = i;
+        while (end < listed.size() && listed[end].first == listed[i].first)
+            ++end;
+        for (size_t j = i; j < end; ++j)
+            for (size_t k = j + 1; k < end; ++k) {
+                const uint32_t ta = listed[j].second, tb = listed[k].second;
+                const Triangle &a = triangles[ta], &b = triangles[tb];
+                const dvec3 overlapLo = glm::max(a.lo, b.lo) - tolerance;
+                const dvec3 overlapHi = glm::min(a.hi, b.hi) + tolerance;
+                if (glm::any(glm::greaterThan(overlapLo, overlapHi)) ||
+                    key(cellOf(overlapLo)) != listed[i].first)
+                    continue;
+                const uint32_t* va = &mesh.indices[3 * size_t(ta)];
+                const uint32_t* vb = &mesh.indices[3 * size_t(tb)];
+                int shared = 0, inA = -1, inB = -1; // a shared vertex's place in a and in b
+                int onlyA = 3, onlyB = 3;           // the sum of the unshared places
+                for (int x = 0; x < 3; ++x)
+                    for (int y = 0; y < 3; ++y)
+                        if (va[x] == vb[y]) {
+                            ++shared;
+                            inA = x, inB = y;
+                            onlyA -= x, onlyB -= y;
+                        }
+                if (shared == 0) {
+                    if (geometry::trianglesMeet(a, b, tolerance))
+                        found(r.crossing, ta, tb, "cross");
+                } else if (shared == 1) {
+                    const dvec3 &a1 = a.v[(inA + 1) % 3], &a2 = a.v[(inA + 2) % 3];
+                    const dvec3 &b1 = b.v[(inB + 1) % 3], &b2 = b.v[(inB + 2) % 3];
+                    if (geometry::segmentMeetsTriangle(a1, a2, b, tolerance) ||
+                        geometry::segmentMeetsTriangle(b1, b2, a, tolerance))
+                        found(r.overlapping, ta, tb, "overlap beyond their common vertex");
+                } else if (shared == 2) {
+                    if (!a.hasPlane() || !b.hasPlane()) continue;
+                    // onlyA and onlyB now name each triangle's vertex off the common side.
+                    const dvec3 u = a.v[(onlyA + 1) % 3], side = a.v[(onlyA + 2) % 3] - u;
+                    auto across = [&](dvec3 p) { // from the side's line to p, at right angles
+                        const dvec3 d = p - u;
+                        return glm::normalize(d -
+                                              side * (glm::dot(d, side) / glm::dot(side, side)));
+                    };
+                    if (glm::dot(across(a.v[onlyA]), across(b.v[onlyB])) > std::cos(foldAngle))
+                        found(r.folded, ta, tb, "fold onto their common side");
+                } else {
+                    found(r.duplicates, ta, tb, "have the same vertices");
+                }
+            }
+        i = end;
+    }
+    return r;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Triangles that face against the field.
+
+struct TriangleFacing {
+    size_t degenerate = 0; // no usable normal: height over the longest side under 1e-4 cell
+    size_t flipped = 0;    // facing against the field's gradient at the centre
+    double worstCos = 1;   // the least cosine between a judged triangle and the gradient
+    std::string first;     // the first flipped or degenerate triangle
+
+    std::string str() const {
+        std::ostringstream s;
+        s << flipped << " triangles flipped, " << degenerate
+          << " degenerate, least cosine to the gradient " << worstCos;
+        if (!first.empty()) s << "; first: " << first;
+        return s.str();
+    }
+};
+
+// Each triangle against the gradient of the CPU evaluator's field at its centre (tetrahedral
+// differences a hundredth of a cell wide), for a mesh from a grid of cells of edge h. On the
+// surface the field's gradient is the outward normal, and a little off it the normal of the
+// nearest part of the surface, which a triangle lying along that part faces like; one that spans
+// a sharp edge faces between its two sides. So a triangle facing more than a right angle away
+// from the gradient is flipped. (Where two sheets of surface pass within a cell of each other,
+// the grid does not tell them apart and this holds only roughly.) Bad triangles (see
+// measureMesh) are skipped.
+inline TriangleFacing checkTriangleFacing(const Mesh& mesh, const Evaluator& evaluator, float h) {
+    TriangleFacing r;
+    const float e = 0.01f * h;
+    const glm::vec3 taps[4] = {{1, -1, -1}, {-1, -1, 1}, {-1, 1, -1}, {1, 1, 1}};
+    for (size_t t = 0; t < mesh.triangleCount(); ++t) {
+        const uint32_t* v = &mesh.indices[3 * t];
+        if (v[0] >= mesh.vertexCount() || v[1] >= mesh.vertexCount() ||
+            v[2] >= mesh.vertexCount() || v[0] == v[1] || v[1] == v[2] || v[2] == v[0])
+            continue;
+        const glm::dvec3 a(mesh.positions[v[0]]), b(mesh.positions[v[1]]), c(mesh.positions[v[2]]);
+        const glm::dvec3 n = glm::cross(b - a, c - a);
+        const double longest =
+            std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
+        auto note = [&](const char* what) {
+            if (!r.first.empty()) return;
+            std::ostringstream s;
+            s.precision(7);
+            s << "triangle " << t << " " << what << " at";
+            for (const glm::dvec3& p : {a, b, c})
+                s << " (" << p.x << " " << p.y << " " << p.z << ")";
+            r.first = s.str();
+        };
+        if (!(glm::length(n) > 1e-4 * h * longest)) {
+            ++r.degenerate;
+            note("degenerate");
+            continue;
+        }
+        const glm::vec3 centre((a + b + c) / 3.0);
+        glm::dvec3 g(0.0);
+        for (const glm::vec3& tap : taps)
+            g += glm::dvec3(tap) * double(evaluator.distance(centre + tap * e));
+        if (glm::length(g) <= 0.0) continue; // no direction to judge by
+        const double cosine = glm::dot(glm::normalize(n), glm::normalize(g));
+        r.worstCos = std::min(r.worstCos, cosine);
+        if (cosine < 0.0) {
+            ++r.flipped;
+            note("flipped");
+        }
+    }
+    return r;
 }
 
 struct NormalProperties {

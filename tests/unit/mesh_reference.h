@@ -178,8 +178,8 @@ ReferenceMesh referenceMeshOf(const Distance& distance, const Color& color,
 // others[k] (the same, or the other face's at a sharp edge), kept in the
 // cell [lo, lo + h]: the mass point plus the least-squares step along the eigenvectors of
 // sum n n^T whose eigenvalues reach a hundredth of the largest; outside the cell, moved along
-// the weakest of them into it where it can be, else clamped (solveQef() in
-// shaders/mesh_triangles.comp).
+// the weakest of them into it where it can be, else clamped, or for a slab (two normals more
+// than 143 degrees apart) the mass point (solveQef() in shaders/mesh_triangles.comp).
 inline glm::vec3 referenceQef(const std::vector<glm::vec3>& points,
                               const std::vector<glm::vec3>& normals,
                               const std::vector<glm::vec3>& others, glm::vec3 lo, float h) {
@@ -273,6 +273,7 @@ inline glm::vec3 referenceQef(const std::vector<glm::vec3>& points,
             return glm::clamp(glm::vec3(base + dir * std::clamp(wanted, s0, s1)), lo,
                               lo + glm::vec3(h));
     }
+    if (leastCos < -0.8f) return glm::vec3(mass); // kSlab
     return glm::clamp(glm::vec3(best), lo, lo + glm::vec3(h));
 }
 
@@ -307,8 +308,11 @@ ReferenceMesh referenceDualMeshOf(const Distance& distance, const Color& color,
                         normal += field.points.normals[k];
                         colours.push_back(field.points.colors[k]);
                     }
-                    const glm::vec3 p = referenceQef(points, normals, others,
-                                                     field.position(cell), grid.voxelSize);
+                    // kInset in shaders/mesh_triangles.comp: off the cell's faces.
+                    const glm::vec3 lo = field.position(cell);
+                    const glm::vec3 p = glm::clamp(
+                        referenceQef(points, normals, others, lo, grid.voxelSize),
+                        lo + 0.005f * grid.voxelSize, lo + (1.0f - 0.005f) * grid.voxelSize);
                     size_t nearest = 0; // its colour is the vertex's
                     for (size_t k = 1; k < points.size(); ++k)
                         if (glm::dot(points[k] - p, points[k] - p) <
@@ -349,9 +353,10 @@ ReferenceMesh referenceDualMeshOf(const Distance& distance, const Color& color,
                     uint32_t q[4];
                     for (int k = 0; k < 4; ++k)
                         q[k] = vertexOf(cells[k], s - cells[k], axis);
-                    const uint32_t quad[2][6] = {{q[0], q[3], q[2], q[0], q[2], q[1]},
-                                                 {q[0], q[1], q[2], q[0], q[2], q[3]}};
-                    const uint32_t* t = quad[field.inside(s) ? 1 : 0];
+                    uint32_t quad[2][6] = {{q[0], q[3], q[2], q[0], q[2], q[1]},
+                                           {q[0], q[1], q[2], q[0], q[2], q[3]}};
+                    uint32_t* t = quad[field.inside(s) ? 1 : 0];
+                    std::rotate(t + 3, t + 3 + axis, t + 6); // names the axis (foldQuads)
                     mesh.indices.insert(mesh.indices.end(), t, t + 6);
                 }
     detail::foldQuads(mesh);

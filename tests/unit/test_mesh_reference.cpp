@@ -489,5 +489,154 @@ TEST(MeshChecks, CompareIgnoresOrderButNotOrientation) {
     EXPECT_EQ(checkNormals(inward).inward, 1u);
 }
 
+// Two triangles, each with vertices of its own unless `shared` names vertices of the first
+// (by place) that the second uses instead of its own.
+Mesh twoTriangles(std::array<glm::vec3, 3> a, std::array<glm::vec3, 3> b,
+                  std::array<int, 3> shared = {-1, -1, -1}) {
+    Mesh mesh;
+    mesh.positions.assign(a.begin(), a.end());
+    mesh.indices = {0, 1, 2};
+    for (size_t i = 0; i < 3; ++i) {
+        if (shared[i] >= 0) {
+            mesh.indices.push_back(uint32_t(shared[i]));
+            continue;
+        }
+        mesh.indices.push_back(uint32_t(mesh.positions.size()));
+        mesh.positions.push_back(b[i]);
+    }
+    mesh.normals.assign(mesh.positions.size(), glm::vec3(0, 0, 1));
+    mesh.colors.assign(mesh.positions.size(), glm::vec3(0.5f));
+    return mesh;
+}
+
+// Each kind of meeting on its own, and configurations as close to them as can be that do not
+// meet.
+TEST(MeshChecks, SelfIntersectionsOfTrianglePairs) {
+    const std::array<glm::vec3, 3> base = {glm::vec3(0, 0, 0), {1, 0, 0}, {0, 1, 0}};
+    auto count = [](const Mesh& mesh) { return findSelfIntersections(mesh, 1e-6); };
+
+    // No vertex in common: one pierces the other; they touch at a point (a vertex on the other's
+    // face, or two vertices at one position); they overlap in one plane; or they lie apart.
+    SelfIntersections r =
+        count(twoTriangles(base, {{{0.2f, 0.2f, -0.5f}, {0.3f, 0.2f, 0.5f}, {0.2f, 0.3f, 0.5f}}}));
+    EXPECT_EQ(r.crossing, 1u) << r.str();
+    EXPECT_EQ(r.total(), 1u) << r.str();
+    EXPECT_NE(r.first.find("triangle 0"), std::string::npos) << r.first;
+    r = count(twoTriangles(base, {{{0.2f, 0.2f, 0}, {0.3f, 0.2f, 1}, {0.2f, 0.3f, 1}}}));
+    EXPECT_EQ(r.crossing, 1u) << "a vertex on the face: " << r.str();
+    r = count(twoTriangles(base, {{{1, 0, 0}, {2, 0, 1}, {2, 1, 0}}}));
+    EXPECT_EQ(r.crossing, 1u) << "two vertices at one position: " << r.str();
+    r = count(twoTriangles(base, {{{0.5f, 0.5f, 0}, {-0.5f, 0.2f, 0}, {0.2f, -0.5f, 0}}}));
+    EXPECT_EQ(r.crossing, 1u) << "overlapping in one plane: " << r.str();
+    r = count(twoTriangles(base, {{{0.1f, 0.1f, 0}, {0.3f, 0.1f, 0}, {0.1f, 0.3f, 0}}}));
+    EXPECT_EQ(r.crossing, 1u) << "one inside the other in one plane: " << r.str();
+    r = count(twoTriangles(base, {{{0.2f, 0.2f, 1e-3f}, {0.3f, 0.2f, 1}, {0.2f, 0.3f, 1}}}));
+    EXPECT_EQ(r.total(), 0u) << "a vertex just above the face: " << r.str();
+    r = count(twoTriangles(base, {{{0.6f, 0.6f, 0}, {1, 1, 0}, {0.6f, 1, 0}}}));
+    EXPECT_EQ(r.total(), 0u) << "apart in one plane: " << r.str();
+
+    // One vertex in common (the first's corner 0): the second passes through the first, or folds
+    // back into its plane over it; or it only meets it at the corner, in one plane or not.
+    r = count(twoTriangles(base, {{{0, 0, 0}, {0.3f, 0.3f, -1}, {0.4f, 0.3f, 1}}}, {0, -1, -1}));
+    EXPECT_EQ(r.overlapping, 1u) << r.str();
+    EXPECT_EQ(r.total(), 1u) << r.str();
+    r = count(twoTriangles(base, {{{0, 0, 0}, {0.5f, 0.1f, 0}, {0.1f, 0.5f, 0}}}, {0, -1, -1}));
+    EXPECT_EQ(r.overlapping, 1u) << "within it in one plane: " << r.str();
+    r = count(twoTriangles(base, {{{0, 0, 0}, {-1, 0.1f, 0}, {-1, -0.1f, 0}}}, {0, -1, -1}));
+    EXPECT_EQ(r.total(), 0u) << "beside it in one plane: " << r.str();
+    r = count(twoTriangles(base, {{{0, 0, 0}, {0.3f, 0.3f, 1}, {0.4f, 0.3f, 1}}}, {0, -1, -1}));
+    EXPECT_EQ(r.total(), 0u) << "above it: " << r.str();
+
+    // A side in common (the first's corners 1 and 2, in the opposite direction): the second
+    // folds onto the first in its plane; it folds nearly onto it, or continues it in its plane.
+    r = count(twoTriangles(base, {{{0, 1, 0}, {1, 0, 0}, {0.2f, 0.2f, 0}}}, {2, 1, -1}));
+    EXPECT_EQ(r.folded, 1u) << r.str();
+    EXPECT_EQ(r.total(), 1u) << r.str();
+    r = count(twoTriangles(base, {{{0, 1, 0}, {1, 0, 0}, {0.2f, 0.2f, 0.05f}}}, {2, 1, -1}));
+    EXPECT_EQ(r.total(), 0u) << "a sharp fold: " << r.str();
+    r = count(twoTriangles(base, {{{0, 1, 0}, {1, 0, 0}, {1, 1, 0}}}, {2, 1, -1}));
+    EXPECT_EQ(r.total(), 0u) << "a flat quad: " << r.str();
+
+    r = count(twoTriangles(base, base, {0, 1, 2}));
+    EXPECT_EQ(r.duplicates, 1u) << r.str();
+    EXPECT_EQ(r.total(), 1u) << r.str();
+}
+
+// Meshes of many triangles: closed surfaces that do not meet themselves, two that cross, and one
+// with a vertex pushed through the far side.
+TEST(MeshChecks, SelfIntersectionsOfClosedMeshes) {
+    const Evaluator evaluator(makeScene(torus(0.7f, 0.25f).rotated(30, 0, 20)));
+    const ReferenceGrid grid = gridAround(evaluator.bounds(), 32);
+    Mesh torusMesh = referenceMesh(evaluator, grid, 3, MeshMethod::DualContouring).mesh;
+    SelfIntersections r = findSelfIntersections(torusMesh);
+    EXPECT_EQ(r.total(), 0u) << r.str();
+
+    Mesh two = torusMesh; // a copy moved along the hole's axis by half the tube's radius
+    const uint32_t offset = uint32_t(two.vertexCount());
+    for (uint32_t i = 0; i < offset; ++i) {
+        two.positions.push_back(torusMesh.positions[i] + glm::vec3(0.05f, 0.1f, 0.05f));
+        two.normals.push_back(torusMesh.normals[i]);
+        two.colors.push_back(torusMesh.colors[i]);
+    }
+    for (uint32_t index : torusMesh.indices)
+        two.indices.push_back(index + offset);
+    EXPECT_TRUE(measureMesh(two).closedManifold());
+    r = findSelfIntersections(two);
+    EXPECT_GT(r.crossing, 100u) << r.str();
+    EXPECT_EQ(r.overlapping + r.folded + r.duplicates, 0u) << r.str();
+
+    // The vertex farthest out along x, pushed to the inner rim's far side.
+    Mesh dented = torusMesh;
+    size_t outermost = 0;
+    for (size_t i = 0; i < dented.vertexCount(); ++i)
+        if (dented.positions[i].x > dented.positions[outermost].x) outermost = i;
+    dented.positions[outermost] *= -0.5f;
+    r = findSelfIntersections(dented);
+    EXPECT_GT(r.total(), 0u) << r.str();
+}
+
+// A flipped triangle and a degenerate one in a closed mesh of a sphere, which has neither.
+TEST(MeshChecks, FlippedAndDegenerateTriangles) {
+    const Evaluator evaluator(makeScene(sphere(1.0f)));
+    const ReferenceGrid grid = gridAround(evaluator.bounds(), 24);
+    for (MeshMethod method : {MeshMethod::DualContouring, MeshMethod::MarchingCubes}) {
+        const Mesh mesh = referenceMesh(evaluator, grid, 3, method).mesh;
+        TriangleFacing f = checkTriangleFacing(mesh, evaluator, grid.voxelSize);
+        EXPECT_EQ(f.flipped + f.degenerate, 0u) << f.str();
+        EXPECT_GT(f.worstCos, 0.5) << f.str();
+
+        Mesh flipped = mesh;
+        std::swap(flipped.indices[30], flipped.indices[31]);
+        f = checkTriangleFacing(flipped, evaluator, grid.voxelSize);
+        EXPECT_EQ(f.flipped, 1u) << f.str();
+        EXPECT_EQ(f.degenerate, 0u) << f.str();
+        EXPECT_LT(f.worstCos, -0.9) << f.str();
+        EXPECT_NE(f.first.find("triangle 10 flipped"), std::string::npos) << f.first;
+
+        // Triangle 10's first vertex moved onto the middle of its opposite side.
+        Mesh flat = mesh;
+        const uint32_t* v = &flat.indices[30];
+        flat.positions[v[0]] = 0.5f * (flat.positions[v[1]] + flat.positions[v[2]]);
+        f = checkTriangleFacing(flat, evaluator, grid.voxelSize);
+        EXPECT_GE(f.degenerate, 1u) << f.str();
+    }
+}
+
+// Points across the triangles see what the vertices miss: a coarse cube's faces cut into a
+// sphere.
+TEST(MeshChecks, SampledSurfaceDistanceSeesAcrossTriangles) {
+    const Evaluator evaluator(makeScene(sphere(1.0f)));
+    Mesh cube;
+    for (int k = 0; k < 8; ++k)
+        cube.positions.push_back(
+            glm::normalize(glm::vec3(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1)));
+    cube.indices = {0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4,
+                    2, 6, 7, 2, 7, 3, 0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5};
+    EXPECT_TRUE(measureMesh(cube).closedManifold()) << measureMesh(cube).str();
+    EXPECT_LT(maxSurfaceDistance(cube, evaluator), 1e-6f);
+    // The face centres lie 1/sqrt(3) from the centre.
+    EXPECT_NEAR(maxSampledSurfaceDistance(cube, evaluator), 1.0f - 1.0f / std::sqrt(3.0f), 1e-5f);
+}
+
 } // namespace
 } // namespace sdfcsg::test
