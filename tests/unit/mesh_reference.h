@@ -126,10 +126,11 @@ template <class Distance, class Color> struct ReferenceSamples {
         }
         glm::vec3 g = gradients[0], other = g;
         if (gradients.size() == 3) {
-            const glm::vec3 a = glm::normalize(gradients[1]), b = glm::normalize(gradients[2]);
-            if (glm::dot(a, b) < 0.98f) {
-                g = a;
-                other = b;
+            const glm::vec3 ahead = glm::normalize(gradients[1]);
+            const glm::vec3 behind = glm::normalize(gradients[2]);
+            if (glm::dot(ahead, behind) < 0.98f) {
+                g = ahead;
+                other = behind;
             }
         }
         glm::vec3 normal(0.0f);

@@ -186,7 +186,7 @@ TEST_P(KindMesh, IsClosedManifoldWithItsTopology) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Kinds, KindMesh, ::testing::ValuesIn(kKindTopologies),
-                         [](const auto& info) { return std::string(info.param.name); });
+                         [](const auto& test) { return std::string(test.param.name); });
 
 // Scenes where dual contouring folds a few triangles over at the default resolution (today's
 // count in the comment; the test allows about half as many again). One vertex per piece of
