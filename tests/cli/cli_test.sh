@@ -124,6 +124,12 @@ for v in x 0 -5 2.5 99999999999999999999999; do
     check "mesh bad target triangles $v" 2 "$bin" mesh "$mesh_a" -o bad.ply --target-triangles "$v"
     expect_text "mesh bad target triangles $v message" err.txt "sdfcsg mesh: --target-triangles expects a positive integer, got '$v'"
 done
+mkdir -p benchscenes && cp "$mesh_a" benchscenes/
+check "bench mesh simplify" 0 "$bin" bench --mesh --scenes benchscenes --resolutions 24 --runs 1 \
+    --simplify 0.1 --error
+grep -q '^scene .* triangles  *before .* simplify .* max err' out.txt ||
+    { echo "FAIL bench --mesh --simplify columns:"; cat out.txt; failures=$((failures + 1)); }
+check "bench bad simplify" 2 "$bin" bench --mesh --simplify 0
 check "mesh bad bounds" 2 "$bin" mesh "$mesh_a" -o bad.ply --bounds 1,1,1,0,0,0
 check "mesh short bounds" 2 "$bin" mesh "$mesh_a" -o bad.ply --bounds 0,0,0,1,1
 check "mesh resolution and voxel size" 2 "$bin" mesh "$mesh_a" -o bad.ply --resolution 8 --voxel-size 0.1
