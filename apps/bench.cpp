@@ -44,7 +44,7 @@ std::vector<fs::path> findScenes(const fs::path& dir) {
 const char* kHelp = R"(Usage: sdfcsg bench [--scenes DIR] [--width W] [--height H] [--frames N] [--buffer]
                    [--evaluation E]
        sdfcsg bench --mesh [--scenes DIR] [--resolutions 128,256,512] [--runs N]
-                   [--method dc|mc] [--error]
+                   [--method dc|mc] [--simplify E] [--error]
 
 For every scene (*.json) in DIR (default assets/scenes), prints the median milliseconds per
 frame in shaded mode with and without bounding-box skipping (after two warm-up frames; a frame
@@ -78,7 +78,9 @@ extraction and of the whole (from a compiled scene to an indexed mesh in host me
 --runs extractions (default 3) after one warm-up per scene. The resolution is the number of
 cells along the longest axis of the bounds: the scene's finite bounds plus a margin, except
 for the reference scenes mesh_a and mesh_b, which are meshed in the bounds their benchmark
-defines. --method picks dual contouring (default) or marching cubes. --error adds the
+defines. --method picks dual contouring (default) or marching cubes. --simplify E then
+simplifies every mesh with a largest error of E cells (as sdfcsg mesh --simplify does, its
+time in the total), and the triangle counts before and after are shown. --error adds the
 distance from the surface of points spread over every triangle (not only its vertices),
 by the CPU evaluator, in cells: the largest and the 99th percentile.
 )";
@@ -224,7 +226,7 @@ struct MeshRow {
     std::string scene;
     uint32_t resolution = 0;
     glm::uvec3 cells{0};
-    uint64_t triangles = 0;
+    uint64_t triangles = 0, unsimplified = 0;
     float maxError = NAN, p99Error = NAN; // cells
     std::vector<double> stages; // median seconds, in the order of the stage names
     double total = 0;
@@ -257,6 +259,7 @@ int runMeshBench(int argc, char** argv) {
     uint32_t runs = 3;
     MeshMethod method = MeshMethod::DualContouring;
     bool measureError = false;
+    float simplifyCells = 0; // 0: no simplification
     for (int i = 0; i < argc; ++i) {
         std::string_view a = argv[i];
         bool ok = true;
@@ -268,7 +271,11 @@ int runMeshBench(int argc, char** argv) {
             method = MeshMethod::DualContouring, ++i;
         else if (i + 1 < argc && a == "--method" && std::string_view(argv[i + 1]) == "mc")
             method = MeshMethod::MarchingCubes, ++i;
-        else if (i + 1 < argc && a == "--scenes")
+        else if (i + 1 < argc && a == "--simplify") {
+            char* end = nullptr;
+            simplifyCells = std::strtof(argv[++i], &end);
+            ok = *argv[i] && !*end && std::isfinite(simplifyCells) && simplifyCells > 0;
+        } else if (i + 1 < argc && a == "--scenes")
             dir = argv[++i];
         else if (i + 1 < argc && a == "--resolutions")
             ok = parseList(argv[++i], resolutions);
@@ -331,6 +338,12 @@ int runMeshBench(int argc, char** argv) {
             for (uint32_t run = 0; run < runs && status == 0; ++run) {
                 MeshStats stats;
                 auto mesh = (*mesher)->extract(options, &stats);
+                if (mesh && simplifyCells > 0) {
+                    SimplifyOptions simplify;
+                    simplify.maxError = simplifyCells * stats.voxelSize;
+                    mesh = simplifyMesh(*mesh, evaluator, simplify, &stats);
+                    row.unsimplified = stats.unsimplifiedTriangles;
+                }
                 if (!mesh) {
                     failed(mesh.error());
                     break;
@@ -360,6 +373,7 @@ int runMeshBench(int argc, char** argv) {
     }
 
     std::printf("\n%-16s %5s %16s %10s", "scene", "res", "cells", "triangles");
+    if (simplifyCells > 0) std::printf(" %10s", "before");
     for (const std::string& stage : stageNames)
         std::printf(" %*s", int(std::max<size_t>(stage.size(), 8)), stage.c_str());
     std::printf(" %8s", "total s");
@@ -370,6 +384,8 @@ int runMeshBench(int argc, char** argv) {
                                   "x" + std::to_string(r.cells.z);
         std::printf("%-16s %5u %16s %10llu", r.scene.c_str(), r.resolution, cells.c_str(),
                     static_cast<unsigned long long>(r.triangles));
+        if (simplifyCells > 0)
+            std::printf(" %10llu", static_cast<unsigned long long>(r.unsimplified));
         for (size_t k = 0; k < stageNames.size(); ++k) {
             const int width = int(std::max<size_t>(stageNames[k].size(), 8));
             if (k < r.stages.size() && !std::isnan(r.stages[k]))

@@ -101,6 +101,35 @@ check "mesh unit for another format" 2 "$bin" mesh "$mesh_a" -o bad.ply --unit c
 expect_text "mesh unit for another format message" err.txt "sdfcsg mesh: --unit applies to .3mf output only"
 check "mesh bad unit" 2 "$bin" mesh "$mesh_a" -o bad.3mf --unit furlong
 expect_text "mesh bad unit message" err.txt "sdfcsg mesh: --unit expects mm, cm, m or inch"
+# Simplification: far fewer triangles, still closed, the file as --stats says; bad values.
+check "mesh simplify" 0 "$bin" mesh "$mesh_a" -o simple.ply --resolution 48 --bounds $box \
+    --simplify 0.005 --stats
+expect_text "mesh simplify closed" out.txt "surface:   inside the bounds (the mesh is closed)"
+before=$(sed -n 's/^simplify: *\([0-9]*\) -> [0-9]* triangles.*/\1/p' out.txt)
+after=$(sed -n 's/^simplify: *[0-9]* -> \([0-9]*\) triangles.*/\1/p' out.txt)
+[ "${after:-0}" -gt 100 ] && [ $((${after:-0} * 3)) -lt "${before:-0}" ] &&
+    grep -aqx "element face $after" simple.ply ||
+    { echo "FAIL mesh --simplify: $before -> $after triangles"; failures=$((failures + 1)); }
+check "mesh target triangles" 0 "$bin" mesh "$mesh_a" -o target.obj --resolution 48 --bounds $box \
+    --target-triangles 3000 --stats
+after=$(sed -n 's/^simplify: *[0-9]* -> \([0-9]*\) triangles.*/\1/p' out.txt)
+[ "${after:-0}" -gt 2000 ] && [ "${after:-0}" -le 3000 ] &&
+    [ "$(grep -c '^f ' target.obj)" -eq "$after" ] ||
+    { echo "FAIL mesh --target-triangles 3000: $after triangles"; failures=$((failures + 1)); }
+for v in x 0 -1 nan inf; do
+    check "mesh bad simplify $v" 2 "$bin" mesh "$mesh_a" -o bad.ply --simplify "$v"
+    expect_text "mesh bad simplify $v message" err.txt "sdfcsg mesh: --simplify expects a distance greater than 0, got '$v'"
+done
+for v in x 0 -5 2.5 99999999999999999999999; do
+    check "mesh bad target triangles $v" 2 "$bin" mesh "$mesh_a" -o bad.ply --target-triangles "$v"
+    expect_text "mesh bad target triangles $v message" err.txt "sdfcsg mesh: --target-triangles expects a positive integer, got '$v'"
+done
+mkdir -p benchscenes && cp "$mesh_a" benchscenes/
+check "bench mesh simplify" 0 "$bin" bench --mesh --scenes benchscenes --resolutions 24 --runs 1 \
+    --simplify 0.1 --error
+grep -q '^scene .* triangles  *before .* simplify .* max err' out.txt ||
+    { echo "FAIL bench --mesh --simplify columns:"; cat out.txt; failures=$((failures + 1)); }
+check "bench bad simplify" 2 "$bin" bench --mesh --simplify 0
 check "mesh bad bounds" 2 "$bin" mesh "$mesh_a" -o bad.ply --bounds 1,1,1,0,0,0
 check "mesh short bounds" 2 "$bin" mesh "$mesh_a" -o bad.ply --bounds 0,0,0,1,1
 check "mesh resolution and voxel size" 2 "$bin" mesh "$mesh_a" -o bad.ply --resolution 8 --voxel-size 0.1

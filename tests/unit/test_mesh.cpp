@@ -312,7 +312,7 @@ TEST_F(MeshTest, CubeCornersAreKept) {
         EXPECT_EQ(m.euler, 2);
         EXPECT_NEAR(m.volume, 1.0, 0.01);
         expectEmbedded(mesh, evaluator, stats.voxelSize);
-        // p = Rz Ry Rx l + t (the order of engine/src/eval.cpp).
+        // p = Rz Ry Rx l + t (the order of engine/src/field/eval.cpp).
         const glm::mat4 turn =
             glm::rotate(glm::mat4(1.0f), glm::radians(c.rotate.z), glm::vec3(0, 0, 1)) *
             glm::rotate(glm::mat4(1.0f), glm::radians(c.rotate.y), glm::vec3(0, 1, 0)) *

@@ -90,6 +90,13 @@ struct MeshStats {
     std::vector<Stage> stages; // wall time per stage, in order
     double totalSeconds = 0;
     size_t peakBytes = 0;      // largest working memory held at once (buffers and mesh)
+    // Set by simplifyMesh, which also updates the counts above and appends its stages (their
+    // time counted in totalSeconds): the triangles it was given, how many simplifications it
+    // ran and checked, and the largest sampled distance of the result from the surface (NaN
+    // without SimplifyOptions::maxError, which is when it does not sample).
+    uint64_t unsimplifiedTriangles = 0;
+    uint32_t simplifyAttempts = 0;
+    float simplifiedError = 0;
 };
 
 // Extracts meshes of one scene. Compiles the scene's kernels once; extract() may then be called
@@ -116,5 +123,45 @@ class Mesher {
 // One-shot convenience: Mesher::create + extract.
 Result<Mesh> extractMesh(Context& context, const Scene& scene, const MeshOptions& options = {},
                          MeshStats* stats = nullptr);
+
+// Simplification (engine/src/mesh/mesh_simplify.cpp, by meshoptimizer's edge collapses ranked by
+// quadric error). A collapse moves one vertex onto a neighbour, so every vertex of the result is
+// a vertex of the input with its position, normal and colour. A vertex with a neighbour of
+// another colour never moves: each patch of one colour keeps its outline, and the colour of every
+// point of the surface stays what it was. The outline of an open mesh (bounds that cut the
+// surface) never moves either.
+struct SimplifyOptions {
+    // How far from the scene's surface any point of the result may lie, in scene units (a finite
+    // number > 0); where the input already lay farther than that, no farther than it did there.
+    // Unset: no bound, targetTriangles alone decides.
+    std::optional<float> maxError;
+    // At most this many triangles, where the topology and the vertices that must stay allow it.
+    // Unset: as few as maxError allows. With both, the simplification stops at whichever limit
+    // it reaches first.
+    std::optional<size_t> targetTriangles;
+};
+
+// The simplified mesh, closed and manifold with the same Euler characteristic wherever the input
+// was, ordered as optimizeMeshOrder orders it. `evaluator` is the scene that `mesh` was extracted
+// from (for scenes of kTapeMinNodes nodes or more its prunedDistance is used). Each
+// simplification is checked: the field is sampled over every triangle (at the points that
+// `sdfcsg bench --mesh --error` samples, and on triangles longer than two of the input's mean
+// edges on a lattice about one such edge apart), and the edges, vertex fans and parts are held
+// to the input's. A result that strays too far or whose topology changed is simplified again
+// with the input's vertices around the faults held in place; the target error grows over a few
+// passes, each from the last result that passed, and where the whole mesh cannot be mended it
+// is simplified in blocks of space, each on its own. At worst the input comes back (ordered).
+// Runs on up to two threads. Fails with ErrorKind::Usage when neither limit is set, maxError is
+// not a finite number > 0 or targetTriangles is 0.
+Result<Mesh> simplifyMesh(const Mesh& mesh, const Evaluator& evaluator,
+                          const SimplifyOptions& options, MeshStats* stats = nullptr);
+
+// Reorders the triangles for the GPU's post-transform vertex cache and then the vertices in the
+// order the triangles first use them (for fetch locality), dropping vertices that no triangle
+// uses. The surface, its winding and every vertex's attributes are unchanged. `fast` plans for a
+// FIFO cache instead: for a mesh from Mesher::extract, 0.85 vertex transforms per triangle
+// instead of 0.83 (with a 32-entry cache; 0.94 as extracted) in a third of the time (0.05 s
+// instead of 0.18 s for 880,000 triangles on one core).
+void optimizeMeshOrder(Mesh& mesh, bool fast = false);
 
 } // namespace sdfcsg
