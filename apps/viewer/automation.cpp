@@ -153,10 +153,11 @@ bool runScript(Viewer& v) {
             v.pendingShot = arg;
             v.waitStart = now();
         } else if (c.verb == "mesh" && arg == "extract") {
-            MeshOptions o;
-            o.resolution = uint32_t(c.numbers[0]);
-            v.meshResolution = int(o.resolution); // as if set in the panel
-            v.mesher->start(v.scene, o);
+            // As if set in the panel.
+            v.meshResolution = int(c.numbers[0]);
+            v.meshMethod = c.args.size() > 2 && c.args[2] == "mc" ? 1 : 0;
+            v.meshSimplify = c.numbers[1];
+            startMesh(v);
             v.meshScript = where;
         } else if (c.verb == "mesh") { // export
             if (!v.mesh) return fail("mesh export: no mesh extracted");

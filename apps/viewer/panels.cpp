@@ -213,6 +213,10 @@ void fileBrowser(Viewer& v) {
 
 void meshPanel(Viewer& v) {
     ImGui::SliderInt("resolution", &v.meshResolution, 16, 512);
+    ImGui::Combo("method", &v.meshMethod, "dual contouring (sharp edges)\0marching cubes\0");
+    // Off at 0: a distance in cells, so that one setting serves every resolution.
+    ImGui::SliderFloat("simplify", &v.meshSimplify, 0.0f, 1.0f,
+                       v.meshSimplify > 0.0f ? "within %.2f cell" : "off");
     ImGui::Checkbox("custom bounds", &v.customBounds);
     if (v.customBounds) {
         ImGui::DragFloat3("min", v.boundsMin, 0.01f);
@@ -222,13 +226,7 @@ void meshPanel(Viewer& v) {
         ImGui::ProgressBar(v.mesher->progress());
         if (ImGui::Button("cancel")) v.mesher->cancel();
     } else if (ImGui::Button("extract mesh") && v.scene) {
-        MeshOptions o;
-        o.resolution = uint32_t(v.meshResolution);
-        if (v.customBounds)
-            o.bounds = Aabb{glm::vec3(v.boundsMin[0], v.boundsMin[1], v.boundsMin[2]),
-                            glm::vec3(v.boundsMax[0], v.boundsMax[1], v.boundsMax[2])};
-        v.mesher->start(v.scene, o);
-        v.meshMessage = "extracting...";
+        startMesh(v);
     }
     if (!v.meshMessage.empty()) ImGui::TextWrapped("%s", v.meshMessage.c_str());
     if (!v.mesh) return;
@@ -240,9 +238,15 @@ void meshPanel(Viewer& v) {
             ImGui::Text("preview mesh: %u triangles", previewMeshTriangles(*v.presenter));
         else
             ImGui::Text("full mesh: %zu triangles", v.mesh->triangleCount());
+        if (v.meshStats.unsimplifiedTriangles > 0)
+            ImGui::Text("simplified from %llu triangles, %.3f cell from the surface at most",
+                        (unsigned long long)v.meshStats.unsimplifiedTriangles,
+                        v.meshStats.simplifiedError / v.meshStats.voxelSize);
         ImGui::Text("mesh frame %.1f ms, last drawn in %.1f ms", v.meshFrameMs, v.meshDrawMs);
     }
     ImGui::InputText("file", v.exportPath, sizeof v.exportPath);
+    if (meshFormatFromPath(v.exportPath) == MeshFormat::ThreeMf)
+        ImGui::Combo("one scene unit is", &v.exportUnit, "1 mm\0 1 cm\0 1 m\0 1 inch\0");
     ImGui::SameLine();
     if (v.exporter->running()) {
         ImGui::TextDisabled("writing...");

@@ -64,7 +64,7 @@ const std::vector<Verb>& verbs() {
         {"expect-error", 1, -1, false, {}, "the error"},
         {"expect-selected", 1, 1, false, {}},
         {"print-bounds", 1, 1, false, {}},
-        {"mesh", 2, 2, false, {"extract", "export"}},
+        {"mesh", 2, 4, false, {"extract", "export"}},
         {"view", 1, 1, false, {"mesh", "march"}},
         {"wireframe", 1, 1, false, {"on", "off"}},
     };
@@ -165,6 +165,22 @@ Result<std::vector<Command>> parseScript(std::string_view text, std::string_view
                 continue;
             }
             c.numbers.push_back(cells);
+            // Then optionally the method and the simplification error, in cells.
+            if (n > 2 && c.args[2] != "dc" && c.args[2] != "mc") {
+                problem("mesh extract: expected the method dc or mc, got \"" + c.args[2] + "\"");
+                continue;
+            }
+            float simplify = 0;
+            if (n > 3 && (!parseFloat(c.args[3], simplify) || !(simplify > 0.0f))) {
+                problem("mesh extract: expected a simplification error in cells greater than 0, "
+                        "got \"" + c.args[3] + "\"");
+                continue;
+            }
+            c.numbers.push_back(simplify);
+        }
+        if (c.verb == "mesh" && c.args[0] == "export" && n != 2) {
+            problem("mesh export: expected a file name");
+            continue;
         }
         if (c.verb == "parent" && n == 2) {
             float index = 0;

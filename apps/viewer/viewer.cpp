@@ -161,12 +161,26 @@ bool finishGeneration(Viewer& v) {
 
 // ---- Mesh ------------------------------------------------------------------------------------
 
+void startMesh(Viewer& v) {
+    MeshOptions o;
+    o.resolution = uint32_t(v.meshResolution);
+    o.method = v.meshMethod == 1 ? MeshMethod::MarchingCubes : MeshMethod::DualContouring;
+    if (v.customBounds)
+        o.bounds = Aabb{glm::vec3(v.boundsMin[0], v.boundsMin[1], v.boundsMin[2]),
+                        glm::vec3(v.boundsMax[0], v.boundsMax[1], v.boundsMax[2])};
+    v.mesher->start(v.scene, o, v.meshSimplify);
+    v.meshMessage = "extracting...";
+}
+
 std::optional<std::string> startExport(Viewer& v, const fs::path& path) {
     auto format = meshFormatFromPath(path);
     if (!format)
         return path.string() +
                ": the extension names no mesh format (.ply, .obj, .stl, .glb, .3mf)";
-    if (!v.exporter->start(v.mesh, path, *format)) return "a mesh is being written";
+    constexpr LengthUnit kUnits[] = {LengthUnit::Millimeter, LengthUnit::Centimeter,
+                                     LengthUnit::Meter, LengthUnit::Inch};
+    if (!v.exporter->start(v.mesh, path, *format, kUnits[v.exportUnit]))
+        return "a mesh is being written";
     v.exporting = path;
     v.meshMessage = "writing " + path.string() + "...";
     return std::nullopt;

@@ -329,19 +329,14 @@ MeshWorker::~MeshWorker() {
     if (thread_.joinable()) thread_.join();
 }
 
-uint32_t previewMeshResolution(uint32_t resolution, size_t triangles, size_t threshold) {
-    if (triangles <= threshold) return 0;
-    const uint32_t preview = std::max(resolution / 3, 64u);
-    return preview < resolution ? preview : 0;
-}
-
-bool MeshWorker::start(std::shared_ptr<const Scene> scene, MeshOptions options) {
+bool MeshWorker::start(std::shared_ptr<const Scene> scene, MeshOptions options, float simplify) {
     if (running_) return false;
     if (thread_.joinable()) thread_.join();
     running_ = true;
     cancel_ = false;
     progress_ = 0.0f;
-    thread_ = std::thread([this, scene = std::move(scene), options = std::move(options)]() mutable {
+    thread_ = std::thread([this, scene = std::move(scene), options = std::move(options),
+                           simplify]() mutable {
         options.progress = [this](float done) {
             progress_ = done;
             return !cancel_.load();
@@ -352,24 +347,23 @@ bool MeshWorker::start(std::shared_ptr<const Scene> scene, MeshOptions options) 
             if (!mesher) return mesher.error();
             auto mesh = (*mesher)->extract(options, &stats);
             if (!mesh) return mesh.error();
-            ExtractedMesh extracted{std::move(*mesh), std::nullopt, 0};
-            // With a voxel size the grid's own cell count is the resolution to divide.
-            const uint32_t cells = options.voxelSize
-                                       ? std::max({stats.cells.x, stats.cells.y, stats.cells.z})
-                                       : options.resolution;
-            const uint32_t resolution =
-                previewMeshResolution(cells, extracted.mesh.triangleCount(), previewThreshold_);
-            if (resolution == 0) return extracted;
-            MeshOptions coarse = options;
-            coarse.voxelSize.reset();
-            coarse.resolution = resolution;
-            coarse.progress = [this](float) { return !cancel_.load(); };
-            if (auto preview = (*mesher)->extract(coarse); preview) {
-                extracted.preview = std::move(*preview);
-                extracted.previewResolution = resolution;
+            ExtractedMesh extracted{std::move(*mesh), std::nullopt};
+            const Evaluator evaluator(*scene);
+            if (simplify > 0.0f && !cancel_) {
+                SimplifyOptions fewer;
+                fewer.maxError = simplify * stats.voxelSize;
+                auto simplified = simplifyMesh(extracted.mesh, evaluator, fewer, &stats);
+                if (!simplified) return simplified.error();
+                extracted.mesh = std::move(*simplified);
             }
+            if (extracted.mesh.triangleCount() <= previewThreshold_ || cancel_) return extracted;
+            SimplifyOptions preview;
+            preview.targetTriangles = previewThreshold_;
+            if (auto copy = simplifyMesh(extracted.mesh, evaluator, preview); copy)
+                extracted.preview = std::move(*copy);
             return extracted;
         }();
+        if (cancel_ && out) out = Error::message(ErrorKind::Cancelled, "<mesh>", "cancelled");
         {
             std::lock_guard lock(mutex_);
             done_ = std::move(out);
@@ -397,12 +391,12 @@ ExportWorker::~ExportWorker() {
 }
 
 bool ExportWorker::start(std::shared_ptr<const Mesh> mesh, std::filesystem::path path,
-                         MeshFormat format) {
+                         MeshFormat format, LengthUnit unit) {
     if (running_) return false;
     if (thread_.joinable()) thread_.join();
     running_ = true;
-    thread_ = std::thread([this, mesh = std::move(mesh), path = std::move(path), format] {
-        Status written = writeMesh(*mesh, path, format);
+    thread_ = std::thread([this, mesh = std::move(mesh), path = std::move(path), format, unit] {
+        Status written = writeMesh(*mesh, path, format, unit);
         {
             std::lock_guard lock(mutex_);
             done_ = std::move(written);

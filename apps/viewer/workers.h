@@ -175,25 +175,18 @@ class RenderWorker {
     std::thread thread_;
 };
 
-// An extraction as the mesh view shows it: the mesh asked for and, when that one is too large to
-// redraw at interactive rates, a coarser one of the same scene and bounds to draw while the
+// An extraction as the mesh view shows it: the mesh asked for (simplified, when asked) and, when
+// that one is too large to redraw at interactive rates, a simplified copy to draw while the
 // camera moves.
 struct ExtractedMesh {
     Mesh mesh;
     std::optional<Mesh> preview;
-    uint32_t previewResolution = 0; // cells along the longest axis; 0 without a preview
 };
 
-// Meshes with more triangles than this get a preview: lavapipe redraws about 15 million
-// triangles a second (2.9 million in 200 ms), so a larger mesh takes over 20 ms a frame.
+// Meshes with more triangles than this get a preview of at most this many: lavapipe redraws
+// about 15 million triangles a second (2.9 million in 200 ms), so a larger mesh takes over
+// 20 ms a frame.
 inline constexpr size_t kPreviewMeshTriangles = 300000;
-
-// The resolution of the preview of a mesh of `triangles` triangles extracted at `resolution`
-// cells, or 0 when it needs none (`threshold` triangles or fewer). Triangles grow with the square
-// of the resolution, so a third of it gives about a ninth of them; at least 64 cells, so thin parts
-// keep their shape, and always fewer cells than the mesh itself.
-uint32_t previewMeshResolution(uint32_t resolution, size_t triangles,
-                               size_t threshold = kPreviewMeshTriangles);
 
 class MeshWorker {
   public:
@@ -202,17 +195,19 @@ class MeshWorker {
         : context_(context), previewThreshold_(previewThreshold) {}
     ~MeshWorker();
 
-    // Starts an extraction unless one is running (false then). A large mesh is followed by its
-    // preview (previewMeshResolution()), on the same thread and compiled kernels, before the
-    // result is handed over: with a ninth of the cells' faces to mesh it adds little.
-    bool start(std::shared_ptr<const Scene> scene, MeshOptions options);
+    // Starts an extraction unless one is running (false then). With `simplify` > 0 the mesh is
+    // simplified to within that many cells of the surface (simplifyMesh). A large mesh is then
+    // followed by its preview, a copy simplified to kPreviewMeshTriangles (or the threshold
+    // given), before the result is handed over: no second extraction, and the preview keeps the
+    // mesh's outline and colours.
+    bool start(std::shared_ptr<const Scene> scene, MeshOptions options, float simplify = 0.0f);
     void cancel() { cancel_ = true; }
     bool running() const { return running_; }
     float progress() const { return progress_; }
     // The finished extraction, once (an Error when it failed or was cancelled; a preview that
     // fails or is cancelled is only left out).
     std::optional<Result<ExtractedMesh>> take();
-    MeshStats stats() const; // of the mesh, not of its preview
+    MeshStats stats() const; // of the mesh (and its simplification), not of its preview
 
   private:
     Context& context_;
@@ -236,7 +231,8 @@ class ExportWorker {
 
     // Starts writing unless a write is running (false then). The mesh is shared, not copied: it
     // stays alive while the write needs it, even when the caller replaces its own.
-    bool start(std::shared_ptr<const Mesh> mesh, std::filesystem::path path, MeshFormat format);
+    bool start(std::shared_ptr<const Mesh> mesh, std::filesystem::path path, MeshFormat format,
+               LengthUnit unit = LengthUnit::Millimeter);
     bool running() const { return running_; }
     // The finished write's outcome, once.
     std::optional<Status> take();

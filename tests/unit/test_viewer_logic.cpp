@@ -952,35 +952,29 @@ TEST(ViewerResolution, PreviewScaleAimsAtTheTargetTime) {
     EXPECT_FLOAT_EQ(previewScale(0.0, 0, 1000000, 0.1), 0.5f);
 }
 
-TEST(ViewerResolution, PreviewMeshHasAboutAnEighthOfTheTriangles) {
-    // mesh_b at 512 cells has 2.9 million triangles: its preview at 170 has about 330 thousand.
-    EXPECT_EQ(previewMeshResolution(512, 2900000), 170u);
-    EXPECT_EQ(previewMeshResolution(300, 400000), 100u);
-    // Small meshes draw quickly enough as they are.
-    EXPECT_EQ(previewMeshResolution(512, kPreviewMeshTriangles), 0u);
-    EXPECT_EQ(previewMeshResolution(128, 1000), 0u);
-    // Never below 64 cells, and never as many cells as the mesh itself.
-    EXPECT_EQ(previewMeshResolution(150, 500000), 64u);
-    EXPECT_EQ(previewMeshResolution(64, 500000), 0u);
-    EXPECT_EQ(previewMeshResolution(96, 5000, 1000), 64u);
-}
-
 TEST(ViewerScript, MeshCommands) {
     auto script = parseScript("mesh extract 64\nview mesh\nwireframe on\nmesh export out.obj\n"
-                              "view march\n",
+                              "view march\nmesh extract 96 mc\nmesh extract 32 dc 0.25\n",
                               "s.txt");
     ASSERT_TRUE(script) << script.error().str();
-    ASSERT_EQ(script->size(), 5u);
-    EXPECT_EQ((*script)[0].numbers, std::vector<float>{64});
+    ASSERT_EQ(script->size(), 7u);
+    EXPECT_EQ((*script)[0].numbers, (std::vector<float>{64, 0}));
     EXPECT_EQ((*script)[3].args, (std::vector<std::string>{"export", "out.obj"}));
-    auto bad =
-        parseScript("mesh extract fine\nmesh extract 2.5\nmesh render x\nview both\n", "s.txt");
+    EXPECT_EQ((*script)[5].args[2], "mc");
+    EXPECT_EQ((*script)[6].numbers, (std::vector<float>{32, 0.25f}));
+    auto bad = parseScript("mesh extract fine\nmesh extract 2.5\nmesh render x\nview both\n"
+                           "mesh extract 64 qd\nmesh extract 64 dc 0\nmesh export a b\n",
+                           "s.txt");
     ASSERT_FALSE(bad);
     EXPECT_EQ(bad.error().str(),
               "s.txt:1:1: mesh extract: expected a whole number of cells, got \"fine\"\n"
               "s.txt:2:1: mesh extract: expected a whole number of cells, got \"2.5\"\n"
               "s.txt:3:1: mesh: expected one of extract, export, got \"render\"\n"
-              "s.txt:4:1: view: expected one of mesh, march, got \"both\"");
+              "s.txt:4:1: view: expected one of mesh, march, got \"both\"\n"
+              "s.txt:5:1: mesh extract: expected the method dc or mc, got \"qd\"\n"
+              "s.txt:6:1: mesh extract: expected a simplification error in cells greater than 0, "
+              "got \"0\"\n"
+              "s.txt:7:1: mesh export: expected a file name");
 }
 
 TEST(ViewerExport, WritesOnItsOwnThread) {

@@ -248,6 +248,14 @@ run "$scene" --script mesh.txt --size 320x240 --no-ui || fail "scripted mesh ses
 "$diff" m1-mesh.png m4-grid.png differ 0.005 || fail "the mesh view shows no grid"
 "$diff" m3-march.png m0-march.png same 0 0 || fail "the ray-marched view did not come back"
 grep -q "^f " mesh.obj || fail "the exported mesh has no faces"
+# Marching cubes, then a simplified mesh written as 3MF.
+cat > mesh3mf.txt <<'SCRIPT'
+mesh extract 64 mc
+mesh extract 96 dc 0.2
+mesh export part.3mf
+SCRIPT
+run "$scene" --script mesh3mf.txt --size 320x240 --no-ui || fail "scripted simplified mesh"
+[ "$(head -c 2 part.3mf)" = "PK" ] || fail "part.3mf is not a 3MF package"
 # A large mesh is drawn coarse while the view moves (under the validation layer), and whole
 # again once it settles.
 cat > preview.txt <<'SCRIPT'
