@@ -5,6 +5,7 @@
 
 #include "gpu/scoped_env.h"
 #include "codegen/shader_compile.h"
+#include "mesh/mesh_simplify.h"
 
 #include <sdfcsg/sdfcsg.h>
 
@@ -232,19 +233,15 @@ struct MeshRow {
     double total = 0;
 };
 
-// The distance from the surface, in cells of edge h, of seven points on every triangle: its
-// centre, the middles of its sides and the points halfway from the centre to each corner.
+// The distance from the surface, in cells of edge h, of the points detail::kTriangleSamples of
+// every triangle.
 std::pair<float, float> surfaceError(const Mesh& mesh, const Evaluator& evaluator, float h) {
     std::vector<float> errors;
     errors.reserve(mesh.indices.size() / 3 * 7);
-    const glm::vec3 weights[7] = {glm::vec3(1.0f / 3),          glm::vec3(0.5f, 0.5f, 0.0f),
-                                  glm::vec3(0.0f, 0.5f, 0.5f),  glm::vec3(0.5f, 0.0f, 0.5f),
-                                  glm::vec3(2, 0.5f, 0.5f) / 3.0f, glm::vec3(0.5f, 2, 0.5f) / 3.0f,
-                                  glm::vec3(0.5f, 0.5f, 2) / 3.0f};
     for (size_t t = 0; t + 3 <= mesh.indices.size(); t += 3) {
         const glm::vec3 a = mesh.positions[mesh.indices[t]], b = mesh.positions[mesh.indices[t + 1]],
                         c = mesh.positions[mesh.indices[t + 2]];
-        for (const glm::vec3& w : weights)
+        for (const glm::vec3& w : detail::kTriangleSamples)
             errors.push_back(std::abs(evaluator.distance(w.x * a + w.y * b + w.z * c)) / h);
     }
     if (errors.empty()) return {0.0f, 0.0f};

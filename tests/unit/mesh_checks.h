@@ -5,6 +5,8 @@
 // meshes.
 #pragma once
 
+#include "mesh/mesh_simplify.h"
+
 #include <sdfcsg/eval.h>
 #include <sdfcsg/mesh.h>
 
@@ -101,24 +103,16 @@ inline float maxSurfaceDistance(const Mesh& mesh, const Evaluator& evaluator) {
     return worst;
 }
 
-// The largest |distance| from the surface, by the CPU evaluator, of seven points on every
-// triangle: its centre, the middles of its sides and the points halfway from the centre to each
-// corner (the points of surfaceError() in apps/bench.cpp). Unlike maxSurfaceDistance(), this
-// sees a triangle that cuts across a sharp edge or corner of the solid.
+// The largest |distance| from the surface, by the CPU evaluator, of the points
+// detail::kTriangleSamples of every triangle. Unlike maxSurfaceDistance(), this sees a triangle
+// that cuts across a sharp edge or corner of the solid.
 inline float maxSampledSurfaceDistance(const Mesh& mesh, const Evaluator& evaluator) {
-    const glm::vec3 weights[7] = {glm::vec3(1.0f / 3),
-                                  glm::vec3(0.5f, 0.5f, 0.0f),
-                                  glm::vec3(0.0f, 0.5f, 0.5f),
-                                  glm::vec3(0.5f, 0.0f, 0.5f),
-                                  glm::vec3(2, 0.5f, 0.5f) / 3.0f,
-                                  glm::vec3(0.5f, 2, 0.5f) / 3.0f,
-                                  glm::vec3(0.5f, 0.5f, 2) / 3.0f};
     float worst = 0.0f;
     for (size_t t = 0; t + 3 <= mesh.indices.size(); t += 3) {
         const glm::vec3 a = mesh.positions[mesh.indices[t]];
         const glm::vec3 b = mesh.positions[mesh.indices[t + 1]];
         const glm::vec3 c = mesh.positions[mesh.indices[t + 2]];
-        for (const glm::vec3& w : weights)
+        for (const glm::vec3& w : detail::kTriangleSamples)
             worst = std::max(worst, std::abs(evaluator.distance(w.x * a + w.y * b + w.z * c)));
     }
     return worst;

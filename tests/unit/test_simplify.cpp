@@ -47,13 +47,8 @@ struct SurfacePoint {
 // points of a barycentric grid of quarters besides.
 std::vector<SurfacePoint> samplePoints(const Mesh& mesh, const Evaluator& evaluator, bool lattice,
                                        bool pruned = false) {
-    std::vector<glm::vec3> weights = {glm::vec3(1.0f / 3),
-                                      glm::vec3(0.5f, 0.5f, 0.0f),
-                                      glm::vec3(0.0f, 0.5f, 0.5f),
-                                      glm::vec3(0.5f, 0.0f, 0.5f),
-                                      glm::vec3(2, 0.5f, 0.5f) / 3.0f,
-                                      glm::vec3(0.5f, 2, 0.5f) / 3.0f,
-                                      glm::vec3(0.5f, 0.5f, 2) / 3.0f};
+    std::vector<glm::vec3> weights(std::begin(detail::kTriangleSamples),
+                                   std::end(detail::kTriangleSamples));
     if (lattice)
         for (int i = 0; i <= 4; ++i)
             for (int j = 0; i + j <= 4; ++j)

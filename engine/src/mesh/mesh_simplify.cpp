@@ -218,14 +218,7 @@ int64_t eulerCharacteristic(const std::vector<uint32_t>& indices, const EdgeTabl
 // samples), and for a triangle longer than twice `spacing` a barycentric lattice about
 // `spacing` apart besides.
 template <class F> void forEachSample(glm::vec3 a, glm::vec3 b, glm::vec3 c, float spacing, F&& f) {
-    static const glm::vec3 kWeights[7] = {glm::vec3(1.0f / 3),
-                                          glm::vec3(0.5f, 0.5f, 0.0f),
-                                          glm::vec3(0.0f, 0.5f, 0.5f),
-                                          glm::vec3(0.5f, 0.0f, 0.5f),
-                                          glm::vec3(2, 0.5f, 0.5f) / 3.0f,
-                                          glm::vec3(0.5f, 2, 0.5f) / 3.0f,
-                                          glm::vec3(0.5f, 0.5f, 2) / 3.0f};
-    for (const glm::vec3& w : kWeights)
+    for (const glm::vec3& w : detail::kTriangleSamples)
         f(w.x * a + w.y * b + w.z * c);
     const float longest = std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
     if (!(longest > 2.0f * spacing)) return;
