@@ -40,6 +40,7 @@
 #include <string>
 #include <thread>
 #include <tuple>
+#include <unordered_map>
 #include <vector>
 
 namespace sdfcsg {
@@ -57,7 +58,8 @@ constexpr float kHoldRadius = 1.0f;
 constexpr float kHoldLimit = 32.0f;
 // How far around a sample of a result the input's own samples set what it may stray, in spacings.
 constexpr float kNear = 2.0f;
-// The edge of the blocks simplified on their own, in spacings: a few thousand triangles each.
+// The edge of the blocks simplified on their own where a pass of the whole cannot be mended, in
+// spacings: a few thousand triangles each.
 constexpr float kBlockSpacings = 32.0f;
 // The FIFO cache that optimizeMeshOrder's fast order plans for, as meshoptimizer's own examples
 // do: it advises less than the hardware's, since a plan for too large a cache thrashes.
@@ -231,13 +233,27 @@ template <class F> void forEachSample(glm::vec3 a, glm::vec3 b, glm::vec3 c, flo
         }
 }
 
+// A triangle by its corners from the one of least index (the same in every mesh that holds it).
+using TriangleKey = std::array<uint32_t, 3>;
+TriangleKey keyOf(const uint32_t* v) {
+    const int first = v[0] < v[1] ? (v[0] < v[2] ? 0 : 2) : (v[1] < v[2] ? 1 : 2);
+    return {v[first], v[(first + 1) % 3], v[(first + 2) % 3]};
+}
+struct TriangleKeyHash {
+    size_t operator()(const TriangleKey& k) const {
+        return std::hash<uint64_t>()((uint64_t(k[0]) << 42) ^ (uint64_t(k[1]) << 21) ^ k[2]);
+    }
+};
+
 struct Probe {
     glm::vec3 point;
-    float error; // |distance|
+    float error;       // |distance|
+    uint32_t triangle; // the triangle it was sampled on
 };
 
 // The largest |distance| sampled on each triangle, on two threads if `parallel`; the samples for
-// which keep(sample) holds are collected in `kept`.
+// which keep(sample) holds are collected in `kept`. A triangle is sampled from its corner of
+// least index, so that it is sampled alike in every mesh that holds it.
 template <class Distance, class Keep>
 std::vector<float> triangleErrors(const std::vector<glm::vec3>& positions,
                                   const std::vector<uint32_t>& indices, float spacing,
@@ -248,9 +264,10 @@ std::vector<float> triangleErrors(const std::vector<glm::vec3>& positions,
     auto run = [&](size_t begin, size_t end, std::vector<Probe>& out) {
         for (size_t t = begin; t < end; ++t) {
             float worst = 0.0f;
-            forEachSample(positions[indices[3 * t]], positions[indices[3 * t + 1]],
-                          positions[indices[3 * t + 2]], spacing, [&](glm::vec3 p) {
-                              const Probe s{p, std::abs(distance(p))};
+            const TriangleKey v = keyOf(&indices[3 * t]);
+            forEachSample(positions[v[0]], positions[v[1]], positions[v[2]], spacing,
+                          [&](glm::vec3 p) {
+                              const Probe s{p, std::abs(distance(p)), uint32_t(t)};
                               worst = std::max(worst, s.error);
                               if (keep(s)) out.push_back(s);
                           });
@@ -620,6 +637,8 @@ class Simplifier {
         const std::vector<bool> referenceClosed = closedFans(reference, n);
         const std::vector<uint32_t> parts = components(reference, n);
         const int64_t referenceEuler = eulerCharacteristic(reference, referenceEdges);
+        // The largest distance sampled on each triangle checked so far that strays nowhere.
+        std::unordered_map<TriangleKey, float, TriangleKeyHash> sampled;
         // False, with the places to hold in `faults` (empty when the topology changed where no
         // check can point), where a result strays too far or its topology changed.
         const auto check = [&](const std::vector<uint32_t>& indices, std::vector<glm::vec3>& faults,
@@ -649,13 +668,31 @@ class Simplifier {
                 if (!present[parts[reference[t]]]) faults.push_back(positions[reference[t]]);
             worst = 0.0f;
             if (options_.maxError) {
+                // Only triangles not sampled before: a retry or the next pass keeps most.
+                std::vector<uint32_t> fresh;
+                std::vector<TriangleKey> freshKeys;
+                for (size_t t = 0; t + 3 <= indices.size(); t += 3) {
+                    const TriangleKey key = keyOf(&indices[t]);
+                    if (auto it = sampled.find(key); it != sampled.end()) {
+                        worst = std::max(worst, it->second);
+                    } else {
+                        fresh.insert(fresh.end(), &indices[t], &indices[t] + 3);
+                        freshKeys.push_back(key);
+                    }
+                }
                 std::vector<Probe> far;
-                for (float e : triangleErrors(
-                         positions, indices, spacing_, [&](glm::vec3 p) { return distance(p); },
-                         [&](const Probe& s) { return tooFar(s); }, far, parallel))
-                    worst = std::max(worst, e);
-                for (const Probe& s : far)
+                const std::vector<float> errors = triangleErrors(
+                    positions, fresh, spacing_, [&](glm::vec3 p) { return distance(p); },
+                    [&](const Probe& s) { return tooFar(s); }, far, parallel);
+                std::vector<bool> strays(errors.size(), false);
+                for (const Probe& s : far) {
                     faults.push_back(s.point);
+                    strays[s.triangle] = true;
+                }
+                for (size_t t = 0; t < errors.size(); ++t) {
+                    worst = std::max(worst, errors[t]);
+                    if (!strays[t]) sampled.emplace(freshKeys[t], errors[t]);
+                }
             }
             return faults.empty() && eulerCharacteristic(indices, edges) == referenceEuler;
         };
@@ -770,9 +807,9 @@ Result<Mesh> simplifyMesh(const Mesh& mesh, const Evaluator& evaluator,
     std::vector<uint32_t> indices = mesh.indices;
     const size_t targetIndices = options.targetTriangles ? *options.targetTriangles * 3 : 0;
     if (!indices.empty()) {
-        // The whole mesh at once leaves the fewest triangles. Where its first pass cannot be
-        // mended, blocks can, a fault costing only its own block: then the mesh in blocks, again
-        // in blocks shifted by half a block, and once more whole for the strips along their
+        // The whole mesh at once leaves the fewest triangles. Where a pass cannot be mended,
+        // blocks can, a fault costing only its own block: then the mesh in blocks, again in
+        // blocks shifted by half a block, and once more whole for the strips along their
         // outlines (which stay as they are if that fails too).
         if (wholeFirst) indices = simplifier.round(indices, 0.0f, 0.0f, targetIndices);
         if (!wholeFirst || simplifier.stalled()) {
