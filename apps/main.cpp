@@ -305,7 +305,7 @@ Options:
                          outlines allow)
   --stats                print the grid, brick and mesh sizes, the time per stage and the
                          peak memory (and the triangles before and after simplifying)
-  --evaluation E          auto (default), inlined or tapes, as for render
+  --evaluation E         auto (default), inlined or tapes, as for render
   --device NAME          Vulkan device: index or part of its name (also SDFCSG_DEVICE)
   --validation           enable the Vulkan validation layer
 )";
