@@ -257,11 +257,17 @@ void emitDualVertices(uint slot, uvec3 brick) {
         uint n = 0u;
         float leastCos = 1.0; // between any normal and the first
         vec3 first0 = vec3(0.0);
+        bool mixed = false; // the edge points have more than one colour
         for (uint edges = pieceEdges(c, piece); edges != 0u; edges &= edges - 1u) {
             uint h = vertexIndex(l, findLSB(edges));
             vec4 a = hermite[3u * h], b = hermite[3u * h + 1u], d = hermite[3u * h + 2u];
             vec3 point = a.xyz - lo, n0 = b.xyz, n1 = d.xyz;
-            if (n == 0u) first0 = n0;
+            vec3 rgb = vec3(a.w, b.w, d.w);
+            if (n == 0u) {
+                first0 = n0;
+                color = rgb;
+            }
+            mixed = mixed || rgb != color;
             leastCos = min(leastCos, min(dot(n0, first0), dot(n1, first0)));
             mass += point;
             normal += n0;
@@ -286,7 +292,7 @@ void emitDualVertices(uint slot, uvec3 brick) {
         // The colour of the nearest edge point: a mean would blend the colours of two operands
         // into one that the scene does not have.
         float nearest = 1e30;
-        for (uint edges = pieceEdges(c, piece); edges != 0u; edges &= edges - 1u) {
+        for (uint edges = mixed ? pieceEdges(c, piece) : 0u; edges != 0u; edges &= edges - 1u) {
             uint h = vertexIndex(l, findLSB(edges));
             vec4 a = hermite[3u * h];
             vec3 d = a.xyz - p;
