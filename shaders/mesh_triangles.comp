@@ -270,7 +270,7 @@ void emitDualVertices(uint slot, uvec3 brick) {
             mixed = mixed || rgb != color;
             leastCos = min(leastCos, min(dot(n0, first0), dot(n1, first0)));
             mass += point;
-            normal += n0;
+            normal += n0 + n1;
             ata += outerProduct(n0, n0) + outerProduct(n1, n1);
             atp += n0 * dot(n0, point) + n1 * dot(n1, point);
             ++n;
@@ -301,7 +301,10 @@ void emitDualVertices(uint slot, uvec3 brick) {
                 color = vec3(a.w, hermite[3u * h + 1u].w, hermite[3u * h + 2u].w);
             }
         }
-        uint o = (first + i) * 9u;
+        // The mean of the edge points, where the host moves vertices whose quads fold.
+        vec3 centre = clamp(lo + mass, lo + kInset * grid.origin.w,
+                            lo + (1.0 - kInset) * grid.origin.w);
+        uint o = (first + i) * 12u;
         vertices[o + 0u] = p.x;
         vertices[o + 1u] = p.y;
         vertices[o + 2u] = p.z;
@@ -311,6 +314,9 @@ void emitDualVertices(uint slot, uvec3 brick) {
         vertices[o + 6u] = color.r;
         vertices[o + 7u] = color.g;
         vertices[o + 8u] = color.b;
+        vertices[o + 9u] = centre.x;
+        vertices[o + 10u] = centre.y;
+        vertices[o + 11u] = centre.z;
     }
 }
 

@@ -291,6 +291,7 @@ ReferenceMesh referenceDualMeshOf(const Distance& distance, const Color& color,
     Mesh& mesh = out.mesh;
     auto cellIndex = [&](glm::uvec3 c) { return (size_t(c.z) * n.y + c.y) * n.x + c.x; };
     std::vector<uint32_t> firstVertex(size_t(n.x) * n.y * n.z, 0);
+    std::vector<glm::vec3> smooth; // per vertex: the mean of its edge points
     for (uint32_t z = 0; z < n.z; ++z)
         for (uint32_t y = 0; y < n.y; ++y)
             for (uint32_t x = 0; x < n.x; ++x) {
@@ -306,7 +307,7 @@ ReferenceMesh referenceDualMeshOf(const Distance& distance, const Color& color,
                         points.push_back(field.points.positions[k]);
                         normals.push_back(field.points.normals[k]);
                         others.push_back(field.others[k]);
-                        normal += field.points.normals[k];
+                        normal += field.points.normals[k] + field.others[k];
                         colours.push_back(field.points.colors[k]);
                     }
                     // kInset in shaders/mesh_triangles.comp: off the cell's faces.
@@ -320,6 +321,12 @@ ReferenceMesh referenceDualMeshOf(const Distance& distance, const Color& color,
                             glm::dot(points[nearest] - p, points[nearest] - p))
                             nearest = k;
                     mesh.positions.push_back(p);
+                    glm::vec3 mass(0.0f);
+                    for (const glm::vec3& point : points)
+                        mass += point;
+                    smooth.push_back(glm::clamp(mass / float(points.size()),
+                                                lo + 0.005f * grid.voxelSize,
+                                                lo + (1.0f - 0.005f) * grid.voxelSize));
                     mesh.normals.push_back(glm::length(normal) > 0.1f ? glm::normalize(normal)
                                                                        : normals[0]);
                     mesh.colors.push_back(colours[nearest]);
@@ -360,7 +367,7 @@ ReferenceMesh referenceDualMeshOf(const Distance& distance, const Color& color,
                     std::rotate(t + 3, t + 3 + axis, t + 6); // names the axis (foldQuads)
                     mesh.indices.insert(mesh.indices.end(), t, t + 6);
                 }
-    detail::foldQuads(mesh);
+    detail::foldQuads(mesh, smooth);
     out.surfaceCut = field.surfaceCut;
     return out;
 }

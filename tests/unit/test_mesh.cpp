@@ -190,25 +190,24 @@ INSTANTIATE_TEST_SUITE_P(Kinds, KindMesh, ::testing::ValuesIn(kKindTopologies),
 
 // Scenes where dual contouring folds a few triangles over at the default resolution (today's
 // count in the comment; the test allows about half as many again). One vertex per piece of
-// surface in a cell cannot follow two sheets of surface within a cell of each other, nor a sharp
-// edge that runs within a few hundredths of a cell of a grid line or plane: the vertices of the
-// cells around it crowd onto the edge, and the thin triangles between them may face either way.
+// surface in a cell cannot follow two sheets of surface within a cell of each other; and along a
+// sharp edge that runs near a grid line or plane, the vertices of the cells around it crowd onto
+// the edge, where foldQuads (engine/src/mesh/mesh_dual.h) moves back those of quads that face
+// against their vertices' normals, but not thin triangles standing on the edge that face
+// neither way much.
 struct FoldedScene {
     const char* scene; // file stem
     size_t flipsAllowed;
 };
 const FoldedScene kFoldedScenes[] = {
-    {"chess_pawn", 60},    // 42: the profile touches the axis, where the field is 0 inside
-    {"csg_part", 4},       // 2: the cube's faces lie 0.002 cells off grid planes
-    {"gallery", 12},       // 8: objects meet the ground in wedges thinner than a cell
-    {"gear", 12},          // 8: edges of the teeth along grid lines
-    {"house", 80},         // 52: fence boards and the roof's eaves thinner than a cell
-    {"knurled_knob", 440}, // 292: the twisted ribs' edges along grid lines, and their edge
-                           // points' second normals blend both faces (shaders/mesh_field.comp)
-    {"mesh_a", 4},         // 2: as the CSG part
-    {"name_plate", 20},    // 13: edges of the letters along grid lines
-    {"robot", 10},         // 6: edges along grid lines
-    {"snowman", 30},       // 20: the body meets the drift in a wedge thinner than a cell
+    {"chess_pawn", 60},    // 40: the profile touches the axis, where the field is 0 inside
+    {"gallery", 14},       // 9: objects meet the ground in wedges thinner than a cell
+    {"gear", 4},           // 2: edges of the teeth along grid lines
+    {"house", 24},         // 16: fence boards and the roof's eaves thinner than a cell
+    {"knurled_knob", 100}, // 65: slivers standing on the twisted ribs' edges, where the field's
+                           // gradient is not of length 1 and sharp edges are found less well
+    {"name_plate", 10},    // 6: edges of the letters along grid lines
+    {"snowman", 8},        // 4: the body meets the drift in a wedge thinner than a cell
 };
 
 // Every bundled scene at the default resolution: closed and manifold where the surface fits the

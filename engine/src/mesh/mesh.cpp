@@ -681,6 +681,7 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
     }
 
     const int triangleKind = dual ? 3 : 1;
+    std::vector<glm::vec3> smooth; // dual contouring: where foldQuads moves folding vertices
     mesh.indices.resize(totals[triangleKind] * 3);
     if (dual) {
         std::swap(buffer(SDFCSG_BINDING_MESH_VERTICES), buffer(SDFCSG_BINDING_MESH_HERMITE));
@@ -688,6 +689,7 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
         mesh.positions.resize(totals.z);
         mesh.normals.resize(totals.z);
         mesh.colors.resize(totals.z);
+        smooth.resize(totals.z);
     }
     for (uint32_t batch = 0; batch < batches; ++batch) {
         MeshPush push = batchOf(batch);
@@ -701,7 +703,7 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
         if (auto ok = reserve(SDFCSG_BINDING_MESH_INDICES, batchTriangles * 12); !ok)
             return ok.error();
         if (dual) {
-            if (auto ok = reserve(SDFCSG_BINDING_MESH_VERTICES, (endVertex - firstVertex) * 36); !ok)
+            if (auto ok = reserve(SDFCSG_BINDING_MESH_VERTICES, (endVertex - firstVertex) * 48); !ok)
                 return ok.error();
         }
         VkCommandBuffer cmd = begin(dual ? dualPass : triangles);
@@ -712,16 +714,18 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
         t0 = Clock::now();
         if (dual) {
             const float* v = mapped<float>(SDFCSG_BINDING_MESH_VERTICES);
-            for (uint64_t o = firstVertex; o < endVertex; ++o, v += 9) {
+            for (uint64_t o = firstVertex; o < endVertex; ++o, v += 12) {
                 mesh.positions[o] = glm::vec3(v[0], v[1], v[2]);
                 mesh.normals[o] = glm::vec3(v[3], v[4], v[5]);
                 mesh.colors[o] = glm::vec3(v[6], v[7], v[8]);
+                smooth[o] = glm::vec3(v[9], v[10], v[11]);
             }
         }
         std::memcpy(mesh.indices.data() + uint64_t(first) * 3,
                     mapped<uint32_t>(SDFCSG_BINDING_MESH_INDICES), batchTriangles * 12);
         stage("download", t0);
-        notePeak(map.size() * 4 + mesh.positions.capacity() * 36 + mesh.indices.capacity() * 4);
+        notePeak(map.size() * 4 + mesh.positions.capacity() * 36 + smooth.capacity() * 12 +
+                 mesh.indices.capacity() * 4);
         if (!progress(1)) return cancelled;
     }
 
@@ -729,7 +733,7 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
     skippedSurface = status[1] != 0;
     if (dual && !skippedSurface) {
         t0 = Clock::now();
-        detail::foldQuads(mesh);
+        detail::foldQuads(mesh, smooth);
         stage("quads", t0);
     }
     stats.surfaceCut = status[0] != 0;

@@ -7,7 +7,16 @@
 
 namespace sdfcsg::detail {
 
-void foldQuads(Mesh& mesh) {
+namespace {
+
+// A quad around a grid edge along `axis`: corners a, b, c, d in order around it.
+struct Quad {
+    uint32_t a, b, c, d;
+    int axis;
+};
+
+// Whether quad q splits along b-d rather than a-c.
+bool splitsAlongBd(const Mesh& mesh, const Quad& q) {
     const std::vector<glm::vec3>& p = mesh.positions;
     const std::vector<glm::vec3>& n = mesh.normals;
     // How well triangle (u, v, w) faces like vertex `off`'s normal: the cosine, or -2 when it
@@ -23,40 +32,89 @@ void foldQuads(Mesh& mesh) {
         const glm::vec2 e = v - u, f = w - u;
         return e.x * f.y - e.y * f.x;
     };
-    for (size_t q = 0; q + 6 <= mesh.indices.size(); q += 6) {
-        uint32_t* t = &mesh.indices[q];
-        const uint32_t a = t[0], b = t[1], c = t[2];
-        const int axis = t[3] == a ? 0 : t[3] == c ? 1 : 2;
-        const uint32_t d = axis == 0 ? t[5] : axis == 1 ? t[4] : t[3];
-        // The quad seen along its edge. Each vertex lies strictly inside its cell (kInset in
-        // the shader), so it is a simple polygon around the edge, and at least one diagonal
-        // lies inside it.
-        auto seen = [&](uint32_t k) {
-            const glm::vec3& x = p[k];
-            return axis == 0   ? glm::vec2(x.y, x.z)
-                   : axis == 1 ? glm::vec2(x.z, x.x)
-                               : glm::vec2(x.x, x.y);
-        };
-        const glm::vec2 sa = seen(a), sb = seen(b), sc = seen(c), sd = seen(d);
-        const float abc = along(sa, sb, sc), acd = along(sa, sc, sd);
-        const float abd = along(sa, sb, sd), bcd = along(sb, sc, sd);
-        const float winding = abc + acd;
-        const bool acWinds = abc * winding > 0.0f && acd * winding > 0.0f;
-        const bool bdWinds = abd * winding > 0.0f && bcd * winding > 0.0f;
-        bool alongBd = bdWinds;
-        if (acWinds == bdWinds) {
-            const float facingAc = std::min(facing(a, b, c, b), facing(a, c, d, d));
-            const float facingBd = std::min(facing(a, b, d, a), facing(b, c, d, c));
-            // The margin keeps the first diagonal where both fold alike (a flat quad), so that
-            // float rounding does not pick between them.
-            alongBd = facingBd > facingAc + 1e-3f;
-        }
-        // Back as (a, b, c), (a, c, d) or (a, b, d), (b, c, d), writing only what changes.
-        if (alongBd) {
-            const uint32_t split[6] = {a, b, d, b, c, d};
-            std::copy(split, split + 6, t);
-        } else if (axis != 0) {
-            t[3] = a, t[4] = c, t[5] = d;
+    // The quad seen along its edge. Each vertex lies strictly inside its cell (kInset in the
+    // shader), so it is a simple polygon around the edge, and at least one diagonal lies
+    // inside it.
+    auto seen = [&](uint32_t k) {
+        const glm::vec3& x = p[k];
+        return q.axis == 0   ? glm::vec2(x.y, x.z)
+               : q.axis == 1 ? glm::vec2(x.z, x.x)
+                             : glm::vec2(x.x, x.y);
+    };
+    const glm::vec2 sa = seen(q.a), sb = seen(q.b), sc = seen(q.c), sd = seen(q.d);
+    const float abc = along(sa, sb, sc), acd = along(sa, sc, sd);
+    const float abd = along(sa, sb, sd), bcd = along(sb, sc, sd);
+    const float winding = abc + acd;
+    const bool acWinds = abc * winding > 0.0f && acd * winding > 0.0f;
+    const bool bdWinds = abd * winding > 0.0f && bcd * winding > 0.0f;
+    if (acWinds != bdWinds) return bdWinds;
+    const float facingAc = std::min(facing(q.a, q.b, q.c, q.b), facing(q.a, q.c, q.d, q.d));
+    const float facingBd = std::min(facing(q.a, q.b, q.d, q.a), facing(q.b, q.c, q.d, q.c));
+    // The margin keeps the first diagonal where both fold alike (a flat quad), so that float
+    // rounding does not pick between them.
+    return facingBd > facingAc + 1e-3f;
+}
+
+// Whether triangle (u, v, w) faces nearly a right angle or more away from the mean of its
+// vertices' normals. A triangle of a wedge of the solid as sharp as 30 degrees faces within 75
+// degrees of it (cosine 0.26).
+bool facesAway(const Mesh& mesh, uint32_t u, uint32_t v, uint32_t w) {
+    const std::vector<glm::vec3>& p = mesh.positions;
+    const std::vector<glm::vec3>& n = mesh.normals;
+    const glm::vec3 c = glm::cross(p[v] - p[u], p[w] - p[u]), m = n[u] + n[v] + n[w];
+    const float cm = glm::dot(c, m);
+    return cm < 0.0f || cm * cm < 0.04f * glm::dot(c, c) * glm::dot(m, m);
+}
+
+// Writes quad q into t split along a-c, as (a, b, c), (a, c, d), or along b-d, as (a, b, d),
+// (b, c, d); returns whether one of the two triangles faces away.
+bool fold(const Mesh& mesh, const Quad& q, uint32_t* t) {
+    const bool alongBd = splitsAlongBd(mesh, q);
+    const uint32_t split[2][6] = {{q.a, q.b, q.c, q.a, q.c, q.d}, {q.a, q.b, q.d, q.b, q.c, q.d}};
+    std::copy(split[alongBd], split[alongBd] + 6, t);
+    return facesAway(mesh, t[0], t[1], t[2]) || facesAway(mesh, t[3], t[4], t[5]);
+}
+
+} // namespace
+
+void foldQuads(Mesh& mesh, const std::vector<glm::vec3>& smooth) {
+    const size_t quads = mesh.indices.size() / 6;
+    std::vector<uint8_t> axes(quads);
+    // movedIn[k]: the round in which vertex k moved to its smooth place, plus one; 0: never.
+    std::vector<uint8_t> movedIn(mesh.positions.size(), 0);
+    auto moveVertices = [&](const uint32_t* t, uint8_t round) {
+        bool moved = false;
+        for (int k = 0; k < 6; ++k)
+            if (movedIn[t[k]] == 0) {
+                movedIn[t[k]] = round;
+                mesh.positions[t[k]] = smooth[t[k]];
+                moved = true;
+            }
+        return moved;
+    };
+    // Round 1 folds every quad as the quads pass wrote it: (a, b, c), then (a, c, d) rotated to
+    // start at its axis'th corner.
+    bool moved = false;
+    for (size_t q = 0; q < quads; ++q) {
+        uint32_t* t = &mesh.indices[6 * q];
+        const int axis = t[3] == t[0] ? 0 : t[3] == t[2] ? 1 : 2;
+        const Quad quad{t[0], t[1], t[2], axis == 0 ? t[5] : axis == 1 ? t[4] : t[3], axis};
+        axes[q] = uint8_t(axis);
+        if (fold(mesh, quad, t)) moved = moveVertices(t, 1) || moved;
+    }
+    // A quad that folds against its vertices' normals has had them moved to their smooth
+    // places; the quads around those fold again and may move theirs, for a few rounds; the last
+    // only folds.
+    for (uint8_t round = 2; moved && round <= 5; ++round) {
+        moved = false;
+        for (size_t q = 0; q < quads; ++q) {
+            uint32_t* t = &mesh.indices[6 * q];
+            if (std::none_of(t, t + 6, [&](uint32_t k) { return movedIn[k] == round - 1; }))
+                continue;
+            // As fold() wrote it: a-c is (a, b, c), (a, c, d); b-d is (a, b, d), (b, c, d).
+            const Quad quad = t[3] == t[0] ? Quad{t[0], t[1], t[2], t[5], axes[q]}
+                                           : Quad{t[0], t[1], t[4], t[2], axes[q]};
+            if (fold(mesh, quad, t) && round < 5) moved = moveVertices(t, round) || moved;
         }
     }
 }

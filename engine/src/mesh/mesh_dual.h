@@ -12,7 +12,11 @@ namespace sdfcsg::detail {
 // (b, c, d): seen along its edge, the quad winds once around it, and the split is one whose two
 // triangles wind the same way, so that the surface crosses the edge once; where both do, the one
 // whose triangles face most like the vertices off the diagonal: at a sharp edge of the solid,
-// the diagonal that runs along the edge, so that the fold lies on it.
-void foldQuads(Mesh& mesh);
+// the diagonal that runs along the edge, so that the fold lies on it. Where a triangle still
+// faces away from its vertices' normals (a sharp edge of the solid that passes along a cell's
+// face or edge, where the vertices of the cells on both sides land on it and cross over), the
+// quad's vertices move to `smooth` (per vertex: the mean of its edge points, where surface nets
+// put it, which seldom folds), and the quads around them are split again.
+void foldQuads(Mesh& mesh, const std::vector<glm::vec3>& smooth);
 
 } // namespace sdfcsg::detail
