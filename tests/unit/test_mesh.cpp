@@ -200,7 +200,6 @@ struct FoldedScene {
     size_t flipsAllowed;
 };
 const FoldedScene kFoldedScenes[] = {
-    {"chess_pawn", 60},    // 40: the profile touches the axis, where the field is 0 inside
     {"gallery", 14},       // 9: objects meet the ground in wedges thinner than a cell
     {"gear", 4},           // 2: edges of the teeth along grid lines
     {"house", 24},         // 16: fence boards and the roof's eaves thinner than a cell

@@ -69,6 +69,27 @@ TEST(Profiles, RevolvedCircleIsATorus) {
                     R"({"type": "torus", "major_radius": 0.6, "minor_radius": 0.2})", 1.2f, 2e-5f);
 }
 
+// A lathe profile that meets the axis along an edge turns into a solid with the axis inside it,
+// not on a surface: the field is the distance to the solid's surface there too (a rectangle
+// against the axis is a cylinder), also with the axis moved by an offset or a shift.
+TEST(Profiles, RevolvedProfileAgainstTheAxisIsSolidThere) {
+    const char* cylinder = R"({"type": "cylinder", "radius": 0.5, "height": 1.6})";
+    expectSameField(R"({"type": "revolve", "children": [{"type": "polygon", "points":
+                        [[0, -0.8], [0.5, -0.8], [0.5, 0.8], [0, 0.8], [0, 0.2]]}]})",
+                    cylinder, 1.2f, 2e-5f);
+    expectSameField(R"({"type": "revolve", "offset": 0.3, "children": [{"type": "polygon",
+                        "points": [[-0.3, -0.8], [0.2, -0.8], [0.2, 0.8], [-0.3, 0.8]]}]})",
+                    cylinder, 1.2f, 2e-5f);
+    expectSameField(R"({"type": "revolve", "children": [{"type": "polygon", "translate": [-0.1, 0, 0],
+                        "points": [[0.1, 0.8], [0.1, -0.8], [0.6, -0.8], [0.6, 0.8]]}]})",
+                    cylinder, 1.2f, 2e-5f);
+    // Touching the axis at a point only, the profile keeps its own outline: the field is 0 on
+    // the axis where it touches.
+    Evaluator cone(parseRoot(R"({"type": "revolve", "children": [{"type": "polygon",
+                                 "points": [[0, 0], [0.5, -0.5], [0.5, 0.5]]}]})"));
+    EXPECT_EQ(cone.distance(glm::vec3(0.0f)), 0.0f);
+}
+
 TEST(Profiles, PolygonSquareIsARectangle) {
     expectSameField(R"({"type": "extrude", "height": 0.6, "children": [
                         {"type": "polygon", "points": [[-0.4, -0.25], [0.4, -0.25], [0.4, 0.25], [-0.4, 0.25]]}]})",

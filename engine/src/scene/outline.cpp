@@ -389,4 +389,31 @@ Result<std::shared_ptr<const std::vector<glm::vec4>>> buildOutline(const Node& n
     return std::make_shared<const std::vector<glm::vec4>>(packOutline(segments, shift));
 }
 
+std::shared_ptr<const std::vector<glm::vec4>> revolvedOutline(std::span<const glm::vec2> points,
+                                                             float axis) {
+    const size_t n = points.size();
+    auto onAxis = [&](size_t i) { return points[i % n].x == axis; };
+    auto axisEdge = [&](size_t i) { return onAxis(i) && onAxis(i + 1); };
+    size_t first = n; // the first point of the edges off the axis, after one on it
+    for (size_t i = 0; i < n; ++i) {
+        if (points[i].x < axis) return nullptr;
+        if (axisEdge(i + n - 1) && !axisEdge(i)) first = i;
+    }
+    if (first == n) return nullptr;
+    // The chain off the axis runs from `first` to `last`, both on the axis, through points off
+    // it; every other edge lies on the axis.
+    size_t last = first + 1;
+    while (!onAxis(last)) ++last;
+    for (size_t i = last; i < first + n; ++i)
+        if (!axisEdge(i)) return nullptr;
+    std::vector<GlyphSegment> segments;
+    for (size_t i = first; i < last; ++i)
+        segments.push_back({points[i % n], points[(i + 1) % n], points[i % n], false});
+    auto mirror = [&](glm::vec2 p) { return glm::vec2(2.0f * axis - p.x, p.y); };
+    for (size_t i = last; i-- > first;)
+        segments.push_back({mirror(points[(i + 1) % n]), mirror(points[i % n]),
+                            mirror(points[(i + 1) % n]), false});
+    return std::make_shared<const std::vector<glm::vec4>>(packOutline(segments, glm::vec2(0.0f)));
+}
+
 } // namespace sdfcsg::detail

@@ -45,4 +45,12 @@ std::string polygonProblem(std::span<const glm::vec2> points);
 // the font's (font.h), for the caller to place at the node.
 Result<std::shared_ptr<const std::vector<glm::vec4>>> buildOutline(const Node& node);
 
+// A revolve's polygon profile that lies at x >= axis and meets the axis x = axis along one run of
+// edges: the outline of the polygon joined with its mirror image across the axis, those edges
+// gone. Turned about the axis, the axis lies inside the solid, and this outline's field is the
+// distance there; the polygon's own would be 0 along the whole axis. nullptr for any other
+// polygon.
+std::shared_ptr<const std::vector<glm::vec4>> revolvedOutline(std::span<const glm::vec2> points,
+                                                             float axis);
+
 } // namespace sdfcsg::detail

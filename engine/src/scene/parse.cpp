@@ -511,6 +511,21 @@ std::optional<dom::array> SceneReader::readNode(element value, std::string path,
     return array;
 }
 
+// A polygon turned by a revolve, untransformed but for a shift, that meets the axis along an
+// edge gets the outline of itself and its mirror image (revolvedOutline in outline.h), so that
+// the axis lies inside the solid and not on a surface of zero thickness.
+void closeRevolvedProfiles(Scene& scene) {
+    for (const Node& node : scene.nodes) {
+        if (node.kind != NodeKind::Revolve || node.children.size() != 1) continue;
+        Node& child = scene.nodes[node.children[0]];
+        if (child.kind != NodeKind::Polygon || !child.outline ||
+            child.transform.rotate != glm::vec3(0.0f) || child.transform.scale != glm::vec3(1.0f))
+            continue;
+        if (auto outline = revolvedOutline(child.points, -node.params[0] - child.transform.translate.x))
+            child.outline = std::move(outline);
+    }
+}
+
 bool finite(glm::vec3 v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
@@ -592,6 +607,7 @@ Result<Scene> parseScene(std::string_view json, std::string_view file, const Lim
     Problems problems(fileName);
     Scene scene = isLegacyScene(top) ? convertLegacy(asObject(top), limits, problems)
                                      : SceneReader(limits, problems).read(top);
+    if (problems.empty()) closeRevolvedProfiles(scene);
     if (problems.empty()) checkCombinedTransforms(scene, problems);
     if (!problems.empty()) return problems.error();
     scene.file = fileName;
