@@ -10,7 +10,10 @@
 //   marching-cubes case; a cell where two sheets pass gets two), placed where the planes through
 //   the piece's edge points meet best (a quadratic error function, solved by eigenvectors and
 //   kept in the cell), and one quad per crossed edge, joining the vertices of its four cells.
-//   Flat faces stay flat, and the sharp edges and corners of the solid stay sharp.
+//   Flat faces stay flat, and the sharp edges and corners of the solid stay sharp. Where a
+//   sharp edge runs close along a grid line or plane, vertices of cells on both sides can land
+//   on it and cross over; a quad that then faces against its vertices' normals has its vertices
+//   moved to the mean of their edge points instead (smooth there, as surface nets are).
 // Either way the mesh is indexed and welded by construction and, wherever the surface lies
 // inside the bounds, closed and manifold, with triangles wound counter-clockwise seen from
 // outside.
