@@ -20,8 +20,8 @@
 #include "mesh_rows.glsl"
 #include "mesh_tables.glsl"
 
-// SDFCSG_MESH_BRICK invocations for the triangles, SDFCSG_MESH_GROUP_X for the dual passes,
-// whose first SDFCSG_MESH_BRICK list the work that all then share.
+// SDFCSG_MESH_BRICK invocations for the triangles; for the dual passes, whose first
+// SDFCSG_MESH_BRICK list the work that all then share, as many or SDFCSG_MESH_GROUP_X (on GPUs).
 layout(local_size_x_id = SDFCSG_SPEC_MESH_GROUP) in;
 
 layout(constant_id = SDFCSG_SPEC_MESH_PASS) const uint kPass = SDFCSG_MESH_PASS_TRIANGLES;
