@@ -139,8 +139,17 @@ void classify() {
         records[record + 2u * r] = next;
         records[record + 2u * r + 1u] = row.crossed.x | row.crossed.y << 8 | row.crossed.z << 16;
         records[record + kRecordDual + r] = nextDual;
-        for (uint cells = row.cells; cells != 0u; cells &= cells - 1u)
-            nextDual += patchCountOf(cellCase(findLSB(cells), y, plane));
+        uvec2 offsets = uvec2(0u); // byte x: the row's dual vertices before cell x
+        uint before = 0u;
+        for (uint cells = row.cells; cells != 0u; cells &= cells - 1u) {
+            uint x = findLSB(cells);
+            if (x < 4u) offsets.x |= before << (8u * x);
+            else offsets.y |= before << (8u * (x - 4u));
+            before += patchCountOf(cellCase(x, y, plane));
+        }
+        nextDual += before;
+        records[record + kRecordOffsets + 2u * r] = offsets.x;
+        records[record + kRecordOffsets + 2u * r + 1u] = offsets.y;
         for (uint any = row.crossed.x | row.crossed.y | row.crossed.z; any != 0u;
              any &= any - 1u) {
             uint x = findLSB(any);

@@ -9,6 +9,7 @@ const uint kSide = SDFCSG_MESH_BRICK_SAMPLES;
 const uint kSignRows = kSide * kSide;
 const uint kRecordDual = 2u * SDFCSG_MESH_BRICK * SDFCSG_MESH_BRICK;  // offsets in a record
 const uint kRecordSigns = 3u * SDFCSG_MESH_BRICK * SDFCSG_MESH_BRICK;
+const uint kRecordOffsets = kRecordSigns + kSignRows;
 
 // Bit x of insideRows[y + kSide * z] is set when sample (x, y, z) of the block is inside.
 shared uint insideRows[kSignRows];

@@ -320,14 +320,14 @@ void emitDualVertices(uint slot, uvec3 brick) {
     }
 }
 
-// The cells that the quads of the brick's edges reach, -1..7 per axis (index (x + 1) + 9 (y + 1)
-// + 81 (z + 1)): each one's first dual vertex, 0xffffffff where its brick was skipped, and its
-// case.
-shared uint cellFirst[729];
-shared uint cellCases[729];
+// The rows of cells that the quads of the brick's edges reach, (y, z) in -1..7 (index
+// (y + 1) + 9 (z + 1)), each split into its cell x = -1 (part 0, from the brick before this one
+// along x) and its cells 0..7 (part 1, index 2 row + part): the first dual vertex of the row in
+// its brick (0xffffffff where the brick was skipped), a byte per cell x of its dual vertices
+// before it in the row (two words), and a byte per cell x of its case (two words).
+shared uint dualFirst[162];
+shared uvec4 dualCells[162];
 
-// Fills cellFirst and cellCases by rows of cells (y, z), each split into its cell x = -1 (part
-// 0, from the brick before this one along x) and its cells 0..7 (part 1).
 void loadDualCells(uint slot, uvec3 b) {
     for (uint i = gl_LocalInvocationID.x; i < 2u * 81u; i += gl_WorkGroupSize.x) {
         uint r = i >> 1, part = i & 1u;
@@ -340,39 +340,47 @@ void loadDualCells(uint slot, uvec3 b) {
                                         : map[nb.x + grid.bricks.x * (nb.y + grid.bricks.y * nb.z)];
         }
         uint ly = before.y == 1u ? 7u : y - 1u, lz = before.z == 1u ? 7u : z - 1u;
-        uint first = 0xffffffffu, r00 = 0u, r10 = 0u, r01 = 0u, r11 = 0u;
+        uint first = 0xffffffffu;
+        uvec4 cells = uvec4(0u);
         if (owner != SDFCSG_MESH_NO_BRICK) {
-            uint signs = owner * SDFCSG_MESH_RECORD + kRecordSigns + ly + kSide * lz;
-            r00 = records[signs];
-            r10 = records[signs + 1u];
-            r01 = records[signs + kSide];
-            r11 = records[signs + kSide + 1u];
-            first = bases[owner].z +
-                    records[owner * SDFCSG_MESH_RECORD + kRecordDual + ly + SDFCSG_MESH_BRICK * lz];
-        }
-        for (uint x = 0u; x < SDFCSG_MESH_BRICK; ++x) {
-            uint c = (r00 >> x & 3u) | (r10 >> x & 3u) << 2 | (r01 >> x & 3u) << 4 |
-                     (r11 >> x & 3u) << 6;
-            if (part == 1u || x == 7u) {
-                uint cell = (part == 1u ? x + 1u : 0u) + 9u * r;
-                cellFirst[cell] = first;
-                cellCases[cell] = c;
+            uint record = owner * SDFCSG_MESH_RECORD, row = ly + SDFCSG_MESH_BRICK * lz;
+            uint signs = record + kRecordSigns + ly + kSide * lz;
+            uint r00 = records[signs], r10 = records[signs + 1u];
+            uint r01 = records[signs + kSide], r11 = records[signs + kSide + 1u];
+            first = bases[owner].z + records[record + kRecordDual + row];
+            cells.xy = uvec2(records[record + kRecordOffsets + 2u * row],
+                             records[record + kRecordOffsets + 2u * row + 1u]);
+            // The cases of cells 0..7 at once: bit x of each row word is corner x of cell x.
+            for (uint k = 0u; k < 4u; ++k) {
+                uint lo = 8u * k;
+                uint c0 = (r00 >> k & 3u) | (r10 >> k & 3u) << 2 | (r01 >> k & 3u) << 4 |
+                          (r11 >> k & 3u) << 6;
+                uint c1 = (r00 >> (k + 4u) & 3u) | (r10 >> (k + 4u) & 3u) << 2 |
+                          (r01 >> (k + 4u) & 3u) << 4 | (r11 >> (k + 4u) & 3u) << 6;
+                cells.z |= c0 << lo;
+                cells.w |= c1 << lo;
             }
-            if (first != 0xffffffffu) first += patchCountOf(c);
         }
+        dualFirst[i] = first;
+        dualCells[i] = cells;
     }
 }
 
 // The dual vertex of cell c (brick-local, -1..7 per axis) on its edge from the corner at offset
 // `corner` along `axis`.
 uint dualVertex(ivec3 c, uvec3 corner, uint axis) {
-    uint cell = uint(c.x + 1 + 9 * (c.y + 1) + 81 * (c.z + 1));
-    uint first = cellFirst[cell];
+    uint part = c.x < 0 ? 0u : 1u, x = c.x < 0 ? 7u : uint(c.x);
+    uint entry = 2u * uint(c.y + 1 + 9 * (c.z + 1)) + part;
+    uint first = dualFirst[entry];
     if (first == 0xffffffffu) {
         status[1] = 1u; // the field is not 1-Lipschitz here; the host meshes again
         return 0u;
     }
-    return first + patchOf(cellCases[cell], edgeAt(corner, axis));
+    uvec4 cells = dualCells[entry];
+    uint shift = 8u * (x & 3u);
+    uint before = ((x < 4u ? cells.x : cells.y) >> shift) & 255u;
+    uint cellCase = ((x < 4u ? cells.z : cells.w) >> shift) & 255u;
+    return first + before + patchOf(cellCase, edgeAt(corner, axis));
 }
 
 void emitQuads(uint slot, uvec3 brick) {

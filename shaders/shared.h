@@ -45,7 +45,7 @@
 #define SDFCSG_MESH_BRICK_BLOCK 729      // SDFCSG_MESH_BRICK_SAMPLES^3
 #define SDFCSG_MESH_BRICK_EDGES 1536     // 3 edges per owned sample
 #define SDFCSG_MESH_GROUP_X 64           // cull and vertex passes
-#define SDFCSG_MESH_RECORD 273           // 3 * 8 * 8 + 9 * 9
+#define SDFCSG_MESH_RECORD 401           // 3 * 8 * 8 + 9 * 9 + 2 * 8 * 8
 #define SDFCSG_MESH_NO_BRICK 0xffffffffu // brick map entry of a skipped brick
 
 #define SDFCSG_BINDING_MESH_GRID 0     // uniform MeshGrid: origin, cell size, counts
@@ -57,7 +57,8 @@
 #define SDFCSG_BINDING_MESH_RECORDS 6  // uint[]: per active brick, SDFCSG_MESH_RECORD words:
                                        // per owned row, first edge vertex and crossed edges;
                                        // per owned row, first dual vertex; then the signs of
-                                       // the block, a word per row
+                                       // the block, a word per row; then per owned row, each
+                                       // cell's dual vertices before it in the row, a byte each
 #define SDFCSG_BINDING_MESH_COUNTS 7   // uvec4[]: per active brick, edge vertices, triangles
                                        // of marching cubes, dual vertices, dual triangles
 #define SDFCSG_BINDING_MESH_BASES 8    // uvec4[]: per active brick, the first of each
