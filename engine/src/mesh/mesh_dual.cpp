@@ -4,6 +4,7 @@
 #include <glm/vec2.hpp>
 
 #include <algorithm>
+#include <thread>
 
 namespace sdfcsg::detail {
 
@@ -80,42 +81,53 @@ bool fold(const Mesh& mesh, const Quad& q, uint32_t* t) {
 void foldQuads(Mesh& mesh, const std::vector<glm::vec3>& smooth) {
     const size_t quads = mesh.indices.size() / 6;
     std::vector<uint8_t> axes(quads);
-    // movedIn[k]: the round in which vertex k moved to its smooth place, plus one; 0: never.
+    // movedIn[k]: the round in which vertex k moved to its smooth place; 0: never.
     std::vector<uint8_t> movedIn(mesh.positions.size(), 0);
-    auto moveVertices = [&](const uint32_t* t, uint8_t round) {
-        bool moved = false;
-        for (int k = 0; k < 6; ++k)
-            if (movedIn[t[k]] == 0) {
-                movedIn[t[k]] = round;
-                mesh.positions[t[k]] = smooth[t[k]];
-                moved = true;
-            }
-        return moved;
-    };
-    // Round 1 folds every quad as the quads pass wrote it: (a, b, c), then (a, c, d) rotated to
-    // start at its axis'th corner.
-    bool moved = false;
-    for (size_t q = 0; q < quads; ++q) {
-        uint32_t* t = &mesh.indices[6 * q];
-        const int axis = t[3] == t[0] ? 0 : t[3] == t[2] ? 1 : 2;
-        const Quad quad{t[0], t[1], t[2], axis == 0 ? t[5] : axis == 1 ? t[4] : t[3], axis};
-        axes[q] = uint8_t(axis);
-        if (fold(mesh, quad, t)) moved = moveVertices(t, 1) || moved;
-    }
-    // A quad that folds against its vertices' normals has had them moved to their smooth
-    // places; the quads around those fold again and may move theirs, for a few rounds; the last
-    // only folds.
-    for (uint8_t round = 2; moved && round <= 5; ++round) {
-        moved = false;
-        for (size_t q = 0; q < quads; ++q) {
+    // Each round folds quads (in round 1 all of them, as the quads pass wrote them: (a, b, c),
+    // then (a, c, d) rotated to start at its axis'th corner; then those around the vertices that
+    // moved in the round before, as fold() wrote them) and lists those that fold against their
+    // vertices' normals; then their vertices move to their smooth places. The last round only
+    // folds. Quads change only their own indices while positions stay, so two threads share a
+    // round's quads and the result does not depend on them.
+    auto foldRange = [&](uint8_t round, size_t begin, size_t end, std::vector<size_t>& folding) {
+        for (size_t q = begin; q < end; ++q) {
             uint32_t* t = &mesh.indices[6 * q];
-            if (std::none_of(t, t + 6, [&](uint32_t k) { return movedIn[k] == round - 1; }))
+            Quad quad;
+            if (round == 1) {
+                const int axis = t[3] == t[0] ? 0 : t[3] == t[2] ? 1 : 2;
+                quad = {t[0], t[1], t[2], axis == 0 ? t[5] : axis == 1 ? t[4] : t[3], axis};
+                axes[q] = uint8_t(axis);
+            } else if (std::any_of(t, t + 6, [&](uint32_t k) { return movedIn[k] == round - 1; })) {
+                // a-c is (a, b, c), (a, c, d); b-d is (a, b, d), (b, c, d).
+                quad = t[3] == t[0] ? Quad{t[0], t[1], t[2], t[5], axes[q]}
+                                    : Quad{t[0], t[1], t[4], t[2], axes[q]};
+            } else {
                 continue;
-            // As fold() wrote it: a-c is (a, b, c), (a, c, d); b-d is (a, b, d), (b, c, d).
-            const Quad quad = t[3] == t[0] ? Quad{t[0], t[1], t[2], t[5], axes[q]}
-                                           : Quad{t[0], t[1], t[4], t[2], axes[q]};
-            if (fold(mesh, quad, t) && round < 5) moved = moveVertices(t, round) || moved;
+            }
+            if (fold(mesh, quad, t)) folding.push_back(q);
         }
+    };
+    constexpr uint8_t kRounds = 5;
+    for (uint8_t round = 1; round <= kRounds; ++round) {
+        std::vector<size_t> folding, theirs;
+        if (quads < 65536 || std::thread::hardware_concurrency() < 2) {
+            foldRange(round, 0, quads, folding);
+        } else {
+            std::thread helper(foldRange, round, quads / 2, quads, std::ref(theirs));
+            foldRange(round, 0, quads / 2, folding);
+            helper.join();
+            folding.insert(folding.end(), theirs.begin(), theirs.end());
+        }
+        if (round == kRounds) break;
+        bool moved = false;
+        for (size_t q : folding)
+            for (int k = 0; k < 6; ++k)
+                if (const uint32_t v = mesh.indices[6 * q + k]; movedIn[v] == 0) {
+                    movedIn[v] = round;
+                    mesh.positions[v] = smooth[v];
+                    moved = true;
+                }
+        if (!moved) break;
     }
 }
 
