@@ -350,7 +350,7 @@ void loadDualCells(uint slot, uvec3 b) {
             first = bases[owner].z + records[record + kRecordDual + row];
             cells.xy = uvec2(records[record + kRecordOffsets + 2u * row],
                              records[record + kRecordOffsets + 2u * row + 1u]);
-            // The cases of cells 0..7 at once: bit x of each row word is corner x of cell x.
+            // The eight cases, a byte each: bits x and x + 1 of the row words are cell x's.
             for (uint k = 0u; k < 4u; ++k) {
                 uint lo = 8u * k;
                 uint c0 = (r00 >> k & 3u) | (r10 >> k & 3u) << 2 | (r01 >> k & 3u) << 4 |

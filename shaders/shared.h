@@ -63,8 +63,9 @@
                                        // of marching cubes, dual vertices, dual triangles
 #define SDFCSG_BINDING_MESH_BASES 8    // uvec4[]: per active brick, the first of each
 #define SDFCSG_BINDING_MESH_EDGES 9    // uint[]: crossed edges of each brick of the batch
-#define SDFCSG_BINDING_MESH_VERTICES 10 // float[]: per vertex: position, normal, colour (and
-                                        // from the vertices pass, a second normal: 12 floats)
+#define SDFCSG_BINDING_MESH_VERTICES 10 // float[]: per vertex: position, normal, colour, and
+                                        // a second normal (vertices pass) or the mean of its
+                                        // edge points (dual pass): 12 floats
 #define SDFCSG_BINDING_MESH_INDICES 11  // uint[]: 3 per triangle
 #define SDFCSG_BINDING_MESH_STATUS 12   // uint[2]: surface cut, brick skipped wrongly
 #define SDFCSG_BINDING_MESH_HERMITE 13  // float[]: dual contouring: every edge vertex, 12 each
