@@ -14,13 +14,20 @@ Trace march(vec3 ro, vec3 rd, float t, float tFar) {
     Trace r = Trace(-1.0, 0u, vec3(0.0), 1.0, vec4(1.0));
     bool marching = t <= tFar;
     while (marching) {
-        float d = sceneDistance(ro + rd * t);
+#ifdef SDFCSG_TAPE_STACK
+        // Tapes: through a cell far from every surface, the step goes as far as the cell's
+        // reach along the ray (tape.glsl), farther than its bound.
+        float step;
+        float d = tapeDistanceAlong(ro + rd * t, rd, step);
+#else
+        float d = sceneDistance(ro + rd * t), step = d;
+#endif
         r.steps += 1u;
         if (d < hitEpsilon(t)) {
             r.t = t;
             marching = false;
         } else {
-            t += d;
+            t += step;
             marching = t <= tFar && r.steps < SDFCSG_MAX_STEPS;
         }
     }

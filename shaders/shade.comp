@@ -55,7 +55,7 @@ void surface(vec3 ro, vec3 rd, vec4 ends, inout Trace r, out vec3 albedo) {
         if (phase == kColor)
             s = sceneSample(origin + dir * t);
         else
-            s = tapeTap(origin + dir * t);
+            s = tapeTap(origin + dir * t, dir);
 #else
         vec4 s = sceneSample(origin + dir * t);
 #endif
@@ -99,11 +99,16 @@ void surface(vec3 ro, vec3 rd, vec4 ends, inout Trace r, out vec3 albedo) {
             }
         } else { // kShadow
             if (s.r < 0.0) {
-                // A bound from a cell far from every surface (tape.glsl): it only steps, and
-                // does not count against the steps (each is at least a cell's radius). Taken as
-                // a distance it would narrow the penumbra's cone and darken lit surfaces, and
-                // where leaf cells are small beside the hit epsilon, read as a hit.
+                // A bound from a cell far from every surface (tape.glsl): it only steps, as far
+                // as the cell's reach along the ray (s.g with tapes), and does not count against
+                // the steps (each is at least a cell's radius). Taken as a distance it would
+                // narrow the penumbra's cone and darken lit surfaces, and where leaf cells are
+                // small beside the hit epsilon, read as a hit.
+#ifdef SDFCSG_TAPE_STACK
+                t += max(s.g, eps);
+#else
                 t += max(d, eps);
+#endif
                 tap -= 1;
             } else if (d < eps * 0.5) {
                 res = 0.0;

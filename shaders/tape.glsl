@@ -3,18 +3,40 @@
 // scene; the tapes, the cells and the node buffer carry everything that is the scene's own.
 // PrunedField::distance and sample in engine/src/field/prune.cpp are this file in C++.
 //
-// The generated scene code defines SDFCSG_TAPE_STACK (the most values a tape holds at once,
-// rounded up), SDFCSG_TAPE_KINDS (a bit for each kind the scene holds) and SDFCSG_TAPE_DOMAINS
-// (the most domain operations nested in one another, 0 for none) before it includes this file.
+// The generated scene code defines, before it includes this file, what the scene's tapes need,
+// so that the machine holds no code for the rest (a CPU driver runs every branch of its loop
+// for every instruction): SDFCSG_TAPE_STACK (the most values a tape holds at once, rounded up;
+// 0 where no instruction reads the stack, when every operation folds in a primitive's value),
+// SDFCSG_TAPE_KINDS (a bit for each kind of primitive), SDFCSG_TAPE_OPERATIONS (a bit for each
+// kind of operation, less Union: union 1, intersection 2, difference 4, shell 8, offset 16),
+// SDFCSG_TAPE_BLENDS (a bit for each blend profile), SDFCSG_TAPE_BALLS (1 where every sphere
+// is a ball, detail::isBall; KINDS then lacks the sphere's bit) and SDFCSG_TAPE_DOMAINS (the
+// most domain operations nested in one another, 0 for none). Some of these follow values (the
+// profiles, the scales): Renderer::updateValues recompiles where they change.
 
 // Mirrors packField() in engine/src/field/prune.cpp: a header of 12 words (origin xyz and leaf cell
 // side as float bits, levels, leaf cells per axis xyz, 1 when bounded, whole-tape length, first
-// tape word), two words per leaf cell, then the tape.
+// tape word, first cell word), four words per node (a ball's centre and radius), two words per
+// leaf cell, then the tape.
 layout(std430, set = 0, binding = SDFCSG_BINDING_FIELD) readonly buffer Field {
     uint field[];
 };
+// The same buffer as vec4s: node i's ball is vec4 3 + i (the header is three of them).
+layout(std430, set = 0, binding = SDFCSG_BINDING_FIELD) readonly buffer FieldBalls {
+    vec4 fieldBalls[];
+};
 
+// Balls (SDFCSG_TAPE_BALLS: every sphere's scale is the same on every axis) read one vec4, their
+// centre and radius (packField: the same value as the sphere's, up to rounding), where other
+// primitives read their transform's three rows, their parameters and their scale: most of the
+// work of a tape of spheres (molecule_1k), as each is a gather on CPU devices.
 float tapePrimitive(uint kind, uint i, vec3 p) {
+#if SDFCSG_TAPE_BALLS
+    if (kind == 0u || SDFCSG_TAPE_KINDS == 0u) {
+        vec4 ball = fieldBalls[3u + i];
+        return length(p - ball.xyz) - ball.w;
+    }
+#endif
     return sdPrimitive(kind, toLocal(i, p), nodes[i].p0, nodes[i].p1, SDFCSG_TAPE_KINDS) *
            nodes[i].color.w;
 }
@@ -23,14 +45,19 @@ const uint kTapeUnion = uint(SDFCSG_TAPE_FIRST_OPERATION), kTapeIntersection = k
 
 // One blend for the three operations, which the compiler would otherwise all evaluate and
 // select from: intersection(a, b) is -union(-a, -b) and difference(a, b) intersection(a, -b),
-// bit for bit as sdf.glsl computes them (negation rounds symmetrically).
+// bit for bit as sdf.glsl computes them (negation rounds symmetrically). Kinds and profiles
+// that the scene lacks fold away.
 float tapeOp(uint kind, float a, float b, float k, uint blend) {
+    if ((SDFCSG_TAPE_OPERATIONS & 6) == 0) kind = kTapeUnion;
+    if (SDFCSG_TAPE_BLENDS == 1) blend = 0u;
     float s = kind == kTapeUnion ? 1.0 : -1.0;
     float c = kind == kTapeIntersection || kind == kTapeUnion ? b : -b;
     return s * opUnion(s * a, s * c, k, blend);
 }
 
 vec4 tapeOp(uint kind, vec4 a, vec4 b, float k, uint blend) {
+    if ((SDFCSG_TAPE_OPERATIONS & 6) == 0) kind = kTapeUnion;
+    if (SDFCSG_TAPE_BLENDS == 1) blend = 0u;
     float s = kind == kTapeUnion ? 1.0 : -1.0;
     float c = kind == kTapeIntersection || kind == kTapeUnion ? b.w : -b.w;
     vec4 u = opUnion(vec4(a.rgb, s * a.w), vec4(b.rgb, s * c), k, blend);
@@ -61,8 +88,12 @@ vec4 tapeOp(uint kind, vec4 a, vec4 b, float k, uint blend) {
 #undef TAPE_DIST
 #undef TAPE_WITH
 
-// Where p's value comes from: x: 0 to run the tape [y, z), 1 for the bound w.
-uvec3 tapeCell(vec3 p, out float bound) {
+// Where p's value comes from: x: 0 to run the tape [y, z), 1 for the bound w. Far from every
+// surface, `reach` is how far a ray from p along the unit vector dir may step without meeting
+// one: to where it leaves the ball of radius |v| around the centre c of the cell found far (no
+// surface lies nearer to c than its value v), at least the bound v - |p - c| and often a few
+// cells more (the bound alone, near a far cell's entry side, is about a leaf cell's radius).
+uvec3 tapeCell(vec3 p, vec3 dir, out float bound, out float reach) {
     vec3 origin = vec3(uintBitsToFloat(field[0]), uintBitsToFloat(field[1]),
                        uintBitsToFloat(field[2]));
     float cell = uintBitsToFloat(field[3]);
@@ -70,23 +101,27 @@ uvec3 tapeCell(vec3 p, out float bound) {
     uvec3 dims = uvec3(field[5], field[6], field[7]);
     vec3 q = floor((p - origin) / cell);
     bound = 0.0;
+    reach = 0.0;
     if (dims.x == 0u || any(lessThan(q, vec3(0.0))) || any(greaterThanEqual(q, vec3(dims)))) {
         if (field[8] == 0u) return uvec3(0u, tapeStart, tapeStart + field[9]); // the whole tape
         // Bounded: the grid holds the bounds and a cell more on every side.
         vec3 top = origin + cell * vec3(dims);
         bound = boundsDistance(origin, top, p) + 0.5 * cell;
+        reach = bound;
         return uvec3(1u, 0u, 0u);
     }
     uvec3 at = uvec3(q);
-    uint entry = 12u + 2u * (at.x + dims.x * (at.y + dims.y * at.z));
+    uint entry = field[11] + 2u * (at.x + dims.x * (at.y + dims.y * at.z));
     uint x = field[entry], y = field[entry + 1u];
     if ((y & 0x80000000u) == 0u) return uvec3(0u, tapeStart + x, tapeStart + x + y);
     // Far from every surface: the root value v at the centre of the cell found far.
     uint shift = levels - (y & 0xffu);
     float size = cell * float(1u << shift);
-    vec3 centre = origin + (vec3(at >> shift) + 0.5) * size;
-    float v = uintBitsToFloat(x), away = length(p - centre);
-    bound = v > 0.0 ? v - away : v + away;
+    vec3 away = p - (origin + (vec3(at >> shift) + 0.5) * size);
+    float v = uintBitsToFloat(x), distance = length(away);
+    bound = v > 0.0 ? v - distance : v + distance;
+    float b = dot(away, dir);
+    reach = max(sqrt(max(b * b + (v * v - distance * distance), 0.0)) - b, abs(bound));
     return uvec3(1u, 0u, 0u);
 }
 
@@ -94,23 +129,34 @@ uvec3 tapeCell(vec3 p, out float bound) {
 float tapeLeafSide() { return field[4] == 0u ? 1e30 : uintBitsToFloat(field[3]); }
 
 float tapeDistance(vec3 p) {
-    float bound;
-    uvec3 c = tapeCell(p, bound);
+    float bound, reach;
+    uvec3 c = tapeCell(p, vec3(0.0), bound, reach);
     return c.x == 1u ? bound : tapeDistanceRun(c.y, c.z, p);
 }
 
-// For the shade pass's taps, which need no colour: the distance in w, and r -1 where it is a
-// bound (as tapeSample gives), else 0. The float stack is about half the work of the colour one.
-vec4 tapeTap(vec3 p) {
+// For a ray from p along the unit vector dir: the field at p, and how far the ray may step
+// (the field's value, or a far cell's reach).
+float tapeDistanceAlong(vec3 p, vec3 dir, out float step) {
     float bound;
-    uvec3 c = tapeCell(p, bound);
-    return c.x == 1u ? vec4(-1.0, 0.0, 0.0, bound)
+    uvec3 c = tapeCell(p, dir, bound, step);
+    if (c.x == 1u) return bound;
+    step = tapeDistanceRun(c.y, c.z, p);
+    return step;
+}
+
+// For the shade pass's taps, which need no colour: the distance in w, and r -1 where it is a
+// bound (as tapeSample gives), then with g the reach along dir (tapeCell), else 0. The float
+// stack is about half the work of the colour one.
+vec4 tapeTap(vec3 p, vec3 dir) {
+    float bound, reach;
+    uvec3 c = tapeCell(p, dir, bound, reach);
+    return c.x == 1u ? vec4(-1.0, reach, 0.0, bound)
                      : vec4(0.0, 0.0, 0.0, tapeDistanceRun(c.y, c.z, p));
 }
 
 // Where the value is a bound, the colour is -1: the shade pass's soft shadows tell the two apart.
 vec4 tapeSample(vec3 p) {
-    float bound;
-    uvec3 c = tapeCell(p, bound);
+    float bound, reach;
+    uvec3 c = tapeCell(p, vec3(0.0), bound, reach);
     return c.x == 1u ? vec4(-1.0, -1.0, -1.0, bound) : tapeSampleRun(c.y, c.z, p);
 }

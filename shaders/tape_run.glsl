@@ -8,8 +8,10 @@
 // it. On CPU devices this keeps most instructions off the stack array, which every lane
 // indexes on its own, and makes nearly every iteration take the same path.
 TAPE_VALUE TAPE_RUN(uint begin, uint end, vec3 p) {
+#if SDFCSG_TAPE_STACK > 0
     TAPE_VALUE stack[SDFCSG_TAPE_STACK];
     int top = -1;
+#endif
     TAPE_VALUE acc = TAPE_VALUE(0.0);
 #if SDFCSG_TAPE_DOMAINS > 0
     // Open domain operations: the point outside, the local point, the least candidate value,
@@ -31,14 +33,22 @@ TAPE_VALUE TAPE_RUN(uint begin, uint end, vec3 p) {
                 acc = tapeOp(fold + kTapeUnion - 1u, acc, d, uintBitsToFloat(field[++at]),
                              ins >> SDFCSG_TAPE_BLEND_SHIFT);
             } else {
+#if SDFCSG_TAPE_STACK > 0
                 stack[++top] = acc;
+#endif
                 acc = d;
             }
-        } else if (kind < kTapeUnion + 3u) {
+        }
+#if SDFCSG_TAPE_STACK > 0
+        else if (kind < kTapeUnion + 3u) {
             acc = tapeOp(kind, stack[top--], acc, nodeSmooth(i), nodeBlend(i));
-        } else if (kind < kTapeUnion + 5u) {
+        }
+#endif
+#if (SDFCSG_TAPE_OPERATIONS & 24) != 0
+        else if (kind < kTapeUnion + 5u) {
             acc = TAPE_WITH(acc, valueOp(kind, TAPE_DIST(acc), nodes[i].p0));
         }
+#endif
 #if SDFCSG_TAPE_DOMAINS > 0
         else if (kind != uint(SDFCSG_TAPE_DOMAIN_END)) {
             // A domain operation: its child runs next, at the first candidate point.

@@ -648,6 +648,44 @@ INSTANTIATE_TEST_SUITE_P(Render, UpdateValues, ::testing::Values(true, false),
                                                 : std::string("BufferValues");
                          });
 
+// On tapes a value edit is an upload, but where it changes what the tape machine holds code for:
+// a sphere scaled differently per axis is no longer a ball (detail::isBall), so the kernel is
+// compiled again, and the image is the new scene's.
+TEST_F(Render, UpdateValuesOnTapesRecompilesOnlyWhereTheCodeChanges) {
+    Scene scene = loadOrDie(scenePath("csg_part.json"));
+    RendererOptions made;
+    made.evaluation = Evaluation::Tapes;
+    auto renderer = Renderer::create(context(), scene, made);
+    ASSERT_TRUE(renderer) << renderer.error().str();
+    RenderOptions options;
+    options.width = options.height = kSize;
+    options.camera = cameraFor(scene, Evaluator(scene));
+    auto lookups = [] {
+        const detail::ShaderCacheStats s = detail::shaderCacheStats();
+        return s.compiles + s.memoryHits + s.diskHits;
+    };
+    for (bool perAxis : {false, true}) {
+        SCOPED_TRACE(perAxis ? "a scale per axis" : "a larger sphere");
+        if (perAxis) {
+            for (Node& node : scene.nodes)
+                if (node.kind == NodeKind::Sphere) node.transform.scale = glm::vec3(1.3f, 1.0f, 0.8f);
+        } else {
+            ASSERT_TRUE(growFirstSphere(scene));
+        }
+        const uint64_t before = lookups();
+        auto updated = (*renderer)->updateValues(scene);
+        ASSERT_TRUE(updated) << updated.error().str();
+        EXPECT_EQ(lookups() - before, perAxis ? 2u : 0u);
+        auto image = (*renderer)->render(options);
+        ASSERT_TRUE(image);
+        auto fresh = Renderer::create(context(), scene, made);
+        ASSERT_TRUE(fresh) << fresh.error().str();
+        auto expected = (*fresh)->render(options);
+        ASSERT_TRUE(expected);
+        EXPECT_EQ(image->rgba, expected->rgba);
+    }
+}
+
 // lavapipe may specialise a kernel on values that it reads from a uniform block or from push
 // constants to decide branches, and then compiles it again whenever they change, which would
 // be at every band of every frame. Whether it does depends on the kernel's code, the scene's

@@ -73,7 +73,9 @@ struct RendererOptions {
     // that several times faster, but updateValues() must then regenerate and recompile.
     // false: values are read from a buffer, so updateValues() only uploads them (the viewer).
     bool inlineValues = true;
-    // Inlined or pruned tapes (CodegenOptions): with tapes, updateValues() never recompiles.
+    // Inlined or pruned tapes (CodegenOptions): with tapes, updateValues() recompiles only
+    // where an edit changes what the tape machine holds code for (a blend profile; a sphere's
+    // scale made to differ per axis, or no longer).
     Evaluation evaluation = Evaluation::Auto;
 };
 

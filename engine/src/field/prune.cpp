@@ -6,6 +6,7 @@
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
 
 #include <algorithm>
 #include <atomic>
@@ -538,8 +539,21 @@ uint32_t PrunedField::activeLength(glm::vec3 p) const {
     return e->y & kFarCell ? 0 : e->y;
 }
 
+bool isBall(const FlatNode& n) {
+    if (n.kind != NodeKind::Sphere) return false;
+    // Its transform times its scale is a rotation (to rounding) unless a scale differs per axis.
+    const glm::dmat3 m = glm::dmat3(n.toLocal) * double(n.scale);
+    const glm::dmat3 g = glm::transpose(m) * m;
+    for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r)
+            if (std::abs(g[c][r] - (c == r ? 1.0 : 0.0)) > 1e-6) return false;
+    return true;
+}
+
 std::vector<uint32_t> packField(const PrunedField& f, const std::vector<FlatNode>& nodes) {
-    std::vector<uint32_t> out(kFieldHeaderWords + 2 * f.cells.size() + f.tape.size());
+    const uint32_t cellStart = uint32_t(kFieldHeaderWords + 4 * nodes.size());
+    const uint32_t tapeStart = uint32_t(cellStart + 2 * f.cells.size());
+    std::vector<uint32_t> out(tapeStart + f.tape.size());
     auto put = [&](size_t at, float v) { out[at] = std::bit_cast<uint32_t>(v); };
     put(0, f.origin.x);
     put(1, f.origin.y);
@@ -551,9 +565,20 @@ std::vector<uint32_t> packField(const PrunedField& f, const std::vector<FlatNode
     out[7] = f.dims.z;
     out[8] = f.bounded ? 1u : 0u;
     out[9] = f.fullLength;
-    const uint32_t tapeStart = uint32_t(kFieldHeaderWords + 2 * f.cells.size());
     out[10] = tapeStart;
-    std::memcpy(out.data() + kFieldHeaderWords, f.cells.data(), f.cells.size() * 8);
+    out[11] = cellStart;
+    // A ball's value (|M p + o| - r) s, with M its rotation divided by its scale s, is
+    // |p - c| - r s with c = -M^-1 o: the shader reads the centre and that radius, one vec4,
+    // in place of the transform's three rows (SDFCSG_TAPE_BALLS, tape.glsl).
+    for (size_t i = 0; i < nodes.size(); ++i) {
+        const FlatNode& n = nodes[i];
+        if (!isBall(n)) continue;
+        const glm::dvec3 c = -(glm::inverse(glm::dmat3(n.toLocal)) * glm::dvec3(n.offset));
+        for (int a = 0; a < 3; ++a)
+            put(kFieldHeaderWords + 4 * i + a, float(c[a]));
+        put(kFieldHeaderWords + 4 * i + 3, n.params[0] * n.scale);
+    }
+    std::memcpy(out.data() + cellStart, f.cells.data(), f.cells.size() * 8);
     uint32_t* tape = out.data() + tapeStart;
     std::copy(f.tape.begin(), f.tape.end(), tape);
     // Within each tape, a primitive whose operation follows at once carries the operation, so

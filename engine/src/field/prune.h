@@ -63,8 +63,8 @@ struct PrunedField {
     std::vector<uint32_t> tape;
     std::vector<glm::uvec2> cells; // x + dims.x * (y + dims.y * z)
 
-    // The field at p, as sceneDistance()/sceneSample() in shaders/tape.glsl compute it; where
-    // the value is a bound, the sample's colour is -1.
+    // The field at p, as sceneDistance()/sceneSample() in shaders/tape.glsl compute it (a ball
+    // there rounds otherwise, isBall); where the value is a bound, the sample's colour is -1.
     float distance(const std::vector<FlatNode>& nodes, glm::vec3 p) const;
     Sample sample(const std::vector<FlatNode>& nodes, glm::vec3 p) const;
     // Instructions that the leaf cell holding p runs (the whole tape outside the cube), 0 in a
@@ -84,8 +84,15 @@ std::vector<uint32_t> fullTape(const std::vector<FlatNode>& nodes, uint32_t& sta
 
 PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options = {});
 
+// A sphere whose transform is a rotation and a uniform scale (none differs per axis): its value
+// is the distance to its centre less its radius, which the tape machine reads as one vec4 where
+// every sphere of the scene is a ball (SDFCSG_TAPE_BALLS, shaders/tape.glsl): the same value up
+// to rounding.
+bool isBall(const FlatNode& node);
+
 // What shaders/tape.glsl reads, as one buffer of 32-bit words: a header of 12 words (origin,
-// cell, levels, dims, 1 when bounded, full tape length, first tape word, 1 spare), the cells
+// cell, levels, dims, 1 when bounded, full tape length, first tape word, first cell word), four
+// words per node (a ball's centre and radius in its frame, zeros for other nodes), the cells
 // (two words each), then the tape.
 inline constexpr uint32_t kFieldHeaderWords = 12;
 // In the packed tapes only: a primitive whose operation is the next instruction carries that

@@ -633,9 +633,13 @@ Status Renderer::updateValues(const Scene& scene) {
         return usage("updateValues: the scene's structure (node kinds or children) differs from "
                      "the compiled one; create a new Renderer instead");
     Impl& r = *impl_;
+    const bool tapes = usesTapes(scene, r.options.evaluation);
+    // The tape machine's code follows a few values too (blend profiles, whether every sphere's
+    // scale is uniform: generateSceneGlsl), which edits seldom change.
+    const std::string tapeCode = tapes ? r.sceneGlsl(r.defaultSkipping()) : std::string();
     Scene previous = std::move(r.scene);
     r.scene = scene;
-    if (r.options.inlineValues && !usesTapes(scene, r.options.evaluation)) {
+    if (tapes ? r.sceneGlsl(r.defaultSkipping()) != tapeCode : r.options.inlineValues) {
         if (auto built = r.buildKernels(); !built) {
             r.scene = std::move(previous);
             return built.error();
