@@ -192,21 +192,19 @@ INSTANTIATE_TEST_SUITE_P(Kinds, KindMesh, ::testing::ValuesIn(kKindTopologies),
 // count in the comment; the test allows about half as many again). One vertex per piece of
 // surface in a cell cannot follow two sheets of surface within a cell of each other; and along a
 // sharp edge that runs near a grid line or plane, the vertices of the cells around it crowd onto
-// the edge, where foldQuads (engine/src/mesh/mesh_dual.h) moves back those of quads that face
-// against their vertices' normals, but not thin triangles standing on the edge that face
-// neither way much.
+// the edge, where foldQuads (engine/src/mesh/mesh_dual.h) moves back those of quads that fold,
+// but not every one.
 struct FoldedScene {
     const char* scene; // file stem
     size_t flipsAllowed;
 };
 const FoldedScene kFoldedScenes[] = {
-    {"gallery", 14},       // 9: objects meet the ground in wedges thinner than a cell
-    {"gear", 4},           // 2: edges of the teeth along grid lines
-    {"house", 24},         // 16: fence boards and the roof's eaves thinner than a cell
-    {"knurled_knob", 100}, // 65: slivers standing on the twisted ribs' edges, where the field's
-                           // gradient is not of length 1 and sharp edges are found less well
-    {"name_plate", 10},    // 6: edges of the letters along grid lines
-    {"snowman", 8},        // 4: the body meets the drift in a wedge thinner than a cell
+    {"gallery", 14},      // 9: objects meet the ground in wedges thinner than a cell
+    {"gear", 4},          // 2: edges of the teeth along grid lines
+    {"house", 24},        // 16: fence boards and the roof's eaves thinner than a cell
+    {"knurled_knob", 14}, // 9: the twisted ribs' edges along grid lines
+    {"name_plate", 4},    // 2: edges of the letters along grid lines
+    {"snowman", 3},       // 1: the body meets the drift in a wedge thinner than a cell
 };
 
 // Every bundled scene at the default resolution: closed and manifold where the surface fits the

@@ -56,29 +56,40 @@ bool splitsAlongBd(const Mesh& mesh, const Quad& q) {
     return facingBd > facingAc + 1e-3f;
 }
 
-// Whether triangle (u, v, w) faces nearly a right angle or more away from the mean of its
-// vertices' normals. A triangle of a wedge of the solid as sharp as 30 degrees faces within 75
-// degrees of it (cosine 0.26).
-bool facesAway(const Mesh& mesh, uint32_t u, uint32_t v, uint32_t w) {
+// Whether triangle (u, v, w) folds: it faces nearly a right angle or more away from the mean of
+// its vertices' normals (a triangle of a wedge of the solid as sharp as 30 degrees faces within
+// 75 degrees of it, cosine 0.26), or, facing more than 60 degrees away from it, against the
+// field's gradient at its centre (`distance`; a thin triangle standing on a sharp edge).
+bool folds(const Mesh& mesh, const Distance& distance, uint32_t u, uint32_t v, uint32_t w) {
     const std::vector<glm::vec3>& p = mesh.positions;
     const std::vector<glm::vec3>& n = mesh.normals;
     const glm::vec3 c = glm::cross(p[v] - p[u], p[w] - p[u]), m = n[u] + n[v] + n[w];
-    const float cm = glm::dot(c, m);
-    return cm < 0.0f || cm * cm < 0.04f * glm::dot(c, c) * glm::dot(m, m);
+    const float cm = glm::dot(c, m), cc = glm::dot(c, c), mm = glm::dot(m, m);
+    if (cm < 0.0f || cm * cm < 0.04f * cc * mm) return true;
+    if (!distance || cm * cm >= 0.25f * cc * mm) return false;
+    const glm::vec3 centre = (p[u] + p[v] + p[w]) / 3.0f;
+    const float e = 0.01f * std::sqrt(std::max({glm::dot(p[v] - p[u], p[v] - p[u]),
+                                                glm::dot(p[w] - p[v], p[w] - p[v]),
+                                                glm::dot(p[u] - p[w], p[u] - p[w])}));
+    const glm::vec3 taps[4] = {{1, -1, -1}, {-1, -1, 1}, {-1, 1, -1}, {1, 1, 1}};
+    glm::vec3 g(0.0f);
+    for (const glm::vec3& tap : taps)
+        g += tap * distance(centre + tap * e);
+    return glm::dot(c, g) < 0.0f;
 }
 
 // Writes quad q into t split along a-c, as (a, b, c), (a, c, d), or along b-d, as (a, b, d),
-// (b, c, d); returns whether one of the two triangles faces away.
-bool fold(const Mesh& mesh, const Quad& q, uint32_t* t) {
+// (b, c, d); returns whether one of the two triangles folds.
+bool fold(const Mesh& mesh, const Distance& distance, const Quad& q, uint32_t* t) {
     const bool alongBd = splitsAlongBd(mesh, q);
     const uint32_t split[2][6] = {{q.a, q.b, q.c, q.a, q.c, q.d}, {q.a, q.b, q.d, q.b, q.c, q.d}};
     std::copy(split[alongBd], split[alongBd] + 6, t);
-    return facesAway(mesh, t[0], t[1], t[2]) || facesAway(mesh, t[3], t[4], t[5]);
+    return folds(mesh, distance, t[0], t[1], t[2]) || folds(mesh, distance, t[3], t[4], t[5]);
 }
 
 } // namespace
 
-void foldQuads(Mesh& mesh, const std::vector<glm::vec3>& smooth) {
+void foldQuads(Mesh& mesh, const std::vector<glm::vec3>& smooth, const Distance& distance) {
     const size_t quads = mesh.indices.size() / 6;
     std::vector<uint8_t> axes(quads);
     // movedIn[k]: the round in which vertex k moved to its smooth place; 0: never.
@@ -104,7 +115,7 @@ void foldQuads(Mesh& mesh, const std::vector<glm::vec3>& smooth) {
             } else {
                 continue;
             }
-            if (fold(mesh, quad, t)) folding.push_back(q);
+            if (fold(mesh, distance, quad, t)) folding.push_back(q);
         }
     };
     constexpr uint8_t kRounds = 5;

@@ -4,6 +4,8 @@
 
 #include "sdfcsg/mesh.h"
 
+#include <functional>
+
 namespace sdfcsg::detail {
 
 // `mesh` holds quads as pairs of triangles (a, b, c), (a, c, d), the second rotated to start at
@@ -13,10 +15,13 @@ namespace sdfcsg::detail {
 // triangles wind the same way, so that the surface crosses the edge once; where both do, the one
 // whose triangles face most like the vertices off the diagonal: at a sharp edge of the solid,
 // the diagonal that runs along the edge, so that the fold lies on it. Where a triangle still
-// faces away from its vertices' normals (a sharp edge of the solid that passes along a cell's
-// face or edge, where the vertices of the cells on both sides land on it and cross over), the
-// quad's vertices move to `smooth` (per vertex: the mean of its edge points, where surface nets
-// put it, which seldom folds), and the quads around them are split again.
-void foldQuads(Mesh& mesh, const std::vector<glm::vec3>& smooth);
+// folds (it faces nearly a right angle or more away from its vertices' normals, or, where
+// `distance` is set, more than 60 degrees away and against the field's gradient at its centre),
+// as where a sharp edge of the solid passes along a cell's face or edge and the vertices of the
+// cells on both sides land on it and cross over, the quad's vertices move to `smooth` (per
+// vertex: the mean of its edge points, where surface nets put it, which seldom folds), and the
+// quads around them are split again. `distance`, the scene's field, is called from two threads.
+using Distance = std::function<float(glm::vec3)>;
+void foldQuads(Mesh& mesh, const std::vector<glm::vec3>& smooth, const Distance& distance);
 
 } // namespace sdfcsg::detail
