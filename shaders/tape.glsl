@@ -9,10 +9,10 @@
 // 0 where no instruction reads the stack, when every operation folds in a primitive's value),
 // SDFCSG_TAPE_KINDS (a bit for each kind of primitive), SDFCSG_TAPE_OPERATIONS (a bit for each
 // kind of operation, less Union: union 1, intersection 2, difference 4, shell 8, offset 16),
-// SDFCSG_TAPE_BLENDS (a bit for each blend profile), SDFCSG_TAPE_BALLS (1 where every sphere
-// is a ball, detail::isBall; KINDS then lacks the sphere's bit) and SDFCSG_TAPE_DOMAINS (the
-// most domain operations nested in one another, 0 for none). Some of these follow values (the
-// profiles, the scales): Renderer::updateValues recompiles where they change.
+// SDFCSG_TAPE_BALLS (1 where every sphere is a ball, detail::isBall; KINDS then lacks the
+// sphere's bit) and SDFCSG_TAPE_DOMAINS (the most domain operations nested in one another, 0
+// for none). Only BALLS follows values (the spheres' scales): Renderer::updateValues recompiles
+// where it changes.
 
 // Mirrors packField() in engine/src/field/prune.cpp: a header of 12 words (origin xyz and leaf cell
 // side as float bits, levels, leaf cells per axis xyz, 1 when bounded, whole-tape length, first
@@ -45,11 +45,10 @@ const uint kTapeUnion = uint(SDFCSG_TAPE_FIRST_OPERATION), kTapeIntersection = k
 
 // One blend for the three operations, which the compiler would otherwise all evaluate and
 // select from: intersection(a, b) is -union(-a, -b) and difference(a, b) intersection(a, -b),
-// bit for bit as sdf.glsl computes them (negation rounds symmetrically). Kinds and profiles
-// that the scene lacks fold away.
+// bit for bit as sdf.glsl computes them (negation rounds symmetrically). Kinds that the scene
+// lacks fold away.
 float tapeOp(uint kind, float a, float b, float k, uint blend) {
     if ((SDFCSG_TAPE_OPERATIONS & 6) == 0) kind = kTapeUnion;
-    if (SDFCSG_TAPE_BLENDS == 1) blend = 0u;
     float s = kind == kTapeUnion ? 1.0 : -1.0;
     float c = kind == kTapeIntersection || kind == kTapeUnion ? b : -b;
     return s * opUnion(s * a, s * c, k, blend);
@@ -57,7 +56,6 @@ float tapeOp(uint kind, float a, float b, float k, uint blend) {
 
 vec4 tapeOp(uint kind, vec4 a, vec4 b, float k, uint blend) {
     if ((SDFCSG_TAPE_OPERATIONS & 6) == 0) kind = kTapeUnion;
-    if (SDFCSG_TAPE_BLENDS == 1) blend = 0u;
     float s = kind == kTapeUnion ? 1.0 : -1.0;
     float c = kind == kTapeIntersection || kind == kTapeUnion ? b.w : -b.w;
     vec4 u = opUnion(vec4(a.rgb, s * a.w), vec4(b.rgb, s * c), k, blend);

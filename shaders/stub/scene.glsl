@@ -46,7 +46,6 @@ vec4 sceneSample(vec3 p) {
 #define SDFCSG_TAPE_STACK 4
 #define SDFCSG_TAPE_KINDS 0xffffffffu
 #define SDFCSG_TAPE_OPERATIONS 31
-#define SDFCSG_TAPE_BLENDS 7
 #define SDFCSG_TAPE_BALLS 1
 #define SDFCSG_TAPE_DOMAINS 2
 #include "tape.glsl"

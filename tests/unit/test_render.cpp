@@ -648,9 +648,9 @@ INSTANTIATE_TEST_SUITE_P(Render, UpdateValues, ::testing::Values(true, false),
                                                 : std::string("BufferValues");
                          });
 
-// On tapes a value edit is an upload, but where it changes what the tape machine holds code for:
-// a sphere scaled differently per axis is no longer a ball (detail::isBall), so the kernel is
-// compiled again, and the image is the new scene's.
+// On tapes a value edit is an upload (a larger sphere, another blend profile), but where it
+// changes what the tape machine holds code for: a sphere scaled differently per axis is no longer
+// a ball (detail::isBall), so the kernel is compiled again, and the image is the new scene's.
 TEST_F(Render, UpdateValuesOnTapesRecompilesOnlyWhereTheCodeChanges) {
     Scene scene = loadOrDie(scenePath("csg_part.json"));
     RendererOptions made;
@@ -664,13 +664,23 @@ TEST_F(Render, UpdateValuesOnTapesRecompilesOnlyWhereTheCodeChanges) {
         const detail::ShaderCacheStats s = detail::shaderCacheStats();
         return s.compiles + s.memoryHits + s.diskHits;
     };
-    for (bool perAxis : {false, true}) {
-        SCOPED_TRACE(perAxis ? "a scale per axis" : "a larger sphere");
-        if (perAxis) {
+    for (int edit = 0; edit < 3; ++edit) {
+        const bool perAxis = edit == 2;
+        SCOPED_TRACE(edit == 0 ? "a larger sphere" : edit == 1 ? "another blend" : "a scale per axis");
+        if (edit == 0) {
+            ASSERT_TRUE(growFirstSphere(scene));
+        } else if (edit == 1) {
+            bool changed = false;
+            for (Node& node : scene.nodes)
+                if (kindInfo(node.kind).role == Role::Boolean && !changed) {
+                    node.params[0] = 0.05f; // smooth
+                    node.params[1] = 2.0f;  // chamfer
+                    changed = true;
+                }
+            ASSERT_TRUE(changed);
+        } else {
             for (Node& node : scene.nodes)
                 if (node.kind == NodeKind::Sphere) node.transform.scale = glm::vec3(1.3f, 1.0f, 0.8f);
-        } else {
-            ASSERT_TRUE(growFirstSphere(scene));
         }
         const uint64_t before = lookups();
         auto updated = (*renderer)->updateValues(scene);

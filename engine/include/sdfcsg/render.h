@@ -74,8 +74,8 @@ struct RendererOptions {
     // false: values are read from a buffer, so updateValues() only uploads them (the viewer).
     bool inlineValues = true;
     // Inlined or pruned tapes (CodegenOptions): with tapes, updateValues() recompiles only
-    // where an edit changes what the tape machine holds code for (a blend profile; a sphere's
-    // scale made to differ per axis, or no longer).
+    // where an edit makes a sphere's scale differ per axis, or no longer (the tape machine reads
+    // spheres as balls where all are).
     Evaluation evaluation = Evaluation::Auto;
 };
 

@@ -554,12 +554,13 @@ std::string generateSceneGlsl(const Scene& scene, const CodegenOptions& options)
         detail::fullTape(nodes, depth);
         // What the tape machine needs, so that it holds no code for the rest: lavapipe runs
         // every branch of its loop at every instruction, taken or not (molecule_1k's frame was
-        // a third shorter without the operations' own branch). The kinds of primitive, of
-        // operation (less Union) and the blend profiles; and whether an operation may fold in
-        // a value that is not a primitive's, which is the only one to read the stack (a domain
-        // operation saves on it too): else every operation folds in the primitive before it at
-        // once (tape.glsl), and pruning keeps that so.
-        uint32_t kinds = 0, operations = 0, blends = 0;
+        // a third shorter without the operations' own branch). The kinds of primitive and of
+        // operation (less Union); and whether an operation may fold in a value that is not a
+        // primitive's, which is the only one to read the stack (a domain operation saves on it
+        // too): else every operation folds in the primitive before it at once (tape.glsl), and
+        // pruning keeps that so. All follow the structure, not values, so that a value edit
+        // stays an upload (every blend profile is kept: a profile is a value), but for one:
+        uint32_t kinds = 0, operations = 0;
         const uint32_t domains = domainNesting(scene);
         bool stackRead = domains > 0;
         for (const FlatNode& n : nodes) {
@@ -568,11 +569,11 @@ std::string generateSceneGlsl(const Scene& scene, const CodegenOptions& options)
             if (role == Role::Boolean || role == Role::Value)
                 operations |= 1u << (uint32_t(n.kind) - uint32_t(NodeKind::Union));
             if (role != Role::Boolean) continue;
-            blends |= 1u << n.blend;
             for (size_t c = 1; c < n.children.size(); ++c)
                 stackRead |= kindInfo(nodes[n.children[c]].kind).role != Role::Primitive;
         }
-        // Spheres read as balls (detail::isBall) where all of them are.
+        // spheres read as balls (detail::isBall) where all of them are, which a sphere scaled
+        // differently per axis changes (Renderer::updateValues then recompiles).
         const uint32_t sphere = 1u << uint32_t(NodeKind::Sphere);
         const bool balls = (kinds & sphere) && std::all_of(nodes.begin(), nodes.end(), [](const FlatNode& n) {
                                return n.kind != NodeKind::Sphere || detail::isBall(n);
@@ -587,7 +588,6 @@ std::string generateSceneGlsl(const Scene& scene, const CodegenOptions& options)
                "#define SDFCSG_TAPE_STACK " + std::to_string(stack) +
                "\n#define SDFCSG_TAPE_KINDS " + std::to_string(kinds) +
                "u\n#define SDFCSG_TAPE_OPERATIONS " + std::to_string(operations) +
-               "\n#define SDFCSG_TAPE_BLENDS " + std::to_string(blends) +
                "\n#define SDFCSG_TAPE_BALLS " + (balls ? "1" : "0") +
                "\n#define SDFCSG_TAPE_DOMAINS " + std::to_string(domains) +
                "\n#include \"tape.glsl\"\n"

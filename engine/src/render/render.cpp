@@ -634,8 +634,8 @@ Status Renderer::updateValues(const Scene& scene) {
                      "the compiled one; create a new Renderer instead");
     Impl& r = *impl_;
     const bool tapes = usesTapes(scene, r.options.evaluation);
-    // The tape machine's code follows a few values too (blend profiles, whether every sphere's
-    // scale is uniform: generateSceneGlsl), which edits seldom change.
+    // The tape machine's code follows one value too (whether every sphere's scale is uniform:
+    // generateSceneGlsl), which edits seldom change.
     const std::string tapeCode = tapes ? r.sceneGlsl(r.defaultSkipping()) : std::string();
     Scene previous = std::move(r.scene);
     r.scene = scene;
