@@ -315,7 +315,7 @@ struct Mesher::Impl {
             uint32_t binding = kBindings[i].binding;
             if (binding == SDFCSG_BINDING_MESH_GRID || binding == SDFCSG_BINDING_NODES ||
                 binding == SDFCSG_BINDING_MESH_TABLES || binding == SDFCSG_BINDING_MESH_STATUS ||
-                buffers[i].size <= 4)
+                binding == SDFCSG_BINDING_FIELD || buffers[i].size <= 4)
                 continue;
             detail::destroyBuffer(ctx, buffers[i]);
             auto placeholder = detail::createBuffer(ctx, 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
