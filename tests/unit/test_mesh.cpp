@@ -534,8 +534,8 @@ TEST_F(MeshTest, CompileHelperHandsMachineCodeOver) {
     MeshOptions options;
     options.resolution = 32;
     std::optional<Mesh> meshes[2];
-    // The vertices and triangle passes.
-    expectHelperHandsOver(cache, 2, [&](Context& ctx, int helper) {
+    // The dual pass.
+    expectHelperHandsOver(cache, 1, [&](Context& ctx, int helper) {
         auto mesher = Mesher::create(ctx, scene);
         ASSERT_TRUE(mesher) << mesher.error().str();
         auto mesh = (*mesher)->extract(options);

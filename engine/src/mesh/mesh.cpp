@@ -221,7 +221,8 @@ struct Mesher::Impl {
     Context::Impl& ctx;
     std::unique_ptr<Evaluator> evaluator;
 
-    VkShaderModule modules[2] = {}; // field (cull, classify, vertices); triangles, dual passes
+    VkShaderModule field = VK_NULL_HANDLE;  // cull, classify and vertices passes
+    VkShaderModule passes = VK_NULL_HANDLE; // triangle and dual passes
     VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
     VkPipelineLayout pipelineLayout = VK_NULL_HANDLE;
     VkPipeline cull = VK_NULL_HANDLE, classify = VK_NULL_HANDLE, vertices = VK_NULL_HANDLE,
@@ -241,11 +242,33 @@ struct Mesher::Impl {
             detail::destroyBuffer(ctx, b);
         for (VkPipeline p : {cull, classify, vertices, triangles, dualPass})
             if (p) vkDestroyPipeline(ctx.device, p, nullptr);
-        for (VkShaderModule m : modules)
+        for (VkShaderModule m : {field, passes})
             if (m) vkDestroyShaderModule(ctx.device, m, nullptr);
         if (pool) vkDestroyDescriptorPool(ctx.device, pool, nullptr);
         if (pipelineLayout) vkDestroyPipelineLayout(ctx.device, pipelineLayout, nullptr);
         if (setLayout) vkDestroyDescriptorSetLayout(ctx.device, setLayout, nullptr);
+    }
+
+    // Bounds tests pay off only where branches are real (see RenderOptions::boundsSkipping).
+    bool cpuDevice() const { return ctx.properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU; }
+
+    // The specialisation of a pass: its kind and workgroup size, and for the field passes whether
+    // the scene code tests bounds. The helper's compile of a pass must use the same.
+    using Spec = std::array<detail::SpecConstant, 3>;
+    Spec spec(uint32_t pass, uint32_t group) const {
+        return Spec{{{SDFCSG_SPEC_MESH_PASS, pass},
+                     {SDFCSG_SPEC_MESH_GROUP, group},
+                     {SDFCSG_SPEC_BOUNDS_SKIPPING, cpuDevice() ? 0u : 1u}}};
+    }
+    // The dual pass's invocations share its lists of vertices and quads. A CPU driver runs a
+    // workgroup as rows of SIMD lanes one after another, switching between them at each barrier:
+    // one row of a brick's planes does the same work without the switches (mesh_a at 256: the
+    // pass takes about 0.6 of the time with 64). A GPU wants its wider groups.
+    Spec dualSpec() const {
+        return spec(SDFCSG_MESH_PASS_DUAL, cpuDevice() ? SDFCSG_MESH_BRICK : SDFCSG_MESH_GROUP_X);
+    }
+    VkPipeline pipeline(VkShaderModule module, const Spec& s) {
+        return detail::createComputePipeline(ctx, module, pipelineLayout, s);
     }
 
     Buffer& buffer(uint32_t binding) {
@@ -390,56 +413,15 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
         return detail::fieldWords(scene, *m.evaluator, evaluation);
     });
 
-    // Bounds tests pay off only where branches are real (see RenderOptions::boundsSkipping).
-    const bool cpuDevice = m.ctx.properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
-    const uint32_t skipping = cpuDevice ? 0 : 1;
     CodegenOptions codegen;
     codegen.inlineParams = true;
     codegen.evaluation = evaluation;
-    codegen.boundsTests = skipping != 0;
+    codegen.boundsTests = !m.cpuDevice();
     const std::string sceneGlsl = generateSceneGlsl(scene, codegen);
-    const char* kernels[] = {"mesh_field.comp", "mesh_triangles.comp"};
-    std::vector<uint32_t> spirv[2];
-    bool fresh[2] = {}; // glslang made the SPIR-V: the driver has most likely not compiled it
-    for (int i = 0; i < 2; ++i) {
-        auto made =
-            detail::compileKernel(kernels[i], i == 0 ? std::string_view(sceneGlsl) : "", fresh[i]);
-        if (!made) return made.error();
-        spirv[i] = std::move(*made);
-        m.modules[i] = detail::createShaderModule(m.ctx, spirv[i]);
-    }
     m.setLayout = detail::createDescriptorSetLayout(m.ctx, kBindings);
     m.pipelineLayout = detail::createPipelineLayout(m.ctx, m.setLayout, sizeof(MeshPush));
     m.pool = detail::createDescriptorPool(m.ctx, kBindings);
     m.set = detail::allocateDescriptorSet(m.ctx, m.pool, m.setLayout);
-
-    using FieldSpec = std::array<detail::SpecConstant, 3>;
-    auto fieldSpec = [&](uint32_t pass, uint32_t group) {
-        return FieldSpec{{{SDFCSG_SPEC_BOUNDS_SKIPPING, skipping},
-                          {SDFCSG_SPEC_MESH_PASS, pass},
-                          {SDFCSG_SPEC_MESH_GROUP, group}}};
-    };
-    const FieldSpec cullSpec = fieldSpec(SDFCSG_MESH_PASS_CULL, SDFCSG_MESH_GROUP_X);
-    const FieldSpec classifySpec = fieldSpec(SDFCSG_MESH_PASS_CLASSIFY, SDFCSG_MESH_BRICK);
-    const FieldSpec verticesSpec = fieldSpec(SDFCSG_MESH_PASS_VERTICES, SDFCSG_MESH_GROUP_X);
-    m.cull = detail::createComputePipeline(m.ctx, m.modules[0], m.pipelineLayout, cullSpec);
-    m.classify = detail::createComputePipeline(m.ctx, m.modules[0], m.pipelineLayout, classifySpec);
-    m.vertices = detail::createComputePipeline(m.ctx, m.modules[0], m.pipelineLayout, verticesSpec);
-    using PassSpec = std::array<detail::SpecConstant, 2>;
-    auto passSpec = [](uint32_t pass, uint32_t group) {
-        return PassSpec{{{SDFCSG_SPEC_MESH_PASS, pass}, {SDFCSG_SPEC_MESH_GROUP, group}}};
-    };
-    const PassSpec trianglesSpec = passSpec(SDFCSG_MESH_PASS_TRIANGLES, SDFCSG_MESH_BRICK);
-    m.triangles =
-        detail::createComputePipeline(m.ctx, m.modules[1], m.pipelineLayout, trianglesSpec);
-    // The dual pass's invocations share its lists of vertices and quads. A CPU driver runs a
-    // workgroup as rows of SIMD lanes one after another, switching between them at each barrier:
-    // one row of a brick's planes does the same work without the switches (mesh_a at 256: the
-    // pass takes about 0.6 of the time with 64). A GPU wants its wider groups.
-    const uint32_t dualGroup = cpuDevice ? SDFCSG_MESH_BRICK : SDFCSG_MESH_GROUP_X;
-    m.dualPass = detail::createComputePipeline(m.ctx, m.modules[1], m.pipelineLayout,
-                                               passSpec(SDFCSG_MESH_PASS_DUAL, dualGroup));
-
     std::vector<detail::GpuNode> nodes = detail::packNodes(*m.evaluator);
     std::vector<uint32_t> tables = packTables();
     for (const detail::Binding& b : kBindings) {
@@ -469,27 +451,51 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
     detail::uploadBuffer(m.ctx, m.buffer(SDFCSG_BINDING_MESH_GRID), &empty, sizeof empty);
     m.writeDescriptors();
 
-    // Every pipeline runs once on an empty batch, so drivers that compile at first use (llvmpipe)
-    // have done so before the first extraction is timed. On lavapipe the compile helper makes the
-    // vertices pass (and a new triangle pass) meanwhile, as buildKernels() in render.cpp does.
-    double helperMs = 0.0; // its compile of the vertices pass
+    // The kernels build on two threads. On llvmpipe, which makes a pipeline's machine code at its
+    // first dispatch, on the one queue's thread, the other thread has the compile helper make the
+    // dual pass (the longest compile, about as long as the three field passes together) while
+    // this device compiles the field passes; this device's dual pass then loads the helper's
+    // machine code. The marching-cubes triangle pass is made at the first extraction that
+    // asks for it (trianglePass()).
+    std::optional<Error> passesError;
+    double helperMs = 0.0; // the helper's compile of the dual pass
     std::thread other([&] {
-        std::vector<detail::Precompile> jobs;
-        if (fresh[0]) jobs.push_back({spirv[0], verticesSpec});
-        if (fresh[1]) jobs.push_back({spirv[1], trianglesSpec});
-        const double ms = detail::precompileElsewhere(m.ctx, jobs, kBindings, sizeof(MeshPush));
-        if (fresh[0]) helperMs = ms;
+        bool fresh = false; // glslang made the SPIR-V: the driver has most likely not compiled it
+        auto spirv = detail::compileKernel("mesh_triangles.comp", "", fresh);
+        if (!spirv) {
+            passesError = spirv.error();
+            return;
+        }
+        const Impl::Spec dual = m.dualSpec();
+        if (fresh) {
+            const detail::Precompile job{*spirv, dual};
+            helperMs = detail::precompileElsewhere(m.ctx, {&job, 1}, kBindings, sizeof(MeshPush));
+        }
+        m.passes = detail::createShaderModule(m.ctx, *spirv);
+        m.dualPass = m.pipeline(m.passes, dual);
     });
-    m.warmUp(m.cull);
-    m.warmUp(m.classify);
+    bool fresh = false;
+    auto spirv = detail::compileKernel("mesh_field.comp", sceneGlsl, fresh);
+    if (spirv) {
+        m.field = detail::createShaderModule(m.ctx, *spirv);
+        m.cull = m.pipeline(m.field, m.spec(SDFCSG_MESH_PASS_CULL, SDFCSG_MESH_GROUP_X));
+        m.classify = m.pipeline(m.field, m.spec(SDFCSG_MESH_PASS_CLASSIFY, SDFCSG_MESH_BRICK));
+        m.vertices = m.pipeline(m.field, m.spec(SDFCSG_MESH_PASS_VERTICES, SDFCSG_MESH_GROUP_X));
+        // Every pipeline runs once on an empty batch, so drivers that compile at first use
+        // (llvmpipe) have done so before the first extraction is timed.
+        for (VkPipeline p : {m.cull, m.classify, m.vertices})
+            m.warmUp(p);
+    }
     other.join();
+    if (!spirv) return spirv.error();
+    if (passesError) return *passesError;
     const auto start = std::chrono::steady_clock::now();
-    m.warmUp(m.vertices);
-    const std::chrono::duration<double, std::milli> verticesMs =
-        std::chrono::steady_clock::now() - start;
-    if (helperMs > 0.0 && verticesMs.count() > 0.25 * helperMs) detail::compileHelperMissed(m.ctx);
-    m.warmUp(m.triangles);
     m.warmUp(m.dualPass);
+    const std::chrono::duration<double, std::milli> dualMs =
+        std::chrono::steady_clock::now() - start;
+    // Loading the helper's machine code takes a tenth of its compile or less.
+    if (helperMs > 0.0 && dualMs.count() > 0.25 * helperMs) detail::compileHelperMissed(m.ctx);
+
     auto words = fieldWords.get();
     if (!words) return words.error();
     auto made = detail::uploadField(m.ctx, m.buffer(SDFCSG_BINDING_FIELD), *words);
@@ -562,8 +568,15 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
     const uint32_t zero[2] = {0, 0};
     detail::uploadBuffer(ctx, buffer(SDFCSG_BINDING_MESH_STATUS), zero, sizeof zero);
 
-    // Cull.
     auto t0 = Clock::now();
+    if (!dual && !triangles) { // the marching-cubes triangle pass, made at its first use
+        triangles = pipeline(passes, spec(SDFCSG_MESH_PASS_TRIANGLES, SDFCSG_MESH_BRICK));
+        warmUp(triangles);
+        stage("compile", t0);
+    }
+
+    // Cull.
+    t0 = Clock::now();
     if (auto ok = reserve(SDFCSG_BINDING_MESH_MAP, g.brickCount * 4); !ok) return ok.error();
     {
         VkCommandBuffer cmd = begin(cull);
