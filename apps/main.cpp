@@ -468,6 +468,9 @@ int cmdMesh(int argc, char** argv) {
     if (!mesh) return fail(mesh.error());
     if (simplify.maxError || simplify.targetTriangles) {
         const sdfcsg::Evaluator evaluator(*scene);
+        ProgressBar bar("simplifying");
+        const bool tty = ::isatty(STDERR_FILENO);
+        simplify.progress = [&](float done) { return (!tty || bar.update(done)) && !interrupted(); };
         mesh = sdfcsg::simplifyMesh(*mesh, evaluator, simplify, &stats);
         if (!mesh) return fail(mesh.error());
     } else {

@@ -352,6 +352,7 @@ bool MeshWorker::start(std::shared_ptr<const Scene> scene, MeshOptions options, 
             if (simplify > 0.0f && !cancel_) {
                 SimplifyOptions fewer;
                 fewer.maxError = simplify * stats.voxelSize;
+                fewer.progress = [this](float) { return !cancel_.load(); };
                 auto simplified = simplifyMesh(extracted.mesh, evaluator, fewer, &stats);
                 if (!simplified) return simplified.error();
                 extracted.mesh = std::move(*simplified);
@@ -359,6 +360,7 @@ bool MeshWorker::start(std::shared_ptr<const Scene> scene, MeshOptions options, 
             if (extracted.mesh.triangleCount() <= previewThreshold_ || cancel_) return extracted;
             SimplifyOptions preview;
             preview.targetTriangles = previewThreshold_;
+            preview.progress = [this](float) { return !cancel_.load(); };
             if (auto copy = simplifyMesh(extracted.mesh, evaluator, preview); copy)
                 extracted.preview = std::move(*copy);
             return extracted;

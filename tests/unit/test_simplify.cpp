@@ -371,6 +371,49 @@ TEST_F(SimplifyTest, IsRepeatable) {
     EXPECT_EQ(c->indices, d->indices) << "blocks on two threads, in any order";
 }
 
+// Progress climbs to 1 without changing the result; a callback that returns false stops the
+// simplification, whole or in blocks, at whichever report it does so.
+TEST_F(SimplifyTest, ProgressEndsAtOneAndFalseCancels) {
+    const Scene scene = loadOrDie(kScenes / "csg_part.json");
+    const Evaluator evaluator(scene);
+    MeshStats stats;
+    const Mesh in = extract(scene, 96, &stats);
+    for (bool wholeFirst : {true, false}) {
+        SCOPED_TRACE(wholeFirst ? "whole first" : "in blocks");
+        SimplifyOptions options;
+        options.maxError = 0.1f * stats.voxelSize;
+        auto quiet = detail::simplifyMesh(in, evaluator, options, nullptr, wholeFirst);
+        ASSERT_TRUE(quiet) << quiet.error().str();
+        std::vector<float> reported;
+        options.progress = [&](float done) {
+            reported.push_back(done);
+            return true;
+        };
+        auto mesh = detail::simplifyMesh(in, evaluator, options, nullptr, wholeFirst);
+        ASSERT_TRUE(mesh) << mesh.error().str();
+        EXPECT_EQ(mesh->indices, quiet->indices);
+        ASSERT_GT(reported.size(), 3u);
+        EXPECT_TRUE(std::is_sorted(reported.begin(), reported.end()));
+        EXPECT_GE(reported.front(), 0.0f);
+        EXPECT_FLOAT_EQ(reported.back(), 1.0f);
+
+        // The first report, the first at half or more, and the last.
+        for (float stop : {0.0f, 0.5f, 1.0f}) {
+            bool said = false, after = false;
+            options.progress = [&](float done) {
+                after = after || said;
+                said = said || done >= stop;
+                return !said;
+            };
+            auto stopped = detail::simplifyMesh(in, evaluator, options, nullptr, wholeFirst);
+            ASSERT_FALSE(stopped) << "stopped at " << stop;
+            EXPECT_EQ(stopped.error().kind, ErrorKind::Cancelled);
+            EXPECT_EQ(stopped.error().str(), "<simplify>: cancelled");
+            EXPECT_FALSE(after) << "no report after the one that said stop";
+        }
+    }
+}
+
 // Post-transform cache misses per triangle, by a FIFO cache of 16 vertices.
 double missesPerTriangle(const Mesh& mesh) {
     std::deque<uint32_t> cache;

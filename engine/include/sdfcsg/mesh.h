@@ -142,6 +142,9 @@ struct SimplifyOptions {
     // Unset: as few as maxError allows. With both, the simplification stops at whichever limit
     // it reaches first.
     std::optional<size_t> targetTriangles;
+    // Called now and then on the calling thread with the fraction done (0 to 1, never falling);
+    // returning false stops the simplification, which then fails with ErrorKind::Cancelled.
+    std::function<bool(float)> progress;
 };
 
 // The simplified mesh, closed and manifold with the same Euler characteristic wherever the input
@@ -155,7 +158,8 @@ struct SimplifyOptions {
 // passes, each from the last result that passed, and where the whole mesh cannot be mended it
 // is simplified in blocks of space, each on its own. At worst the input comes back (ordered).
 // Runs on up to two threads. Fails with ErrorKind::Usage when neither limit is set, maxError is
-// not a finite number > 0 or targetTriangles is 0.
+// not a finite number > 0 or targetTriangles is 0, and with ErrorKind::Cancelled when
+// options.progress returns false.
 Result<Mesh> simplifyMesh(const Mesh& mesh, const Evaluator& evaluator,
                           const SimplifyOptions& options, MeshStats* stats = nullptr);
 

@@ -64,6 +64,8 @@ constexpr float kBlockSpacings = 32.0f;
 // The FIFO cache that optimizeMeshOrder's fast order plans for, as meshoptimizer's own examples
 // do: it advises less than the hardware's, since a plan for too large a cache thrashes.
 constexpr unsigned kFifoCache = 16;
+// The share of the progress that sampling the input takes (csg_part at 256: a tenth of the time).
+constexpr float kSamplingShare = 0.1f;
 
 // Points in a grid of cubic cells, for box queries. The points are not copied.
 class PointGrid {
@@ -245,6 +247,35 @@ struct TriangleKeyHash {
     }
 };
 
+// Reports SimplifyOptions::progress from the calling thread: the fraction done within the
+// current stage of the whole, never falling. Any thread may ask whether the callback said stop.
+class Progress {
+  public:
+    explicit Progress(const std::function<bool(float)>& callback)
+        : callback_(callback), caller_(std::this_thread::get_id()) {}
+    // The part of the whole, [from, to), that the next reports' fractions map to.
+    void stage(float from, float to) {
+        from_ = std::max(from, last_);
+        to_ = std::max(to, from_);
+    }
+    // `done`: the fraction of the stage. Returns whether to go on.
+    bool report(float done) {
+        if (callback_ && std::this_thread::get_id() == caller_ && !stopped_) {
+            last_ = std::max(last_, from_ + (to_ - from_) * std::clamp(done, 0.0f, 1.0f));
+            if (!callback_(last_)) stopped_ = true;
+        }
+        return !stopped_;
+    }
+    bool stopped() const { return stopped_; }
+    float last() const { return last_; }
+
+  private:
+    const std::function<bool(float)>& callback_;
+    const std::thread::id caller_;
+    float from_ = 0.0f, to_ = 1.0f, last_ = 0.0f;
+    std::atomic<bool> stopped_{false};
+};
+
 struct Probe {
     glm::vec3 point;
     float error;       // |distance|
@@ -253,16 +284,21 @@ struct Probe {
 
 // The largest |distance| sampled on each triangle, on two threads if `parallel`; the samples for
 // which keep(sample) holds are collected in `kept`. A triangle is sampled from its corner of
-// least index, so that it is sampled alike in every mesh that holds it.
+// least index, so that it is sampled alike in every mesh that holds it. Reports the fraction
+// sampled to `progress`, and stops early (the errors unfinished) where it says stop.
 template <class Distance, class Keep>
 std::vector<float> triangleErrors(const std::vector<glm::vec3>& positions,
                                   const std::vector<uint32_t>& indices, float spacing,
                                   const Distance& distance, const Keep& keep,
-                                  std::vector<Probe>& kept, bool parallel) {
+                                  std::vector<Probe>& kept, bool parallel,
+                                  Progress* progress = nullptr) {
     const size_t triangles = indices.size() / 3;
     std::vector<float> errors(triangles, 0.0f);
     auto run = [&](size_t begin, size_t end, std::vector<Probe>& out) {
         for (size_t t = begin; t < end; ++t) {
+            if (progress && (t - begin) % 4096 == 0 &&
+                !progress->report(float(t - begin) / float(std::max<size_t>(end - begin, 1))))
+                return;
             float worst = 0.0f;
             const TriangleKey v = keyOf(&indices[3 * t]);
             forEachSample(positions[v[0]], positions[v[1]], positions[v[2]], spacing,
@@ -390,8 +426,10 @@ Error usage(std::string text) {
 // independent, so two threads share them and the result does not depend on their timing.
 class Simplifier {
   public:
-    Simplifier(const Mesh& mesh, const Evaluator& evaluator, const SimplifyOptions& options)
-        : mesh_(mesh), evaluator_(evaluator), options_(options),
+    // Samples the input, reporting to `progress`, which the simplification then reports to.
+    Simplifier(const Mesh& mesh, const Evaluator& evaluator, const SimplifyOptions& options,
+               Progress& progress)
+        : mesh_(mesh), evaluator_(evaluator), options_(options), progress_(progress),
           pruned_(evaluator.nodes().size() >= kTapeMinNodes), spacing_(meanEdge(mesh)),
           held_(colourOutlines(mesh)), inputEdges_(mesh.indices),
           inputClosed_(closedFans(mesh.indices, mesh.vertexCount())),
@@ -402,7 +440,8 @@ class Simplifier {
             for (float e : triangleErrors(
                      mesh.positions, mesh.indices, spacing_,
                      [&](glm::vec3 p) { return distance(p); },
-                     [&](const Probe& s) { return s.error > *options.maxError; }, inputFar_, true))
+                     [&](const Probe& s) { return s.error > *options.maxError; }, inputFar_, true,
+                     &progress))
                 error_ = std::max(error_, e);
         for (const Probe& s : inputFar_)
             inputFarPoints_.push_back(s.point);
@@ -443,9 +482,9 @@ class Simplifier {
         std::vector<Piece> pieces(blocks.size());
         // Simplifies the listed blocks, two at a time.
         auto simplifyBlocks = [&](const std::vector<size_t>& list) {
-            std::atomic<size_t> next{0};
+            std::atomic<size_t> next{0}, done{0};
             auto work = [&] {
-                for (size_t i; (i = next++) < list.size();) {
+                for (size_t i; !progress_.stopped() && (i = next++) < list.size();) {
                     const size_t b = list[i];
                     std::vector<uint32_t> block;
                     block.reserve(3 * (blocks[b].second - blocks[b].first));
@@ -458,6 +497,7 @@ class Simplifier {
                                              : 0;
                     pieces[b] = Piece{};
                     simplify(block, share, blocks.size() == 1, pieces[b]);
+                    if (blocks.size() > 1) progress_.report(float(++done) / float(list.size()));
                 }
             };
             if (list.size() > 1 && std::thread::hardware_concurrency() >= 2) {
@@ -477,6 +517,7 @@ class Simplifier {
         for (size_t b = 0; b < blocks.size(); ++b)
             all[b] = b;
         simplifyBlocks(all);
+        if (progress_.stopped()) return indices;
 
         // Each block keeps its own topology, but two may meet badly along their common outline:
         // both joining the same two outline vertices makes an edge of four triangles. Such
@@ -708,6 +749,10 @@ class Simplifier {
         bool stuck = false;
         for (size_t pass = 0; pass < passes.size() && !stuck; ++pass) {
             for (uint32_t tries = 1;; ++tries) {
+                if (progress_.stopped()) {
+                    stuck = piece.stalled = true;
+                    break;
+                }
                 ++piece.attempts;
                 const std::vector<glm::vec3> withCopies = withHeldCopies(positions, held);
                 indices.resize(current.size());
@@ -717,7 +762,11 @@ class Simplifier {
                                                 meshopt_SimplifyLockBorder, nullptr));
                 removeFins(indices);
                 float worst = 0.0f;
-                if (check(indices, faults, worst)) {
+                const bool passed = check(indices, faults, worst);
+                if (parallel) // the whole mesh in one block
+                    progress_.report((float(pass) + float(passed ? kTries : tries) / kTries) /
+                                     float(passes.size()));
+                if (passed) {
                     current.swap(indices);
                     currentError = worst;
                     break;
@@ -743,6 +792,7 @@ class Simplifier {
     const Mesh& mesh_;
     const Evaluator& evaluator_;
     const SimplifyOptions& options_;
+    Progress& progress_;
     const bool pruned_;      // evaluate by pruned tapes, as the GPU does for large scenes
     const float spacing_;    // the input's mean edge length, about a cell of its grid
     std::vector<bool> held_; // vertices no simplification may move (read by the blocks)
@@ -803,22 +853,38 @@ Result<Mesh> simplifyMesh(const Mesh& mesh, const Evaluator& evaluator,
 
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
-    Simplifier simplifier(mesh, evaluator, options);
+    const Error cancelled = Error::message(ErrorKind::Cancelled, "<simplify>", "cancelled");
+    Progress progress(options.progress);
+    progress.stage(0.0f, kSamplingShare);
+    Simplifier simplifier(mesh, evaluator, options, progress);
     std::vector<uint32_t> indices = mesh.indices;
     const size_t targetIndices = options.targetTriangles ? *options.targetTriangles * 3 : 0;
     if (!indices.empty()) {
         // The whole mesh at once leaves the fewest triangles. Where a pass cannot be mended,
         // blocks can, a fault costing only its own block: then the mesh in blocks, again in
         // blocks shifted by half a block, and once more whole for the strips along their
-        // outlines (which stay as they are if that fails too).
-        if (wholeFirst) indices = simplifier.round(indices, 0.0f, 0.0f, targetIndices);
-        if (!wholeFirst || simplifier.stalled()) {
+        // outlines (which stay as they are if that fails too). Each round reports as a stage.
+        struct Round {
+            float block, shift;
+        };
+        std::vector<Round> rounds;
+        if (wholeFirst) rounds.push_back({0.0f, 0.0f});
+        const auto blockRounds = [&] {
             const float block = kBlockSpacings * simplifier.spacing();
-            indices = simplifier.round(indices, block, 0.0f, targetIndices);
-            indices = simplifier.round(indices, block, 0.5f, targetIndices);
-            indices = simplifier.round(indices, 0.0f, 0.0f, targetIndices);
+            rounds.insert(rounds.end(), {{block, 0.0f}, {block, 0.5f}, {0.0f, 0.0f}});
+        };
+        if (!wholeFirst) blockRounds();
+        for (size_t r = 0; r < rounds.size(); ++r) {
+            const float from = progress.last(), left = float(rounds.size() - r);
+            progress.stage(from, from + (1.0f - from) / left);
+            indices = simplifier.round(indices, rounds[r].block, rounds[r].shift, targetIndices);
+            if (progress.stopped()) return cancelled;
+            if (wholeFirst && r == 0 && simplifier.stalled()) blockRounds();
         }
     }
+    if (progress.stopped()) return cancelled;
+    progress.stage(1.0f, 1.0f);
+    if (!progress.report(1.0f)) return cancelled;
 
     Mesh result;
     result.positions = mesh.positions;
