@@ -128,6 +128,31 @@ Result<double> medianFrameMs(Renderer& renderer, const RenderOptions& options, u
     return median(times);
 }
 
+// A value edit as the viewer makes one on a scene of pruned tapes: the last primitive moved back
+// and forth by a hundredth of the scene's size, then a frame (updateValues() prunes the field
+// again and uploads it; no compile).
+Result<double> medianEditMs(Renderer& renderer, const Scene& scene, const RenderOptions& options,
+                            uint32_t frames) {
+    size_t moved = scene.nodes.size();
+    while (moved > 0 && kindInfo(scene.nodes[moved - 1].kind).operation)
+        --moved;
+    if (moved == 0) return 0.0;
+    const Aabb box = Evaluator(scene).bounds();
+    const float step = box.finite() ? 0.01f * glm::length(box.max - box.min) : 0.01f;
+    std::vector<double> times;
+    Scene edited = scene;
+    for (uint32_t i = 0; i < frames; ++i) {
+        edited.nodes[moved - 1].transform.translate.x += i % 2 == 0 ? step : -step;
+        auto start = Clock::now();
+        if (auto ok = renderer.updateValues(edited); !ok) return ok.error();
+        auto image = renderer.render(options);
+        if (!image) return image.error();
+        times.push_back(msSince(start));
+    }
+    if (auto ok = renderer.updateValues(scene); !ok) return ok.error();
+    return median(times);
+}
+
 // Repetitions against the copies written out: per frame, one copy alone framed on itself (so
 // that it fills the picture about as the N copies do), a repeat or polar_repeat of N copies,
 // and the union of the same N copies as nodes of their own with the same camera.
@@ -195,6 +220,7 @@ struct Row {
     std::string name;
     size_t nodes = 0;
     double skip = 0, noSkip = 0, cold = 0, coldOneDevice = 0, newProcess = 0, first = 0, warm = 0;
+    double edit = NAN; // scenes of pruned tapes
     double buffer = 0, bufferBuild = 0; // with --buffer
 };
 
@@ -571,6 +597,16 @@ int runBench(int argc, char** argv) {
         }
         row.skip = *skip;
         row.noSkip = *noSkip;
+        if (auto scene = parseScene(json, file);
+            scene && usesTapes(*scene, evaluation)) {
+            options.boundsSkipping.reset();
+            auto edit = medianEditMs(*renderer, *scene, options, frames);
+            if (!edit) {
+                fail(edit.error());
+                break;
+            }
+            row.edit = *edit;
+        }
         if (buffer) {
             auto ok = withColdContext(true, Seed::None, [&](Context& coldContext) -> Status {
                 auto scene = parseScene(json, file);
@@ -601,12 +637,17 @@ int runBench(int argc, char** argv) {
     std::printf("\n%-13s %5s %8s %10s %7s %15s %10s %11s %6s %5s", "scene", "nodes", "skip ms",
                 "no-skip ms", "speedup", "json->pipe cold", "one device", "new process", "first",
                 "warm");
+    std::printf(" %7s", "edit ms");
     if (buffer) std::printf(" %10s %16s", "buffer ms", "buffer build ms");
     std::printf("\n");
     for (const Row& r : rows) {
         std::printf("%-13s %5zu %8.1f %10.1f %6.2fx %15.1f %10.1f %11.1f %6.1f %5.1f",
                     r.name.c_str(), r.nodes, r.skip, r.noSkip, r.noSkip / std::max(r.skip, 1e-9),
                     r.cold, r.coldOneDevice, r.newProcess, r.first, r.warm);
+        if (std::isnan(r.edit))
+            std::printf(" %7s", "-");
+        else
+            std::printf(" %7.1f", r.edit);
         if (buffer) std::printf(" %10.1f %16.1f", r.buffer, r.bufferBuild);
         std::printf("\n");
     }
@@ -615,7 +656,9 @@ int runBench(int argc, char** argv) {
         "scene, its kernels cached nowhere, in a context that has built another; one device: "
         "the same without the compile helper; new process: the same in a new context (the disk "
         "caches hold the other scene's build); first: a new context, nothing cached at all; "
-        "warm: SPIR-V and driver disk caches filled, in-process cache cleared.\n"
+        "warm: SPIR-V and driver disk caches filled, in-process cache cleared. edit ms (scenes "
+        "of pruned tapes): a value edit as the viewer makes one, the field pruned again and "
+        "uploaded, and the frame after it.\n"
         "Renders use bounds skipping by default on GPUs and not on CPU devices (lavapipe runs both "
         "sides of every branch, so there the bounds tests only add work).\n");
     if (status == 0 && !runRepeatBench(**context, width, height, frames)) status = 4;
