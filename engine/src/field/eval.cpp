@@ -251,6 +251,11 @@ float primitiveValue(const FlatNode& node, glm::vec3 p) {
     return leaf<float>(node, p);
 }
 
+void primitiveValues(const FlatNode& node, const glm::vec3* p, uint32_t count, float* values) {
+    for (uint32_t i = 0; i < count; ++i)
+        values[i] = leaf<float>(node, p[i]);
+}
+
 glm::vec3 nodeLocalPoint(const FlatNode& node, glm::vec3 p) {
     return localPoint(node, p);
 }

@@ -9,6 +9,7 @@
 #include <glm/matrix.hpp>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <bit>
 #include <cmath>
@@ -37,8 +38,15 @@ template <class V> V opValue(const FlatNode& op, V a, V b) {
                : sdf::opDifference(a, b, op.smooth, op.blend);
 }
 
+// Looked up for every instruction of every cell's pass: a table of their own.
 Role roleOf(NodeKind kind) {
-    return kindInfo(kind).role;
+    static const std::array<Role, kNodeKindCount> roles = [] {
+        std::array<Role, kNodeKindCount> r{};
+        for (int k = 0; k < kNodeKindCount; ++k)
+            r[k] = kindInfo(NodeKind(k)).role;
+        return r;
+    }();
+    return roles[size_t(kind)];
 }
 
 bool isDomainEnd(uint32_t ins) {
@@ -142,11 +150,15 @@ V run(const std::vector<FlatNode>& nodes, const uint32_t* tape, uint32_t length,
 // A domain operation's instructions (its own, its child's and the end) stay whole: the pruner
 // takes its value at c like a primitive's and keeps or drops it as one.
 struct Pruner {
+    // The cells pruned together: the children of one parent, which share its tape. The first
+    // pass reads each node once for all of them.
+    static constexpr uint32_t kLanes = 8;
+
     const std::vector<FlatNode>& nodes;
     const std::vector<uint32_t>& spans; // per domain node: its instructions, the end included
     float slack;
-    std::vector<float> value;    // per instruction of `in`: the value of the subtree it ends
-    std::vector<float> extreme;  // per node: least (union) / greatest operand value
+    std::vector<float> value;    // per instruction of `in` and cell: the value of its subtree
+    std::vector<float> extreme;  // per node and cell: least (union) / greatest operand value
     std::vector<uint32_t> touched;
     std::vector<uint32_t> ends;  // first pass: the stack, as the instructions that end its values
     struct Segment {
@@ -161,51 +173,70 @@ struct Pruner {
         return in[leftEnd] != in[instructionAt];
     }
 
-    // A cell whose root value exceeds `far` in magnitude needs no tape: pass 2 is skipped.
-    float prune(const uint32_t* in, uint32_t length, glm::vec3 c, float r, float far,
-                std::vector<uint32_t>& out) {
-        if (value.size() < length) value.resize(length);
-        if (extreme.size() < nodes.size()) extreme.assign(nodes.size(), NAN);
+    // The first pass, for `lanes` cells of centres c: runs the tape at each centre, noting per
+    // operation the least (union) or greatest (intersection) value of its operands. Returns the
+    // root values in `roots`.
+    void evaluate(const uint32_t* in, uint32_t length, const glm::vec3* c, uint32_t lanes,
+                  float* roots) {
+        if (value.size() < size_t(length) * kLanes) value.resize(size_t(length) * kLanes);
+        if (extreme.size() < nodes.size() * kLanes) extreme.assign(nodes.size() * kLanes, NAN);
         ends.clear();
         for (uint32_t i = 0; i < length; ++i) {
             const uint32_t node = in[i] & kTapeNodeMask;
             const FlatNode& n = nodes[node];
             const NodeKind kind = opcode(in[i]);
             const Role role = roleOf(kind);
+            float* v = &value[size_t(i) * kLanes];
             if (role == Role::Primitive) {
-                value[i] = primitiveValue(n, c);
+                primitiveValues(n, c, lanes, v);
                 ends.push_back(i);
                 continue;
             }
             if (role == Role::Domain) {
                 const uint32_t end = i + spans[node] - 1;
-                value[end] = run<float>(nodes, in + i, spans[node], c);
+                for (uint32_t l = 0; l < lanes; ++l)
+                    value[size_t(end) * kLanes + l] = run<float>(nodes, in + i, spans[node], c[l]);
                 ends.push_back(end);
                 i = end;
                 continue;
             }
             if (role == Role::Value) {
-                value[i] = sdf::valueOp(uint32_t(kind), value[ends.back()], kernelA(n));
+                const float* from = &value[size_t(ends.back()) * kLanes];
+                for (uint32_t l = 0; l < lanes; ++l)
+                    v[l] = sdf::valueOp(uint32_t(kind), from[l], kernelA(n));
                 ends.back() = i;
                 continue;
             }
             const uint32_t b = ends.back();
             ends.pop_back();
             const uint32_t a = ends.back();
-            const uint32_t u = in[i] & kTapeNodeMask;
+            const float* va = &value[size_t(a) * kLanes];
+            const float* vb = &value[size_t(b) * kLanes];
             if (kind != NodeKind::Difference) {
-                float& e = extreme[u];
-                if (std::isnan(e)) touched.push_back(u), e = value[a];
+                float* e = &extreme[size_t(node) * kLanes];
+                if (std::isnan(e[0])) {
+                    touched.push_back(node);
+                    std::copy_n(va, lanes, e);
+                }
                 const bool least = kind == NodeKind::Union;
-                if (firstFold(in, a, i)) e = least ? std::min(e, value[a]) : std::max(e, value[a]);
-                e = least ? std::min(e, value[b]) : std::max(e, value[b]);
+                const bool first = firstFold(in, a, i);
+                for (uint32_t l = 0; l < lanes; ++l) {
+                    if (first) e[l] = least ? std::min(e[l], va[l]) : std::max(e[l], va[l]);
+                    e[l] = least ? std::min(e[l], vb[l]) : std::max(e[l], vb[l]);
+                }
             }
-            value[i] = opValue(n, value[a], value[b]);
+            for (uint32_t l = 0; l < lanes; ++l)
+                v[l] = opValue(n, va[l], vb[l]);
             ends.back() = i;
         }
-        const float root = value[length - 1];
-        if (std::abs(root) > far) return resetExtremes(), root;
+        std::copy_n(&value[size_t(length - 1) * kLanes], lanes, roots);
+    }
 
+    // The second pass for cell `lane` of the last evaluate(), of centre radius r: appends its
+    // tape to `out`.
+    void prune(const uint32_t* in, uint32_t length, uint32_t lane, float r,
+               std::vector<uint32_t>& out) {
+        const auto valueAt = [&](uint32_t i) { return value[size_t(i) * kLanes + lane]; };
         stack.clear();
         for (uint32_t i = 0; i < length; ++i) {
             const uint32_t ins = in[i];
@@ -228,7 +259,7 @@ struct Pruner {
             Segment b = stack.back();
             stack.pop_back();
             Segment& a = stack.back();
-            const float va = value[a.end], vb = value[b.end];
+            const float va = valueAt(a.end), vb = valueAt(b.end);
             const float gap = 2.0f * r + slack + 1e-5f * (std::abs(va) + std::abs(vb));
             bool dropA = false, dropB = false;
             if (kind == NodeKind::Difference) {
@@ -236,7 +267,7 @@ struct Pruner {
             } else {
                 const float sign = kind == NodeKind::Union ? 1.0f : -1.0f;
                 // Far from the operation's extreme operand; or k beyond the running value.
-                const float e = sign * extreme[u] + 2.0f * k + gap;
+                const float e = sign * extreme[size_t(u) * kLanes + lane] + 2.0f * k + gap;
                 dropB = sign * vb >= e || sign * (vb - va) >= gap + k;
                 dropA = (firstFold(in, a.end, i) && sign * va >= e) || sign * (va - vb) >= gap + k;
                 if (dropA && dropB) dropA = false; // keep one (only rounding could ask for both)
@@ -255,13 +286,11 @@ struct Pruner {
             out.resize(stack.back().start);
             out.insert(out.end(), in, in + length);
         }
-        resetExtremes();
-        return root;
     }
 
     void resetExtremes() {
         for (uint32_t u : touched)
-            extreme[u] = NAN;
+            std::fill_n(&extreme[size_t(u) * kLanes], kLanes, NAN);
         touched.clear();
     }
 };
@@ -394,35 +423,42 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) 
         const bool leaf = level == field.levels;
         // The children of this level's cells (the cells themselves at the root).
         const uint32_t fan = level == 0 ? 1 : 8; // the top cells themselves at level 0
-        const size_t jobs = cells.size() * fan;
         struct Out {
             std::vector<Cell> cells;
             std::vector<uint32_t> tapes;
         };
-        const unsigned used = jobs > 64 ? threads : 1;
+        const unsigned used = cells.size() * fan > 64 ? threads : 1;
         std::vector<Out> outs(used);
         std::atomic<bool> overBudget{false};
         auto work = [&](unsigned t) {
             Pruner pruner{nodes, spans, slack, {}};
             Out& out = outs[t];
-            for (size_t j = t; j < jobs && !overBudget; j += used) {
-                const Cell& parent = cells[j / fan];
-                const uint32_t octant = uint32_t(j % fan);
-                const glm::uvec3 at =
-                    level == 0 ? parent.at
-                               : parent.at * 2u +
-                                     glm::uvec3(octant & 1, octant >> 1 & 1, octant >> 2);
-                const glm::vec3 c = field.origin + (glm::vec3(at) + 0.5f) * size;
-                const uint32_t begin = uint32_t(out.tapes.size());
-                const float far = r + (kFarRadii - 1.0f) * leafR + slack;
-                const float v =
-                    pruner.prune(tapes.data() + parent.begin, parent.length, c, r, far, out.tapes);
-                if (std::abs(v) > far) { // no surface: fill its leaf cells
-                    fillLeaves(at, level,
-                               glm::uvec2(std::bit_cast<uint32_t>(v), kFarCell | level));
-                    continue;
+            glm::uvec3 at[8];
+            glm::vec3 centres[8];
+            float roots[8];
+            for (size_t j = t; j < cells.size() && !overBudget; j += used) {
+                const Cell& parent = cells[j];
+                for (uint32_t octant = 0; octant < fan; ++octant) {
+                    at[octant] = level == 0 ? parent.at
+                                            : parent.at * 2u + glm::uvec3(octant & 1, octant >> 1 & 1,
+                                                                          octant >> 2);
+                    centres[octant] = field.origin + (glm::vec3(at[octant]) + 0.5f) * size;
                 }
-                out.cells.push_back({at, begin, uint32_t(out.tapes.size()) - begin});
+                const uint32_t* tape = tapes.data() + parent.begin;
+                pruner.evaluate(tape, parent.length, centres, fan, roots);
+                const float far = r + (kFarRadii - 1.0f) * leafR + slack;
+                for (uint32_t octant = 0; octant < fan; ++octant) {
+                    const float v = roots[octant];
+                    if (std::abs(v) > far) { // no surface: fill its leaf cells
+                        fillLeaves(at[octant], level,
+                                   glm::uvec2(std::bit_cast<uint32_t>(v), kFarCell | level));
+                        continue;
+                    }
+                    const uint32_t begin = uint32_t(out.tapes.size());
+                    pruner.prune(tape, parent.length, octant, r, out.tapes);
+                    out.cells.push_back({at[octant], begin, uint32_t(out.tapes.size()) - begin});
+                }
+                pruner.resetExtremes();
                 if (out.tapes.size() > options.maxWords / used) overBudget = true;
             }
         };

@@ -104,6 +104,8 @@ std::vector<uint32_t> packField(const PrunedField& field, const std::vector<Flat
 
 // Value of a primitive node at p (eval.cpp): the kernel at the local point, times the scale.
 float primitiveValue(const FlatNode& node, glm::vec3 p);
+// The same at `count` points.
+void primitiveValues(const FlatNode& node, const glm::vec3* p, uint32_t count, float* values);
 // p in the node's local space, as nodes.glsl's toLocal computes it (eval.cpp).
 glm::vec3 nodeLocalPoint(const FlatNode& node, glm::vec3 p);
 
