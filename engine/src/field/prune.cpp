@@ -421,42 +421,46 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) 
         const float r = 0.5f * std::sqrt(3.0f) * size;
         const float leafR = 0.5f * std::sqrt(3.0f) * field.cell;
         const bool leaf = level == field.levels;
-        // The children of this level's cells (the cells themselves at the root).
-        const uint32_t fan = level == 0 ? 1 : 8; // the top cells themselves at level 0
+        // This level's cells are the children of the last level's (the top cells themselves at
+        // the root), pruned in groups that share a tape: a cell's eight children; at the root,
+        // eight top cells at a time (they all run the whole tape).
+        const uint32_t lanes = Pruner::kLanes;
+        const size_t groups = level == 0 ? (cells.size() + lanes - 1) / lanes : cells.size();
         struct Out {
             std::vector<Cell> cells;
             std::vector<uint32_t> tapes;
         };
-        const unsigned used = cells.size() * fan > 64 ? threads : 1;
+        const unsigned used = groups * lanes > 64 ? threads : 1;
         std::vector<Out> outs(used);
         std::atomic<bool> overBudget{false};
         auto work = [&](unsigned t) {
             Pruner pruner{nodes, spans, slack, {}};
             Out& out = outs[t];
-            glm::uvec3 at[8];
-            glm::vec3 centres[8];
-            float roots[8];
-            for (size_t j = t; j < cells.size() && !overBudget; j += used) {
-                const Cell& parent = cells[j];
-                for (uint32_t octant = 0; octant < fan; ++octant) {
-                    at[octant] = level == 0 ? parent.at
-                                            : parent.at * 2u + glm::uvec3(octant & 1, octant >> 1 & 1,
-                                                                          octant >> 2);
-                    centres[octant] = field.origin + (glm::vec3(at[octant]) + 0.5f) * size;
+            glm::uvec3 at[lanes];
+            glm::vec3 centres[lanes];
+            float roots[lanes];
+            for (size_t g = t; g < groups && !overBudget; g += used) {
+                const Cell& parent = cells[level == 0 ? g * lanes : g];
+                const uint32_t count =
+                    level == 0 ? uint32_t(std::min<size_t>(lanes, cells.size() - g * lanes)) : lanes;
+                for (uint32_t l = 0; l < count; ++l) {
+                    at[l] = level == 0 ? cells[g * lanes + l].at
+                                       : parent.at * 2u + glm::uvec3(l & 1, l >> 1 & 1, l >> 2);
+                    centres[l] = field.origin + (glm::vec3(at[l]) + 0.5f) * size;
                 }
                 const uint32_t* tape = tapes.data() + parent.begin;
-                pruner.evaluate(tape, parent.length, centres, fan, roots);
+                pruner.evaluate(tape, parent.length, centres, count, roots);
                 const float far = r + (kFarRadii - 1.0f) * leafR + slack;
-                for (uint32_t octant = 0; octant < fan; ++octant) {
-                    const float v = roots[octant];
+                for (uint32_t l = 0; l < count; ++l) {
+                    const float v = roots[l];
                     if (std::abs(v) > far) { // no surface: fill its leaf cells
-                        fillLeaves(at[octant], level,
+                        fillLeaves(at[l], level,
                                    glm::uvec2(std::bit_cast<uint32_t>(v), kFarCell | level));
                         continue;
                     }
                     const uint32_t begin = uint32_t(out.tapes.size());
-                    pruner.prune(tape, parent.length, octant, r, out.tapes);
-                    out.cells.push_back({at[octant], begin, uint32_t(out.tapes.size()) - begin});
+                    pruner.prune(tape, parent.length, l, r, out.tapes);
+                    out.cells.push_back({at[l], begin, uint32_t(out.tapes.size()) - begin});
                 }
                 pruner.resetExtremes();
                 if (out.tapes.size() > options.maxWords / used) overBudget = true;
