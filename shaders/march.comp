@@ -16,14 +16,19 @@ Trace march(vec3 ro, vec3 rd, float t, float tFar) {
     while (marching) {
 #ifdef SDFCSG_TAPE_STACK
         // Tapes: through a cell far from every surface, the step goes as far as the cell's
-        // reach along the ray (tape.glsl), farther than its bound.
+        // reach along the ray (tape.glsl), farther than its bound. Such a cell holds no surface:
+        // its bound is never a hit, however small beside the hit epsilon (the solid's inside
+        // aside).
         float step;
-        float d = tapeDistanceAlong(ro + rd * t, rd, step);
+        bool far;
+        float d = tapeDistanceAlong(ro + rd * t, rd, step, far);
+        float epsilon = far ? 0.0 : hitEpsilon(t);
 #else
         float d = sceneDistance(ro + rd * t), step = d;
+        float epsilon = hitEpsilon(t);
 #endif
         r.steps += 1u;
-        if (d < hitEpsilon(t)) {
+        if (d < epsilon) {
             r.t = t;
             marching = false;
         } else {

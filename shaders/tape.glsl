@@ -133,11 +133,13 @@ float tapeDistance(vec3 p) {
 }
 
 // For a ray from p along the unit vector dir: the field at p, and how far the ray may step
-// (the field's value, or a far cell's reach).
-float tapeDistanceAlong(vec3 p, vec3 dir, out float step) {
+// (the field's value, or a far cell's reach); `far` where the value is a bound (no surface in
+// the cell, or outside the grid).
+float tapeDistanceAlong(vec3 p, vec3 dir, out float step, out bool far) {
     float bound;
     uvec3 c = tapeCell(p, dir, bound, step);
-    if (c.x == 1u) return bound;
+    far = c.x == 1u;
+    if (far) return bound;
     step = tapeDistanceRun(c.y, c.z, p);
     return step;
 }

@@ -299,6 +299,40 @@ TEST_F(Render, RandomScenesRenderTheSameWithTapes) {
         expectTapesMatchInlined(context(), randomScene(seed, 220), 96, 72, 0.06);
 }
 
+// A cell far from every surface holds none, however small beside the hit epsilon: seen from
+// far away at a low resolution, where a pixel's footprint spans several leaf cells, the tapes'
+// silhouette is the inlined tree's, not grown by the far cells around it.
+TEST_F(Render, FarCellsAreNeverHits) {
+    std::vector<Tree> balls;
+    for (int i = 0; i < 200; ++i)
+        balls.push_back(sphere(0.05f).at(0.9f * std::sin(0.37f * float(i)),
+                                          0.9f * std::cos(0.23f * float(i)),
+                                          0.9f * std::sin(0.11f * float(i) + 1.0f)));
+    const Scene scene = makeScene(unite(std::move(balls)), "<far>");
+    RenderOptions options;
+    options.width = 64, options.height = 48;
+    options.camera = Camera{glm::vec3(0.0f, 0.0f, 12.0f), glm::vec3(0.0f), glm::vec3(0, 1, 0), 20.0f};
+    std::vector<PixelInfo> infos[2];
+    for (int tapes = 0; tapes < 2; ++tapes) {
+        RendererOptions made;
+        made.evaluation = tapes ? Evaluation::Tapes : Evaluation::Inlined;
+        auto renderer = Renderer::create(context(), scene, made);
+        ASSERT_TRUE(renderer) << renderer.error().str();
+        ASSERT_TRUE((*renderer)->render(options));
+        infos[tapes] = (*renderer)->lastPixelInfo();
+    }
+    size_t hits[2] = {}, differ = 0;
+    for (size_t i = 0; i < infos[0].size(); ++i) {
+        const bool a = infos[0][i].depth >= 0.0f, b = infos[1][i].depth >= 0.0f;
+        hits[0] += a, hits[1] += b, differ += a != b;
+    }
+    EXPECT_GT(hits[0], 100u);
+    // Rays that pass the surface within the epsilon but beyond a leaf cell's radius hit the
+    // inlined tree and miss the tapes (when far bounds counted as hits: 390 hits against 347).
+    EXPECT_LE(double(differ), 0.005 * double(infos[0].size()))
+        << hits[0] << " inlined hits, " << hits[1] << " with tapes";
+}
+
 // A scene at the node and nesting limits (Limits: 16,384 nodes, 64 nested operations) renders at
 // 1280 x 720 and meshes at resolution 256, the process staying under 2 GiB resident: a chain of
 // 63 smooth unions inside the root, and a field of 16,256 primitives of four kinds.
