@@ -88,8 +88,8 @@ void surface(vec3 ro, vec3 rd, vec4 ends, inout Trace r, out vec3 albedo) {
                 }
             }
         } else if (phase == kOcclusion) {
-            // A far cell's bound (tape.glsl) says only that nothing is nearer: no occlusion.
-            r.ao += (t - (s.r < 0.0 ? max(d, t) : d)) * weight;
+            // In a far cell (tape.glsl), the field's estimate along its direction of ascent.
+            r.ao += (t - (s.r < 0.0 ? s.b : d)) * weight;
             weight *= 0.95;
             tap += 1;
             t += aoScale * 0.03;
@@ -105,6 +105,8 @@ void surface(vec3 ro, vec3 rd, vec4 ends, inout Trace r, out vec3 albedo) {
                 // narrow the penumbra's cone and darken lit surfaces, and where leaf cells are
                 // small beside the hit epsilon, read as a hit.
 #ifdef SDFCSG_TAPE_STACK
+                res = min(res, kShadowSharpness * s.b / t);
+                ph = 1.0e20;
                 t += max(s.g, eps);
 #else
                 t += max(d, eps);

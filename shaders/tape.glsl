@@ -91,7 +91,7 @@ vec4 tapeOp(uint kind, vec4 a, vec4 b, float k, uint blend) {
 // one: to where it leaves the ball of radius |v| around the centre c of the cell found far (no
 // surface lies nearer to c than its value v), at least the bound v - |p - c| and often a few
 // cells more (the bound alone, near a far cell's entry side, is about a leaf cell's radius).
-uvec3 tapeCell(vec3 p, vec3 dir, out float bound, out float reach) {
+uvec3 tapeCell(vec3 p, vec3 dir, out float bound, out float reach, out float estimate) {
     vec3 origin = vec3(uintBitsToFloat(field[0]), uintBitsToFloat(field[1]),
                        uintBitsToFloat(field[2]));
     float cell = uintBitsToFloat(field[3]);
@@ -100,12 +100,14 @@ uvec3 tapeCell(vec3 p, vec3 dir, out float bound, out float reach) {
     vec3 q = floor((p - origin) / cell);
     bound = 0.0;
     reach = 0.0;
+    estimate = 0.0;
     if (dims.x == 0u || any(lessThan(q, vec3(0.0))) || any(greaterThanEqual(q, vec3(dims)))) {
         if (field[8] == 0u) return uvec3(0u, tapeStart, tapeStart + field[9]); // the whole tape
         // Bounded: the grid holds the bounds and a cell more on every side.
         vec3 top = origin + cell * vec3(dims);
         bound = boundsDistance(origin, top, p) + 0.5 * cell;
         reach = bound;
+        estimate = bound;
         return uvec3(1u, 0u, 0u);
     }
     uvec3 at = uvec3(q);
@@ -120,6 +122,16 @@ uvec3 tapeCell(vec3 p, vec3 dir, out float bound, out float reach) {
     bound = v > 0.0 ? v - distance : v + distance;
     float b = dot(away, dir);
     reach = max(sqrt(max(b * b + (v * v - distance * distance), 0.0)) - b, abs(bound));
+    // For shading: the field's value estimated along its direction of ascent over the cell's
+    // siblings, never nearer zero than the bound.
+    estimate = bound;
+    if ((y & 0x40000000u) != 0u) {
+        vec2 o = vec2(uvec2(y >> 8, y >> 19) & 2047u) / 2047.0 * 2.0 - 1.0;
+        vec3 g = vec3(o, 1.0 - abs(o.x) - abs(o.y));
+        if (g.z < 0.0) g.xy = (1.0 - abs(g.yx)) * vec2(g.x >= 0.0 ? 1.0 : -1.0, g.y >= 0.0 ? 1.0 : -1.0);
+        float linear = v + dot(normalize(g), away);
+        estimate = v > 0.0 ? max(linear, bound) : min(linear, bound);
+    }
     return uvec3(1u, 0u, 0u);
 }
 
@@ -127,8 +139,8 @@ uvec3 tapeCell(vec3 p, vec3 dir, out float bound, out float reach) {
 float tapeLeafSide() { return field[4] == 0u ? 1e30 : uintBitsToFloat(field[3]); }
 
 float tapeDistance(vec3 p) {
-    float bound, reach;
-    uvec3 c = tapeCell(p, vec3(0.0), bound, reach);
+    float bound, reach, estimate;
+    uvec3 c = tapeCell(p, vec3(0.0), bound, reach, estimate);
     return c.x == 1u ? bound : tapeDistanceRun(c.y, c.z, p);
 }
 
@@ -136,8 +148,8 @@ float tapeDistance(vec3 p) {
 // (the field's value, or a far cell's reach); `far` where the value is a bound (no surface in
 // the cell, or outside the grid).
 float tapeDistanceAlong(vec3 p, vec3 dir, out float step, out bool far) {
-    float bound;
-    uvec3 c = tapeCell(p, dir, bound, step);
+    float bound, estimate;
+    uvec3 c = tapeCell(p, dir, bound, step, estimate);
     far = c.x == 1u;
     if (far) return bound;
     step = tapeDistanceRun(c.y, c.z, p);
@@ -148,15 +160,15 @@ float tapeDistanceAlong(vec3 p, vec3 dir, out float step, out bool far) {
 // bound (as tapeSample gives), then with g the reach along dir (tapeCell), else 0. The float
 // stack is about half the work of the colour one.
 vec4 tapeTap(vec3 p, vec3 dir) {
-    float bound, reach;
-    uvec3 c = tapeCell(p, dir, bound, reach);
-    return c.x == 1u ? vec4(-1.0, reach, 0.0, bound)
+    float bound, reach, estimate;
+    uvec3 c = tapeCell(p, dir, bound, reach, estimate);
+    return c.x == 1u ? vec4(-1.0, reach, estimate, bound)
                      : vec4(0.0, 0.0, 0.0, tapeDistanceRun(c.y, c.z, p));
 }
 
 // Where the value is a bound, the colour is -1: the shade pass's soft shadows tell the two apart.
 vec4 tapeSample(vec3 p) {
-    float bound, reach;
-    uvec3 c = tapeCell(p, vec3(0.0), bound, reach);
+    float bound, reach, estimate;
+    uvec3 c = tapeCell(p, vec3(0.0), bound, reach, estimate);
     return c.x == 1u ? vec4(-1.0, -1.0, -1.0, bound) : tapeSampleRun(c.y, c.z, p);
 }

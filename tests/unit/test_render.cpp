@@ -321,15 +321,17 @@ TEST_F(Render, FarCellsAreNeverHits) {
         ASSERT_TRUE((*renderer)->render(options));
         infos[tapes] = (*renderer)->lastPixelInfo();
     }
-    size_t hits[2] = {}, differ = 0;
+    size_t hits[2] = {}, grown = 0;
     for (size_t i = 0; i < infos[0].size(); ++i) {
         const bool a = infos[0][i].depth >= 0.0f, b = infos[1][i].depth >= 0.0f;
-        hits[0] += a, hits[1] += b, differ += a != b;
+        hits[0] += a, hits[1] += b, grown += b && !a;
     }
     EXPECT_GT(hits[0], 100u);
-    // Rays that pass the surface within the epsilon but beyond a leaf cell's radius hit the
-    // inlined tree and miss the tapes (when far bounds counted as hits: 390 hits against 347).
-    EXPECT_LE(double(differ), 0.005 * double(infos[0].size()))
+    // When far bounds counted as hits: 414 hits against 347. Rays that pass
+    // the surface within the epsilon but only through far cells (beyond a leaf cell's radius
+    // from it) hit the inlined tree and miss the tapes: a silhouette thinner by a fraction of a
+    // pixel, where the leaf cells are smaller than a pixel's footprint.
+    EXPECT_LE(double(grown), 0.005 * double(infos[0].size()))
         << hits[0] << " inlined hits, " << hits[1] << " with tapes";
 }
 

@@ -267,7 +267,7 @@ struct Pruner {
             } else {
                 const float sign = kind == NodeKind::Union ? 1.0f : -1.0f;
                 // Far from the operation's extreme operand; or k beyond the running value.
-                const float e = sign * extreme[size_t(u) * kLanes + lane] + 2.0f * k + gap;
+                const float e = sign * extreme[size_t(u) * kLanes + lane] + 3.0f * k + gap;
                 dropB = sign * vb >= e || sign * (vb - va) >= gap + k;
                 dropA = (firstFold(in, a.end, i) && sign * va >= e) || sign * (va - vb) >= gap + k;
                 if (dropA && dropB) dropA = false; // keep one (only rounding could ask for both)
@@ -294,6 +294,19 @@ struct Pruner {
         touched.clear();
     }
 };
+
+// A far cell's direction of ascent, octahedral in two 11-bit numbers at bits 8 and 19, with bit
+// 30 set (0: none), as tapeCell() in shaders/tape.glsl reads it.
+uint32_t farGradientBits(glm::vec3 g) {
+    const float sum = std::abs(g.x) + std::abs(g.y) + std::abs(g.z);
+    if (!(sum > 0.0f)) return 0;
+    glm::vec2 o = glm::vec2(g.x, g.y) / sum;
+    if (g.z < 0.0f)
+        o = (1.0f - glm::abs(glm::vec2(o.y, o.x))) *
+            glm::vec2(o.x >= 0.0f ? 1.0f : -1.0f, o.y >= 0.0f ? 1.0f : -1.0f);
+    const glm::uvec2 q = glm::uvec2(glm::round((o * 0.5f + 0.5f) * 2047.0f));
+    return 1u << 30 | q.y << 19 | q.x << 8;
+}
 
 // A cell is far from every surface when its centre value exceeds its radius and this many leaf
 // radii less one: its bound is then at least a leaf cell's radius everywhere in it, which keeps
@@ -451,11 +464,21 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) 
                 const uint32_t* tape = tapes.data() + parent.begin;
                 pruner.evaluate(tape, parent.length, centres, count, roots);
                 const float far = r + (kFarRadii - 1.0f) * leafR + slack;
+                // The field's direction of ascent over the eight siblings (their differences
+                // along each axis), which far cells carry for shading (farGradientBits).
+                uint32_t ascent = 0;
+                if (level > 0) {
+                    glm::vec3 rise(0.0f);
+                    for (uint32_t l = 0; l < lanes; ++l)
+                        rise += glm::vec3(l & 1 ? 1.0f : -1.0f, l & 2 ? 1.0f : -1.0f,
+                                          l & 4 ? 1.0f : -1.0f) * roots[l];
+                    ascent = farGradientBits(rise);
+                }
                 for (uint32_t l = 0; l < count; ++l) {
                     const float v = roots[l];
                     if (std::abs(v) > far) { // no surface: fill its leaf cells
                         fillLeaves(at[l], level,
-                                   glm::uvec2(std::bit_cast<uint32_t>(v), kFarCell | level));
+                                   glm::uvec2(std::bit_cast<uint32_t>(v), kFarCell | ascent | level));
                         continue;
                     }
                     const uint32_t begin = uint32_t(out.tapes.size());

@@ -46,7 +46,7 @@ inline constexpr uint32_t kFarCell = 0x80000000u;
 
 struct PruneOptions {
     uint32_t levels = 5;          // octree levels below the top grid's cells; 0: no pruning
-    uint32_t cells = 1u << 18;    // about this many leaf cells in the bounds
+    uint32_t cells = 1u << 19;    // about this many leaf cells in the bounds
     // At most about this many tape words (4 bytes each) per level: where the tree prunes too
     // little for that, refinement stops and the leaf cells run their coarser parents' tapes.
     size_t maxWords = size_t(1) << 24;
