@@ -41,7 +41,8 @@ inline constexpr uint32_t kTapeDomainEnd = SDFCSG_TAPE_DOMAIN_END;
 inline constexpr uint32_t kTapeNodeMask = (1u << kTapeNodeBits) - 1u;
 // A leaf cell entry (x, y): near a surface, the cell's tape [x, x + y) in PrunedField::tape;
 // far from every surface, x holds the root value at the centre of the cell of level
-// y & 0xff that was found far, and y has kFarCell set.
+// y & 0xff that was found far, y has kFarCell set and, with bit 30, the field's direction of
+// ascent there in bits 8 to 29 (for shading; farGradientBits in prune.cpp).
 inline constexpr uint32_t kFarCell = 0x80000000u;
 
 struct PruneOptions {
