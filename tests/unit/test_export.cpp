@@ -150,9 +150,12 @@ TEST(Export, StlRoundTripsWithFacetNormalsFromTheWinding) {
     EXPECT_NE(stl.header.rfind("solid", 0), 0u) << "a binary STL header must not start 'solid'";
     ASSERT_EQ(stl.facetNormals.size(), mesh.triangleCount());
     ASSERT_EQ(stl.corners.size(), mesh.indices.size());
-    for (size_t i = 0; i < mesh.indices.size(); ++i)
-        EXPECT_EQ(stl.corners[i], mesh.positions[mesh.indices[i]]) << "corner " << i;
-    const glm::vec3 centre(0.1f, 0.6f, 1.2f);
+    // z up, as slicers build: the scene's y is z, its z is -y.
+    for (size_t i = 0; i < mesh.indices.size(); ++i) {
+        const glm::vec3 p = mesh.positions[mesh.indices[i]];
+        EXPECT_EQ(stl.corners[i], glm::vec3(p.x, -p.z, p.y)) << "corner " << i;
+    }
+    const glm::vec3 centre(0.1f, -1.2f, 0.6f); // the box's (0.1, 0.6, 1.2), turned
     for (size_t t = 0; t < stl.facetNormals.size(); ++t) {
         const glm::vec3 n = stl.facetNormals[t];
         EXPECT_NEAR(glm::length(n), 1.0f, 1e-6f);

@@ -14,7 +14,7 @@ namespace sdfcsg {
 enum class MeshFormat {
     Ply, // binary little-endian PLY: float positions and normals, uchar RGB colours, uint indices
     Obj, // Wavefront OBJ: "v x y z r g b" (the common colour extension), "vn", "f a//a b//b c//c"
-    Stl, // binary STL: facet normals from the triangle winding, no colours (for printing)
+    Stl, // binary STL for printing: z up as 3MF, facet normals from the winding, no colours
     Glb, // glTF 2.0 binary: POSITION, NORMAL, COLOR_0 (linear), indices, one mesh and node
     // 3MF (3D Manufacturing Format, core and materials specifications), as slicers read it: one
     // object, z up (the scene's y becomes z), per-vertex sRGB colours as a colour group, in a

@@ -137,6 +137,12 @@ glm::vec3 corner(const Mesh& mesh, size_t i) {
     return v < mesh.positions.size() ? mesh.positions[v] : glm::vec3(0.0f);
 }
 
+// The formats for printing (STL, 3MF) are z up, as slicers build along z: the scene's y becomes
+// z, (x, y, z) -> (x, -z, y), a rotation, so windings stay outward.
+glm::vec3 zUp(glm::vec3 p) {
+    return {p.x, -p.z, p.y};
+}
+
 std::string encodeStl(const Mesh& mesh) {
     // The header must not begin with "solid", which readers take for the ASCII variant.
     std::string out = "sdfcsg binary STL";
@@ -144,8 +150,8 @@ std::string encodeStl(const Mesh& mesh) {
     putU32(out, uint32_t(mesh.triangleCount()));
     out.reserve(out.size() + mesh.triangleCount() * 50);
     for (size_t t = 0; t < mesh.triangleCount(); ++t) {
-        const glm::vec3 a = corner(mesh, 3 * t), b = corner(mesh, 3 * t + 1),
-                        c = corner(mesh, 3 * t + 2);
+        const glm::vec3 a = zUp(corner(mesh, 3 * t)), b = zUp(corner(mesh, 3 * t + 1)),
+                        c = zUp(corner(mesh, 3 * t + 2));
         const glm::vec3 n = glm::cross(b - a, c - a);
         const float length = glm::length(n);
         putVec3(out, length > 0.0f ? n / length : glm::vec3(0.0f));
@@ -286,8 +292,8 @@ const char* unitName(LengthUnit unit) {
     return "millimeter";
 }
 
-// The model part of a 3MF package: vertices turned z up ((x, y, z) -> (x, -z, y), a rotation,
-// so the winding stays outward), triangles with their corners' colours, and one build item.
+// The model part of a 3MF package: vertices turned z up (zUp), triangles with their corners'
+// colours, and one build item.
 // The specification forbids a triangle that names a vertex twice; such a triangle has no area
 // and is left out.
 std::string threeMfModel(const Mesh& mesh, LengthUnit unit) {
@@ -328,7 +334,7 @@ std::string threeMfModel(const Mesh& mesh, LengthUnit unit) {
     out += "  <mesh>\n   <vertices>\n";
     out.reserve(out.size() + mesh.vertexCount() * 48 + mesh.triangleCount() * 64);
     for (const glm::vec3& v : mesh.positions) {
-        const float turned[3] = {v.x, -v.z, v.y};
+        const glm::vec3 turned = zUp(v);
         out += "    <vertex";
         for (int k = 0; k < 3; ++k) {
             out += k == 0 ? " x=\"" : k == 1 ? "\" y=\"" : "\" z=\"";
