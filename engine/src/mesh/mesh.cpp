@@ -456,7 +456,7 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
     // dual pass (the longest compile, about as long as the three field passes together) while
     // this device compiles the field passes; this device's dual pass then loads the helper's
     // machine code. The marching-cubes triangle pass is made at the first extraction that
-    // asks for it (trianglePass()).
+    // asks for it (run()).
     std::optional<Error> passesError;
     double helperMs = 0.0; // the helper's compile of the dual pass
     std::thread other([&] {
