@@ -135,16 +135,16 @@ V run(const std::vector<FlatNode>& nodes, const uint32_t* tape, uint32_t length,
     return stack.back();
 }
 
-// Prunes `in` for a cell of centre c and radius r (see prune.h), appending the cell's tape to
-// `out`; returns the root value at c. The first pass runs the tape at c and notes, per
-// operation, the least (union) or greatest (intersection) value of its operands. The second
-// drops the operands that cannot matter anywhere in the cell, where each value lies within
-// v +- r, widened by `slack` for the rounding of single precision (at c here, at p on the GPU):
-//  - of a union, an operand whose lower bound is at least 2k above the least upper bound (k:
+// Prunes `in` for cells of centre c and radius r (see prune.h), appending each cell's tape to
+// `out`. The first pass runs the tape at c and notes, per operation, the least (union) or
+// greatest (intersection) value of its operands. The second drops the operands that cannot
+// matter anywhere in the cell, where each value lies within v +- r, widened by `slack` for the
+// rounding of single precision (at c here, at p on the GPU):
+//  - of a union, an operand whose lower bound is at least 3k above the least upper bound (k:
 //    the blend radius); of an intersection, the mirror image. Sharp (k = 0), the result is the
-//    same bits. Smooth, an operand 2k above the least one changes the left-to-right fold only
-//    through a chain of blends each of which passes on at most half of a change, well under
-//    1e-5 of k (the tests check 1e-5 absolute near the surface);
+//    same bits. Smooth, an operand 3k above the least one changes the left-to-right fold only
+//    through a chain of blends each of which passes on at most half of a change (the tests
+//    check 1e-5 absolute near the surface; at 2k, cells of 2^19 in the bounds strayed to 2e-5);
 //  - a subtrahend b of a difference where a + b >= k over the cell (max(a, -b) is a), and the
 //    running union a or operand b where they lie k apart (opUnion returns the other).
 // A domain operation's instructions (its own, its child's and the end) stay whole: the pruner
