@@ -99,11 +99,12 @@ void surface(vec3 ro, vec3 rd, vec4 ends, inout Trace r, out vec3 albedo) {
             }
         } else { // kShadow
             if (s.r < 0.0) {
-                // A bound from a cell far from every surface (tape.glsl): it only steps, as far
-                // as the cell's reach along the ray (s.g with tapes), and does not count against
-                // the steps (each is at least a cell's radius). Taken as a distance it would
-                // narrow the penumbra's cone and darken lit surfaces, and where leaf cells are
-                // small beside the hit epsilon, read as a hit.
+                // A bound from a cell far from every surface (tape.glsl): the ray steps as far
+                // as the cell's reach along it (s.g with tapes), a step that does not count
+                // against the steps (each is at least a cell's radius), and is never a hit. The
+                // penumbra takes the field's estimate there (s.b with tapes): the bound would
+                // narrow its cone and darken lit surfaces, and no sample at all lightened them
+                // where far cells lie near the surface.
 #ifdef SDFCSG_TAPE_STACK
                 res = min(res, kShadowSharpness * s.b / t);
                 ph = 1.0e20;

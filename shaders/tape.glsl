@@ -128,7 +128,8 @@ uvec3 tapeCell(vec3 p, vec3 dir, out float bound, out float reach, out float est
     if ((y & 0x40000000u) != 0u) {
         vec2 o = vec2(uvec2(y >> 8, y >> 19) & 2047u) / 2047.0 * 2.0 - 1.0;
         vec3 g = vec3(o, 1.0 - abs(o.x) - abs(o.y));
-        if (g.z < 0.0) g.xy = (1.0 - abs(g.yx)) * vec2(g.x >= 0.0 ? 1.0 : -1.0, g.y >= 0.0 ? 1.0 : -1.0);
+        if (g.z < 0.0)
+            g.xy = (1.0 - abs(g.yx)) * vec2(g.x >= 0.0 ? 1.0 : -1.0, g.y >= 0.0 ? 1.0 : -1.0);
         float linear = v + dot(normalize(g), away);
         estimate = v > 0.0 ? max(linear, bound) : min(linear, bound);
     }
@@ -157,8 +158,8 @@ float tapeDistanceAlong(vec3 p, vec3 dir, out float step, out bool far) {
 }
 
 // For the shade pass's taps, which need no colour: the distance in w, and r -1 where it is a
-// bound (as tapeSample gives), then with g the reach along dir (tapeCell), else 0. The float
-// stack is about half the work of the colour one.
+// bound (as tapeSample gives), then with g the reach along dir and b the estimate for shading
+// (tapeCell), else 0. The float stack is about half the work of the colour one.
 vec4 tapeTap(vec3 p, vec3 dir) {
     float bound, reach, estimate;
     uvec3 c = tapeCell(p, dir, bound, reach, estimate);
