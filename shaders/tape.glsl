@@ -9,10 +9,10 @@
 // 0 where no instruction reads the stack, when every operation folds in a primitive's value),
 // SDFCSG_TAPE_KINDS (a bit for each kind of primitive), SDFCSG_TAPE_OPERATIONS (a bit for each
 // kind of operation, less Union: union 1, intersection 2, difference 4, shell 8, offset 16),
-// SDFCSG_TAPE_BALLS (1 where every sphere is a ball, detail::isBall; KINDS then lacks the
-// sphere's bit) and SDFCSG_TAPE_DOMAINS (the most domain operations nested in one another, 0
-// for none). Only BALLS follows values (the spheres' scales): Renderer::updateValues recompiles
-// where it changes.
+// SDFCSG_TAPE_BALLS (1 where every sphere is a ball, detail::isBall, in kernels that may follow
+// values, CodegenOptions::inlineParams; KINDS then lacks the sphere's bit) and
+// SDFCSG_TAPE_DOMAINS (the most domain operations nested in one another, 0 for none). Only BALLS
+// follows values (the spheres' scales): Renderer::updateValues recompiles where it changes.
 
 // Mirrors packField() in engine/src/field/prune.cpp: a header of 12 words (origin xyz and leaf cell
 // side as float bits, levels, leaf cells per axis xyz, 1 when bounded, whole-tape length, first

@@ -221,18 +221,29 @@ RenderOutput RenderWorker::process(const RenderJob& job) {
     // sooner: on lavapipe a small scene's inlined kernel compiles in a fraction of a second
     // and draws several times faster, so at full resolution the live frame can come later.
     // Until the live renderer has drawn, its speed is guessed from the baked one's (on
-    // lavapipe the house's live frame took 6 times as long).
+    // lavapipe the house's live frame took 6 times as long; a scene evaluated from pruned
+    // tapes reads its values from buffers either way).
+    const bool tapes = usesTapes(*job.scene, Evaluation::Auto);
     const double pixels = double(job.options.width) * double(job.options.height);
     const double liveRate =
-        liveRate_ > 0 ? liveRate_ : bakedRate_ * (context_.cpuDevice() ? 6.0 : 1.0);
+        liveRate_ > 0 ? liveRate_ : bakedRate_ * (context_.cpuDevice() ? (tapes ? 1.5 : 6.0) : 1.0);
     const bool bakeSooner =
         !job.preview && bakedRate_ > 0 && bakeSeconds_ + bakedRate_ * pixels < liveRate * pixels;
-    // A scene evaluated from pruned tapes reads every value from buffers, so its one renderer
-    // takes value edits itself, previews and still frames alike: no live renderer, no bake.
-    const bool tapes = usesTapes(*job.scene, Evaluation::Auto);
+    // A scene evaluated from pruned tapes reads every value from buffers, so its baked renderer
+    // takes value edits itself, previews and still frames alike, but for one that its kernel
+    // follows (a sphere scaled differently per axis, or no longer, where it reads spheres as
+    // balls): the live renderer draws that one, once built, and the bake follows as a
+    // refinement.
+    const bool uploads = tapes && baked_ && bakedVersion_ != job.sceneVersion &&
+                         baked_->uploads(*job.scene);
     if (tapes && baked_ && bakedVersion_ != job.sceneVersion &&
-        sameStructure(*bakedScene_, *job.scene)) {
-        if (auto updated = baked_->updateValues(*job.scene); updated) {
+        sameStructure(*bakedScene_, *job.scene) && (uploads || !live_)) {
+        auto start = std::chrono::steady_clock::now();
+        compilingHere_ = !uploads;
+        auto updated = baked_->updateValues(*job.scene);
+        compilingHere_ = false;
+        if (!uploads) out.compileSeconds = secondsSince(start);
+        if (updated) {
             bakedScene_ = job.scene;
             bakedVersion_ = job.sceneVersion;
             drawn_.reset();
@@ -276,7 +287,7 @@ RenderOutput RenderWorker::process(const RenderJob& job) {
             renderer = baked_.get();
             // A structure on screen: its live renderer is built now, so that the first value
             // edit is already an upload.
-            if (!tapes && !live_ && !liveBuilder_->pendingStructure(*job.scene))
+            if (baked_->followsValues() && !live_ && !liveBuilder_->pendingStructure(*job.scene))
                 liveBuilder_->request(job.scene, job.sceneVersion);
         } else {
             failedVersion_ = job.sceneVersion;

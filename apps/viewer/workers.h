@@ -108,6 +108,11 @@ class RendererBuilder {
 // baked again by a second builder in the background: a refinement (faster to draw, and the
 // same pixels as `sdfcsg render`) that the caller asks for once refinementReady(), never a wait
 // before the edit shows.
+//
+// A scene evaluated from pruned tapes reads its values from buffers, so the baked renderer takes
+// its value edits, but where its kernel reads every sphere as a ball (Renderer::followsValues):
+// then a live renderer, which reads spheres through their transforms, is built beside it and
+// draws the edit that scales a sphere differently per axis, or no longer.
 class RenderWorker {
   public:
     // The live renderer is built and draws on `liveContext` (null: on `context`). Both must

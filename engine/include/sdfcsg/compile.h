@@ -34,7 +34,9 @@ struct CodegenOptions {
     // changing a value needs no recompile (the viewer). true: they are baked in as literals,
     // which the driver's compiler folds (fastest for one-off headless renders). Scenes of more
     // than 1024 nodes always read the buffer: glslang's time grows with the square of the
-    // number of distinct literals.
+    // number of distinct literals. Scenes evaluated from tapes read every value from buffers
+    // either way; true lets their kernel read spheres as balls (centre and radius) where every
+    // sphere's scale is the same on every axis, so that an edit changing that recompiles.
     bool inlineParams = false;
     // Whether each operand of a union or difference is guarded by a test of its bounds, which
     // the kernels turn on or off with a specialisation constant (kBoundsSkipping in

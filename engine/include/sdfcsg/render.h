@@ -72,11 +72,11 @@ struct RendererOptions {
     // true: numeric values are baked into the kernel as literals. CPU drivers (lavapipe) run
     // that several times faster, but updateValues() must then regenerate and recompile.
     // false: values are read from a buffer, so updateValues() only uploads them (the viewer).
+    // Scenes evaluated from pruned tapes read their values from buffers either way; true lets
+    // the tape machine read spheres as balls where every sphere's scale is the same on every
+    // axis (faster), so that updateValues() recompiles where an edit changes that.
     bool inlineValues = true;
-    // Inlined or pruned tapes (CodegenOptions): with tapes, updateValues() recompiles only
-    // where an edit makes a sphere's scale differ per axis, or no longer (the tape machine reads
-    // spheres as balls where all are).
-    Evaluation evaluation = Evaluation::Auto;
+    Evaluation evaluation = Evaluation::Auto; // inlined or pruned tapes (CodegenOptions)
 };
 
 class Renderer {
@@ -93,6 +93,12 @@ class Renderer {
     // the kernel is regenerated. Fails with ErrorKind::Usage if the structure (kinds, children)
     // differs from the compiled one.
     Status updateValues(const Scene& scene);
+    // Whether updateValues(scene) would only upload: the structure is the same, and the kernel
+    // holds none of the values that differ (see followsValues()).
+    bool uploads(const Scene& scene) const;
+    // Whether the kernel holds some of the scene's values, so that some edits of values rebuild
+    // it: values inlined, or on tapes spheres read as balls (see inlineValues).
+    bool followsValues() const;
 
     Result<Image> render(const RenderOptions& options);
     // Per-pixel hit depth and step count of the last render().

@@ -572,12 +572,11 @@ std::string generateSceneGlsl(const Scene& scene, const CodegenOptions& options)
             for (size_t c = 1; c < n.children.size(); ++c)
                 stackRead |= kindInfo(nodes[n.children[c]].kind).role != Role::Primitive;
         }
-        // spheres read as balls (detail::isBall) where all of them are, which a sphere scaled
-        // differently per axis changes (Renderer::updateValues then recompiles).
+        // spheres read as balls (detail::isBall) where all of them are and values may be baked
+        // in: a sphere scaled differently per axis changes that (Renderer::updateValues then
+        // recompiles). Kernels that take every value from buffers read spheres as the others.
         const uint32_t sphere = 1u << uint32_t(NodeKind::Sphere);
-        const bool balls = (kinds & sphere) && std::all_of(nodes.begin(), nodes.end(), [](const FlatNode& n) {
-                               return n.kind != NodeKind::Sphere || detail::isBall(n);
-                           });
+        const bool balls = options.inlineParams && detail::allSpheresAreBalls(nodes);
         if (balls) kinds &= ~sphere;
         // Stacks in powers of two: scenes of similar depth share their kernels.
         const uint32_t stack = stackRead ? std::max(4u, std::bit_ceil(depth)) : 0u;

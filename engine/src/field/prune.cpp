@@ -613,6 +613,16 @@ bool isBall(const FlatNode& n) {
     return true;
 }
 
+bool allSpheresAreBalls(const std::vector<FlatNode>& nodes) {
+    bool spheres = false;
+    for (const FlatNode& n : nodes) {
+        if (n.kind != NodeKind::Sphere) continue;
+        if (!isBall(n)) return false;
+        spheres = true;
+    }
+    return spheres;
+}
+
 std::vector<uint32_t> packField(const PrunedField& f, const std::vector<FlatNode>& nodes) {
     const uint32_t cellStart = uint32_t(kFieldHeaderWords + 4 * nodes.size());
     const uint32_t tapeStart = uint32_t(cellStart + 2 * f.cells.size());

@@ -90,6 +90,9 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options =
 // every sphere of the scene is a ball (SDFCSG_TAPE_BALLS, shaders/tape.glsl): the same value up
 // to rounding.
 bool isBall(const FlatNode& node);
+// The scene has spheres and every one is a ball: what SDFCSG_TAPE_BALLS asks of kernels that may
+// follow values (CodegenOptions::inlineParams).
+bool allSpheresAreBalls(const std::vector<FlatNode>& nodes);
 
 // What shaders/tape.glsl reads, as one buffer of 32-bit words: a header of 12 words (origin,
 // cell, levels, dims, 1 when bounded, full tape length, first tape word, first cell word), four

@@ -7,6 +7,7 @@
 #include "render/camera.h"
 #include "codegen/gpu_nodes.h"
 #include "codegen/shader_compile.h"
+#include "field/prune.h"
 #include "gpu/vk.h"
 
 #include "sdfcsg/compile.h"
@@ -163,6 +164,8 @@ struct Renderer::Impl {
     RendererOptions options;
     Scene scene; // the values last uploaded; structure fixed at creation
     std::unique_ptr<Evaluator> evaluator;
+    bool tapes = false; // evaluated from pruned tapes
+    bool balls = false; // the tape machine reads spheres as balls (SDFCSG_TAPE_BALLS)
     uint32_t nodeCount = 0;
 
     std::shared_ptr<SharedPasses> shared;
@@ -334,6 +337,11 @@ struct Renderer::Impl {
             *made[i] = detail::createShaderModule(ctx, *spirv);
         }
         return Ok{};
+    }
+
+    // Whether the tape machine reads the spheres of a scene with these values as balls.
+    bool readsBalls(const Evaluator& values) const {
+        return tapes && options.inlineValues && detail::allSpheresAreBalls(values.nodes());
     }
 
     bool defaultSkipping() const {
@@ -585,6 +593,8 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene
     r.options = options;
     r.scene = scene;
     r.evaluator = std::make_unique<Evaluator>(scene);
+    r.tapes = usesTapes(scene, options.evaluation);
+    r.balls = r.readsBalls(*r.evaluator);
     r.nodeCount = uint32_t(scene.nodes.size());
     // Pruned on the host while the kernels build (with tapes, they are the same for every
     // scene): on the forest benchmark scene, most of the prune's time.
@@ -633,26 +643,32 @@ Status Renderer::updateValues(const Scene& scene) {
         return usage("updateValues: the scene's structure (node kinds or children) differs from "
                      "the compiled one; create a new Renderer instead");
     Impl& r = *impl_;
-    const bool tapes = usesTapes(scene, r.options.evaluation);
-    // The tape machine's code follows one value too (whether every sphere's scale is uniform:
-    // generateSceneGlsl), which edits seldom change.
-    const std::string tapeCode = tapes ? r.sceneGlsl(r.defaultSkipping()) : std::string();
+    auto evaluator = std::make_unique<Evaluator>(scene);
+    auto words = detail::fieldWords(scene, *evaluator, r.options.evaluation);
+    if (!words) return words.error();
+    const bool balls = r.readsBalls(*evaluator);
     Scene previous = std::move(r.scene);
     r.scene = scene;
-    if (tapes ? r.sceneGlsl(r.defaultSkipping()) != tapeCode : r.options.inlineValues) {
+    if (r.options.inlineValues && (!r.tapes || balls != r.balls)) {
         if (auto built = r.buildKernels(); !built) {
             r.scene = std::move(previous);
             return built.error();
         }
+        r.balls = balls;
     }
-    r.evaluator = std::make_unique<Evaluator>(scene);
-    auto words = detail::fieldWords(scene, *r.evaluator, r.options.evaluation);
-    if (!words) {
-        r.scene = std::move(previous);
-        r.evaluator = std::make_unique<Evaluator>(r.scene);
-        return words.error();
-    }
+    r.evaluator = std::move(evaluator);
     return r.uploadNodes(*words); // no render is in flight: render() waits for its fence
+}
+
+bool Renderer::uploads(const Scene& scene) const {
+    const Impl& r = *impl_;
+    if (!sameStructure(r.scene, scene)) return false;
+    if (!r.options.inlineValues) return true;
+    return r.tapes && r.readsBalls(Evaluator(scene)) == r.balls;
+}
+
+bool Renderer::followsValues() const {
+    return impl_->options.inlineValues && (!impl_->tapes || impl_->balls);
 }
 
 Result<Image> Renderer::render(const RenderOptions& options) {
