@@ -866,6 +866,38 @@ TEST_F(Render, CompileHelperStopsWhereTheCacheHandsNothingOver) {
     EXPECT_FALSE(fs::exists(cache.dir()));
 }
 
+// A renderer that reads its values from the node buffer takes a blend profile as a value, as it
+// takes the radius: no compile, and the image a new renderer makes of the edited scene.
+TEST_F(Render, BufferValuesTakeABlendProfileEdit) {
+    Scene scene = makeScene(unite({sphere(0.6f).at(-0.3f, 0, 0), box(0.5f, 0.5f, 0.5f).at(0.4f, 0, 0)},
+                                  0.3f));
+    ASSERT_EQ(scene.nodes[0].kind, NodeKind::Union);
+    RendererOptions buffered;
+    buffered.inlineValues = false;
+    auto renderer = Renderer::create(context(), scene, buffered);
+    ASSERT_TRUE(renderer) << renderer.error().str();
+    RenderOptions options;
+    options.width = options.height = kSize;
+    options.camera = cameraFor(scene, Evaluator(scene));
+    auto first = (*renderer)->render(options);
+    ASSERT_TRUE(first);
+    scene.nodes[0].params[1] = 2.0f; // chamfer
+    const detail::ShaderCacheStats before = detail::shaderCacheStats();
+    auto updated = (*renderer)->updateValues(scene);
+    ASSERT_TRUE(updated) << updated.error().str();
+    const detail::ShaderCacheStats after = detail::shaderCacheStats();
+    EXPECT_EQ(after.compiles + after.memoryHits + after.diskHits,
+              before.compiles + before.memoryHits + before.diskHits);
+    auto second = (*renderer)->render(options);
+    ASSERT_TRUE(second);
+    EXPECT_NE(second->rgba, first->rgba);
+    auto fresh = Renderer::create(context(), scene, buffered);
+    ASSERT_TRUE(fresh) << fresh.error().str();
+    auto expected = (*fresh)->render(options);
+    ASSERT_TRUE(expected);
+    EXPECT_EQ(second->rgba, expected->rgba);
+}
+
 TEST_F(Render, UpdateValuesRefusesStructuralChanges) {
     Scene scene = loadOrDie(scenePath("csg_part.json"));
     auto renderer = Renderer::create(context(), scene);
