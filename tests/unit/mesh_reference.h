@@ -367,7 +367,7 @@ ReferenceMesh referenceDualMeshOf(const Distance& distance, const Color& color,
                     std::rotate(t + 3, t + 3 + axis, t + 6); // names the axis (foldQuads)
                     mesh.indices.insert(mesh.indices.end(), t, t + 6);
                 }
-    detail::foldQuads(mesh, smooth, distance);
+    detail::foldQuads(mesh, smooth, distance, grid.voxelSize);
     out.surfaceCut = field.surfaceCut;
     return out;
 }

@@ -29,14 +29,13 @@ Scene sceneFrom(std::string_view json) {
 const char* const kSphere = R"({"version": 1, "root": {"type": "sphere", "radius": 1}})";
 
 // No two triangles meet except along the sides and at the vertices they share, none is
-// degenerate, and at most `flipsAllowed` face against the field (mesh_checks.h).
-void expectEmbedded(const Mesh& mesh, const Evaluator& evaluator, float voxelSize,
-                    size_t flipsAllowed = 0) {
+// degenerate, and none faces against the field (mesh_checks.h).
+void expectEmbedded(const Mesh& mesh, const Evaluator& evaluator, float voxelSize) {
     const SelfIntersections crossings = findSelfIntersections(mesh);
     EXPECT_EQ(crossings.total(), 0u) << crossings.str();
     const TriangleFacing facing = checkTriangleFacing(mesh, evaluator, voxelSize);
     EXPECT_EQ(facing.degenerate, 0u) << facing.str();
-    EXPECT_LE(facing.flipped, flipsAllowed) << facing.str();
+    EXPECT_EQ(facing.flipped, 0u) << facing.str();
 }
 
 class MeshTest : public GpuTest {
@@ -188,28 +187,9 @@ TEST_P(KindMesh, IsClosedManifoldWithItsTopology) {
 INSTANTIATE_TEST_SUITE_P(Kinds, KindMesh, ::testing::ValuesIn(kKindTopologies),
                          [](const auto& test) { return std::string(test.param.name); });
 
-// Scenes where dual contouring folds a few triangles over at the default resolution (today's
-// count in the comment; the test allows about half as many again). One vertex per piece of
-// surface in a cell cannot follow two sheets of surface within a cell of each other; and along a
-// sharp edge that runs near a grid line or plane, the vertices of the cells around it crowd onto
-// the edge, where foldQuads (engine/src/mesh/mesh_dual.h) moves back those of quads that fold,
-// but not every one.
-struct FoldedScene {
-    const char* scene; // file stem
-    size_t flipsAllowed;
-};
-const FoldedScene kFoldedScenes[] = {
-    {"gallery", 14},      // 9: objects meet the ground in wedges thinner than a cell
-    {"gear", 4},          // 2: edges of the teeth along grid lines
-    {"house", 24},        // 16: fence boards and the roof's eaves thinner than a cell
-    {"knurled_knob", 14}, // 9: the twisted ribs' edges along grid lines
-    {"name_plate", 4},    // 2: edges of the letters along grid lines
-    {"snowman", 3},       // 1: the body meets the drift in a wedge thinner than a cell
-};
-
 // Every bundled scene at the default resolution: closed and manifold where the surface fits the
 // bounds; scenes with a ground plane reach the bounds, say so, and are still manifold. No
-// triangles cross, and none faces against the field but in the scenes above.
+// triangles cross, and none faces against the field.
 class BundledSceneMesh : public GpuTest,
                          public ::testing::WithParamInterface<std::filesystem::path> {};
 
@@ -240,10 +220,7 @@ TEST_P(BundledSceneMesh, IsClosedManifoldWhereTheSurfaceFitsTheBounds) {
     EXPECT_LE(maxSurfaceDistance(*mesh, evaluator), stats.voxelSize);
     const NormalProperties normals = checkNormals(*mesh);
     EXPECT_EQ(normals.notUnit, 0u) << normals.str();
-    size_t flipsAllowed = 0;
-    for (const FoldedScene& folded : kFoldedScenes)
-        if (GetParam().stem() == folded.scene) flipsAllowed = folded.flipsAllowed;
-    expectEmbedded(*mesh, evaluator, stats.voxelSize, flipsAllowed);
+    expectEmbedded(*mesh, evaluator, stats.voxelSize);
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, BundledSceneMesh, ::testing::ValuesIn(bundledScenes()),

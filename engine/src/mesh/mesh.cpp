@@ -758,7 +758,7 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
         detail::Distance distance;
         if (evaluator->nodes().size() < kTapeMinNodes)
             distance = [&](glm::vec3 p) { return evaluator->distance(p); };
-        detail::foldQuads(mesh, smooth, distance);
+        detail::foldQuads(mesh, smooth, distance, g.h);
         stage("quads", t0);
     }
     stats.surfaceCut = status[0] != 0;

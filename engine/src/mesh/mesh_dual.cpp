@@ -4,6 +4,7 @@
 #include <glm/vec2.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <thread>
 
 namespace sdfcsg::detail {
@@ -16,8 +17,13 @@ struct Quad {
     int axis;
 };
 
-// Whether quad q splits along b-d rather than a-c.
-bool splitsAlongBd(const Mesh& mesh, const Quad& q) {
+// The diagonal that quad q splits along by its shape and its vertices' normals: b-d rather than
+// a-c (`bd`), and whether the other one would also do (`either`: both split it into triangles
+// that wind around the edge alike).
+struct Diagonal {
+    bool bd, either;
+};
+Diagonal diagonalOf(const Mesh& mesh, const Quad& q) {
     const std::vector<glm::vec3>& p = mesh.positions;
     const std::vector<glm::vec3>& n = mesh.normals;
     // How well triangle (u, v, w) faces like vertex `off`'s normal: the cosine, or -2 when it
@@ -48,58 +54,84 @@ bool splitsAlongBd(const Mesh& mesh, const Quad& q) {
     const float winding = abc + acd;
     const bool acWinds = abc * winding > 0.0f && acd * winding > 0.0f;
     const bool bdWinds = abd * winding > 0.0f && bcd * winding > 0.0f;
-    if (acWinds != bdWinds) return bdWinds;
+    if (acWinds != bdWinds) return {bdWinds, false};
     const float facingAc = std::min(facing(q.a, q.b, q.c, q.b), facing(q.a, q.c, q.d, q.d));
     const float facingBd = std::min(facing(q.a, q.b, q.d, q.a), facing(q.b, q.c, q.d, q.c));
     // The margin keeps the first diagonal where both fold alike (a flat quad), so that float
     // rounding does not pick between them.
-    return facingBd > facingAc + 1e-3f;
+    return {facingBd > facingAc + 1e-3f, acWinds};
 }
 
-// Whether triangle (u, v, w) folds: it faces nearly a right angle or more away from the mean of
-// its vertices' normals (a triangle of a wedge of the solid as sharp as 30 degrees faces within
-// 75 degrees of it, cosine 0.26), or, facing more than 60 degrees away from it, against the
-// field's gradient at its centre (`distance`; a thin triangle standing on a sharp edge).
-bool folds(const Mesh& mesh, const Distance& distance, uint32_t u, uint32_t v, uint32_t w) {
+// A triangle faces the field only where the cosine between it and the gradient is above this
+// (it faces within 84 degrees of it), so that one nearly side-on to the gradient, as where a
+// sheet thinner than a cell passes through it, does not pass or fail by rounding.
+constexpr float kLeastCosine = 0.1f;
+
+// How triangle (u, v, w) faces, positive where it does not fold. By its vertices' normals alone
+// it folds (-2, below any cosine) where it faces nearly a right angle or more away from their
+// mean (a triangle of a wedge of the solid as sharp as 30 degrees faces within 75 degrees of it,
+// cosine 0.26), and it is fine (1) where it faces within 30 degrees of each of them. Between, as
+// across a sharp edge or where the normals miss a sheet thinner than a cell, the field decides
+// where `distance` is set: the cosine between the triangle and the field's gradient at its
+// centre (tetrahedral differences a hundredth of a cell `h` wide, as in the tests' check), less
+// kLeastCosine. The field is slow, so only these ask it.
+float facing(const Mesh& mesh, const Distance& distance, float h, uint32_t u, uint32_t v,
+             uint32_t w) {
     const std::vector<glm::vec3>& p = mesh.positions;
     const std::vector<glm::vec3>& n = mesh.normals;
     const glm::vec3 c = glm::cross(p[v] - p[u], p[w] - p[u]), m = n[u] + n[v] + n[w];
     const float cm = glm::dot(c, m), cc = glm::dot(c, c), mm = glm::dot(m, m);
-    if (cm < 0.0f || cm * cm < 0.04f * cc * mm) return true;
-    if (!distance || cm * cm >= 0.25f * cc * mm) return false;
+    if (cm < 0.0f || cm * cm < 0.04f * cc * mm) return -2.0f;
+    const float least = 0.866f * std::sqrt(cc); // cos 30 degrees
+    if (!distance ||
+        (glm::dot(c, n[u]) >= least && glm::dot(c, n[v]) >= least && glm::dot(c, n[w]) >= least))
+        return 1.0f;
     const glm::vec3 centre = (p[u] + p[v] + p[w]) / 3.0f;
-    const float e = 0.01f * std::sqrt(std::max({glm::dot(p[v] - p[u], p[v] - p[u]),
-                                                glm::dot(p[w] - p[v], p[w] - p[v]),
-                                                glm::dot(p[u] - p[w], p[u] - p[w])}));
     const glm::vec3 taps[4] = {{1, -1, -1}, {-1, -1, 1}, {-1, 1, -1}, {1, 1, 1}};
     glm::vec3 g(0.0f);
     for (const glm::vec3& tap : taps)
-        g += tap * distance(centre + tap * e);
-    return glm::dot(c, g) < 0.0f;
+        g += tap * distance(centre + tap * (0.01f * h));
+    const float gg = glm::dot(g, g);
+    if (!(gg > 0.0f)) return 1.0f; // no direction to judge by
+    return glm::dot(c, g) / std::sqrt(cc * gg) - kLeastCosine;
 }
 
 // Writes quad q into t split along a-c, as (a, b, c), (a, c, d), or along b-d, as (a, b, d),
-// (b, c, d); returns whether one of the two triangles folds.
-bool fold(const Mesh& mesh, const Distance& distance, const Quad& q, uint32_t* t) {
-    const bool alongBd = splitsAlongBd(mesh, q);
+// (b, c, d); returns whether one of the two triangles folds. Where the diagonal of diagonalOf()
+// folds and the other would also do, the one whose worse triangle faces better is taken.
+bool fold(const Mesh& mesh, const Distance& distance, float h, const Quad& q, uint32_t* t) {
     const uint32_t split[2][6] = {{q.a, q.b, q.c, q.a, q.c, q.d}, {q.a, q.b, q.d, q.b, q.c, q.d}};
-    std::copy(split[alongBd], split[alongBd] + 6, t);
-    return folds(mesh, distance, t[0], t[1], t[2]) || folds(mesh, distance, t[3], t[4], t[5]);
+    auto worse = [&](const uint32_t* s) {
+        return std::min(facing(mesh, distance, h, s[0], s[1], s[2]),
+                        facing(mesh, distance, h, s[3], s[4], s[5]));
+    };
+    const Diagonal diagonal = diagonalOf(mesh, q);
+    int k = diagonal.bd ? 1 : 0;
+    float f = worse(split[k]);
+    if (f < 0.0f && diagonal.either && distance) {
+        if (const float other = worse(split[1 - k]); other > f) {
+            k = 1 - k;
+            f = other;
+        }
+    }
+    std::copy(split[k], split[k] + 6, t);
+    return f < 0.0f;
 }
 
 } // namespace
 
-void foldQuads(Mesh& mesh, const std::vector<glm::vec3>& smooth, const Distance& distance) {
+void foldQuads(Mesh& mesh, const std::vector<glm::vec3>& smooth, const Distance& distance,
+               float h) {
     const size_t quads = mesh.indices.size() / 6;
     std::vector<uint8_t> axes(quads);
     // movedIn[k]: the round in which vertex k moved to its smooth place; 0: never.
     std::vector<uint8_t> movedIn(mesh.positions.size(), 0);
     // Each round folds quads (in round 1 all of them, as the quads pass wrote them: (a, b, c),
     // then (a, c, d) rotated to start at its axis'th corner; then those around the vertices that
-    // moved in the round before, as fold() wrote them) and lists those that fold against their
-    // vertices' normals; then their vertices move to their smooth places. The last round only
-    // folds. Quads change only their own indices while positions stay, so two threads share a
-    // round's quads and the result does not depend on them.
+    // moved in the round before, as fold() wrote them) and lists those that still fold (see
+    // facing()); then their vertices move to their smooth places. The last round only folds.
+    // Quads change only their own indices while positions stay, so two threads share a round's
+    // quads and the result does not depend on them.
     auto foldRange = [&](uint8_t round, size_t begin, size_t end, std::vector<size_t>& folding) {
         for (size_t q = begin; q < end; ++q) {
             uint32_t* t = &mesh.indices[6 * q];
@@ -115,7 +147,7 @@ void foldQuads(Mesh& mesh, const std::vector<glm::vec3>& smooth, const Distance&
             } else {
                 continue;
             }
-            if (fold(mesh, distance, quad, t)) folding.push_back(q);
+            if (fold(mesh, distance, h, quad, t)) folding.push_back(q);
         }
     };
     constexpr uint8_t kRounds = 5;

@@ -14,14 +14,17 @@ namespace sdfcsg::detail {
 // (b, c, d): seen along its edge, the quad winds once around it, and the split is one whose two
 // triangles wind the same way, so that the surface crosses the edge once; where both do, the one
 // whose triangles face most like the vertices off the diagonal: at a sharp edge of the solid,
-// the diagonal that runs along the edge, so that the fold lies on it. Where a triangle still
-// folds (it faces nearly a right angle or more away from its vertices' normals, or, where
-// `distance` is set, more than 60 degrees away and against the field's gradient at its centre),
-// as where a sharp edge of the solid passes along a cell's face or edge and the vertices of the
-// cells on both sides land on it and cross over, the quad's vertices move to `smooth` (per
-// vertex: the mean of its edge points, where surface nets put it, which seldom folds), and the
-// quads around them are split again. `distance`, the scene's field, is called from two threads.
+// the diagonal that runs along the edge, so that the fold lies on it. A triangle folds where it
+// faces nearly a right angle or more away from its vertices' normals, or, where `distance` is
+// set and it faces more than 30 degrees away from one of them, where it does not face the
+// field's gradient at its centre (differences a hundredth of the cell edge `h` wide) by a margin;
+// there the other split is taken if it winds too and its triangles face the field better. Where
+// a triangle still folds, as where a sharp edge of the solid passes along a cell's face or edge
+// and the vertices of the cells on both sides land on it and cross over, or where the vertices
+// miss a sheet thinner than a cell, the quad's vertices move to `smooth` (per vertex: the mean of
+// its edge points, where surface nets put it, which seldom folds), and the quads around them are
+// split again. `distance`, the scene's field, is called from two threads.
 using Distance = std::function<float(glm::vec3)>;
-void foldQuads(Mesh& mesh, const std::vector<glm::vec3>& smooth, const Distance& distance);
+void foldQuads(Mesh& mesh, const std::vector<glm::vec3>& smooth, const Distance& distance, float h);
 
 } // namespace sdfcsg::detail
