@@ -192,13 +192,13 @@ bool RenderWorker::compiling() const {
     return compilingHere_ || liveBuilder_->building() || bakeBuilder_->building();
 }
 
-// Takes finished builds that fit the job: a live renderer for its structure (one built for a
-// structure edited away meanwhile is dropped), a baked one for its values.
+// Takes finished builds that fit the job: a live renderer that takes its values as an upload
+// (one built for a structure or blend profile edited away meanwhile is dropped), a baked one
+// for its values.
 void RenderWorker::adoptBuilds(const RenderJob& job) {
     if (auto built = liveBuilder_->take();
-        built && built->renderer && sameStructure(*built->scene, *job.scene)) {
+        built && built->renderer && (*built->renderer)->uploads(*job.scene)) {
         live_ = std::move(*built->renderer);
-        liveScene_ = built->scene;
         liveVersion_ = built->version; // it holds that version's values
         drawn_.reset();
     }
@@ -215,7 +215,8 @@ RenderOutput RenderWorker::process(const RenderJob& job) {
     RenderOutput out;
     out.id = job.id;
     adoptBuilds(job);
-    if (live_ && !sameStructure(*liveScene_, *job.scene)) live_.reset(), drawn_.reset();
+    // A structural edit, or one of a blend profile, which the live kernel holds as code too.
+    if (live_ && !live_->uploads(*job.scene)) live_.reset(), drawn_.reset();
 
     // A still frame is drawn live unless recompiling and drawing baked is expected to be
     // sooner: on lavapipe a small scene's inlined kernel compiles in a fraction of a second

@@ -158,7 +158,6 @@ class RenderWorker {
     std::shared_ptr<const Scene> bakedScene_;
     uint64_t bakedVersion_ = 0;
     std::unique_ptr<Renderer> live_;
-    std::shared_ptr<const Scene> liveScene_; // the structure it was built for
     uint64_t liveVersion_ = 0;               // the values it holds
     std::optional<uint64_t> failedVersion_;
     std::optional<Error> failure_;
