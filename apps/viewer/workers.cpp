@@ -193,8 +193,7 @@ bool RenderWorker::compiling() const {
 }
 
 // Takes finished builds that fit the job: a live renderer that takes its values as an upload
-// (one built for a structure or blend profile edited away meanwhile is dropped), a baked one
-// for its values.
+// (one built for a structure edited away meanwhile is dropped), a baked one for its values.
 void RenderWorker::adoptBuilds(const RenderJob& job) {
     if (auto built = liveBuilder_->take();
         built && built->renderer && (*built->renderer)->uploads(*job.scene)) {
@@ -215,7 +214,6 @@ RenderOutput RenderWorker::process(const RenderJob& job) {
     RenderOutput out;
     out.id = job.id;
     adoptBuilds(job);
-    // A structural edit, or one of a blend profile, which the live kernel holds as code too.
     if (live_ && !live_->uploads(*job.scene)) live_.reset(), drawn_.reset();
 
     // A still frame is drawn live unless recompiling and drawing baked is expected to be

@@ -196,6 +196,7 @@ TEST(Codegen, ChangingValuesKeepsTheBufferModeCode) {
     for (Node& n : b.nodes) {
         n.transform.translate += glm::vec3(0.5f);
         n.params[0] *= 1.5f;
+        if (kindInfo(n.kind).role == Role::Boolean) n.params[1] = 2.0f; // chamfer
         n.color = glm::vec3(0.1f, 0.2f, 0.3f);
     }
     EXPECT_EQ(generateSceneGlsl(a), generateSceneGlsl(b));
@@ -253,7 +254,8 @@ TEST(Codegen, LiteralSharpOperationsTakeTheShortForm) {
     EXPECT_NE(literal.find("d1 = opUnion(d1, d3, 0.25);"), std::string::npos) << literal;
     const std::string buffer = generateSceneGlsl(scene);
     EXPECT_EQ(buffer.find("sharp"), std::string::npos) << buffer;
-    EXPECT_NE(buffer.find("d0 = opDifference(d0, d4, nodeSmooth(0u));"), std::string::npos)
+    EXPECT_NE(buffer.find("d0 = opDifference(d0, d4, nodeSmooth(0u), nodeBlend(0u));"),
+              std::string::npos)
         << buffer;
 }
 

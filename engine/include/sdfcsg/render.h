@@ -71,8 +71,7 @@ bool sameStructure(const Scene& a, const Scene& b);
 struct RendererOptions {
     // true: numeric values are baked into the kernel as literals. CPU drivers (lavapipe) run
     // that several times faster, but updateValues() must then regenerate and recompile.
-    // false: values are read from a buffer, so updateValues() only uploads them (the viewer),
-    // but for blend profiles, which are code as node kinds are (uploads() says which edits).
+    // false: values are read from a buffer, so updateValues() only uploads them (the viewer).
     // Scenes evaluated from pruned tapes read their values from buffers either way; true lets
     // the tape machine read spheres as balls where every sphere's scale is the same on every
     // axis (faster), so that updateValues() recompiles where an edit changes that.
@@ -98,7 +97,7 @@ class Renderer {
     // holds none of the values that differ (see followsValues()).
     bool uploads(const Scene& scene) const;
     // Whether the kernel holds some of the scene's values, so that some edits of values rebuild
-    // it: values inlined, blend profiles, or on tapes spheres read as balls (see inlineValues).
+    // it: values inlined, or on tapes spheres read as balls (see inlineValues).
     bool followsValues() const;
 
     Result<Image> render(const RenderOptions& options);

@@ -500,9 +500,12 @@ class Emitter {
         if (!sharp) {
             out_ += ", ";
             smooth(op);
-            // The profile is part of the code, as the kind is: a plain blend keeps its short call.
-            // (Renderer::uploads: an edit of it rebuilds a kernel that reads the buffer too.)
-            if (const uint32_t blend = uint32_t(scene_.nodes[op].params[1]); blend != 0)
+            // Literal, the profile is part of the code, as the kind is: a plain blend keeps its
+            // short call. Read from the buffer it is a value, as the radius is, so that
+            // Renderer::updateValues keeps the kernel (sameStructure does not compare it).
+            if (!lit_)
+                out_ += ", nodeBlend(" + std::to_string(op) + "u)";
+            else if (const uint32_t blend = uint32_t(scene_.nodes[op].params[1]); blend != 0)
                 out_ += ", " + std::to_string(blend) + "u";
         }
         out_ += ");\n";

@@ -150,16 +150,6 @@ Result<std::shared_ptr<SharedPasses>> sharedPasses(Context::Impl& ctx) {
 // Polygon and text outlines follow the nodes in their buffer: a new size is a new buffer.
 static size_t outlineSize(const Node& n) { return n.outline ? n.outline->size() : 0; }
 
-// The same blend profile for every operation: the code of scenes inlined holds them
-// (generateSceneGlsl), whether values are or not.
-static bool sameBlends(const Scene& a, const Scene& b) {
-    for (size_t i = 0; i < a.nodes.size(); ++i)
-        if (kindInfo(a.nodes[i].kind).role == Role::Boolean &&
-            a.nodes[i].params[1] != b.nodes[i].params[1])
-            return false;
-    return true;
-}
-
 bool sameStructure(const Scene& a, const Scene& b) {
     if (a.nodes.size() != b.nodes.size()) return false;
     for (size_t i = 0; i < a.nodes.size(); ++i)
@@ -657,11 +647,9 @@ Status Renderer::updateValues(const Scene& scene) {
     auto words = detail::fieldWords(scene, *evaluator, r.options.evaluation);
     if (!words) return words.error();
     const bool balls = r.readsBalls(*evaluator);
-    const bool rebuild = r.tapes ? r.options.inlineValues && balls != r.balls
-                                 : r.options.inlineValues || !sameBlends(r.scene, scene);
     Scene previous = std::move(r.scene);
     r.scene = scene;
-    if (rebuild) {
+    if (r.options.inlineValues && (!r.tapes || balls != r.balls)) {
         if (auto built = r.buildKernels(); !built) {
             r.scene = std::move(previous);
             return built.error();
@@ -675,12 +663,12 @@ Status Renderer::updateValues(const Scene& scene) {
 bool Renderer::uploads(const Scene& scene) const {
     const Impl& r = *impl_;
     if (!sameStructure(r.scene, scene)) return false;
-    if (!r.tapes) return !r.options.inlineValues && sameBlends(r.scene, scene);
-    return !r.options.inlineValues || r.readsBalls(Evaluator(scene)) == r.balls;
+    if (!r.options.inlineValues) return true;
+    return r.tapes && r.readsBalls(Evaluator(scene)) == r.balls;
 }
 
 bool Renderer::followsValues() const {
-    return !impl_->tapes || (impl_->options.inlineValues && impl_->balls);
+    return impl_->options.inlineValues && (!impl_->tapes || impl_->balls);
 }
 
 Result<Image> Renderer::render(const RenderOptions& options) {
