@@ -224,8 +224,8 @@ RenderOutput RenderWorker::process(const RenderJob& job) {
     // tapes reads its values from buffers either way).
     const bool tapes = usesTapes(*job.scene, Evaluation::Auto);
     const double pixels = double(job.options.width) * double(job.options.height);
-    const double liveRate =
-        liveRate_ > 0 ? liveRate_ : bakedRate_ * (context_.cpuDevice() ? (tapes ? 1.5 : 6.0) : 1.0);
+    const double guess = context_.cpuDevice() ? (tapes ? 1.5 : 6.0) : 1.0;
+    const double liveRate = liveRate_ > 0 ? liveRate_ : bakedRate_ * guess;
     const bool bakeSooner =
         !job.preview && bakedRate_ > 0 && bakeSeconds_ + bakedRate_ * pixels < liveRate * pixels;
     // A scene evaluated from pruned tapes reads every value from buffers, so its baked renderer

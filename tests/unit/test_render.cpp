@@ -869,8 +869,8 @@ TEST_F(Render, CompileHelperStopsWhereTheCacheHandsNothingOver) {
 // A renderer that reads its values from the node buffer takes a blend profile as a value, as it
 // takes the radius: no compile, and the image a new renderer makes of the edited scene.
 TEST_F(Render, BufferValuesTakeABlendProfileEdit) {
-    Scene scene = makeScene(unite({sphere(0.6f).at(-0.3f, 0, 0), box(0.5f, 0.5f, 0.5f).at(0.4f, 0, 0)},
-                                  0.3f));
+    Scene scene = makeScene(
+        unite({sphere(0.6f).at(-0.3f, 0, 0), box(0.5f, 0.5f, 0.5f).at(0.4f, 0, 0)}, 0.3f));
     ASSERT_EQ(scene.nodes[0].kind, NodeKind::Union);
     RendererOptions buffered;
     buffered.inlineValues = false;
