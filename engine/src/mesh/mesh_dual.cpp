@@ -19,9 +19,10 @@ struct Quad {
 
 // The diagonal that quad q splits along by its shape and its vertices' normals: b-d rather than
 // a-c (`bd`), and whether the other one would also do (`either`: both split it into triangles
-// that wind around the edge alike).
+// that wind around the edge alike); and which splits wind so.
 struct Diagonal {
     bool bd, either;
+    bool winds[2]; // along a-c, along b-d
 };
 Diagonal diagonalOf(const Mesh& mesh, const Quad& q) {
     const std::vector<glm::vec3>& p = mesh.positions;
@@ -54,12 +55,12 @@ Diagonal diagonalOf(const Mesh& mesh, const Quad& q) {
     const float winding = abc + acd;
     const bool acWinds = abc * winding > 0.0f && acd * winding > 0.0f;
     const bool bdWinds = abd * winding > 0.0f && bcd * winding > 0.0f;
-    if (acWinds != bdWinds) return {bdWinds, false};
+    if (acWinds != bdWinds) return {bdWinds, false, {acWinds, bdWinds}};
     const float facingAc = std::min(facing(q.a, q.b, q.c, q.b), facing(q.a, q.c, q.d, q.d));
     const float facingBd = std::min(facing(q.a, q.b, q.d, q.a), facing(q.b, q.c, q.d, q.c));
     // The margin keeps the first diagonal where both fold alike (a flat quad), so that float
     // rounding does not pick between them.
-    return {facingBd > facingAc + 1e-3f, acWinds};
+    return {facingBd > facingAc + 1e-3f, acWinds, {acWinds, bdWinds}};
 }
 
 // A triangle faces the field only where the cosine between it and the gradient is above this
@@ -74,17 +75,17 @@ constexpr float kLeastCosine = 0.1f;
 // across a sharp edge or where the normals miss a sheet thinner than a cell, the field decides
 // where `distance` is set: the cosine between the triangle and the field's gradient at its
 // centre (tetrahedral differences a hundredth of a cell `h` wide, as in the tests' check), less
-// kLeastCosine. The field is slow, so only these ask it.
+// kLeastCosine. The field is slow, so only these ask it, unless `always`.
 float facing(const Mesh& mesh, const Distance& distance, float h, uint32_t u, uint32_t v,
-             uint32_t w) {
+             uint32_t w, bool always = false) {
     const std::vector<glm::vec3>& p = mesh.positions;
     const std::vector<glm::vec3>& n = mesh.normals;
     const glm::vec3 c = glm::cross(p[v] - p[u], p[w] - p[u]), m = n[u] + n[v] + n[w];
     const float cm = glm::dot(c, m), cc = glm::dot(c, c), mm = glm::dot(m, m);
     if (cm < 0.0f || cm * cm < 0.04f * cc * mm) return -2.0f;
     const float least = 0.866f * std::sqrt(cc); // cos 30 degrees
-    if (!distance ||
-        (glm::dot(c, n[u]) >= least && glm::dot(c, n[v]) >= least && glm::dot(c, n[w]) >= least))
+    if (!distance || (!always && glm::dot(c, n[u]) >= least && glm::dot(c, n[v]) >= least &&
+                      glm::dot(c, n[w]) >= least))
         return 1.0f;
     const glm::vec3 centre = (p[u] + p[v] + p[w]) / 3.0f;
     const glm::vec3 taps[4] = {{1, -1, -1}, {-1, -1, 1}, {-1, 1, -1}, {1, 1, 1}};
@@ -116,6 +117,54 @@ bool fold(const Mesh& mesh, const Distance& distance, float h, const Quad& q, ui
     }
     std::copy(split[k], split[k] + 6, t);
     return f < 0.0f;
+}
+
+// A folding quad moves all four of its vertices, most of them only for being its corners. Each
+// moved vertex goes back where the QEF placed it (on the sharp features) wherever every quad
+// around it then still splits into triangles that wind around its edge alike and none of them
+// folds, by its vertices' normals nor by the field (asked of each: a vertex going back may turn a
+// triangle over that still faces like its vertices' normals, as on a sheet thinner than a cell).
+// One vertex at a time, in the order they moved, so that the result does not depend on threads.
+void placeBack(Mesh& mesh, const std::vector<uint8_t>& axes,
+               const std::vector<std::pair<uint32_t, glm::vec3>>& moves, const Distance& distance,
+               float h) {
+    if (moves.empty()) return;
+    // The quads around each moved vertex, by its place in `moves`.
+    std::vector<uint32_t> slot(mesh.positions.size(), UINT32_MAX), first(moves.size() + 1, 0);
+    for (uint32_t i = 0; i < moves.size(); ++i)
+        slot[moves[i].first] = i;
+    auto forEachMoved = [&](size_t q, auto&& f) {
+        const uint32_t* t = &mesh.indices[6 * q];
+        for (int k = 0; k < 6; ++k) // each corner once: t[3] and t[5] repeat t[0], t[2] or t[1]
+            if (slot[t[k]] != UINT32_MAX && std::find(t, t + k, t[k]) == t + k) f(slot[t[k]]);
+    };
+    const size_t quads = mesh.indices.size() / 6;
+    for (size_t q = 0; q < quads; ++q)
+        forEachMoved(q, [&](uint32_t i) { ++first[i + 1]; });
+    for (size_t i = 0; i < moves.size(); ++i)
+        first[i + 1] += first[i];
+    std::vector<uint32_t> around(first.back()), filled(first.begin(), first.end() - 1);
+    for (size_t q = 0; q < quads; ++q)
+        forEachMoved(q, [&](uint32_t i) { around[filled[i]++] = uint32_t(q); });
+
+    for (uint32_t i = 0; i < moves.size(); ++i) {
+        const auto [v, placed] = moves[i];
+        const glm::vec3 smooth = mesh.positions[v];
+        mesh.positions[v] = placed;
+        for (uint32_t j = first[i]; j < first[i + 1]; ++j) {
+            const uint32_t* t = &mesh.indices[6 * size_t(around[j])];
+            // As fold() wrote it: a-c is (a, b, c), (a, c, d); b-d is (a, b, d), (b, c, d).
+            const bool bd = t[3] != t[0];
+            const Quad quad = bd ? Quad{t[0], t[1], t[4], t[2], axes[around[j]]}
+                                 : Quad{t[0], t[1], t[2], t[5], axes[around[j]]};
+            if (!diagonalOf(mesh, quad).winds[bd] ||
+                facing(mesh, distance, h, t[0], t[1], t[2], true) < 0 ||
+                facing(mesh, distance, h, t[3], t[4], t[5], true) < 0) {
+                mesh.positions[v] = smooth;
+                break;
+            }
+        }
+    }
 }
 
 } // namespace
@@ -150,6 +199,7 @@ void foldQuads(Mesh& mesh, const std::vector<glm::vec3>& smooth, const Distance&
             if (fold(mesh, distance, h, quad, t)) folding.push_back(q);
         }
     };
+    std::vector<std::pair<uint32_t, glm::vec3>> moves; // vertex, where the QEF placed it
     constexpr uint8_t kRounds = 5;
     for (uint8_t round = 1; round <= kRounds; ++round) {
         std::vector<size_t> folding, theirs;
@@ -167,11 +217,13 @@ void foldQuads(Mesh& mesh, const std::vector<glm::vec3>& smooth, const Distance&
             for (int k = 0; k < 6; ++k)
                 if (const uint32_t v = mesh.indices[6 * q + k]; movedIn[v] == 0) {
                     movedIn[v] = round;
+                    moves.push_back({v, mesh.positions[v]});
                     mesh.positions[v] = smooth[v];
                     moved = true;
                 }
         if (!moved) break;
     }
+    placeBack(mesh, axes, moves, distance, h);
 }
 
 } // namespace sdfcsg::detail

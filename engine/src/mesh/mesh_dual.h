@@ -23,7 +23,9 @@ namespace sdfcsg::detail {
 // and the vertices of the cells on both sides land on it and cross over, or where the vertices
 // miss a sheet thinner than a cell, the quad's vertices move to `smooth` (per vertex: the mean of
 // its edge points, where surface nets put it, which seldom folds), and the quads around them are
-// split again. `distance`, the scene's field, is called from two threads.
+// split again. Last, each moved vertex goes back where the QEF placed it wherever that turns no
+// quad around it over (most moved only for being a folding quad's corner), so that sharp
+// features stay sharp. `distance`, the scene's field, is called from two threads.
 using Distance = std::function<float(glm::vec3)>;
 void foldQuads(Mesh& mesh, const std::vector<glm::vec3>& smooth, const Distance& distance, float h);
 
