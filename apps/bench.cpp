@@ -3,8 +3,8 @@
 // times per stage at several resolutions instead.
 #include "bench.h"
 
-#include "gpu/scoped_env.h"
 #include "codegen/shader_compile.h"
+#include "gpu/scoped_env.h"
 #include "mesh/mesh_simplify.h"
 
 #include <sdfcsg/sdfcsg.h>
@@ -42,7 +42,8 @@ std::vector<fs::path> findScenes(const fs::path& dir) {
     return scenes;
 }
 
-const char* kHelp = R"(Usage: sdfcsg bench [--scenes DIR] [--width W] [--height H] [--frames N] [--buffer]
+const char* kHelp =
+    R"(Usage: sdfcsg bench [--scenes DIR] [--width W] [--height H] [--frames N] [--buffer]
                    [--evaluation E]
        sdfcsg bench --mesh [--scenes DIR] [--resolutions 128,256,512] [--runs N]
                    [--method dc|mc] [--simplify E] [--error]
@@ -164,12 +165,15 @@ struct RepeatCase {
 
 const char* const kCopy = R"({"type": "round_box", "size": [0.3, 0.3, 0.3], "radius": 0.05)";
 
-std::string sceneJson(const std::string& root) { return R"({"version": 1, "root": )" + root + "}"; }
+std::string sceneJson(const std::string& root) {
+    return R"({"version": 1, "root": )" + root + "}";
+}
 
 std::vector<RepeatCase> repeatCases() {
     RepeatCase grid{"repeat 8x8", 64, {}, {}};
     grid.repeated = R"({"type": "repeat", "count": [8, 1, 8], "spacing": [0.5, 1, 0.5], )"
-                    R"("children": [)" + std::string(kCopy) + "}]}";
+                    R"("children": [)" +
+                    std::string(kCopy) + "}]}";
     RepeatCase ring{"polar_repeat 24", 24, {}, {}};
     ring.repeated = R"({"type": "polar_repeat", "count": 24, "radius": 1.5, "children": [)" +
                     std::string(kCopy) + "}]}";
@@ -192,8 +196,8 @@ std::vector<RepeatCase> repeatCases() {
 
 // Prints the repetition lines; false after printing an error.
 bool runRepeatBench(Context& context, uint32_t width, uint32_t height, uint32_t frames) {
-    std::printf("\n%-16s %6s %8s %10s %9s %11s\n", "repetition", "copies", "one ms",
-                "repeat ms", "union ms", "repeat/one");
+    std::printf("\n%-16s %6s %8s %10s %9s %11s\n", "repetition", "copies", "one ms", "repeat ms",
+                "union ms", "repeat/one");
     for (const RepeatCase& c : repeatCases()) {
         auto framing = parseScene(sceneJson(c.repeated), c.name);
         if (!framing) return std::fprintf(stderr, "%s\n", framing.error().str().c_str()), false;
@@ -202,16 +206,18 @@ bool runRepeatBench(Context& context, uint32_t width, uint32_t height, uint32_t 
         double ms[3] = {};
         const std::string roots[3] = {kCopy + std::string("}"), c.repeated, c.unionOf};
         for (int k = 0; k < 3; ++k) {
-            if (k == 0) options.camera.reset(); // one copy fills the picture as the N do
-            else options.camera = frameCamera(Evaluator(*framing), float(width) / float(height));
+            if (k == 0)
+                options.camera.reset(); // one copy fills the picture as the N do
+            else
+                options.camera = frameCamera(Evaluator(*framing), float(width) / float(height));
             auto renderer = buildFromJson(context, sceneJson(roots[k]), c.name);
             auto frame = renderer ? medianFrameMs(**renderer, options, frames)
                                   : Result<double>(renderer.error());
             if (!frame) return std::fprintf(stderr, "%s\n", frame.error().str().c_str()), false;
             ms[k] = *frame;
         }
-        std::printf("%-16s %6d %8.1f %10.1f %9.1f %10.2fx\n", c.name, c.copies, ms[0], ms[1],
-                    ms[2], ms[1] / std::max(ms[0], 1e-9));
+        std::printf("%-16s %6d %8.1f %10.1f %9.1f %10.2fx\n", c.name, c.copies, ms[0], ms[1], ms[2],
+                    ms[1] / std::max(ms[0], 1e-9));
     }
     return true;
 }
@@ -220,7 +226,7 @@ struct Row {
     std::string name;
     size_t nodes = 0;
     double skip = 0, noSkip = 0, cold = 0, coldOneDevice = 0, newProcess = 0, first = 0, warm = 0;
-    double edit = NAN; // scenes of pruned tapes
+    double edit = NAN;                  // scenes of pruned tapes
     double buffer = 0, bufferBuild = 0; // with --buffer
 };
 
@@ -255,7 +261,7 @@ struct MeshRow {
     glm::uvec3 cells{0};
     uint64_t triangles = 0, unsimplified = 0;
     float maxError = NAN, p99Error = NAN; // cells
-    std::vector<double> stages; // median seconds, in the order of the stage names
+    std::vector<double> stages;           // median seconds, in the order of the stage names
     double total = 0;
 };
 
@@ -265,7 +271,8 @@ std::pair<float, float> surfaceError(const Mesh& mesh, const Evaluator& evaluato
     std::vector<float> errors;
     errors.reserve(mesh.indices.size() / 3 * 7);
     for (size_t t = 0; t + 3 <= mesh.indices.size(); t += 3) {
-        const glm::vec3 a = mesh.positions[mesh.indices[t]], b = mesh.positions[mesh.indices[t + 1]],
+        const glm::vec3 a = mesh.positions[mesh.indices[t]],
+                        b = mesh.positions[mesh.indices[t + 1]],
                         c = mesh.positions[mesh.indices[t + 2]];
         for (const glm::vec3& w : detail::kTriangleSamples)
             errors.push_back(std::abs(evaluator.distance(w.x * a + w.y * b + w.z * c)) / h);
@@ -597,8 +604,7 @@ int runBench(int argc, char** argv) {
         }
         row.skip = *skip;
         row.noSkip = *noSkip;
-        if (auto scene = parseScene(json, file);
-            scene && usesTapes(*scene, evaluation)) {
+        if (auto scene = parseScene(json, file); scene && usesTapes(*scene, evaluation)) {
             options.boundsSkipping.reset();
             auto edit = medianEditMs(*renderer, *scene, options, frames);
             if (!edit) {

@@ -19,8 +19,8 @@ namespace {
 constexpr auto kGrace = std::chrono::milliseconds(600);
 
 volatile std::sig_atomic_t gInterrupted = 0;
-sem_t gSignalled;                  // posted by the signal handler (sem_post is signal-safe)
-std::mutex gFinishing;             // held while outputs are written whole, or reports left
+sem_t gSignalled;                   // posted by the signal handler (sem_post is signal-safe)
+std::mutex gFinishing;              // held while outputs are written whole, or reports left
 std::atomic<bool> gReported{false}; // the reason of the stop has been printed
 
 extern "C" void onInterrupt(int) {
@@ -45,15 +45,21 @@ void watchdog() {
 
 int exitCode(const Error& e) {
     switch (e.kind) {
-    case ErrorKind::Io: return kIo;
+    case ErrorKind::Io:
+        return kIo;
     case ErrorKind::Syntax:
     case ErrorKind::Validation:
-    case ErrorKind::Limit: return kInvalidScene;
-    case ErrorKind::Usage: return kUsage;
+    case ErrorKind::Limit:
+        return kInvalidScene;
+    case ErrorKind::Usage:
+        return kUsage;
     case ErrorKind::Shader:
-    case ErrorKind::Vulkan: return kGpu;
-    case ErrorKind::Remote: return kRemote;
-    case ErrorKind::Cancelled: return kInterrupted;
+    case ErrorKind::Vulkan:
+        return kGpu;
+    case ErrorKind::Remote:
+        return kRemote;
+    case ErrorKind::Cancelled:
+        return kInterrupted;
     }
     return kGpu;
 }

@@ -11,11 +11,11 @@ namespace sdfcsg::app {
 // Exit codes, documented in docs/cli.md.
 enum Exit : int {
     kOk = 0,
-    kInvalidScene = 1, // the scene failed to parse or validate, or a limit was exceeded
-    kUsage = 2,        // bad command line
-    kIo = 3,           // a file could not be read or written
-    kGpu = 4,          // no usable Vulkan device, or a shader failed to compile
-    kRemote = 5,       // the language model endpoint failed, refused or answered unusably
+    kInvalidScene = 1,  // the scene failed to parse or validate, or a limit was exceeded
+    kUsage = 2,         // bad command line
+    kIo = 3,            // a file could not be read or written
+    kGpu = 4,           // no usable Vulkan device, or a shader failed to compile
+    kRemote = 5,        // the language model endpoint failed, refused or answered unusably
     kInterrupted = 130, // Ctrl-C (SIGINT) or SIGTERM; nothing written but a recording or report
 };
 

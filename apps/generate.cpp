@@ -273,15 +273,14 @@ int generateAndWrite(std::string_view command, std::string_view request, Generat
             return fail(generated.error());
         }
     }
-    if (auto written = writeOutput([&] { return writeFileAtomic(out, generated->json); });
-        !written)
+    if (auto written = writeOutput([&] { return writeFileAtomic(out, generated->json); }); !written)
         return fail(written.error());
     printSummary(out, *generated, stats);
     if (const std::string png = args.get("--render"); !png.empty()) {
         Renders renders;
         auto image = renders.render(generated->scene, 800, 600);
-        Status written = image ? writeOutput([&] { return writePng(*image, png); })
-                               : Status(image.error());
+        Status written =
+            image ? writeOutput([&] { return writePng(*image, png); }) : Status(image.error());
         if (!written && written.error().kind == ErrorKind::Cancelled && interrupted())
             return stopInterrupted("sdfcsg: interrupted; " + out + " was written, " + png +
                                    " was not");
@@ -617,7 +616,8 @@ int runEvalPrompts(int argc, char** argv) {
             std::fprintf(stderr, "%s\n", generated.error().str().c_str());
         } else {
             const std::string base = (fs::path(dir) / twoDigits(i + 1)).string();
-            if (auto w = writeWhole([&] { return writeFileAtomic(base + ".json", generated->json); });
+            if (auto w =
+                    writeWhole([&] { return writeFileAtomic(base + ".json", generated->json); });
                 !w)
                 return fail(w.error());
             for (const Diagnostic& w : generated->warnings)

@@ -38,7 +38,8 @@ struct Args {
         : command(std::move(cmd)) {
         for (int i = 0; i < argc; ++i) {
             std::string_view a = argv[i];
-            if (a.size() > 1 && a[0] == '-' && !(a.size() > 1 && (std::isdigit(a[1]) || a[1] == '.'))) {
+            if (a.size() > 1 && a[0] == '-' &&
+                !(a.size() > 1 && (std::isdigit(a[1]) || a[1] == '.'))) {
                 std::string name(a), value;
                 if (auto eq = name.find('='); eq != std::string::npos) {
                     value = name.substr(eq + 1);
@@ -105,9 +106,12 @@ bool parseVec3(const std::string& s, glm::vec3& out) {
     return true;
 }
 
-sdfcsg::Result<sdfcsg::Scene> load(const std::string& path) { return sdfcsg::loadScene(path); }
+sdfcsg::Result<sdfcsg::Scene> load(const std::string& path) {
+    return sdfcsg::loadScene(path);
+}
 
-const char* kMainHelp = R"(sdfcsg - constructive solid geometry on signed distance fields, with Vulkan
+const char* kMainHelp =
+    R"(sdfcsg - constructive solid geometry on signed distance fields, with Vulkan
 
 Usage: sdfcsg COMMAND [ARGS...]
 
@@ -400,8 +404,8 @@ int cmdMesh(int argc, char** argv) {
         const std::string method = args.get("--method");
         if (method != "dc" && method != "mc")
             return usageError("mesh", "--method expects dc or mc, got '" + method + "'");
-        options.method = method == "mc" ? sdfcsg::MeshMethod::MarchingCubes
-                                        : sdfcsg::MeshMethod::DualContouring;
+        options.method =
+            method == "mc" ? sdfcsg::MeshMethod::MarchingCubes : sdfcsg::MeshMethod::DualContouring;
     }
     if (args.has("--resolution") && args.has("--voxel-size"))
         return usageError("mesh", "give --resolution or --voxel-size, not both");
@@ -436,10 +440,10 @@ int cmdMesh(int argc, char** argv) {
         char* end = nullptr;
         errno = 0;
         const unsigned long long n = std::strtoull(value.c_str(), &end, 10);
-        if (value.empty() || !std::isdigit(static_cast<unsigned char>(value[0])) || *end ||
-            errno || n == 0)
-            return usageError("mesh", "--target-triangles expects a positive integer, got '" +
-                                          value + "'");
+        if (value.empty() || !std::isdigit(static_cast<unsigned char>(value[0])) || *end || errno ||
+            n == 0)
+            return usageError("mesh",
+                              "--target-triangles expects a positive integer, got '" + value + "'");
         simplify.targetTriangles = size_t(n);
     }
 
@@ -470,7 +474,9 @@ int cmdMesh(int argc, char** argv) {
         const sdfcsg::Evaluator evaluator(*scene);
         ProgressBar bar("simplifying");
         const bool tty = ::isatty(STDERR_FILENO);
-        simplify.progress = [&](float done) { return (!tty || bar.update(done)) && !interrupted(); };
+        simplify.progress = [&](float done) {
+            return (!tty || bar.update(done)) && !interrupted();
+        };
         mesh = sdfcsg::simplifyMesh(*mesh, evaluator, simplify, &stats);
         if (!mesh) return fail(mesh.error());
     } else {
@@ -606,8 +612,12 @@ int main(int argc, char** argv) {
         return kOk;
     }
     const std::pair<std::string_view, std::function<int(int, char**)>> commands[] = {
-        {"render", cmdRender},   {"mesh", cmdMesh},     {"validate", cmdValidate},
-        {"glsl", cmdGlsl},       {"convert", cmdConvert}, {"schema", cmdSchema},
+        {"render", cmdRender},
+        {"mesh", cmdMesh},
+        {"validate", cmdValidate},
+        {"glsl", cmdGlsl},
+        {"convert", cmdConvert},
+        {"schema", cmdSchema},
         {"bench", sdfcsg::app::runBench},
         {"generate", sdfcsg::app::runGenerate},
         {"edit", sdfcsg::app::runEdit},

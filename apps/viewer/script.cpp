@@ -173,7 +173,8 @@ Result<std::vector<Command>> parseScript(std::string_view text, std::string_view
             float simplify = 0;
             if (n > 3 && (!parseFloat(c.args[3], simplify) || !(simplify > 0.0f))) {
                 problem("mesh extract: expected a simplification error in cells greater than 0, "
-                        "got \"" + c.args[3] + "\"");
+                        "got \"" +
+                        c.args[3] + "\"");
                 continue;
             }
             c.numbers.push_back(simplify);

@@ -103,9 +103,9 @@ struct Viewer {
     std::string meshScript, exportScript; // "file:line: " while a script's extraction or write runs
     bool meshView = false, wireframe = false;
     int meshResolution = 128;
-    int meshMethod = 0;         // 0 dual contouring, 1 marching cubes (MeshMethod's order)
-    float meshSimplify = 0.0f;  // cells from the surface that simplification may move it; 0: off
-    int exportUnit = 0;         // 3MF: LengthUnit's order
+    int meshMethod = 0;        // 0 dual contouring, 1 marching cubes (MeshMethod's order)
+    float meshSimplify = 0.0f; // cells from the surface that simplification may move it; 0: off
+    int exportUnit = 0;        // 3MF: LengthUnit's order
     bool customBounds = false;
     float boundsMin[3] = {-1, -1, -1}, boundsMax[3] = {1, 1, 1};
     std::string meshMessage;

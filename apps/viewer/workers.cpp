@@ -233,8 +233,8 @@ RenderOutput RenderWorker::process(const RenderJob& job) {
     // follows (a sphere scaled differently per axis, or no longer, where it reads spheres as
     // balls): the live renderer draws that one, once built, and the bake follows as a
     // refinement.
-    const bool uploads = tapes && baked_ && bakedVersion_ != job.sceneVersion &&
-                         baked_->uploads(*job.scene);
+    const bool uploads =
+        tapes && baked_ && bakedVersion_ != job.sceneVersion && baked_->uploads(*job.scene);
     if (tapes && baked_ && bakedVersion_ != job.sceneVersion &&
         sameStructure(*bakedScene_, *job.scene) && (uploads || !live_)) {
         auto start = std::chrono::steady_clock::now();
@@ -345,44 +345,45 @@ bool MeshWorker::start(std::shared_ptr<const Scene> scene, MeshOptions options, 
     running_ = true;
     cancel_ = false;
     progress_ = 0.0f;
-    thread_ = std::thread([this, scene = std::move(scene), options = std::move(options),
-                           simplify]() mutable {
-        options.progress = [this](float done) {
-            progress_ = done;
-            return !cancel_.load();
-        };
-        MeshStats stats;
-        Result<ExtractedMesh> out = [&]() -> Result<ExtractedMesh> {
-            auto mesher = Mesher::create(context_, *scene);
-            if (!mesher) return mesher.error();
-            auto mesh = (*mesher)->extract(options, &stats);
-            if (!mesh) return mesh.error();
-            ExtractedMesh extracted{std::move(*mesh), std::nullopt};
-            const Evaluator evaluator(*scene);
-            if (simplify > 0.0f && !cancel_) {
-                SimplifyOptions fewer;
-                fewer.maxError = simplify * stats.voxelSize;
-                fewer.progress = [this](float) { return !cancel_.load(); };
-                auto simplified = simplifyMesh(extracted.mesh, evaluator, fewer, &stats);
-                if (!simplified) return simplified.error();
-                extracted.mesh = std::move(*simplified);
+    thread_ = std::thread(
+        [this, scene = std::move(scene), options = std::move(options), simplify]() mutable {
+            options.progress = [this](float done) {
+                progress_ = done;
+                return !cancel_.load();
+            };
+            MeshStats stats;
+            Result<ExtractedMesh> out = [&]() -> Result<ExtractedMesh> {
+                auto mesher = Mesher::create(context_, *scene);
+                if (!mesher) return mesher.error();
+                auto mesh = (*mesher)->extract(options, &stats);
+                if (!mesh) return mesh.error();
+                ExtractedMesh extracted{std::move(*mesh), std::nullopt};
+                const Evaluator evaluator(*scene);
+                if (simplify > 0.0f && !cancel_) {
+                    SimplifyOptions fewer;
+                    fewer.maxError = simplify * stats.voxelSize;
+                    fewer.progress = [this](float) { return !cancel_.load(); };
+                    auto simplified = simplifyMesh(extracted.mesh, evaluator, fewer, &stats);
+                    if (!simplified) return simplified.error();
+                    extracted.mesh = std::move(*simplified);
+                }
+                if (extracted.mesh.triangleCount() <= previewThreshold_ || cancel_)
+                    return extracted;
+                SimplifyOptions preview;
+                preview.targetTriangles = previewThreshold_;
+                preview.progress = [this](float) { return !cancel_.load(); };
+                if (auto copy = simplifyMesh(extracted.mesh, evaluator, preview); copy)
+                    extracted.preview = std::move(*copy);
+                return extracted;
+            }();
+            if (cancel_ && out) out = Error::message(ErrorKind::Cancelled, "<mesh>", "cancelled");
+            {
+                std::lock_guard lock(mutex_);
+                done_ = std::move(out);
+                stats_ = stats;
             }
-            if (extracted.mesh.triangleCount() <= previewThreshold_ || cancel_) return extracted;
-            SimplifyOptions preview;
-            preview.targetTriangles = previewThreshold_;
-            preview.progress = [this](float) { return !cancel_.load(); };
-            if (auto copy = simplifyMesh(extracted.mesh, evaluator, preview); copy)
-                extracted.preview = std::move(*copy);
-            return extracted;
-        }();
-        if (cancel_ && out) out = Error::message(ErrorKind::Cancelled, "<mesh>", "cancelled");
-        {
-            std::lock_guard lock(mutex_);
-            done_ = std::move(out);
-            stats_ = stats;
-        }
-        running_ = false;
-    });
+            running_ = false;
+        });
     return true;
 }
 

@@ -158,7 +158,7 @@ class RenderWorker {
     std::shared_ptr<const Scene> bakedScene_;
     uint64_t bakedVersion_ = 0;
     std::unique_ptr<Renderer> live_;
-    uint64_t liveVersion_ = 0;               // the values it holds
+    uint64_t liveVersion_ = 0; // the values it holds
     std::optional<uint64_t> failedVersion_;
     std::optional<Error> failure_;
     // Measured: seconds per pixel of the last live and baked frames, and of the last compile.

@@ -1,8 +1,8 @@
 // Mesa's disk cache of machine code, for the tests that look at what lavapipe compiled.
 #pragma once
 
-#include "gpu/scoped_env.h"
 #include "codegen/shader_compile.h"
+#include "gpu/scoped_env.h"
 #include "gpu/vk.h"
 
 #include <sdfcsg/sdfcsg.h>

@@ -87,7 +87,9 @@ inline std::optional<Image> readPng(const std::filesystem::path& path) {
 }
 
 // Every bundled scene, sorted by name.
-inline std::vector<std::filesystem::path> bundledScenes() { return bundledScenePaths(); }
+inline std::vector<std::filesystem::path> bundledScenes() {
+    return bundledScenePaths();
+}
 
 // Test names for TEST_P over scene paths: the file stem.
 inline std::string sceneTestName(const ::testing::TestParamInfo<std::filesystem::path>& info) {

@@ -116,9 +116,8 @@ template <class Distance, class Color> struct ReferenceSamples {
         for (float side : {0.0f, 1.0f, -1.0f}) {
             // Only where the gradient is a blend of two faces (kBlendedGradient in
             // shaders/mesh_common.glsl).
-            if (side != 0.0f &&
-                (tapOffset == 0.0f ||
-                 std::abs(glm::length(gradients[0]) - 4.0f * e) <= 0.001f * 4.0f * e))
+            if (side != 0.0f && (tapOffset == 0.0f || std::abs(glm::length(gradients[0]) -
+                                                               4.0f * e) <= 0.001f * 4.0f * e))
                 break;
             const glm::vec3 c = p + side * offset;
             gradients.push_back(xyy * distance(c + xyy * e) + yyx * distance(c + yyx * e) +
@@ -204,8 +203,8 @@ inline glm::vec3 referenceQef(const std::vector<glm::vec3>& points,
     float leastCos = 1.0f;
     glm::vec3 mean(0.0f);
     for (size_t k = 0; k < points.size(); ++k) {
-        leastCos = std::min(leastCos, std::min(glm::dot(normals[k], normals[0]),
-                                               glm::dot(others[k], normals[0])));
+        leastCos = std::min(
+            leastCos, std::min(glm::dot(normals[k], normals[0]), glm::dot(others[k], normals[0])));
         mean += normals[k];
     }
     if (leastCos > 0.995f) {
@@ -222,7 +221,8 @@ inline glm::vec3 referenceQef(const std::vector<glm::vec3>& points,
         for (auto [p, q] : {std::pair{0, 1}, {0, 2}, {1, 2}}) {
             if (std::abs(a[p][q]) < 1e-15) continue;
             const double theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
-            const double t = (theta >= 0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1.0));
+            const double t =
+                (theta >= 0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1.0));
             const double c = 1.0 / std::sqrt(t * t + 1.0), s = t * c;
             for (int k = 0; k < 3; ++k) { // a = a J, v = v J
                 const double akp = a[k][p], akq = a[k][q];
@@ -240,7 +240,9 @@ inline glm::vec3 referenceQef(const std::vector<glm::vec3>& points,
         }
     const glm::dvec3 lambda(a[0][0], a[1][1], a[2][2]);
     const double largest = std::max(lambda.x, std::max(lambda.y, lambda.z));
-    const int weakest = lambda.x <= lambda.y && lambda.x <= lambda.z ? 0 : lambda.y <= lambda.z ? 1 : 2;
+    const int weakest = lambda.x <= lambda.y && lambda.x <= lambda.z ? 0
+                        : lambda.y <= lambda.z                       ? 1
+                                                                     : 2;
     auto eigenvector = [&](int k) { return glm::dvec3(v[0][k], v[1][k], v[2][k]); };
     const glm::dvec3 atb(b[0], b[1], b[2]);
     glm::dvec3 base = mass;
@@ -328,7 +330,7 @@ ReferenceMesh referenceDualMeshOf(const Distance& distance, const Color& color,
                                                 lo + 0.005f * grid.voxelSize,
                                                 lo + (1.0f - 0.005f) * grid.voxelSize));
                     mesh.normals.push_back(glm::length(normal) > 0.1f ? glm::normalize(normal)
-                                                                       : normals[0]);
+                                                                      : normals[0]);
                     mesh.colors.push_back(colours[nearest]);
                 }
             }

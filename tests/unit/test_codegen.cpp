@@ -1,9 +1,9 @@
 // Scene -> GLSL -> SPIR-V without a GPU: the generated code's shape (one line per node, nothing
 // pasted twice, linear size), that it compiles in both modes through compileKernel, compile
 // errors as values, and the SPIR-V cache in memory and on disk.
-#include "scene_build_util.h"
-#include "gpu/scoped_env.h"
 #include "codegen/shader_compile.h"
+#include "gpu/scoped_env.h"
+#include "scene_build_util.h"
 
 #include <sdfcsg/compile.h>
 
@@ -244,8 +244,8 @@ TEST(Codegen, SizeAndCompileTimeAreLinear) {
 // With literal values, an operation whose blend radius is 0 takes the sharp form (one
 // comparison, same bits); a smooth one keeps the blend. Buffer-mode code reads every radius.
 TEST(Codegen, LiteralSharpOperationsTakeTheShortForm) {
-    Scene scene = makeScene(
-        subtract({unite({sphere(1), sphere(0.5f).at(1, 0, 0)}, 0.25f), sphere(0.3f)}));
+    Scene scene =
+        makeScene(subtract({unite({sphere(1), sphere(0.5f).at(1, 0, 0)}, 0.25f), sphere(0.3f)}));
     CodegenOptions inl;
     inl.inlineParams = true;
     const std::string literal = generateSceneGlsl(scene, inl);

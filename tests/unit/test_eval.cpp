@@ -315,7 +315,8 @@ TEST(Eval, FrameCameraSeesTheWholeScene) {
                 boxes.push_back(eval.bounds());
             else
                 for (const FlatNode& n : eval.nodes())
-                    if (!kindInfo(n.kind).operation && n.bounds.finite() && n.frame == kWorldFrame) boxes.push_back(n.bounds);
+                    if (!kindInfo(n.kind).operation && n.bounds.finite() && n.frame == kWorldFrame)
+                        boxes.push_back(n.bounds);
             ASSERT_FALSE(boxes.empty());
             for (const Aabb& b : boxes) {
                 for (int c = 0; c < 8; ++c) {

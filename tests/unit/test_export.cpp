@@ -87,8 +87,8 @@ TEST(Export, FormatFromPath) {
     EXPECT_EQ(meshFormatFromPath("b.gltf"), std::nullopt);
     EXPECT_EQ(meshFormatFromPath("ply"), std::nullopt);
     EXPECT_EQ(meshFormatFromPath("b.ply.txt"), std::nullopt);
-    for (MeshFormat f : {MeshFormat::Ply, MeshFormat::Obj, MeshFormat::Stl, MeshFormat::Glb,
-                         MeshFormat::ThreeMf})
+    for (MeshFormat f :
+         {MeshFormat::Ply, MeshFormat::Obj, MeshFormat::Stl, MeshFormat::Glb, MeshFormat::ThreeMf})
         EXPECT_EQ(meshFormatFromPath("x." + std::string(meshFormatName(f))), f);
 }
 

@@ -2,10 +2,10 @@
 // sceneSample at thousands of points, for every primitive kind, the operations, and every bundled
 // scene, with bounds skipping on and off, and with the bounds tests left out of the code.
 #include "codegen/gpu_nodes.h"
-#include "gpu_test.h"
 #include "field/prune.h"
-#include "shared.h"
 #include "gpu/vk.h"
+#include "gpu_test.h"
+#include "shared.h"
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
@@ -27,7 +27,8 @@ struct Probe {
     // The result is read back through a staging copy, as on GPUs whose storage memory is not
     // mappable (lavapipe's always is), so that path runs under validation too.
     bool viaStaging;
-    // Pruned tapes (shaders/tape.glsl), held to the CPU's pruned field (engine/src/field/prune.cpp).
+    // Pruned tapes (shaders/tape.glsl), held to the CPU's pruned field
+    // (engine/src/field/prune.cpp).
     bool tapes = false;
 };
 
@@ -222,7 +223,8 @@ const std::map<std::string, std::string>& profileExamples() {
         {"circle", R"("radius": 0.5)"},
         {"rectangle", R"("width": 0.9, "height": 0.6, "rounding": 0.1)"},
         {"regular_polygon", R"("radius": 0.6, "sides": 5)"},
-        {"polygon", R"("points": [[-0.5, -0.4], [0.6, -0.4], [0.1, 0.0], [0.3, 0.5], [-0.4, 0.3]])"},
+        {"polygon",
+         R"("points": [[-0.5, -0.4], [0.6, -0.4], [0.1, 0.0], [0.3, 0.5], [-0.4, 0.3]])"},
         // Large enough for a grid (engine/src/scene/outline.h); the polygon is listed by contour.
         {"text", R"("text": "Bo sdfg", "size": 0.5)"},
     };
@@ -250,7 +252,8 @@ TEST_F(GpuEval, EveryProfileMatchesTheCpu) {
         Scene scene = parseOrDie(R"({"version": 1, "root": {"type": "union", "smooth": 0.2,
             "children": [
             {"type": "extrude", "height": 0.5, "rounding": 0.05, "rotate": [30, 20, 0],
-             "color": [0.9, 0.3, 0.1], "children": [)" + profile + R"(]},
+             "color": [0.9, 0.3, 0.1], "children": [)" +
+                                 profile + R"(]},
             {"type": "revolve", "offset": 0.2, "translate": [0, -1.2, 0], "children": [)" +
                                  profile + R"(]},
             {"type": "sphere", "radius": 0.4, "translate": [1.1, 0.6, 0.2], "color": [0.1, 0.4, 0.9]}
@@ -335,18 +338,21 @@ TEST_F(GpuEval, EveryValueAndDomainOperationMatchesTheCpu) {
         SCOPED_TRACE(type);
         // Transformed itself, around a transformed child, inside a smooth union, and with a
         // repeat around it so that domains nest.
-        const std::string op = R"({"type": ")" + type + R"(", )" + params +
-                               R"(, "rotate": [10, 25, -5], "scale": 0.9, "translate": [0.1, -0.2, 0.1],
+        const std::string op =
+            R"({"type": ")" + type + R"(", )" + params +
+            R"(, "rotate": [10, 25, -5], "scale": 0.9, "translate": [0.1, -0.2, 0.1],
               "children": [{"type": "round_box", "size": [0.5, 0.8, 0.3], "radius": 0.05,
                  "translate": [0.2, 0.1, -0.1], "rotate": [0, 30, 10], "scale": [1, 1.2, 0.9],
                  "color": [0.9, 0.3, 0.1]}]})";
         Scene scene = parseOrDie(R"({"version": 1, "root": {"type": "union", "smooth": 0.2,
-            "children": [)" + op + R"(,
+            "children": [)" + op +
+                                 R"(,
             {"type": "sphere", "radius": 0.4, "translate": [1.1, 0.6, 0.2], "color": [0.1, 0.4, 0.9]}]}})");
         ASSERT_FALSE(scene.nodes.empty());
         expectGpuMatchesCpu(context(), scene, 4096);
         Scene nested = parseOrDie(R"({"version": 1, "root": {"type": "repeat", "count": [2, 1, 2],
-            "spacing": [4, 1, 4], "children": [)" + op + "]}}");
+            "spacing": [4, 1, 4], "children": [)" +
+                                  op + "]}}");
         ASSERT_FALSE(nested.nodes.empty());
         expectGpuMatchesCpu(context(), nested, 2048);
     }
@@ -360,8 +366,10 @@ TEST_F(GpuEval, BlendProfilesMatchTheCpu) {
         const std::string b = std::string(R"("blend": ")") + blend + "\"";
         Scene scene = parseOrDie(R"({"version": 1, "root": {"type": "union", "smooth": 0.2, )" + b +
                                  R"(, "children": [
-            {"type": "difference", "smooth": 0.15, )" + b + R"(, "color": [0.8, 0.8, 0.2], "children": [
-                {"type": "intersection", "smooth": 0.2, )" + b + R"(, "children": [
+            {"type": "difference", "smooth": 0.15, )" +
+                                 b + R"(, "color": [0.8, 0.8, 0.2], "children": [
+                {"type": "intersection", "smooth": 0.2, )" +
+                                 b + R"(, "children": [
                     {"type": "box", "size": [1.5, 1.5, 1.5], "color": [1, 0, 0]},
                     {"type": "sphere", "radius": 1.0, "scale": [1.2, 0.9, 1], "color": [0, 1, 0]}]},
                 {"type": "cylinder", "radius": 0.4, "height": 3, "color": [0, 0, 1]}]},

@@ -1,7 +1,7 @@
-// The GPU mesher (engine/src/mesh/mesh.cpp) by the properties of its meshes: analytic volume and area,
-// topology, vertices on the surface, outward normals, closed and manifold meshes of the bundled
-// scenes without self-intersections or flipped triangles, sharp edges and corners kept, equality
-// with the CPU reference (mesh_reference.h), repeatability, and its errors.
+// The GPU mesher (engine/src/mesh/mesh.cpp) by the properties of its meshes: analytic volume and
+// area, topology, vertices on the surface, outward normals, closed and manifold meshes of the
+// bundled scenes without self-intersections or flipped triangles, sharp edges and corners kept,
+// equality with the CPU reference (mesh_reference.h), repeatability, and its errors.
 #include "driver_cache.h"
 #include "gpu_test.h"
 #include "mesh_checks.h"
@@ -350,19 +350,19 @@ void expectMatchesReference(Context& context, const Scene& scene, const std::str
         ASSERT_GT(reference.mesh.triangleCount(), 0u);
         // A dual vertex solves a least-squares problem that float rounding in its normals moves
         // more than an edge point.
-        const float tolerance = (method == MeshMethod::DualContouring ? 1e-2f : 1e-3f) * grid.voxelSize;
+        const float tolerance =
+            (method == MeshMethod::DualContouring ? 1e-2f : 1e-3f) * grid.voxelSize;
         const MeshComparison diff = compareMeshes(*mesh, reference.mesh, tolerance);
         // Dual contouring decides by thresholds whether an edge point lies on a sharp edge and
         // which directions constrain a vertex, so rounding may move a few vertices (and the
         // triangles around them): 1 in 200, no more. Marching cubes must agree everywhere.
-        const bool same = method == MeshMethod::MarchingCubes
-                              ? diff.same()
-                              : diff.verticesA == diff.verticesB &&
-                                    diff.trianglesA == diff.trianglesB &&
-                                    diff.unmatchedVertices + diff.normalMismatches +
-                                            diff.colorMismatches <=
-                                        diff.verticesA / 200 &&
-                                    diff.unmatchedTriangles <= diff.trianglesA / 50;
+        const bool same =
+            method == MeshMethod::MarchingCubes
+                ? diff.same()
+                : diff.verticesA == diff.verticesB && diff.trianglesA == diff.trianglesB &&
+                      diff.unmatchedVertices + diff.normalMismatches + diff.colorMismatches <=
+                          diff.verticesA / 200 &&
+                      diff.unmatchedTriangles <= diff.trianglesA / 50;
         if (!same) {
             // Float differences between the two evaluators can flip a sample that lies within a
             // rounding error of the surface; name such samples to tell that apart from a real bug.
@@ -674,7 +674,6 @@ TEST_F(MeshTest, BadOptionsAreUsageErrors) {
     EXPECT_EQ(mesh.error().kind, ErrorKind::Usage);
     EXPECT_EQ(mesh.error().diagnostics.at(0).message, "the voxel size must be a positive number");
 }
-
 
 } // namespace
 } // namespace sdfcsg::test

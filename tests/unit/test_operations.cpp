@@ -56,7 +56,8 @@ TEST(Operations, RepeatIsTheUnionOfItsCopies) {
         for (int k = 0; k < 2; ++k)
             copies += (copies.empty() ? "" : ", ") + copyAt((i - 1) * 0.7f, 0, (k - 0.5f) * 0.6f);
     expectSameSolid(R"({"type": "repeat", "count": [3, 1, 2], "spacing": [0.7, 1, 0.6],
-        "children": [)" + kPart + "]}",
+        "children": [)" +
+                        kPart + "]}",
                     R"({"type": "union", "children": [)" + copies + "]}", 2.5f, 0.3f);
 }
 
@@ -66,19 +67,21 @@ TEST(Operations, RepeatOfOverlappingCopiesIsTheirUnion) {
     for (int i = 0; i < 9; ++i)
         copies += (copies.empty() ? "" : ", ") + copyAt((i - 4) * 0.2f, 0, 0);
     expectSameSolid(R"({"type": "repeat", "count": [9, 1, 1], "spacing": [0.2, 1, 1],
-        "children": [)" + kPart + "]}",
+        "children": [)" +
+                        kPart + "]}",
                     R"({"type": "union", "children": [)" + copies + "]}", 1.2f, 0.1f);
 }
 
 TEST(Operations, PolarRepeatIsTheUnionOfItsTurnedCopies) {
     std::string copies;
     for (int i = 0; i < 9; ++i)
-        copies += std::string(copies.empty() ? "" : ", ") +
-                  R"({"type": "union", "rotate": [0, )" + std::to_string(i * 40.0f) +
-                  R"(, 0], "children": [{"type": "union", "translate": [1.1, 0, 0], "children": [)" +
-                  kPart + "]}]}";
-    expectSameSolid(R"({"type": "polar_repeat", "count": 9, "radius": 1.1, "children": [)" +
-                        kPart + "]}",
+        copies +=
+            std::string(copies.empty() ? "" : ", ") + R"({"type": "union", "rotate": [0, )" +
+            std::to_string(i * 40.0f) +
+            R"(, 0], "children": [{"type": "union", "translate": [1.1, 0, 0], "children": [)" +
+            kPart + "]}]}";
+    expectSameSolid(R"({"type": "polar_repeat", "count": 9, "radius": 1.1, "children": [)" + kPart +
+                        "]}",
                     R"({"type": "union", "children": [)" + copies + "]}", 2.5f, 0.3f);
 }
 
@@ -101,7 +104,7 @@ TEST(Operations, ShellAndOffsetOfASphere) {
         R"({"type": "sphere", "radius": 0.4})", 2.0f, 10.0f);
     Evaluator shell(parseRoot(
         R"({"type": "shell", "thickness": 0.1, "scale": 2, "children": [{"type": "sphere", "radius": 0.5}]})"));
-    EXPECT_NEAR(shell.distance({0, 0, 0}), 0.9f, 1e-6f);   // |-1| - 0.1
+    EXPECT_NEAR(shell.distance({0, 0, 0}), 0.9f, 1e-6f);    // |-1| - 0.1
     EXPECT_NEAR(shell.distance({1.5f, 0, 0}), 0.4f, 1e-6f); // |0.5| - 0.1
     EXPECT_NEAR(shell.distance({0, 1.05f, 0}), -0.05f, 1e-6f);
 }

@@ -75,12 +75,13 @@ std::vector<BadInput> badInputs() {
     std::string fiveLights = R"({"direction": [0, -1, 0]})";
     for (int i = 0; i < 4; ++i)
         fiveLights += R"(, {"direction": [0, -1, 0]})";
-    const std::string kinds = "sphere, box, round_box, plane, triangular_prism, torus, cylinder, "
-                              "cone, capsule, ellipsoid, hex_prism, octahedron, pyramid, "
-                              "rounded_cylinder, round_cone, link, capped_torus, circle, rectangle, "
-                              "regular_polygon, polygon, text, union, intersection, difference, "
-                              "shell, offset, repeat, polar_repeat, mirror, elongate, twist, bend, "
-                              "taper, extrude or revolve";
+    const std::string kinds =
+        "sphere, box, round_box, plane, triangular_prism, torus, cylinder, "
+        "cone, capsule, ellipsoid, hex_prism, octahedron, pyramid, "
+        "rounded_cylinder, round_cone, link, capped_torus, circle, rectangle, "
+        "regular_polygon, polygon, text, union, intersection, difference, "
+        "shell, offset, repeat, polar_repeat, mirror, elongate, twist, bend, "
+        "taper, extrude or revolve";
     return {
         // JSON syntax: line and column of the first problem.
         {"empty", "", "scene.json:1:1: expected a JSON value, got end of input"},
@@ -217,7 +218,8 @@ std::vector<BadInput> badInputs() {
          "scene.json: root.scale: expected a positive number, got 0"},
         {"scale of another type", scene(R"({"type": "sphere", "radius": 1, "scale": "big"})"),
          R"(scene.json: root.scale: expected a positive number or an array of 3 positive numbers, got "big")"},
-        {"scale vector with a zero", scene(R"({"type": "sphere", "radius": 1, "scale": [1, 0, 1]})"),
+        {"scale vector with a zero",
+         scene(R"({"type": "sphere", "radius": 1, "scale": [1, 0, 1]})"),
          "scene.json: root.scale[1]: expected a positive number, got 0"},
         {"scale vector too short", scene(R"({"type": "sphere", "radius": 1, "scale": [1, 2]})"),
          "scene.json: root.scale: expected an array of 3 positive numbers, got [1, 2]"},
@@ -243,14 +245,17 @@ std::vector<BadInput> badInputs() {
         {"link length negative",
          scene(R"({"type": "link", "length": -1, "major_radius": 1, "minor_radius": 0.2})"),
          "scene.json: root.length: expected a non-negative number, got -1"},
-        {"hex prism with a misspelt key", scene(R"({"type": "hex_prism", "raduis": 1, "height": 1})"),
+        {"hex prism with a misspelt key",
+         scene(R"({"type": "hex_prism", "raduis": 1, "height": 1})"),
          "scene.json: root: unknown key \"raduis\"; did you mean \"radius\"?\nscene.json: root: "
          "missing required key \"radius\" (a positive number)"},
         {"misspelt blend",
-         scene(R"({"type": "union", "smooth": 0.1, "blend": "chamfr", "children": [{"type": "sphere", "radius": 1}]})"),
+         scene(
+             R"({"type": "union", "smooth": 0.1, "blend": "chamfr", "children": [{"type": "sphere", "radius": 1}]})"),
          R"(scene.json: root.blend: expected one of "smooth", "round" or "chamfer", got "chamfr"; did you mean "chamfer"?)"},
         {"blend not a string",
-         scene(R"({"type": "union", "smooth": 0.1, "blend": 2, "children": [{"type": "sphere", "radius": 1}]})"),
+         scene(
+             R"({"type": "union", "smooth": 0.1, "blend": 2, "children": [{"type": "sphere", "radius": 1}]})"),
          R"(scene.json: root.blend: expected one of "smooth", "round" or "chamfer", got 2)"},
         {"primitive with children", scene(R"({"type": "sphere", "radius": 1, "children": []})"),
          "scene.json: root: a sphere takes no \"children\"; only operations (union, intersection, "

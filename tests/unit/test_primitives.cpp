@@ -158,7 +158,8 @@ std::vector<dvec2> twoCircleHull(double y1, double r1, double y2, double r2) {
 double arcDistance(dvec3 p, dvec3 c, dvec3 u, dvec3 v, double r, double t0, double t1) {
     dvec3 q = p - c;
     double t = std::atan2(dot(q, v), dot(q, u));
-    while (t < t0) t += 2 * M_PI;
+    while (t < t0)
+        t += 2 * M_PI;
     auto at = [&](double a) { return c + r * (std::cos(a) * u + std::sin(a) * v); };
     double d = std::min(length(p - at(t0)), length(p - at(t1)));
     if (t <= t1) d = std::min(d, length(p - at(t)));
@@ -344,9 +345,8 @@ std::vector<Case> cases() {
             "link", NodeKind::Link, {float(l.x), float(l.y), float(l.z)},
             [le, r1, r2](dvec3 p) {
                 const dvec3 x(1, 0, 0), y(0, 1, 0);
-                double d = std::min(
-                    {arcDistance(p, {0, le, 0}, x, y, r1, 0, M_PI),
-                     arcDistance(p, {0, -le, 0}, x, y, r1, M_PI, 2 * M_PI)});
+                double d = std::min({arcDistance(p, {0, le, 0}, x, y, r1, 0, M_PI),
+                                     arcDistance(p, {0, -le, 0}, x, y, r1, M_PI, 2 * M_PI)});
                 if (le > 0)
                     for (double side : {-r1, r1}) {
                         dvec3 a(side, -le, 0), b(side, le, 0);

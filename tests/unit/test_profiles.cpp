@@ -80,9 +80,10 @@ TEST(Profiles, RevolvedProfileAgainstTheAxisIsSolidThere) {
     expectSameField(R"({"type": "revolve", "offset": 0.3, "children": [{"type": "polygon",
                         "points": [[-0.3, -0.8], [0.2, -0.8], [0.2, 0.8], [-0.3, 0.8]]}]})",
                     cylinder, 1.2f, 2e-5f);
-    expectSameField(R"({"type": "revolve", "children": [{"type": "polygon", "translate": [-0.1, 0, 0],
+    expectSameField(
+        R"({"type": "revolve", "children": [{"type": "polygon", "translate": [-0.1, 0, 0],
                         "points": [[0.1, 0.8], [0.1, -0.8], [0.6, -0.8], [0.6, 0.8]]}]})",
-                    cylinder, 1.2f, 2e-5f);
+        cylinder, 1.2f, 2e-5f);
     // Touching the axis at a point only, the profile keeps its own outline: the field is 0 on
     // the axis where it touches.
     Evaluator cone(parseRoot(R"({"type": "revolve", "children": [{"type": "polygon",
@@ -119,7 +120,8 @@ TEST(Profiles, PolygonIsTheExactDistanceToItsEdges) {
     std::string json;
     Brute brute;
     for (size_t i = 0; i < pts.size(); ++i) {
-        json += (i ? ", [" : "[") + std::to_string(pts[i].x) + ", " + std::to_string(pts[i].y) + "]";
+        json +=
+            (i ? ", [" : "[") + std::to_string(pts[i].x) + ", " + std::to_string(pts[i].y) + "]";
         brute.edges.push_back({pts[i], pts[(i + 1) % pts.size()]});
     }
     // Clockwise or not, the same solid.
@@ -132,7 +134,8 @@ TEST(Profiles, PolygonIsTheExactDistanceToItsEdges) {
                         std::to_string(pts[i].y) + "]";
         }
         Evaluator e(parseRoot(R"({"type": "extrude", "height": 100, "children": [
-            {"type": "polygon", "points": [)" + list + "]}]}"));
+            {"type": "polygon", "points": [)" +
+                              list + "]}]}"));
         for (glm::vec3 p : randomPoints(9, 3000, 0.9f)) {
             const float expected = brute.distance({p.x, p.y});
             ASSERT_NEAR(e.distance(glm::vec3(p.x, p.y, 0.0f)), expected, 2e-5f)
@@ -142,8 +145,9 @@ TEST(Profiles, PolygonIsTheExactDistanceToItsEdges) {
 }
 
 TEST(Profiles, BadProfilesGiveExactMessages) {
-    EXPECT_EQ(errorOf(R"({"type": "circle", "radius": 1})"),
-              "test.json: root: a circle is a 2D profile: it must be inside an extrude or a revolve");
+    EXPECT_EQ(
+        errorOf(R"({"type": "circle", "radius": 1})"),
+        "test.json: root: a circle is a 2D profile: it must be inside an extrude or a revolve");
     EXPECT_EQ(errorOf(R"({"type": "extrude", "height": 1, "children": [
                   {"type": "polygon", "points": [[0, 0], [1, 0]]}]})"),
               "test.json: root.children[0].points: expected an array of 3 to 1024 points [x, y], "
@@ -183,9 +187,10 @@ TEST(Profiles, BadProfilesGiveExactMessages) {
                   {"type": "text", "text": "a", "font": "/nonexistent.ttf"}]})"),
               "test.json: root.children[0].font: cannot load font \"/nonexistent.ttf\": no such "
               "file");
-    EXPECT_EQ(errorOf(R"({"type": "extrude", "height": 1, "children": [
+    EXPECT_EQ(
+        errorOf(R"({"type": "extrude", "height": 1, "children": [
                   {"type": "text", "text": "a", "font": "/dev/zero"}]})"),
-              "test.json: root.children[0].font: cannot load font \"/dev/zero\": not a regular file");
+        "test.json: root.children[0].font: cannot load font \"/dev/zero\": not a regular file");
     EXPECT_EQ(errorOf(R"({"type": "extrude", "height": 1, "children": [
                   {"type": "text", "text": "a", "font": ")" SDFCSG_SOURCE_DIR R"(/LICENSE"}]})"),
               "test.json: root.children[0].font: cannot load font \"" SDFCSG_SOURCE_DIR
@@ -199,8 +204,8 @@ TEST(Profiles, BadProfilesGiveExactMessages) {
 TEST(Profiles, OutlinesOfAllNodesAreBounded) {
     std::string kids;
     for (int i = 0; i < 200; ++i)
-        kids += std::string(i ? ", " : "") + R"({"type": "text", "text": ")" + std::string(256, '@') +
-                "\"}";
+        kids += std::string(i ? ", " : "") + R"({"type": "text", "text": ")" +
+                std::string(256, '@') + "\"}";
     const std::string error =
         errorOf(R"({"type": "extrude", "height": 1, "children": [{"type": "union", "children": [)" +
                 kids + "]}]}");
@@ -220,8 +225,9 @@ TEST(Profiles, FontOutlinesAreClosedContours) {
         const detail::GlyphSegment& s = text->segments[i];
         area += 0.5 * (double(s.a.x) * s.b.y - double(s.b.x) * s.a.y);
         if (s.quadratic) // the curve's area beyond its chord: 2/3 of the control triangle's
-            area += (2.0 / 3.0) * 0.5 *
-                    ((s.c.x - s.a.x) * double(s.b.y - s.a.y) - (s.b.x - s.a.x) * double(s.c.y - s.a.y));
+            area +=
+                (2.0 / 3.0) * 0.5 *
+                ((s.c.x - s.a.x) * double(s.b.y - s.a.y) - (s.b.x - s.a.x) * double(s.c.y - s.a.y));
         const bool last = i + 1 == text->segments.size() || text->segments[i + 1].a != s.b;
         if (last) {
             areas.push_back(area);
@@ -284,7 +290,8 @@ void expectGridField(const std::string& root, const Brute& brute, glm::vec2 reac
     const glm::vec2 far = corner + glm::vec2(k[1], k[6]) * k[7];
     auto field = [&](glm::vec2 p) { return e.distance(glm::vec3(p, 0.0f)); };
     int on = 0, beyond = 0, inside = 0;
-    const std::vector<glm::vec3> at = randomPoints(5, 4000, 1.0f), steps = randomPoints(6, 4000, 1.0f);
+    const std::vector<glm::vec3> at = randomPoints(5, 4000, 1.0f),
+                                 steps = randomPoints(6, 4000, 1.0f);
     for (size_t i = 0; i < at.size(); ++i) {
         const glm::vec2 p = reach * glm::vec2(at[i]);
         SCOPED_TRACE(std::to_string(p.x) + " " + std::to_string(p.y));
@@ -361,7 +368,8 @@ TEST(Profiles, GriddedPolygonIsExactOnItsGrid) {
     for (size_t i = 0; i < pts.size(); ++i)
         brute.edges.push_back({pts[i], pts[(i + 1) % pts.size()]});
     expectGridField(R"({"type": "extrude", "height": 100, "children": [
-        {"type": "polygon", "points": [)" + list + "]}]}",
+        {"type": "polygon", "points": [)" +
+                        list + "]}]}",
                     brute, {1.2f, 1.2f}, 2e-5f);
 }
 

@@ -32,7 +32,8 @@ std::vector<glm::vec3> points(const Evaluator& ev, size_t count, uint32_t seed) 
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
     std::vector<glm::vec3> out;
     for (size_t i = 0; i < count; ++i) {
-        glm::vec3 p = glm::mix(box.min - margin, box.max + margin, glm::vec3(u(rng), u(rng), u(rng)));
+        glm::vec3 p =
+            glm::mix(box.min - margin, box.max + margin, glm::vec3(u(rng), u(rng), u(rng)));
         out.push_back(p);
         const float h = 1e-3f;
         glm::vec3 g(ev.distance(p + glm::vec3(h, 0, 0)) - ev.distance(p - glm::vec3(h, 0, 0)),
@@ -179,8 +180,8 @@ TEST(Prune, TheEvaluatorsPrunedDistanceIsThePrunedField) {
 }
 
 // 2,000 spheres nearly on top of each other prune to little: past the budget, refinement stops,
-// so the tapes stay within it (about 4,000 words a cell; the sphere's shell crosses some 20,000 leaf cells), and
-// the coarser cells still give the whole tree's values.
+// so the tapes stay within it (about 4,000 words a cell; the sphere's shell crosses some 20,000
+// leaf cells), and the coarser cells still give the whole tree's values.
 TEST(Prune, TreesThatPruneLittleStayWithinTheBudget) {
     std::mt19937 rng(5);
     std::uniform_real_distribution<float> jitter(-0.01f, 0.01f);

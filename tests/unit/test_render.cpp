@@ -1,12 +1,12 @@
 // The GPU ray march against CPU sphere tracing with the reference evaluator: same rays (camera.h),
 // same clipping, same epsilon rule. Plus modes, bounds skipping, value updates and PNG output.
-#include "render/camera.h"
-#include "driver_cache.h"
-#include "gpu_test.h"
-#include "gpu/scoped_env.h"
 #include "codegen/shader_compile.h"
-#include "shared.h"
+#include "driver_cache.h"
+#include "gpu/scoped_env.h"
 #include "gpu/vk.h"
+#include "gpu_test.h"
+#include "render/camera.h"
+#include "shared.h"
 
 #include <glm/common.hpp>
 #include <glm/exponential.hpp>
@@ -220,8 +220,8 @@ TEST_P(SceneRender, BoundsSkippingDoesNotChangeTheImage) {
 
 // Pruned tapes against the inlined tree: the same hits and depths, and the same colours but
 // where a far cell's bound steers a shadow ray or an occlusion tap differently.
-void expectTapesMatchInlined(Context& context, const Scene& scene, uint32_t width,
-                             uint32_t height, double colourShare = 0.02) {
+void expectTapesMatchInlined(Context& context, const Scene& scene, uint32_t width, uint32_t height,
+                             double colourShare = 0.02) {
     RenderOptions options;
     options.width = width, options.height = height;
     std::optional<Image> images[2];
@@ -238,11 +238,12 @@ void expectTapesMatchInlined(Context& context, const Scene& scene, uint32_t widt
     }
     // The two march with other steps (a far cell's bound is shorter than the field), so their
     // hits may lie apart by the hit tolerance: up to half a pixel's footprint.
-    const float footprint = 2.0f * std::tan(glm::radians(cameraFor(scene, Evaluator(scene),
-                                                                 float(width) / float(height))
-                                                           .fov) *
-                                            0.5f) /
-                            float(height);
+    const float footprint =
+        2.0f *
+        std::tan(
+            glm::radians(cameraFor(scene, Evaluator(scene), float(width) / float(height)).fov) *
+            0.5f) /
+        float(height);
     size_t agree = 0, hits = 0, colourOff = 0;
     for (size_t i = 0; i < infos[0].size(); ++i) {
         const PixelInfo &a = infos[0][i], &b = infos[1][i];
@@ -253,8 +254,8 @@ void expectTapesMatchInlined(Context& context, const Scene& scene, uint32_t widt
         ++hits;
         int worst = 0;
         for (int c = 0; c < 3; ++c)
-            worst = std::max(worst, std::abs(int(images[0]->rgba[4 * i + c]) -
-                                             int(images[1]->rgba[4 * i + c])));
+            worst = std::max(
+                worst, std::abs(int(images[0]->rgba[4 * i + c]) - int(images[1]->rgba[4 * i + c])));
         colourOff += worst > 24;
     }
     EXPECT_GE(double(agree) / double(infos[0].size()), 0.995) << scene.file;
@@ -306,12 +307,13 @@ TEST_F(Render, FarCellsAreNeverHits) {
     std::vector<Tree> balls;
     for (int i = 0; i < 200; ++i)
         balls.push_back(sphere(0.05f).at(0.9f * std::sin(0.37f * float(i)),
-                                          0.9f * std::cos(0.23f * float(i)),
-                                          0.9f * std::sin(0.11f * float(i) + 1.0f)));
+                                         0.9f * std::cos(0.23f * float(i)),
+                                         0.9f * std::sin(0.11f * float(i) + 1.0f)));
     const Scene scene = makeScene(unite(std::move(balls)), "<far>");
     RenderOptions options;
     options.width = 64, options.height = 48;
-    options.camera = Camera{glm::vec3(0.0f, 0.0f, 12.0f), glm::vec3(0.0f), glm::vec3(0, 1, 0), 20.0f};
+    options.camera =
+        Camera{glm::vec3(0.0f, 0.0f, 12.0f), glm::vec3(0.0f), glm::vec3(0, 1, 0), 20.0f};
     std::vector<PixelInfo> infos[2];
     for (int tapes = 0; tapes < 2; ++tapes) {
         RendererOptions made;
@@ -341,8 +343,8 @@ TEST_F(Render, FarCellsAreNeverHits) {
 TEST_F(Render, SceneAtTheLimitsRendersAndMeshesUnderTwoGiB) {
     Tree chain = sphere(0.6f).at(0.0f, 1.0f, 0.0f);
     for (int d = 1; d < 64; ++d)
-        chain = unite({std::move(chain), box(0.3f, 0.3f, 0.3f).at(0.1f * float(d), 1.0f, 0.0f)},
-                      0.05f);
+        chain =
+            unite({std::move(chain), box(0.3f, 0.3f, 0.3f).at(0.1f * float(d), 1.0f, 0.0f)}, 0.05f);
     std::vector<Tree> parts{std::move(chain)};
     const Tree kinds[] = {sphere(0.3f), box(0.3f, 0.2f, 0.3f), cylinder(0.25f, 0.4f),
                           torus(0.25f, 0.08f)};
@@ -710,7 +712,9 @@ TEST_F(Render, UpdateValuesOnTapesRecompilesOnlyWhereTheCodeChanges) {
     };
     for (int edit = 0; edit < 3; ++edit) {
         const bool perAxis = edit == 2;
-        SCOPED_TRACE(edit == 0 ? "a larger sphere" : edit == 1 ? "another blend" : "a scale per axis");
+        SCOPED_TRACE(edit == 0   ? "a larger sphere"
+                     : edit == 1 ? "another blend"
+                                 : "a scale per axis");
         if (edit == 0) {
             ASSERT_TRUE(growFirstSphere(scene));
         } else if (edit == 1) {
@@ -724,7 +728,8 @@ TEST_F(Render, UpdateValuesOnTapesRecompilesOnlyWhereTheCodeChanges) {
             ASSERT_TRUE(changed);
         } else {
             for (Node& node : scene.nodes)
-                if (node.kind == NodeKind::Sphere) node.transform.scale = glm::vec3(1.3f, 1.0f, 0.8f);
+                if (node.kind == NodeKind::Sphere)
+                    node.transform.scale = glm::vec3(1.3f, 1.0f, 0.8f);
         }
         EXPECT_EQ((*renderer)->uploads(scene), !perAxis);
         EXPECT_TRUE((*live)->uploads(scene));

@@ -75,7 +75,8 @@ TEST(Schema, CheckedInFileIsUpToDate) {
     const fs::path actual = fs::path(SDFCSG_TEST_OUTPUT_DIR) / "scene.schema.json";
     fs::create_directories(actual.parent_path());
     std::ofstream(actual, std::ios::binary) << generated;
-    FAIL() << kSchemaFile << " is out of date with the node kind table (engine/src/scene/nodes.cpp).\n"
+    FAIL() << kSchemaFile
+           << " is out of date with the node kind table (engine/src/scene/nodes.cpp).\n"
            << "Regenerate it with:  sdfcsg schema -o assets/scene.schema.json\n"
            << "or run this test with SDFCSG_UPDATE_SCHEMA=1 set "
            << "(SDFCSG_UPDATE_SCHEMA=1 ctest -R Schema.CheckedInFileIsUpToDate).\n"
@@ -159,9 +160,8 @@ TEST(Schema, EveryKindAndParameterOfTheTableAppears) {
                 continue;
             }
             const bool count = p.check == Check::Count;
-            EXPECT_EQ(std::string_view(prop["type"]), p.type == ValueType::Number
-                                                          ? (count ? "integer" : "number")
-                                                          : "array");
+            EXPECT_EQ(std::string_view(prop["type"]),
+                      p.type == ValueType::Number ? (count ? "integer" : "number") : "array");
             auto bounds = p.type == ValueType::Number ? prop : prop["items"];
             if (count) {
                 EXPECT_EQ(std::string_view(bounds["type"]), "integer");

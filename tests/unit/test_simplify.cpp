@@ -3,8 +3,8 @@
 // and colours taken from the input, every colour outline kept, points sampled on the triangles
 // within the bound by the CPU evaluator, triangle counts; and the GPU ordering.
 #include "gpu_test.h"
-#include "mesh_checks.h"
 #include "mesh/mesh_simplify.h"
+#include "mesh_checks.h"
 
 #include <glm/geometric.hpp>
 

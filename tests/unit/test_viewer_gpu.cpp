@@ -133,8 +133,8 @@ TEST_F(ViewerGpu, ValueEditsUploadAndStructuralEditsRecompile) {
 // renderer is built beside it, and draws at once, without a compile, the edit that scales a
 // sphere differently per axis; the bake of that follows as a refinement.
 TEST_F(ViewerGpu, ValueEditsOfALargeSceneRedrawWithoutACompile) {
-    auto scene = std::make_shared<const Scene>(
-        test::loadOrDie(std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/bench/molecule_1k.json"));
+    auto scene = std::make_shared<const Scene>(test::loadOrDie(
+        std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/bench/molecule_1k.json"));
     RenderWorker worker(context());
     RenderJob job;
     job.options.width = 160;

@@ -38,17 +38,17 @@ inline constexpr uint32_t kWorldFrame = UINT32_MAX;
 // Index-aligned with Scene::nodes.
 struct FlatNode {
     NodeKind kind;
-    uint32_t frame;      // the domain operation whose child space this node lives in, or
-                         // kWorldFrame
-    glm::mat3 toLocal;   // frame -> local linear part (rotation transposed, divided by scale)
-    glm::vec3 offset;    // local = toLocal * frame point + offset
-    float scale;         // accumulated uniform scale: frame distance = scale * local distance
-    glm::vec3 color;     // resolved (inherited) colour
-    float smooth;        // operations: blend radius in world units
-    uint32_t blend;      // operations: the blend profile (the "blend" field's index)
+    uint32_t frame;    // the domain operation whose child space this node lives in, or
+                       // kWorldFrame
+    glm::mat3 toLocal; // frame -> local linear part (rotation transposed, divided by scale)
+    glm::vec3 offset;  // local = toLocal * frame point + offset
+    float scale;       // accumulated uniform scale: frame distance = scale * local distance
+    glm::vec3 color;   // resolved (inherited) colour
+    float smooth;      // operations: blend radius in world units
+    uint32_t blend;    // operations: the blend profile (the "blend" field's index)
     std::array<float, kMaxParams> params; // the kernel's parameters (half extents, unit normal,
                                           // ...): KindInfo::kernel and ::kernelAround
-    Aabb bounds;         // bounds in the frame; the node's value at p is >= bounds.signedDistance(p)
+    Aabb bounds; // bounds in the frame; the node's value at p is >= bounds.signedDistance(p)
     std::vector<uint32_t> children;
     // Polygon and text: Node::outline; the parameters then hold the glyph count (slot 1) and
     // the outline's extents (slots 2-5).

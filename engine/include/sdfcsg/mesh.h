@@ -78,10 +78,10 @@ struct MeshOptions {
 };
 
 struct MeshStats {
-    glm::uvec3 cells{0};    // grid size in cells
-    float voxelSize = 0;    // cell edge length
-    Aabb bounds;            // the region the grid covers (at least the requested bounds)
-    uint64_t bricks = 0;    // bricks in the grid
+    glm::uvec3 cells{0};       // grid size in cells
+    float voxelSize = 0;       // cell edge length
+    Aabb bounds;               // the region the grid covers (at least the requested bounds)
+    uint64_t bricks = 0;       // bricks in the grid
     uint64_t activeBricks = 0; // bricks that may contain surface
     uint64_t vertices = 0, triangles = 0;
     // True when the solid reaches the boundary of the bounds: the mesh is open there.
@@ -92,7 +92,7 @@ struct MeshStats {
     };
     std::vector<Stage> stages; // wall time per stage, in order
     double totalSeconds = 0;
-    size_t peakBytes = 0;      // largest working memory held at once (buffers and mesh)
+    size_t peakBytes = 0; // largest working memory held at once (buffers and mesh)
     // Set by simplifyMesh, which also updates the counts above and appends its stages (their
     // time counted in totalSeconds): the triangles it was given, how many simplifications it
     // ran and checked, and the largest sampled distance of the result from the surface (NaN

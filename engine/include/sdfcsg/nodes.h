@@ -79,14 +79,14 @@ struct ParamInfo {
     std::string_view name; // JSON key
     ValueType type;
     Check check;
-    uint8_t slot;          // first float slot in Node::params (a Vec3 takes three)
+    uint8_t slot; // first float slot in Node::params (a Vec3 takes three)
     bool required;
     float fallback[3];     // value when an optional parameter is absent
     std::string_view unit; // "length", "unit vector", ...
     std::string_view doc;
-    float maximum = 3.4e38f;                      // Number: the largest value accepted
-    std::span<const std::string_view> choices{};  // Choice: the names, in stored order
-    float least = 1.0f;                           // Count: the smallest value accepted
+    float maximum = 3.4e38f;                     // Number: the largest value accepted
+    std::span<const std::string_view> choices{}; // Choice: the names, in stored order
+    float least = 1.0f;                          // Count: the smallest value accepted
 };
 
 // How the inlined GLSL calls a primitive's formula: the kernel parameters after the local point,

@@ -44,8 +44,8 @@ struct RenderOptions {
     // every branch in their SIMD lanes, so the bounds tests only add work there.
     std::optional<bool> boundsSkipping;
     BoxOverlay boxes = BoxOverlay::None;
-    int selectedNode = -1;        // for BoxOverlay::Selected
-    bool grid = false;            // ground grid (groundGrid()), hidden behind surfaces
+    int selectedNode = -1; // for BoxOverlay::Selected
+    bool grid = false;     // ground grid (groundGrid()), hidden behind surfaces
     // The image is computed in bands of rows, one submission each, so no single dispatch runs
     // for long. Called after each band with the fraction done; returning false stops the
     // render (ErrorKind::Cancelled).
@@ -61,7 +61,7 @@ struct Image {
 // Per-pixel data of the last render, for tests and picking: hit mask, ray distance and
 // iteration count (first sample of each pixel).
 struct PixelInfo {
-    float depth;     // ray parameter t of the hit, or a negative value for a miss
+    float depth; // ray parameter t of the hit, or a negative value for a miss
     uint32_t steps;
 };
 

@@ -32,12 +32,12 @@ struct Transform {
 
 struct Node {
     NodeKind kind = NodeKind::Sphere;
-    std::string name;               // optional label
-    std::string path;               // JSON path in the source, e.g. "root.children[1]"
+    std::string name; // optional label
+    std::string path; // JSON path in the source, e.g. "root.children[1]"
     Transform transform;
-    std::optional<glm::vec3> color; // unset: inherited from the parent
+    std::optional<glm::vec3> color;         // unset: inherited from the parent
     std::array<float, kMaxParams> params{}; // laid out by the kind's ParamInfo::slot
-    std::vector<uint32_t> children;  // indices into Scene::nodes, operations only
+    std::vector<uint32_t> children;         // indices into Scene::nodes, operations only
     // Polygon: its points; text: its string and font (ParamInfo::slot indexes strings).
     std::vector<glm::vec2> points;
     std::array<std::string, 2> strings;
@@ -60,20 +60,20 @@ struct Light {
 };
 
 struct Scene {
-    std::string file;          // where it came from, for messages
-    std::vector<Node> nodes;   // nodes[0] is the root; a parent always precedes its children
+    std::string file;             // where it came from, for messages
+    std::vector<Node> nodes;      // nodes[0] is the root; a parent always precedes its children
     std::optional<Camera> camera; // unset: framed automatically from the scene's bounds
     std::vector<Light> lights;    // empty: the default two-light rig (defaultLights())
     glm::vec3 background{0.60f, 0.72f, 0.85f};
-    std::string name;          // optional title ("name" in the file)
-    std::string description;   // optional free text ("description" in the file)
+    std::string name;        // optional title ("name" in the file)
+    std::string description; // optional free text ("description" in the file)
 };
 
 // Limits enforced while loading, before any work that depends on the input's size.
 struct Limits {
     size_t maxFileBytes = 16u << 20; // 16 MiB
     uint32_t maxNodes = 16384;
-    uint32_t maxDepth = 64;          // operations nested inside operations
+    uint32_t maxDepth = 64; // operations nested inside operations
 };
 
 // Parses and validates a scene in either the current format or the legacy SDFBooleanEngine

@@ -206,7 +206,8 @@ class Emitter {
                     ")) && all(lessThanEqual(p, " + vec2Literal(box.z, box.w) + "));\n";
             uint32_t at = uint32_t(range.x);
             for (uint32_t s = 0; s < uint32_t(range.y); ++s, ++at) {
-                const std::string a = vec2Literal(w[at].x, w[at].y), b = vec2Literal(w[at].z, w[at].w);
+                const std::string a = vec2Literal(w[at].x, w[at].y),
+                                  b = vec2Literal(w[at].z, w[at].w);
                 out_ += "    if (holds) winding += lineCrossing(p, " + a + ", " + b + ");\n";
                 out_ += "    best = min(best, sqSegment2(p, " + a + ", " + b + "));\n";
             }
@@ -214,8 +215,8 @@ class Emitter {
                 const std::string a = vec2Literal(w[at].x, w[at].y),
                                   b = vec2Literal(w[at].z, w[at].w),
                                   c = vec2Literal(w[at + 1].x, w[at + 1].y);
-                out_ += "    if (holds) winding += quadraticCrossing(p, " + a + ", " + c + ", " + b +
-                        ");\n";
+                out_ += "    if (holds) winding += quadraticCrossing(p, " + a + ", " + c + ", " +
+                        b + ");\n";
                 out_ += "    best = min(best, sqQuadratic2(p, " + a + ", " + c + ", " + b + "));\n";
             }
         }
@@ -281,8 +282,7 @@ class Emitter {
         const Node& n = scene_.nodes[i];
         const uint32_t kind = uint32_t(n.kind);
         const std::string level = std::to_string(points_.size());
-        const std::string local = "l" + level, best = "b" + level, c = "c" + level,
-                          q = "q" + level;
+        const std::string local = "l" + level, best = "b" + level, c = "c" + level, q = "q" + level;
         indent(depth);
         out_ += sample_ ? "vec4 " : "float ";
         var(i);
@@ -355,7 +355,8 @@ class Emitter {
             value += " * ";
             appendFloat(value, (*lit_)[i].color.w);
         }
-        if (sdf::domainClamps(kind)) value = "max(" + value + ", " + boundsDistanceOf(i, point()) + ")";
+        if (sdf::domainClamps(kind))
+            value = "max(" + value + ", " + boundsDistanceOf(i, point()) + ")";
         indent(depth + 1);
         var(i);
         out_ += " = ";
@@ -518,8 +519,8 @@ class Emitter {
     const Scene& scene_;
     std::string& out_;
     const std::vector<detail::GpuNode>* lit_; // null: values come from the node buffer
-    bool tests_;                                  // CodegenOptions::boundsTests
-    std::vector<bool> gridded_;                   // per node, see the constructor
+    bool tests_;                              // CodegenOptions::boundsTests
+    std::vector<bool> gridded_;               // per node, see the constructor
     bool sample_ = false;
     std::vector<std::string> points_{"p"}; // see point()
     std::vector<bool> loops_;              // per open domain operation: whether it loops
@@ -588,8 +589,8 @@ std::string generateSceneGlsl(const Scene& scene, const CodegenOptions& options)
         appendCommentText(out, scene.file.empty() ? std::string_view("<scene>") : scene.file);
         out += " (" + std::to_string(scene.nodes.size()) +
                " nodes, evaluated per region from pruned tapes: shaders/tape.glsl).\n"
-               "#define SDFCSG_TAPE_STACK " + std::to_string(stack) +
-               "\n#define SDFCSG_TAPE_KINDS " + std::to_string(kinds) +
+               "#define SDFCSG_TAPE_STACK " +
+               std::to_string(stack) + "\n#define SDFCSG_TAPE_KINDS " + std::to_string(kinds) +
                "u\n#define SDFCSG_TAPE_OPERATIONS " + std::to_string(operations) +
                "\n#define SDFCSG_TAPE_BALLS " + (balls ? "1" : "0") +
                "\n#define SDFCSG_TAPE_DOMAINS " + std::to_string(domains) +

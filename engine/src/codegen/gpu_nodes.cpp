@@ -82,7 +82,8 @@ Result<bool> uploadField(Context::Impl& ctx, Buffer& buffer, std::span<const uin
     const VkDeviceSize bytes = words.size() * sizeof(uint32_t);
     bool made = false;
     if (!buffer.buffer || buffer.size < bytes) {
-        auto grown = createBuffer(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::Upload);
+        auto grown =
+            createBuffer(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::Upload);
         if (!grown) return grown.error();
         destroyBuffer(ctx, buffer);
         buffer = *grown;

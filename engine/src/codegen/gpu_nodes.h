@@ -1,9 +1,9 @@
 // The node buffer: one GpuNode per scene node, index-aligned, read by the generated scene code.
 #pragma once
 
+#include "gpu/vk.h"
 #include "sdfcsg/compile.h"
 #include "sdfcsg/eval.h"
-#include "gpu/vk.h"
 
 #include <glm/vec4.hpp>
 

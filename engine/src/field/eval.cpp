@@ -189,7 +189,8 @@ V evaluate(const std::vector<FlatNode>& nodes, uint32_t root, glm::vec3 p, bool 
             const FlatNode& op = nodes[f.node];
             const Role role = roleOf(op.kind);
             if (role == Role::Value) {
-                value = withDistance(value, sdf::valueOp(uint32_t(op.kind), dist(value), kernelA(op)));
+                value =
+                    withDistance(value, sdf::valueOp(uint32_t(op.kind), dist(value), kernelA(op)));
                 stack.pop_back();
                 continue;
             }
@@ -201,8 +202,8 @@ V evaluate(const std::vector<FlatNode>& nodes, uint32_t root, glm::vec3 p, bool 
                 while (!again && ++f.candidate < f.count) {
                     const glm::vec4 q =
                         sdf::domainPoint(kind, f.local, kernelA(op), kernelB(op), f.candidate);
-                    again = q.w == 0.0f && (!skipping || child.bounds.signedDistance(glm::vec3(q)) <
-                                                             dist(f.acc));
+                    again = q.w == 0.0f &&
+                            (!skipping || child.bounds.signedDistance(glm::vec3(q)) < dist(f.acc));
                     if (again) p = glm::vec3(q);
                 }
                 if (again) {
@@ -298,7 +299,8 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
         // least the product of its factors'), which is exact for uniform scales.
         const glm::dvec3 s(src.transform.scale);
         glm::dvec3 t(src.transform.translate);
-        const glm::dmat3 scaling(glm::dvec3(s.x, 0, 0), glm::dvec3(0, s.y, 0), glm::dvec3(0, 0, s.z));
+        const glm::dmat3 scaling(glm::dvec3(s.x, 0, 0), glm::dvec3(0, s.y, 0),
+                                 glm::dvec3(0, 0, s.z));
         const glm::dmat3 unscaling(glm::dvec3(1 / s.x, 0, 0), glm::dvec3(0, 1 / s.y, 0),
                                    glm::dvec3(0, 0, 1 / s.z));
         glm::dmat3 inv = unscaling * glm::transpose(r);
@@ -344,8 +346,8 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
         const KindInfo& info = kindInfo(n.kind);
         if (!isOperation(n.kind)) {
             glm::vec3 lo, hi;
-            n.bounds = sdf::localBounds(n.kind, n.params, lo, hi) ? toFrame(i, lo, hi)
-                                                                 : infiniteBox();
+            n.bounds =
+                sdf::localBounds(n.kind, n.params, lo, hi) ? toFrame(i, lo, hi) : infiniteBox();
         } else if (info.role == Role::Value) {
             // Lengths in the frame's units, as the child's values are.
             Params values = scene.nodes[i].params;
@@ -353,8 +355,8 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
             const Aabb& child = nodes_[n.children[0]].bounds;
             n.params = info.kernelAround(values, child.min, child.max);
             n.bounds = child;
-            if (child.finite()) info.boundsAround(n.params, child.min, child.max, n.bounds.min,
-                                                  n.bounds.max);
+            if (child.finite())
+                info.boundsAround(n.params, child.min, child.max, n.bounds.min, n.bounds.max);
         } else if (info.role == Role::Domain) {
             const Aabb& child = nodes_[n.children[0]].bounds;
             if (!child.finite()) { // refused by the parser, but for mirror and elongate

@@ -32,10 +32,9 @@ NodeKind opcode(uint32_t instruction) {
 }
 
 template <class V> V opValue(const FlatNode& op, V a, V b) {
-    return op.kind == NodeKind::Union ? sdf::opUnion(a, b, op.smooth, op.blend)
-           : op.kind == NodeKind::Intersection
-               ? sdf::opIntersection(a, b, op.smooth, op.blend)
-               : sdf::opDifference(a, b, op.smooth, op.blend);
+    return op.kind == NodeKind::Union          ? sdf::opUnion(a, b, op.smooth, op.blend)
+           : op.kind == NodeKind::Intersection ? sdf::opIntersection(a, b, op.smooth, op.blend)
+                                               : sdf::opDifference(a, b, op.smooth, op.blend);
 }
 
 // Looked up for every instruction of every cell's pass: a table of their own.
@@ -60,10 +59,18 @@ glm::vec4 kernelB(const FlatNode& n) {
     return {n.params[4], n.params[5], n.params[6], n.params[7]};
 }
 
-float distanceOf(float v) { return v; }
-float distanceOf(glm::vec4 v) { return v.w; }
-float withDistance(float, float d) { return d; }
-glm::vec4 withDistance(glm::vec4 v, float d) { return {glm::vec3(v), d}; }
+float distanceOf(float v) {
+    return v;
+}
+float distanceOf(glm::vec4 v) {
+    return v.w;
+}
+float withDistance(float, float d) {
+    return d;
+}
+glm::vec4 withDistance(glm::vec4 v, float d) {
+    return {glm::vec3(v), d};
+}
 
 // Runs tape[begin, end) at p. V: float (distance) or vec4 (colour, distance in w).
 template <class V>
@@ -89,10 +96,10 @@ V run(const std::vector<FlatNode>& nodes, const uint32_t* tape, uint32_t length,
             const FlatNode& child = nodes[n.children[0]];
             bool again = false;
             while (!again && ++d.candidate < d.count) {
-                const glm::vec4 q = sdf::domainPoint(kind, d.local, kernelA(n), kernelB(n),
-                                                     d.candidate);
-                again = q.w == 0.0f &&
-                        child.bounds.signedDistance(glm::vec3(q)) < distanceOf(d.best);
+                const glm::vec4 q =
+                    sdf::domainPoint(kind, d.local, kernelA(n), kernelB(n), d.candidate);
+                again =
+                    q.w == 0.0f && child.bounds.signedDistance(glm::vec3(q)) < distanceOf(d.best);
                 if (again) p = glm::vec3(q);
             }
             if (again) {
@@ -118,8 +125,8 @@ V run(const std::vector<FlatNode>& nodes, const uint32_t* tape, uint32_t length,
                 stack.push_back(glm::vec4(n.color, d));
         } else if (role == Role::Domain) {
             const uint32_t k = uint32_t(kind);
-            const glm::vec3 local =
-                nodeLocalPoint(n, sdf::domainClamps(k) ? glm::clamp(p, n.bounds.min, n.bounds.max) : p);
+            const glm::vec3 local = nodeLocalPoint(
+                n, sdf::domainClamps(k) ? glm::clamp(p, n.bounds.min, n.bounds.max) : p);
             domains.push_back({p, local, withDistance(V{}, INFINITY), 0,
                                sdf::domainCount(k, kernelA(n), kernelB(n)), i + 1});
             p = glm::vec3(sdf::domainPoint(k, local, kernelA(n), kernelB(n), 0));
@@ -157,10 +164,10 @@ struct Pruner {
     const std::vector<FlatNode>& nodes;
     const std::vector<uint32_t>& spans; // per domain node: its instructions, the end included
     float slack;
-    std::vector<float> value;    // per instruction of `in` and cell: the value of its subtree
-    std::vector<float> extreme;  // per node and cell: least (union) / greatest operand value
+    std::vector<float> value;   // per instruction of `in` and cell: the value of its subtree
+    std::vector<float> extreme; // per node and cell: least (union) / greatest operand value
     std::vector<uint32_t> touched;
-    std::vector<uint32_t> ends;  // first pass: the stack, as the instructions that end its values
+    std::vector<uint32_t> ends; // first pass: the stack, as the instructions that end its values
     struct Segment {
         uint32_t start; // in out
         uint32_t end;   // its last instruction in `in` (value[end] is its value at c)
@@ -403,8 +410,8 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) 
     }
     const glm::uvec3 dims = field.dims;
     field.cells.assign(size_t(dims.x) * dims.y * dims.z, glm::uvec2(0));
-    const float slack = 1e-5f * (field.cell * float(dims.x + dims.y + dims.z) +
-                                 glm::length(field.origin));
+    const float slack =
+        1e-5f * (field.cell * float(dims.x + dims.y + dims.z) + glm::length(field.origin));
 
     // Sets every leaf entry under the cell `at` of `level` (in cells of its level).
     auto fillLeaves = [&](glm::uvec3 at, uint32_t level, glm::uvec2 entry) {
@@ -455,7 +462,8 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) 
             for (size_t g = t; g < groups && !overBudget; g += used) {
                 const Cell& parent = cells[level == 0 ? g * lanes : g];
                 const uint32_t count =
-                    level == 0 ? uint32_t(std::min<size_t>(lanes, cells.size() - g * lanes)) : lanes;
+                    level == 0 ? uint32_t(std::min<size_t>(lanes, cells.size() - g * lanes))
+                               : lanes;
                 for (uint32_t l = 0; l < count; ++l) {
                     at[l] = level == 0 ? cells[g * lanes + l].at
                                        : parent.at * 2u + glm::uvec3(l & 1, l >> 1 & 1, l >> 2);
@@ -471,14 +479,16 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) 
                     glm::vec3 rise(0.0f);
                     for (uint32_t l = 0; l < lanes; ++l)
                         rise += glm::vec3(l & 1 ? 1.0f : -1.0f, l & 2 ? 1.0f : -1.0f,
-                                          l & 4 ? 1.0f : -1.0f) * roots[l];
+                                          l & 4 ? 1.0f : -1.0f) *
+                                roots[l];
                     ascent = farGradientBits(rise);
                 }
                 for (uint32_t l = 0; l < count; ++l) {
                     const float v = roots[l];
                     if (std::abs(v) > far) { // no surface: fill its leaf cells
-                        fillLeaves(at[l], level,
-                                   glm::uvec2(std::bit_cast<uint32_t>(v), kFarCell | ascent | level));
+                        fillLeaves(
+                            at[l], level,
+                            glm::uvec2(std::bit_cast<uint32_t>(v), kFarCell | ascent | level));
                         continue;
                     }
                     const uint32_t begin = uint32_t(out.tapes.size());

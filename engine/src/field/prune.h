@@ -46,19 +46,19 @@ inline constexpr uint32_t kTapeNodeMask = (1u << kTapeNodeBits) - 1u;
 inline constexpr uint32_t kFarCell = 0x80000000u;
 
 struct PruneOptions {
-    uint32_t levels = 5;          // octree levels below the top grid's cells; 0: no pruning
-    uint32_t cells = 1u << 19;    // about this many leaf cells in the bounds
+    uint32_t levels = 5;       // octree levels below the top grid's cells; 0: no pruning
+    uint32_t cells = 1u << 19; // about this many leaf cells in the bounds
     // At most about this many tape words (4 bytes each) per level: where the tree prunes too
     // little for that, refinement stops and the leaf cells run their coarser parents' tapes.
     size_t maxWords = size_t(1) << 24;
 };
 
 struct PrunedField {
-    glm::vec3 origin{0.0f}; // the grid's minimum corner
-    float cell = 1.0f;      // leaf cell side
-    uint32_t levels = 0;    // a top cell holds 2^levels leaf cells per axis
-    glm::uvec3 dims{0};     // leaf cells per axis
-    bool bounded = false;   // outside the grid, the field is at least its distance to it
+    glm::vec3 origin{0.0f};  // the grid's minimum corner
+    float cell = 1.0f;       // leaf cell side
+    uint32_t levels = 0;     // a top cell holds 2^levels leaf cells per axis
+    glm::uvec3 dims{0};      // leaf cells per axis
+    bool bounded = false;    // outside the grid, the field is at least its distance to it
     uint32_t fullLength = 0; // tape[0, fullLength) is the whole tree
     uint32_t stackDepth = 0; // the most values any tape holds at once
     std::vector<uint32_t> tape;

@@ -280,8 +280,8 @@ Status detail::setUpContext(Context::Impl& impl, const ContextOptions& options,
         if (!wanted.empty())
             return vulkanError(
                 "no Vulkan 1.1 device with a compute queue and subgroup ballot matches "
-                "SDFCSG_DEVICE=\"" + wanted +
-                "\"; devices:" + list);
+                "SDFCSG_DEVICE=\"" +
+                wanted + "\"; devices:" + list);
         return vulkanError(
             "no Vulkan 1.1 device with a compute queue and subgroup ballot; devices:" + list);
     }

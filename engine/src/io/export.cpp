@@ -9,8 +9,8 @@
 #include "sdfcsg/export.h"
 #include "sdfcsg/io.h"
 
-#include "scene/json_writer.h"
 #include "io/zip.h"
+#include "scene/json_writer.h"
 
 #include <glm/geometric.hpp>
 

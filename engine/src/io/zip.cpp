@@ -40,7 +40,7 @@ std::optional<std::string> deflateRaw(std::string_view data) {
 }
 
 constexpr uint32_t kDate = (0 << 9) | (1 << 5) | 1; // 1980-01-01 in DOS form
-constexpr uint32_t kVersion = 20;                     // 2.0: deflate
+constexpr uint32_t kVersion = 20;                   // 2.0: deflate
 constexpr uint32_t kDeflate = 8;
 
 } // namespace
@@ -54,9 +54,9 @@ std::optional<std::string> zipArchive(std::span<const ZipEntry> entries) {
         auto packed = deflateRaw(e.data);
         if (!packed || out.size() + packed->size() + 64 + e.name.size() >= kMax)
             return std::nullopt;
-        const uint32_t crc = uint32_t(crc32(crc32(0L, Z_NULL, 0),
-                                            reinterpret_cast<const Bytef*>(e.data.data()),
-                                            uInt(e.data.size())));
+        const uint32_t crc =
+            uint32_t(crc32(crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(e.data.data()),
+                           uInt(e.data.size())));
         const uint32_t offset = uint32_t(out.size());
         // The fields from "version needed" to the name's length, the same in both headers.
         std::string common;

@@ -4,8 +4,8 @@
 #include "sdfcsg/eval.h"
 #include "sdfcsg/generate.h"
 
-#include "scene/parse_util.h"
 #include "field/sdf.h"
+#include "scene/parse_util.h"
 
 #include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>

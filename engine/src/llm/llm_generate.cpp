@@ -3,8 +3,8 @@
 // fallbacks, and the repair loop around parseScene().
 #include "sdfcsg/generate.h"
 
-#include "scene/json_writer.h"
 #include "llm/llm_http.h"
+#include "scene/json_writer.h"
 #include "scene/parse_util.h"
 
 #include <simdjson.h>

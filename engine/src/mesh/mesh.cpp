@@ -18,12 +18,12 @@
 // Vertices and triangles come out in brick order, so the mesh is the same on every run.
 #include "sdfcsg/mesh.h"
 
-#include "render/camera.h"
 #include "codegen/gpu_nodes.h"
-#include "mesh/mc_tables.h"
-#include "mesh/mesh_dual.h"
 #include "codegen/shader_compile.h"
 #include "gpu/vk.h"
+#include "mesh/mc_tables.h"
+#include "mesh/mesh_dual.h"
+#include "render/camera.h"
 
 #include "sdfcsg/compile.h"
 
@@ -48,8 +48,8 @@ using detail::Buffer;
 using detail::MemoryUse;
 
 constexpr uint32_t kBrick = SDFCSG_MESH_BRICK;
-constexpr uint32_t kBatchBricks = 4096;      // bricks sampled and classified per submission
-constexpr uint32_t kMaxGroups = 65535;       // the minimum maxComputeWorkGroupCount[0]
+constexpr uint32_t kBatchBricks = 4096;   // bricks sampled and classified per submission
+constexpr uint32_t kMaxGroups = 65535;    // the minimum maxComputeWorkGroupCount[0]
 constexpr uint64_t kMaxActive = 1u << 22; // slots * SDFCSG_MESH_RECORD fits a uint32_t index
 // Bytes each active brick holds for the whole extraction: slot, record, counts, bases.
 constexpr uint64_t kBytesPerActive = 4 + SDFCSG_MESH_RECORD * 4 + 16 + 16;
@@ -114,8 +114,8 @@ std::vector<uint32_t> packTables() {
                                               << (8 * (k % 4));
     }
     for (int e = 0; e < 12; ++e)
-        t[1280 + e] =
-            bits(detail::kCornerOffset[detail::kEdgeCorners[e][0]]) | detail::kEdgeAxis[e] << 3;
+        t[1280 + e] = bits(detail::kCornerOffset[detail::kEdgeCorners[e][0]]) | detail::kEdgeAxis[e]
+                                                                                    << 3;
     for (uint32_t canonical = 0; canonical < 256; ++canonical) {
         uint32_t c = 0;
         for (uint32_t k = 0; k < 8; ++k)
@@ -129,8 +129,8 @@ std::vector<uint32_t> packTables() {
             }
     }
     for (int e = 0; e < 12; ++e)
-        t[1548 + 8 * detail::kEdgeAxis[e] + bits(detail::kCornerOffset[detail::kEdgeCorners[e][0]])] =
-            uint32_t(e);
+        t[1548 + 8 * detail::kEdgeAxis[e] +
+          bits(detail::kCornerOffset[detail::kEdgeCorners[e][0]])] = uint32_t(e);
     return t;
 }
 
@@ -285,13 +285,16 @@ struct Mesher::Impl {
         case SDFCSG_BINDING_MESH_ACTIVE:
         case SDFCSG_BINDING_MESH_BASES:
         case SDFCSG_BINDING_MESH_HERMITE:
-        case SDFCSG_BINDING_FIELD: return MemoryUse::Upload;
+        case SDFCSG_BINDING_FIELD:
+            return MemoryUse::Upload;
         case SDFCSG_BINDING_MESH_MAP: // written by the cull pass, read and rewritten by the host
         case SDFCSG_BINDING_MESH_COUNTS:
         case SDFCSG_BINDING_MESH_VERTICES:
         case SDFCSG_BINDING_MESH_INDICES:
-        case SDFCSG_BINDING_MESH_STATUS: return MemoryUse::Staging;
-        default: return MemoryUse::Device;
+        case SDFCSG_BINDING_MESH_STATUS:
+            return MemoryUse::Staging;
+        default:
+            return MemoryUse::Device;
         }
     }
 
@@ -365,8 +368,7 @@ struct Mesher::Impl {
     }
 
     void dispatch(VkCommandBuffer cmd, const MeshPush& push, uint32_t groups) {
-        vkCmdPushConstants(cmd, pipelineLayout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push,
-                           &push);
+        vkCmdPushConstants(cmd, pipelineLayout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
         vkCmdDispatch(cmd, groups, 1, 1);
     }
 
@@ -409,9 +411,8 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
     Impl& m = *impl;
     m.evaluator = std::make_unique<Evaluator>(scene);
     // Pruned on the host while the kernels build, as in Renderer::create.
-    auto fieldWords = std::async(std::launch::async, [&] {
-        return detail::fieldWords(scene, *m.evaluator, evaluation);
-    });
+    auto fieldWords = std::async(
+        std::launch::async, [&] { return detail::fieldWords(scene, *m.evaluator, evaluation); });
 
     CodegenOptions codegen;
     codegen.inlineParams = true;
@@ -432,11 +433,11 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
                          : b.binding == SDFCSG_BINDING_FIELD       ? 0 // uploadField() makes it
                                                                    : 4;
         if (b.binding == SDFCSG_BINDING_FIELD) continue;
-        auto made = detail::createBuffer(
-            m.ctx, bytes,
-            b.type == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER ? VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT
-                                                        : VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-            Impl::memoryUse(b.binding));
+        auto made = detail::createBuffer(m.ctx, bytes,
+                                         b.type == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER
+                                             ? VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT
+                                             : VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                         Impl::memoryUse(b.binding));
         if (!made) return made.error();
         m.buffer(b.binding) = *made;
     }
@@ -444,7 +445,8 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
                          nodes.size() * sizeof nodes[0]);
     detail::uploadBuffer(m.ctx, m.buffer(SDFCSG_BINDING_MESH_TABLES), tables.data(),
                          tables.size() * 4);
-    if (auto made = detail::uploadField(m.ctx, m.buffer(SDFCSG_BINDING_FIELD), detail::emptyField());
+    if (auto made =
+            detail::uploadField(m.ctx, m.buffer(SDFCSG_BINDING_FIELD), detail::emptyField());
         !made)
         return made.error();
     MeshGrid empty = {};
@@ -561,9 +563,9 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
     gridUniform.bricks = glm::uvec4(g.bricks, 0);
     const float halfDiagonal = 0.5f * std::sqrt(3.0f) * float(kBrick) * g.h;
     const bool dual = options.method == MeshMethod::DualContouring;
-    gridUniform.cull = glm::vec4(cullBricks ? halfDiagonal * 1.001f : INFINITY,
-                                 dual ? kDualNormalOffset : 0.0f,
-                                 dual ? kDualNormalTaps : kNormalTaps, 0);
+    gridUniform.cull =
+        glm::vec4(cullBricks ? halfDiagonal * 1.001f : INFINITY, dual ? kDualNormalOffset : 0.0f,
+                  dual ? kDualNormalTaps : kNormalTaps, 0);
     detail::uploadBuffer(ctx, buffer(SDFCSG_BINDING_MESH_GRID), &gridUniform, sizeof gridUniform);
     const uint32_t zero[2] = {0, 0};
     detail::uploadBuffer(ctx, buffer(SDFCSG_BINDING_MESH_STATUS), zero, sizeof zero);
@@ -612,17 +614,17 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
         return overBudget(g, "the " + std::to_string(activeCount) + " bricks that hold surface",
                           fixedBytes, options.memoryBudget);
     detail::uploadBuffer(ctx, buffer(SDFCSG_BINDING_MESH_MAP), map.data(), map.size() * 4);
-    for (auto [binding, bytes] : {std::pair{SDFCSG_BINDING_MESH_ACTIVE, activeCount * 4ull},
-                                  {SDFCSG_BINDING_MESH_RECORDS, activeCount * uint64_t(SDFCSG_MESH_RECORD) * 4},
-                                  {SDFCSG_BINDING_MESH_COUNTS, activeCount * 16ull},
-                                  {SDFCSG_BINDING_MESH_BASES, activeCount * 16ull},
-                                  {SDFCSG_BINDING_MESH_SAMPLES,
-                                   batchBricks * uint64_t(SDFCSG_MESH_BRICK_BLOCK) * 4},
-                                  {SDFCSG_BINDING_MESH_EDGES,
-                                   batchBricks * uint64_t(SDFCSG_MESH_BRICK_EDGES) * 4}})
+    for (auto [binding, bytes] :
+         {std::pair{SDFCSG_BINDING_MESH_ACTIVE, activeCount * 4ull},
+          {SDFCSG_BINDING_MESH_RECORDS, activeCount * uint64_t(SDFCSG_MESH_RECORD) * 4},
+          {SDFCSG_BINDING_MESH_COUNTS, activeCount * 16ull},
+          {SDFCSG_BINDING_MESH_BASES, activeCount * 16ull},
+          {SDFCSG_BINDING_MESH_SAMPLES, batchBricks * uint64_t(SDFCSG_MESH_BRICK_BLOCK) * 4},
+          {SDFCSG_BINDING_MESH_EDGES, batchBricks * uint64_t(SDFCSG_MESH_BRICK_EDGES) * 4}})
         if (auto ok = reserve(binding, bytes); !ok) return ok.error();
-    if (activeCount) detail::uploadBuffer(ctx, buffer(SDFCSG_BINDING_MESH_ACTIVE), active.data(),
-                                          active.size() * 4);
+    if (activeCount)
+        detail::uploadBuffer(ctx, buffer(SDFCSG_BINDING_MESH_ACTIVE), active.data(),
+                             active.size() * 4);
     notePeak(map.size() * 4);
 
     // Per active brick: the first edge point, marching-cubes triangle, dual vertex and dual
@@ -637,9 +639,8 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
     };
     // The [first, end) range of bases[.][k] over the batch of `push`.
     auto batchRange = [&](const MeshPush& push, int k) {
-        const uint64_t end = push.first + push.count < activeCount
-                                 ? bases[push.first + push.count][k]
-                                 : totals[k];
+        const uint64_t end =
+            push.first + push.count < activeCount ? bases[push.first + push.count][k] : totals[k];
         return std::pair<uint32_t, uint64_t>(bases[push.first][k], end);
     };
     Mesh mesh;
@@ -659,10 +660,9 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
         if (!progress(1)) return cancelled;
 
         const uint64_t batchVertices = totals.x - push.vertexBase;
-        const uint64_t meshBytes =
-            dual ? totals.x * kBytesPerVertex + totals.z * kBytesPerVertex +
-                       totals.w * kBytesPerTriangle
-                 : totals.x * kBytesPerVertex + totals.y * kBytesPerTriangle;
+        const uint64_t meshBytes = dual ? totals.x * kBytesPerVertex + totals.z * kBytesPerVertex +
+                                              totals.w * kBytesPerTriangle
+                                        : totals.x * kBytesPerVertex + totals.y * kBytesPerTriangle;
         if (totals.x > UINT32_MAX || totals.z > UINT32_MAX ||
             fixedBytes + meshBytes > options.memoryBudget)
             return overBudget(g, "the mesh", fixedBytes + meshBytes, options.memoryBudget);
@@ -722,7 +722,8 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
         if (auto ok = reserve(SDFCSG_BINDING_MESH_INDICES, batchTriangles * 12); !ok)
             return ok.error();
         if (dual) {
-            if (auto ok = reserve(SDFCSG_BINDING_MESH_VERTICES, (endVertex - firstVertex) * 48); !ok)
+            if (auto ok = reserve(SDFCSG_BINDING_MESH_VERTICES, (endVertex - firstVertex) * 48);
+                !ok)
                 return ok.error();
         }
         VkCommandBuffer cmd = begin(dual ? dualPass : triangles);

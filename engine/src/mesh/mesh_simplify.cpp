@@ -287,11 +287,10 @@ struct Probe {
 // least index, so that it is sampled alike in every mesh that holds it. Reports the fraction
 // sampled to `progress`, and stops early (the errors unfinished) where it says stop.
 template <class Distance, class Keep>
-std::vector<float> triangleErrors(const std::vector<glm::vec3>& positions,
-                                  const std::vector<uint32_t>& indices, float spacing,
-                                  const Distance& distance, const Keep& keep,
-                                  std::vector<Probe>& kept, bool parallel,
-                                  Progress* progress = nullptr) {
+std::vector<float>
+triangleErrors(const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices,
+               float spacing, const Distance& distance, const Keep& keep, std::vector<Probe>& kept,
+               bool parallel, Progress* progress = nullptr) {
     const size_t triangles = indices.size() / 3;
     std::vector<float> errors(triangles, 0.0f);
     auto run = [&](size_t begin, size_t end, std::vector<Probe>& out) {

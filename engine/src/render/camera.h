@@ -111,7 +111,7 @@ inline std::vector<SurfacePart> surfaceParts(const Evaluator& evaluator) {
 // the surfaces.
 struct ClipVolume {
     Aabb box;
-    float far;               // no ray goes beyond this t
+    float far;                      // no ray goes beyond this t
     std::vector<SurfacePart> parts; // surfaceParts(); empty: the box alone
 };
 

@@ -4,11 +4,11 @@
 // per-pixel info.
 #include "sdfcsg/render.h"
 
-#include "render/camera.h"
 #include "codegen/gpu_nodes.h"
 #include "codegen/shader_compile.h"
 #include "field/prune.h"
 #include "gpu/vk.h"
+#include "render/camera.h"
 
 #include "sdfcsg/compile.h"
 #include "sdfcsg/eval.h"
@@ -49,7 +49,7 @@ struct FrameUniform {
     glm::vec4 distances; // depth near, depth far, occlusion scale, shadow reach
     FrameLight lights[SDFCSG_MAX_LIGHTS];
     glm::vec4 surfaceBoxes[2 * SDFCSG_MAX_CLIP_BOXES]; // surface parts, as in raymarch.glsl
-    glm::vec4 grid; // centre x, z; plane height; spacing
+    glm::vec4 grid;                                    // centre x, z; plane height; spacing
 };
 static_assert(sizeof(FrameUniform) ==
               10 * 16 + SDFCSG_MAX_LIGHTS * 48 + SDFCSG_MAX_CLIP_BOXES * 32);
@@ -114,7 +114,7 @@ struct BandConstants {
 };
 
 constexpr uint32_t kGroupSize = SDFCSG_RAYMARCH_GROUP_X * SDFCSG_RAYMARCH_GROUP_Y;
-constexpr VkDeviceSize kHitsHeader = 16; // count, then the shade pass's dispatch
+constexpr VkDeviceSize kHitsHeader = 16;   // count, then the shade pass's dispatch
 constexpr VkDeviceSize kSurfaceBytes = 64; // per listed hit: four vec4 (raymarch.glsl)
 constexpr VkDeviceSize kRangeBytes = 32;   // per sample: two vec4 (raymarch.glsl)
 
@@ -148,7 +148,9 @@ Result<std::shared_ptr<SharedPasses>> sharedPasses(Context::Impl& ctx) {
 } // namespace
 
 // Polygon and text outlines follow the nodes in their buffer: a new size is a new buffer.
-static size_t outlineSize(const Node& n) { return n.outline ? n.outline->size() : 0; }
+static size_t outlineSize(const Node& n) {
+    return n.outline ? n.outline->size() : 0;
+}
 
 bool sameStructure(const Scene& a, const Scene& b) {
     if (a.nodes.size() != b.nodes.size()) return false;
@@ -183,9 +185,9 @@ struct Renderer::Impl {
     // the workgroups to march and the hits to shade.
     Buffer frame, control, nodes, pixels, info, pixelsStaging, infoStaging, samples, hits, tiles,
         surfaces, ranges, field;
-    uint32_t capacity = 0;       // pixels the image buffers hold
-    uint32_t sampleCapacity = 0; // samples the band buffers hold
-    uint32_t tileCapacity = 0;   // workgroups the tile list holds
+    uint32_t capacity = 0;         // pixels the image buffers hold
+    uint32_t sampleCapacity = 0;   // samples the band buffers hold
+    uint32_t tileCapacity = 0;     // workgroups the tile list holds
     bool samplesArePixels = false; // what the SAMPLES binding points at
     std::vector<PixelInfo> lastInfo;
 
@@ -349,8 +351,8 @@ struct Renderer::Impl {
     }
 
     static std::array<detail::SpecConstant, 2> specConstants(uint32_t pass, bool skipping) {
-        return {{{SDFCSG_SPEC_BOUNDS_SKIPPING, skipping ? 1u : 0u},
-                 {SDFCSG_SPEC_RAYMARCH_PASS, pass}}};
+        return {
+            {{SDFCSG_SPEC_BOUNDS_SKIPPING, skipping ? 1u : 0u}, {SDFCSG_SPEC_RAYMARCH_PASS, pass}}};
     }
 
     VkPipeline createPipeline(VkShaderModule module, uint32_t pass, bool skipping) const {
@@ -509,8 +511,8 @@ struct Renderer::Impl {
         fc.parts.x = uint32_t(clip.parts.size());
         for (size_t i = 0; i < clip.parts.size(); ++i) {
             const detail::SurfacePart& part = clip.parts[i];
-            f.surfaceBoxes[2 * i] = part.halfSpace ? glm::vec4(part.normal, 1.0f)
-                                                   : glm::vec4(part.box.min, 0.0f);
+            f.surfaceBoxes[2 * i] =
+                part.halfSpace ? glm::vec4(part.normal, 1.0f) : glm::vec4(part.box.min, 0.0f);
             f.surfaceBoxes[2 * i + 1] = part.halfSpace ? glm::vec4(part.offset, 0.0f, 0.0f, 0.0f)
                                                        : glm::vec4(part.box.max, 0.0f);
         }
@@ -617,9 +619,9 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene
         r.ctx, sizeof(FrameControl), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, detail::MemoryUse::Upload);
     if (!control) return control.error();
     r.control = *control;
-    auto nodes =
-        detail::createBuffer(r.ctx, detail::packNodes(*r.evaluator).size() * sizeof(detail::GpuNode),
-                             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, detail::MemoryUse::Upload);
+    auto nodes = detail::createBuffer(
+        r.ctx, detail::packNodes(*r.evaluator).size() * sizeof(detail::GpuNode),
+        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, detail::MemoryUse::Upload);
     if (!nodes) return nodes.error();
     r.nodes = *nodes;
     if (auto uploaded = r.uploadNodes(detail::emptyField()); !uploaded) return uploaded.error();
@@ -686,13 +688,13 @@ Result<Image> Renderer::render(const RenderOptions& options) {
     // seconds), and the caller can follow progress and stop between bands.
     const uint64_t count = uint64_t(options.width) * options.height;
     const uint32_t aa = options.aa;
-    const uint64_t rowGroupSamples =
-        uint64_t(options.width) * aa * aa * SDFCSG_RAYMARCH_GROUP_Y;
+    const uint64_t rowGroupSamples = uint64_t(options.width) * aa * aa * SDFCSG_RAYMARCH_GROUP_Y;
     const uint32_t bandGroups = uint32_t(std::max<uint64_t>(1, kBandSamples / rowGroupSamples));
     const uint64_t bandSamples = rowGroupSamples * bandGroups;
     const uint64_t sampleColumns = uint64_t(options.width) * aa;
     const uint32_t groupsY = detail::groupCount(options.height, SDFCSG_RAYMARCH_GROUP_Y);
-    const uint64_t groupsX = (sampleColumns + SDFCSG_RAYMARCH_GROUP_X - 1) / SDFCSG_RAYMARCH_GROUP_X;
+    const uint64_t groupsX =
+        (sampleColumns + SDFCSG_RAYMARCH_GROUP_X - 1) / SDFCSG_RAYMARCH_GROUP_X;
     if (count * 8 > limits.maxStorageBufferRange ||
         kHitsHeader + bandSamples * 8 > limits.maxStorageBufferRange ||
         groupsX > limits.maxComputeWorkGroupCount[0] || groupsX > 0xffff ||
@@ -705,7 +707,8 @@ Result<Image> Renderer::render(const RenderOptions& options) {
                                   (aa > 1 ? " at aa " + std::to_string(aa) : std::string()) +
                                   " is too large for " + r.ctx.properties.deviceName);
     if (auto reserved = r.reserve(uint32_t(count)); !reserved) return reserved.error();
-    if (auto reserved = r.reserveSamples(uint32_t(bandSamples), uint32_t(groupsX) * bandGroups * aa);
+    if (auto reserved =
+            r.reserveSamples(uint32_t(bandSamples), uint32_t(groupsX) * bandGroups * aa);
         !reserved)
         return reserved.error();
     // One sample per pixel: the passes write the image directly and no resolve runs.
@@ -750,8 +753,8 @@ Result<Image> Renderer::render(const RenderOptions& options) {
         glm::uvec3 u(glm::clamp(c, 0.0f, 1.0f) * 255.0f + 0.5f);
         return u.r | (u.g << 8) | (u.b << 16) | (255u << 24);
     };
-    const uint32_t missColor = packed(options.mode == RenderMode::Shaded ? r.scene.background
-                                                                          : glm::vec3(0.0f));
+    const uint32_t missColor =
+        packed(options.mode == RenderMode::Shaded ? r.scene.background : glm::vec3(0.0f));
     const float missInfo = -1.0f;
     uint32_t missInfoBits;
     std::memcpy(&missInfoBits, &missInfo, sizeof missInfoBits);
@@ -791,8 +794,8 @@ Result<Image> Renderer::render(const RenderOptions& options) {
         vkCmdFillBuffer(cmd, r.hits.buffer, 0, 8, 0); // count, and the shade dispatch's x
         vkCmdFillBuffer(cmd, r.hits.buffer, 8, 8, 1); // its y and z
         detail::recordComputeBarrier(cmd);
-        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r.pipelineLayout, 0, 1,
-                                &r.set, 0, nullptr);
+        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r.pipelineLayout, 0, 1, &r.set,
+                                0, nullptr);
         vkCmdPushConstants(cmd, r.pipelineLayout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof band,
                            &band);
         if (!tiles.empty()) { // the listed workgroups' samples
@@ -834,7 +837,8 @@ Result<Image> Renderer::render(const RenderOptions& options) {
     const auto* info = static_cast<const float*>(detail::readback(r.ctx, r.info, &r.infoStaging));
     r.lastInfo.resize(count);
     for (uint64_t i = 0; i < count; ++i)
-        r.lastInfo[i] = PixelInfo{info[2 * i], info[2 * i + 1] > 0.0f ? uint32_t(info[2 * i + 1]) : 0u};
+        r.lastInfo[i] =
+            PixelInfo{info[2 * i], info[2 * i + 1] > 0.0f ? uint32_t(info[2 * i + 1]) : 0u};
     return image;
 }
 

@@ -122,7 +122,8 @@ void JsonWriter::string(std::string_view text) {
 }
 
 // JSON has no NaN or infinity; null makes the reader fail with a clear message instead. Zero is
-// written without a sign: a reader may take "-0" for the integer 0, and no field gives -0 a meaning.
+// written without a sign: a reader may take "-0" for the integer 0, and no field gives -0 a
+// meaning.
 void JsonWriter::number(double value) {
     beforeValue();
     out_ += !std::isfinite(value) ? "null" : value == 0.0 ? "0" : formatNumber(value);

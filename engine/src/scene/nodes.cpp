@@ -16,23 +16,61 @@ constexpr ParamInfo kBox[] = {
     {"size", Vec3, Positive, 0, true, {}, "length", "Full edge lengths along x, y and z."},
 };
 constexpr ParamInfo kRoundBox[] = {
-    {"size", Vec3, Positive, 0, true, {}, "length", "Full edge lengths along x, y and z, rounding included."},
-    {"radius", Number, NonNegative, 3, true, {}, "length",
+    {"size",
+     Vec3,
+     Positive,
+     0,
+     true,
+     {},
+     "length",
+     "Full edge lengths along x, y and z, rounding included."},
+    {"radius",
+     Number,
+     NonNegative,
+     3,
+     true,
+     {},
+     "length",
      "Edge rounding radius; at most half the smallest edge length."},
 };
 constexpr ParamInfo kPlane[] = {
-    {"normal", Vec3, NonZero, 0, false, {0, 1, 0}, "direction",
+    {"normal",
+     Vec3,
+     NonZero,
+     0,
+     false,
+     {0, 1, 0},
+     "direction",
      "Outward normal; the solid is the half-space behind it. Normalised on load."},
-    {"offset", Number, Any, 3, false, {0, 0, 0}, "length",
+    {"offset",
+     Number,
+     Any,
+     3,
+     false,
+     {0, 0, 0},
+     "length",
      "Signed distance of the plane from the origin along the normal."},
 };
 constexpr ParamInfo kTriangularPrism[] = {
     {"width", Number, Positive, 0, true, {}, "length", "Base width of the triangle (x)."},
-    {"height", Number, Positive, 1, true, {}, "length", "Height of the triangle from base to apex (y)."},
+    {"height",
+     Number,
+     Positive,
+     1,
+     true,
+     {},
+     "length",
+     "Height of the triangle from base to apex (y)."},
     {"length", Number, Positive, 2, true, {}, "length", "Extrusion length (z)."},
 };
 constexpr ParamInfo kTorus[] = {
-    {"major_radius", Number, Positive, 0, true, {}, "length",
+    {"major_radius",
+     Number,
+     Positive,
+     0,
+     true,
+     {},
+     "length",
      "Radius of the ring's centre line, in the xz plane."},
     {"minor_radius", Number, Positive, 1, true, {}, "length", "Radius of the tube."},
 };
@@ -41,9 +79,22 @@ constexpr ParamInfo kCylinder[] = {
     {"height", Number, Positive, 1, true, {}, "length", "Full height along y."},
 };
 constexpr ParamInfo kCone[] = {
-    {"radius", Number, Positive, 0, true, {}, "length", "Base radius (at the bottom, y = -height/2)."},
+    {"radius",
+     Number,
+     Positive,
+     0,
+     true,
+     {},
+     "length",
+     "Base radius (at the bottom, y = -height/2)."},
     {"height", Number, Positive, 1, true, {}, "length", "Full height along y."},
-    {"top_radius", Number, NonNegative, 2, false, {0, 0, 0}, "length",
+    {"top_radius",
+     Number,
+     NonNegative,
+     2,
+     false,
+     {0, 0, 0},
+     "length",
      "Radius at the top (y = +height/2); 0 gives a pointed cone, more a frustum (truncated cone)."},
 };
 constexpr ParamInfo kCapsule[] = {
@@ -55,7 +106,13 @@ constexpr ParamInfo kEllipsoid[] = {
     {"radii", Vec3, Positive, 0, true, {}, "length", "Semi-axes along x, y and z."},
 };
 constexpr ParamInfo kHexPrism[] = {
-    {"radius", Number, Positive, 0, true, {}, "length",
+    {"radius",
+     Number,
+     Positive,
+     0,
+     true,
+     {},
+     "length",
      "Distance from the axis to the corners of the hexagon (two of them lie on the x axis)."},
     {"height", Number, Positive, 1, true, {}, "length", "Full height along y."},
 };
@@ -69,29 +126,66 @@ constexpr ParamInfo kPyramid[] = {
 constexpr ParamInfo kRoundedCylinder[] = {
     {"radius", Number, Positive, 0, true, {}, "length", "Radius, rounding included."},
     {"height", Number, Positive, 1, true, {}, "length", "Full height along y, rounding included."},
-    {"rounding", Number, NonNegative, 2, true, {}, "length",
+    {"rounding",
+     Number,
+     NonNegative,
+     2,
+     true,
+     {},
+     "length",
      "Radius of the rounded rims; clamped to the radius and to half the height."},
 };
 constexpr ParamInfo kRoundCone[] = {
     {"radius", Number, Positive, 0, true, {}, "length", "Radius of the bottom sphere."},
     {"top_radius", Number, Positive, 1, true, {}, "length", "Radius of the top sphere."},
-    {"height", Number, Positive, 2, true, {}, "length",
+    {"height",
+     Number,
+     Positive,
+     2,
+     true,
+     {},
+     "length",
      "Distance between the two spheres' centres (y); where one sphere holds the other, the "
      "solid is the larger sphere."},
 };
 constexpr ParamInfo kLink[] = {
-    {"length", Number, NonNegative, 0, true, {}, "length",
+    {"length",
+     Number,
+     NonNegative,
+     0,
+     true,
+     {},
+     "length",
      "Length of the straight sides (y); 0 gives a torus standing in the xy plane."},
-    {"major_radius", Number, Positive, 1, true, {}, "length",
+    {"major_radius",
+     Number,
+     Positive,
+     1,
+     true,
+     {},
+     "length",
      "Radius of the centre line's round ends."},
     {"minor_radius", Number, Positive, 2, true, {}, "length", "Radius of the wire."},
 };
 constexpr ParamInfo kCappedTorus[] = {
-    {"major_radius", Number, Positive, 0, true, {}, "length",
+    {"major_radius",
+     Number,
+     Positive,
+     0,
+     true,
+     {},
+     "length",
      "Radius of the ring's centre line, in the xz plane."},
     {"minor_radius", Number, Positive, 1, true, {}, "length", "Radius of the tube."},
-    {"angle", Number, Positive, 2, true, {}, "degrees",
-     "Angle the arc spans, centred on +z; 360 closes the ring.", 360.0f},
+    {"angle",
+     Number,
+     Positive,
+     2,
+     true,
+     {},
+     "degrees",
+     "Angle the arc spans, centred on +z; 360 closes the ring.",
+     360.0f},
 };
 constexpr ParamInfo kCircle[] = {
     {"radius", Number, Positive, 0, true, {}, "length", "Radius."},
@@ -99,101 +193,229 @@ constexpr ParamInfo kCircle[] = {
 constexpr ParamInfo kRectangle[] = {
     {"width", Number, Positive, 0, true, {}, "length", "Width along x."},
     {"height", Number, Positive, 1, true, {}, "length", "Height along y."},
-    {"rounding", Number, NonNegative, 2, false, {0, 0, 0}, "length",
+    {"rounding",
+     Number,
+     NonNegative,
+     2,
+     false,
+     {0, 0, 0},
+     "length",
      "Radius of the rounded corners; clamped to half the smaller side."},
 };
 constexpr ParamInfo kRegularPolygon[] = {
-    {"radius", Number, Positive, 0, true, {}, "length",
+    {"radius",
+     Number,
+     Positive,
+     0,
+     true,
+     {},
+     "length",
      "Distance from the centre to each corner; one edge is flat on top (+y)."},
     {"sides", Number, Count, 1, true, {}, "sides", "Number of sides.", 64.0f, {}, 3.0f},
 };
 constexpr ParamInfo kPolygon[] = {
-    {"points", Points, Any, 0, true, {}, "points",
+    {"points",
+     Points,
+     Any,
+     0,
+     true,
+     {},
+     "points",
      "The corners [[x, y], ...] in order, either way round: 3 to 1024 of them, edges that do "
      "not cross (a simple polygon)."},
 };
 constexpr ParamInfo kText[] = {
     {"text", Text, Any, 0, true, {}, "characters", "One line of text, at most 256 characters."},
-    {"size", Number, Positive, 0, false, {1, 0, 0}, "length",
+    {"size",
+     Number,
+     Positive,
+     0,
+     false,
+     {1, 0, 0},
+     "length",
      "Font size: the height of the font's em square (capitals are about 0.7 of it)."},
-    {"font", Text, Any, 1, false, {}, "file",
+    {"font",
+     Text,
+     Any,
+     1,
+     false,
+     {},
+     "file",
      "A TrueType or OpenType font file; empty or absent: DejaVu Sans (Debian's "
      "fonts-dejavu-core)."},
 };
 constexpr ParamInfo kExtrude[] = {
-    {"height", Number, Positive, 0, true, {}, "length",
+    {"height",
+     Number,
+     Positive,
+     0,
+     true,
+     {},
+     "length",
      "Thickness along z, centred on the profile's plane."},
-    {"rounding", Number, NonNegative, 1, false, {0, 0, 0}, "length",
+    {"rounding",
+     Number,
+     NonNegative,
+     1,
+     false,
+     {0, 0, 0},
+     "length",
      "Radius of the rounded edges where the sides meet the faces; clamped to half the height."},
 };
 constexpr ParamInfo kRevolve[] = {
-    {"offset", Number, Any, 0, false, {0, 0, 0}, "length",
+    {"offset",
+     Number,
+     Any,
+     0,
+     false,
+     {0, 0, 0},
+     "length",
      "Distance of the axis from the profile's x = 0: the profile turns about the y axis after "
      "moving +offset along x (a ring from a circle)."},
 };
 constexpr std::string_view kBlends[] = {"smooth", "round", "chamfer"};
 constexpr ParamInfo kOperation[] = {
-    {"smooth", Number, NonNegative, 0, false, {0, 0, 0}, "length",
+    {"smooth",
+     Number,
+     NonNegative,
+     0,
+     false,
+     {0, 0, 0},
+     "length",
      "Blend radius where the operands meet; 0 gives sharp edges. Colours blend over the same "
      "width."},
-    {"blend", Choice, Any, 1, false, {0, 0, 0}, "profile",
+    {"blend",
+     Choice,
+     Any,
+     1,
+     false,
+     {0, 0, 0},
+     "profile",
      "Profile of the blend: \"smooth\" (polynomial smooth minimum/maximum), \"round\" (a "
      "circular fillet, of radius `smooth` where the surfaces meet at a right angle) or "
      "\"chamfer\" (a flat bevel cutting `smooth` off each surface).",
-     3.4e38f, kBlends},
+     3.4e38f,
+     kBlends},
 };
 
 constexpr ParamInfo kShell[] = {
     {"thickness", Number, Positive, 0, true, {}, "length", "Thickness of the skin."},
 };
 constexpr ParamInfo kOffset[] = {
-    {"distance", Number, Any, 0, true, {}, "length",
+    {"distance",
+     Number,
+     Any,
+     0,
+     true,
+     {},
+     "length",
      "How far the surface moves outwards; negative moves it inwards."},
 };
 constexpr ParamInfo kRepeat[] = {
     {"count", Vec3, Count, 0, true, {}, "copies", "Copies along x, y and z (1: no repetition)."},
-    {"spacing", Vec3, Positive, 3, true, {}, "length",
+    {"spacing",
+     Vec3,
+     Positive,
+     3,
+     true,
+     {},
+     "length",
      "Distance between neighbouring copies' centres along x, y and z."},
 };
 constexpr ParamInfo kPolarRepeat[] = {
     {"count", Number, Count, 0, true, {}, "copies", "Copies around the axis."},
-    {"radius", Number, Any, 1, false, {0, 0, 0}, "length",
+    {"radius",
+     Number,
+     Any,
+     1,
+     false,
+     {0, 0, 0},
+     "length",
      "How far the child moves along +x before it is copied around the y axis."},
 };
 constexpr std::string_view kMirrorAxes[] = {"x", "y", "z", "xy", "xz", "yz", "xyz"};
 constexpr uint32_t kMirrorMasks[] = {1, 2, 4, 3, 5, 6, 7};
 constexpr ParamInfo kMirror[] = {
-    {"axes", Choice, Any, 0, false, {0, 0, 0}, "axes",
+    {"axes",
+     Choice,
+     Any,
+     0,
+     false,
+     {0, 0, 0},
+     "axes",
      "The axes whose planes through the origin mirror the child: \"x\" keeps x >= 0 and "
      "mirrors it to x < 0, and so on.",
-     3.4e38f, kMirrorAxes},
-    {"smooth", Number, NonNegative, 1, false, {0, 0, 0}, "length",
+     3.4e38f,
+     kMirrorAxes},
+    {"smooth",
+     Number,
+     NonNegative,
+     1,
+     false,
+     {0, 0, 0},
+     "length",
      "Blend radius of the seam at each mirror plane; 0 gives the exact mirror image."},
 };
 constexpr ParamInfo kElongate[] = {
-    {"length", Vec3, NonNegative, 0, true, {}, "length",
+    {"length",
+     Vec3,
+     NonNegative,
+     0,
+     true,
+     {},
+     "length",
      "How far apart the halves move along x, y and z."},
 };
 constexpr ParamInfo kTwist[] = {
-    {"angle", Number, Any, 0, true, {}, "degrees per unit length",
+    {"angle",
+     Number,
+     Any,
+     0,
+     true,
+     {},
+     "degrees per unit length",
      "Turn about y per unit of height (positive: counter-clockwise seen from +y)."},
 };
 constexpr ParamInfo kBend[] = {
-    {"angle", Number, Any, 0, true, {}, "degrees per unit length",
+    {"angle",
+     Number,
+     Any,
+     0,
+     true,
+     {},
+     "degrees per unit length",
      "Turn in the xy plane per unit along x."},
 };
 constexpr ParamInfo kTaper[] = {
-    {"height", Number, Positive, 0, true, {}, "length",
+    {"height",
+     Number,
+     Positive,
+     0,
+     true,
+     {},
+     "length",
      "Height over which the scale changes, centred on y = 0."},
-    {"top_scale", Number, Positive, 1, true, {}, "factor",
+    {"top_scale",
+     Number,
+     Positive,
+     1,
+     true,
+     {},
+     "factor",
      "Scale of x and z at y = +height/2 (1 at y = -height/2)."},
 };
 
 // Kernel parameters and local bounds (see KindInfo::kernel and ::bounds).
 using glm::vec3;
-Params halve3(const Params& v) { return {0.5f * v[0], 0.5f * v[1], 0.5f * v[2]}; }
-bool symmetric(vec3 half, vec3& lo, vec3& hi) { return lo = -half, hi = half, true; }
-float radians(float degrees) { return float(double(degrees) * 3.14159265358979323846 / 180.0); }
+Params halve3(const Params& v) {
+    return {0.5f * v[0], 0.5f * v[1], 0.5f * v[2]};
+}
+bool symmetric(vec3 half, vec3& lo, vec3& hi) {
+    return lo = -half, hi = half, true;
+}
+float radians(float degrees) {
+    return float(double(degrees) * 3.14159265358979323846 / 180.0);
+}
 
 // The largest distance from the y axis (reach) or from the z axis (reachXY) over a box.
 float reach(vec3 lo, vec3 hi) {
@@ -207,7 +429,9 @@ float reachXY(vec3 lo, vec3 hi) {
 
 // The largest singular value of the identity plus a column of length a, a bound of the twist's
 // and the bend's Jacobians where the turn per unit times the distance from the axis is a.
-float stretch(float a) { return 0.5f * (a + std::sqrt(a * a + 4.0f)) * (1.0f + 1e-6f); }
+float stretch(float a) {
+    return 0.5f * (a + std::sqrt(a * a + 4.0f)) * (1.0f + 1e-6f);
+}
 
 // Repeat: spacing s, count n, and per axis the copies either side of the nearest that can reach
 // a point (M, packed a byte each); the evaluation takes the nearest copy, M more either side and
@@ -273,14 +497,18 @@ constexpr KindInfo kKinds[] = {
      [](const Params& k, vec3& lo, vec3& hi) { return symmetric(vec3(k[0]), lo, hi); }},
     {NodeKind::Box, "box", false, kBox, "Axis-aligned box centred at the origin.", "sdBox", kA3,
      halve3,
-     [](const Params& k, vec3& lo, vec3& hi) { return symmetric({k[0], k[1], k[2]}, lo, hi); }},
+     [](const Params& k, vec3& lo, vec3& hi) {
+         return symmetric({k[0], k[1], k[2]}, lo, hi);
+     }},
     {NodeKind::RoundBox, "round_box", false, kRoundBox,
      "Box with rounded edges, centred at the origin.", "sdRoundBox", kA3A1,
      [](const Params& v) -> Params {
          vec3 b = 0.5f * vec3(v[0], v[1], v[2]);
          return {b.x, b.y, b.z, std::min(v[3], std::min(b.x, std::min(b.y, b.z)))};
      },
-     [](const Params& k, vec3& lo, vec3& hi) { return symmetric({k[0], k[1], k[2]}, lo, hi); }},
+     [](const Params& k, vec3& lo, vec3& hi) {
+         return symmetric({k[0], k[1], k[2]}, lo, hi);
+     }},
     {NodeKind::Plane, "plane", false, kPlane, "Half-space bounded by a plane (infinite).",
      "sdPlane", kA3A1,
      [](const Params& v) -> Params {
@@ -291,25 +519,38 @@ constexpr KindInfo kKinds[] = {
      },
      [](const Params&, vec3&, vec3&) { return false; }},
     {NodeKind::TriangularPrism, "triangular_prism", false, kTriangularPrism,
-     "Isosceles triangle in the xy plane (apex up, +y) extruded along z, its bounding box centred at "
+     "Isosceles triangle in the xy plane (apex up, +y) extruded along z, its bounding box centred "
+     "at "
      "the origin. A gable roof is one of these.",
      "sdTriangularPrism", kA0A1A2,
-     [](const Params& v) -> Params { return {0.5f * v[0], v[1], 0.5f * v[2]}; },
+     [](const Params& v) -> Params {
+         return {0.5f * v[0], v[1], 0.5f * v[2]};
+     },
      [](const Params& k, vec3& lo, vec3& hi) {
          return symmetric({k[0], 0.5f * k[1], k[2]}, lo, hi);
      }},
     {NodeKind::Torus, "torus", false, kTorus, "Ring around the y axis, centred at the origin.",
-     "sdTorus", kA0A1, [](const Params& v) -> Params { return {v[0], v[1]}; },
+     "sdTorus", kA0A1,
+     [](const Params& v) -> Params {
+         return {v[0], v[1]};
+     },
      [](const Params& k, vec3& lo, vec3& hi) {
          return symmetric({k[0] + k[1], k[1], k[0] + k[1]}, lo, hi);
      }},
     {NodeKind::Cylinder, "cylinder", false, kCylinder,
      "Capped cylinder along y, centred at the origin.", "sdCylinder", kA0A1,
-     [](const Params& v) -> Params { return {v[0], 0.5f * v[1]}; },
-     [](const Params& k, vec3& lo, vec3& hi) { return symmetric({k[0], k[1], k[0]}, lo, hi); }},
+     [](const Params& v) -> Params {
+         return {v[0], 0.5f * v[1]};
+     },
+     [](const Params& k, vec3& lo, vec3& hi) {
+         return symmetric({k[0], k[1], k[0]}, lo, hi);
+     }},
     {NodeKind::Cone, "cone", false, kCone,
      "Capped cone along y, base at the bottom, centred at the origin (half way up).", "sdCone",
-     kA0A1A2, [](const Params& v) -> Params { return {v[0], 0.5f * v[1], v[2]}; },
+     kA0A1A2,
+     [](const Params& v) -> Params {
+         return {v[0], 0.5f * v[1], v[2]};
+     },
      [](const Params& k, vec3& lo, vec3& hi) {
          float r = std::max(k[0], k[2]);
          return symmetric({r, k[1], r}, lo, hi);
@@ -336,7 +577,9 @@ constexpr KindInfo kKinds[] = {
     {NodeKind::HexPrism, "hex_prism", false, kHexPrism,
      "Regular hexagonal prism along y, centred at the origin (a nut, a bolt head, a pencil).",
      "sdHexPrism", kA0A1,
-     [](const Params& v) -> Params { return {v[0] * 0.8660254f, 0.5f * v[1]}; },
+     [](const Params& v) -> Params {
+         return {v[0] * 0.8660254f, 0.5f * v[1]};
+     },
      [](const Params& k, vec3& lo, vec3& hi) {
          return symmetric({k[0] / 0.8660254f, k[1], k[0]}, lo, hi);
      }},
@@ -347,7 +590,9 @@ constexpr KindInfo kKinds[] = {
     {NodeKind::Pyramid, "pyramid", false, kPyramid,
      "Square pyramid, base at the bottom, apex up (+y), its bounding box centred at the origin.",
      "sdPyramid", kA0A1A2,
-     [](const Params& v) -> Params { return {v[0], v[1] / v[0], 0.5f * v[1]}; },
+     [](const Params& v) -> Params {
+         return {v[0], v[1] / v[0], 0.5f * v[1]};
+     },
      [](const Params& k, vec3& lo, vec3& hi) {
          return symmetric({0.5f * k[0], k[2], 0.5f * k[0]}, lo, hi);
      }},
@@ -382,8 +627,10 @@ constexpr KindInfo kKinds[] = {
          return true;
      }},
     {NodeKind::Link, "link", false, kLink,
-     "Chain link standing in the xy plane, long along y, centred at the origin.", "sdLink",
-     kA0A1A2, [](const Params& v) -> Params { return {0.5f * v[0], v[1], v[2]}; },
+     "Chain link standing in the xy plane, long along y, centred at the origin.", "sdLink", kA0A1A2,
+     [](const Params& v) -> Params {
+         return {0.5f * v[0], v[1], v[2]};
+     },
      [](const Params& k, vec3& lo, vec3& hi) {
          return symmetric({k[1] + k[2], k[0] + k[1] + k[2], k[2]}, lo, hi);
      }},
@@ -426,46 +673,108 @@ constexpr KindInfo kKinds[] = {
      "FreeType and centred on the origin (the middle of its outlines' extents); exact distance "
      "to the glyphs' outlines.",
      "sdOutline", kOutlineArgs, nullptr, outlineBounds},
-    {NodeKind::Union, "union", true, kOperation, "All children together.", {}, {}, nullptr,
-     nullptr, Role::Boolean},
-    {NodeKind::Intersection, "intersection", true, kOperation, "What all children have in common.",
-     {}, {}, nullptr, nullptr, Role::Boolean},
-    {NodeKind::Difference, "difference", true, kOperation, "The first child minus all the others.",
-     {}, {}, nullptr, nullptr, Role::Boolean},
-    {NodeKind::Shell, "shell", true, kShell,
+    {NodeKind::Union,
+     "union",
+     true,
+     kOperation,
+     "All children together.",
+     {},
+     {},
+     nullptr,
+     nullptr,
+     Role::Boolean},
+    {NodeKind::Intersection,
+     "intersection",
+     true,
+     kOperation,
+     "What all children have in common.",
+     {},
+     {},
+     nullptr,
+     nullptr,
+     Role::Boolean},
+    {NodeKind::Difference,
+     "difference",
+     true,
+     kOperation,
+     "The first child minus all the others.",
+     {},
+     {},
+     nullptr,
+     nullptr,
+     Role::Boolean},
+    {NodeKind::Shell,
+     "shell",
+     true,
+     kShell,
      "Its child hollowed to a skin of the given thickness, centred on the child's surface (an "
      "onion). Cut it open with a difference to see inside.",
-     {}, {}, nullptr, nullptr, Role::Value,
+     {},
+     {},
+     nullptr,
+     nullptr,
+     Role::Value,
      [](const Params& v, vec3, vec3) -> Params { return {0.5f * v[0]}; },
      [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
          outLo = lo - k[0], outHi = hi + k[0];
      }},
-    {NodeKind::Offset, "offset", true, kOffset,
-     "Its child grown by a distance (rounding its edges), or shrunk by a negative one.", {}, {},
-     nullptr, nullptr, Role::Value, [](const Params& v, vec3, vec3) -> Params { return {v[0]}; },
+    {NodeKind::Offset,
+     "offset",
+     true,
+     kOffset,
+     "Its child grown by a distance (rounding its edges), or shrunk by a negative one.",
+     {},
+     {},
+     nullptr,
+     nullptr,
+     Role::Value,
+     [](const Params& v, vec3, vec3) -> Params { return {v[0]}; },
      [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
          outLo = lo - std::max(k[0], 0.0f), outHi = hi + std::max(k[0], 0.0f);
      }},
-    {NodeKind::Repeat, "repeat", true, kRepeat,
+    {NodeKind::Repeat,
+     "repeat",
+     true,
+     kRepeat,
      "A grid of copies of its child, centred on the origin: count copies along each axis, "
      "spacing apart. Costs about one copy to evaluate, however many there are.",
-     {}, {}, nullptr, nullptr, Role::Domain, repeatKernel,
+     {},
+     {},
+     nullptr,
+     nullptr,
+     Role::Domain,
+     repeatKernel,
      [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
          const vec3 span = 0.5f * (vec3(k[4], k[5], k[6]) - 1.0f) * vec3(k[0], k[1], k[2]);
          outLo = lo - span, outHi = hi + span;
      }},
-    {NodeKind::PolarRepeat, "polar_repeat", true, kPolarRepeat,
+    {NodeKind::PolarRepeat,
+     "polar_repeat",
+     true,
+     kPolarRepeat,
      "Copies of its child around the y axis, evenly spaced: the child moved radius along +x, "
      "then turned about y by each multiple of 360 / count degrees. Costs about one copy.",
-     {}, {}, nullptr, nullptr, Role::Domain, polarKernel,
+     {},
+     {},
+     nullptr,
+     nullptr,
+     Role::Domain,
+     polarKernel,
      [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
          const float r = reach(lo + vec3(k[1], 0, 0), hi + vec3(k[1], 0, 0));
          outLo = vec3(-r, lo.y, -r), outHi = vec3(r, hi.y, r);
      }},
-    {NodeKind::Mirror, "mirror", true, kMirror,
+    {NodeKind::Mirror,
+     "mirror",
+     true,
+     kMirror,
      "Its child's part on the positive side of each chosen axis plane, and that part's mirror "
      "image (a symmetric shape from one half).",
-     {}, {}, nullptr, nullptr, Role::Domain,
+     {},
+     {},
+     nullptr,
+     nullptr,
+     Role::Domain,
      [](const Params& v, vec3, vec3) -> Params {
          const uint32_t mask = kMirrorMasks[size_t(v[0])];
          return {float(mask & 1), float(mask >> 1 & 1), float(mask >> 2 & 1), v[1]};
@@ -477,41 +786,73 @@ constexpr KindInfo kKinds[] = {
              outHi[a] = k[a] != 0.0f ? e : hi[a];
          }
      }},
-    {NodeKind::Elongate, "elongate", true, kElongate,
+    {NodeKind::Elongate,
+     "elongate",
+     true,
+     kElongate,
      "Its child cut through its centre planes and stretched apart by the given lengths: a sphere "
      "becomes a capsule or a rounded box, a torus a stadium-shaped ring.",
-     {}, {}, nullptr, nullptr, Role::Domain,
-     [](const Params& v, vec3, vec3) -> Params { return {0.5f * v[0], 0.5f * v[1], 0.5f * v[2]}; },
+     {},
+     {},
+     nullptr,
+     nullptr,
+     Role::Domain,
+     [](const Params& v, vec3, vec3) -> Params {
+         return {0.5f * v[0], 0.5f * v[1], 0.5f * v[2]};
+     },
      [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
          outLo = lo - vec3(k[0], k[1], k[2]), outHi = hi + vec3(k[0], k[1], k[2]);
      }},
-    {NodeKind::Twist, "twist", true, kTwist,
+    {NodeKind::Twist,
+     "twist",
+     true,
+     kTwist,
      "Its child twisted about the y axis, turning by the given angle per unit of height. The "
      "field is divided by the twist's Lipschitz bound, so it stays safe to trace.",
-     {}, {}, nullptr, nullptr, Role::Domain,
+     {},
+     {},
+     nullptr,
+     nullptr,
+     Role::Domain,
      [](const Params& v, vec3, vec3) -> Params { return {radians(v[0])}; },
      [](const Params&, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
          const float r = reach(lo, hi);
          outLo = vec3(-r, lo.y, -r), outHi = vec3(r, hi.y, r);
      },
      [](const Params& k, vec3 lo, vec3 hi) { return stretch(std::abs(k[0]) * reach(lo, hi)); }},
-    {NodeKind::Bend, "bend", true, kBend,
+    {NodeKind::Bend,
+     "bend",
+     true,
+     kBend,
      "Its child bent in the xy plane about the z axis, turning by the given angle per unit "
      "along x: a bar along x becomes an arc. The field is divided by the bend's Lipschitz "
      "bound.",
-     {}, {}, nullptr, nullptr, Role::Domain,
+     {},
+     {},
+     nullptr,
+     nullptr,
+     Role::Domain,
      [](const Params& v, vec3, vec3) -> Params { return {radians(v[0])}; },
      [](const Params&, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
          const float r = reachXY(lo, hi);
          outLo = vec3(-r, -r, lo.z), outHi = vec3(r, r, hi.z);
      },
      [](const Params& k, vec3 lo, vec3 hi) { return stretch(std::abs(k[0]) * reachXY(lo, hi)); }},
-    {NodeKind::Taper, "taper", true, kTaper,
+    {NodeKind::Taper,
+     "taper",
+     true,
+     kTaper,
      "Its child scaled in x and z by a factor that changes linearly with height: 1 at y = "
      "-height/2, top_scale at y = +height/2, constant beyond. The field is divided by the "
      "taper's Lipschitz bound.",
-     {}, {}, nullptr, nullptr, Role::Domain,
-     [](const Params& v, vec3, vec3) -> Params { return {0.5f * v[0], v[1]}; },
+     {},
+     {},
+     nullptr,
+     nullptr,
+     Role::Domain,
+     [](const Params& v, vec3, vec3) -> Params {
+         return {0.5f * v[0], v[1]};
+     },
      [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
          const float top = k[1];
          outLo = vec3(std::min(lo.x, lo.x * top), lo.y, std::min(lo.z, lo.z * top));
@@ -528,20 +869,34 @@ constexpr KindInfo kKinds[] = {
          const float slope = std::abs(top - 1.0f) / (2.0f * hh);
          return std::max(1.0f / least, 1.0f) + reach(lo, hi) * slope / (least * least);
      }},
-    {NodeKind::Extrude, "extrude", true, kExtrude,
+    {NodeKind::Extrude,
+     "extrude",
+     true,
+     kExtrude,
      "The cross-section of its child in the plane z = 0 (a 2D profile: circle, rectangle, "
      "polygon, text...) swept along z to the given thickness. Exact where the child's field is.",
-     {}, {}, nullptr, nullptr, Role::Domain,
+     {},
+     {},
+     nullptr,
+     nullptr,
+     Role::Domain,
      [](const Params& v, vec3, vec3) -> Params {
          return {0.5f * v[0], std::min(v[1], 0.5f * v[0])};
      },
      [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
          outLo = vec3(lo.x, lo.y, -k[0]), outHi = vec3(hi.x, hi.y, k[0]);
      }},
-    {NodeKind::Revolve, "revolve", true, kRevolve,
+    {NodeKind::Revolve,
+     "revolve",
+     true,
+     kRevolve,
      "The cross-section of its child in the plane z = 0, its part at x >= -offset, turned about "
      "the y axis (a lathe): a vase, a chess piece, a ring.",
-     {}, {}, nullptr, nullptr, Role::Domain,
+     {},
+     {},
+     nullptr,
+     nullptr,
+     Role::Domain,
      [](const Params& v, vec3, vec3) -> Params { return {v[0]}; },
      [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
          const float r = std::max(hi.x + k[0], 0.0f);
@@ -552,16 +907,19 @@ static_assert(sizeof(kKinds) / sizeof(kKinds[0]) == kNodeKindCount);
 
 constexpr CommonKey kCommonKeys[] = {
     {"type", R"({"type":"string"})", "Node kind: a primitive or an operation name."},
-    {"name", R"({"type":"string","maxLength":200})", "Optional label, shown in errors and in generated GLSL."},
+    {"name", R"({"type":"string","maxLength":200})",
+     "Optional label, shown in errors and in generated GLSL."},
     {"translate", R"({"type":"array","items":{"type":"number"},"minItems":3,"maxItems":3})",
      "Translation [x, y, z] in parent units, applied after rotation and scale."},
     {"rotate", R"({"type":"array","items":{"type":"number"},"minItems":3,"maxItems":3})",
      "Rotation in degrees about x, then y, then z."},
-    {"scale", R"({"oneOf":[{"type":"number","exclusiveMinimum":0},{"type":"array","items":{"type":"number","exclusiveMinimum":0},"minItems":3,"maxItems":3}]})",
+    {"scale",
+     R"({"oneOf":[{"type":"number","exclusiveMinimum":0},{"type":"array","items":{"type":"number","exclusiveMinimum":0},"minItems":3,"maxItems":3}]})",
      "Scale factor (> 0), one for every axis or [x, y, z]. Where the factors differ the field "
      "is scaled by the smallest, a lower bound of the distance: sphere tracing stays safe, "
      "but takes more steps."},
-    {"color", R"({"oneOf":[{"type":"array","items":{"type":"number","minimum":0,"maximum":1},"minItems":3,"maxItems":3},{"type":"string","pattern":"^#[0-9a-fA-F]{6}$"}]})",
+    {"color",
+     R"({"oneOf":[{"type":"array","items":{"type":"number","minimum":0,"maximum":1},"minItems":3,"maxItems":3},{"type":"string","pattern":"^#[0-9a-fA-F]{6}$"}]})",
      "Colour as [r, g, b] in 0..1 or \"#rrggbb\"; inherited by children that set none."},
     {"children", R"({"type":"array","minItems":1,"items":{"$ref":"#/$defs/node"}})",
      "Operations only: the operands, at least one."},
@@ -569,9 +927,13 @@ constexpr CommonKey kCommonKeys[] = {
 
 } // namespace
 
-std::span<const KindInfo> nodeKinds() { return kKinds; }
+std::span<const KindInfo> nodeKinds() {
+    return kKinds;
+}
 
-const KindInfo& kindInfo(NodeKind kind) { return kKinds[static_cast<int>(kind)]; }
+const KindInfo& kindInfo(NodeKind kind) {
+    return kKinds[static_cast<int>(kind)];
+}
 
 const KindInfo* findKind(std::string_view name) {
     for (const KindInfo& k : kKinds)
@@ -579,6 +941,8 @@ const KindInfo* findKind(std::string_view name) {
     return nullptr;
 }
 
-std::span<const CommonKey> commonNodeKeys() { return kCommonKeys; }
+std::span<const CommonKey> commonNodeKeys() {
+    return kCommonKeys;
+}
 
 } // namespace sdfcsg

@@ -13,7 +13,9 @@ namespace sdfcsg::detail {
 
 namespace {
 
-float cross(glm::vec2 a, glm::vec2 b) { return a.x * b.y - a.y * b.x; }
+float cross(glm::vec2 a, glm::vec2 b) {
+    return a.x * b.y - a.y * b.x;
+}
 
 // A curve whose control point lies on its chord (within a millionth of it) is that chord: the
 // exact quadratic distance divides by the curve's second difference, which is then near zero.
@@ -39,23 +41,28 @@ void appendMonotonic(const GlyphSegment& s, std::vector<GlyphSegment>& out, bool
     const float t = turn(s, axis);
     const bool last = axis == 0 || !inX;
     if (t < 0.0f) {
-        if (last) out.push_back(s);
-        else appendMonotonic(s, out, inX, 0);
+        if (last)
+            out.push_back(s);
+        else
+            appendMonotonic(s, out, inX, 0);
         return;
     }
     const glm::vec2 ac = glm::mix(s.a, s.c, t), cb = glm::mix(s.c, s.b, t);
     const glm::vec2 m = glm::mix(ac, cb, t);
     for (const GlyphSegment& piece :
          {GlyphSegment{s.a, m, ac, true}, GlyphSegment{m, s.b, cb, true}}) {
-        if (last) out.push_back(piece);
-        else appendMonotonic(piece, out, inX, 0);
+        if (last)
+            out.push_back(piece);
+        else
+            appendMonotonic(piece, out, inX, 0);
     }
 }
 
 bool segmentsCross(glm::vec2 a, glm::vec2 b, glm::vec2 c, glm::vec2 d) {
     const float d1 = cross(b - a, c - a), d2 = cross(b - a, d - a);
     const float d3 = cross(d - c, a - c), d4 = cross(d - c, b - c);
-    if (((d1 > 0) != (d2 > 0) || d1 == 0 || d2 == 0) && ((d3 > 0) != (d4 > 0) || d3 == 0 || d4 == 0)) {
+    if (((d1 > 0) != (d2 > 0) || d1 == 0 || d2 == 0) &&
+        ((d3 > 0) != (d4 > 0) || d3 == 0 || d4 == 0)) {
         // Collinear pairs cross only where they overlap.
         if (d1 == 0 && d2 == 0) {
             const glm::vec2 lo = glm::min(a, b), hi = glm::max(a, b);
@@ -75,8 +82,12 @@ struct Box2 {
     glm::vec2 lo, hi;
 };
 
-glm::vec2 segmentMin(const GlyphSegment& s) { return glm::min(glm::min(s.a, s.b), s.c); }
-glm::vec2 segmentMax(const GlyphSegment& s) { return glm::max(glm::max(s.a, s.b), s.c); }
+glm::vec2 segmentMin(const GlyphSegment& s) {
+    return glm::min(glm::min(s.a, s.b), s.c);
+}
+glm::vec2 segmentMax(const GlyphSegment& s) {
+    return glm::max(glm::max(s.a, s.b), s.c);
+}
 
 float boxDistance(const Box2& box, glm::vec2 p) {
     return glm::length(glm::max(glm::max(box.lo - p, p - box.hi), 0.0f));
@@ -129,8 +140,8 @@ float lowerDistance(const GlyphSegment& s, const Box2& box) {
             // The piece's control point: where the tangents at its ends meet.
             const glm::vec2 a = at(s, t0), b = at(s, t1);
             const glm::vec2 c = glm::mix(glm::mix(s.a, s.c, t0), glm::mix(s.c, s.b, t0), t1);
-            least = std::min(least, gap(box, {glm::min(glm::min(a, b), c),
-                                              glm::max(glm::max(a, b), c)}));
+            least = std::min(least,
+                             gap(box, {glm::min(glm::min(a, b), c), glm::max(glm::max(a, b), c)}));
         }
         return least;
     }
@@ -210,8 +221,8 @@ class GridBuilder {
             after[k] = after[k + 1] + (s.b.y > s.a.y ? 1.0f : -1.0f);
         }
         auto below = [&](float x) {
-            return size_t(std::lower_bound(crossings.begin(), crossings.end(),
-                                           std::pair(x, 0u)) - crossings.begin());
+            return size_t(std::lower_bound(crossings.begin(), crossings.end(), std::pair(x, 0u)) -
+                          crossings.begin());
         };
         for (uint32_t x = 0; x < nx_; ++x) {
             const glm::vec2 c = centre(x, y);
@@ -277,7 +288,7 @@ class GridBuilder {
     uint32_t nx_, ny_;
     size_t budget_;
     std::vector<glm::vec4> out_;
-    std::vector<float> windings_; // at each cell's centre
+    std::vector<float> windings_;                     // at each cell's centre
     std::map<std::vector<uint32_t>, uint32_t> lists_; // each list's first word
 };
 
@@ -306,8 +317,8 @@ std::vector<glm::vec4> packContours(std::vector<std::vector<GlyphSegment>> conto
 
 // The grid of cells of about equal count to `target` over the outline's box and two cells
 // around it, or empty where its lists pass `budget` words.
-std::vector<glm::vec4> packGrid(const std::vector<GlyphSegment>& segments, Box2 box,
-                                size_t target, size_t budget) {
+std::vector<glm::vec4> packGrid(const std::vector<GlyphSegment>& segments, Box2 box, size_t target,
+                                size_t budget) {
     const glm::vec2 extent = glm::max(box.hi - box.lo, glm::vec2(1e-6f));
     float side = std::sqrt(extent.x * extent.y / float(target));
     uint32_t nx = 1, ny = 1;
@@ -340,8 +351,7 @@ std::vector<glm::vec4> packOutline(std::span<const GlyphSegment> segments, glm::
     if (all.empty()) return {};
     std::vector<glm::vec4> listed = packContours(std::move(contours));
     if (listed.size() <= kGridOutlineWords) {
-        std::vector<glm::vec4> out = {{0.0f, listed[1].z, 0.0f, 0.0f},
-                                      {box.lo, box.hi}};
+        std::vector<glm::vec4> out = {{0.0f, listed[1].z, 0.0f, 0.0f}, {box.lo, box.hi}};
         out.insert(out.end(), listed.begin(), listed.end());
         return out;
     }
@@ -380,8 +390,8 @@ Result<std::shared_ptr<const std::vector<glm::vec4>>> buildOutline(const Node& n
             segments.push_back({p[i], p[(i + 1) % p.size()], p[i], false});
     } else {
         const std::string& font = node.strings[1];
-        auto text = textOutline(node.strings[0], font.empty() ? defaultFontFile() : font,
-                                node.params[0]);
+        auto text =
+            textOutline(node.strings[0], font.empty() ? defaultFontFile() : font, node.params[0]);
         if (!text) return text.error();
         segments = std::move(text->segments);
         shift = -0.5f * (text->min + text->max);
@@ -390,7 +400,7 @@ Result<std::shared_ptr<const std::vector<glm::vec4>>> buildOutline(const Node& n
 }
 
 std::shared_ptr<const std::vector<glm::vec4>> revolvedOutline(std::span<const glm::vec2> points,
-                                                             float axis) {
+                                                              float axis) {
     const size_t n = points.size();
     auto onAxis = [&](size_t i) { return points[i % n].x == axis; };
     auto axisEdge = [&](size_t i) { return onAxis(i) && onAxis(i + 1); };
@@ -403,7 +413,8 @@ std::shared_ptr<const std::vector<glm::vec4>> revolvedOutline(std::span<const gl
     // The chain off the axis runs from `first` to `last`, both on the axis, through points off
     // it; every other edge lies on the axis.
     size_t last = first + 1;
-    while (!onAxis(last)) ++last;
+    while (!onAxis(last))
+        ++last;
     for (size_t i = last; i < first + n; ++i)
         if (!axisEdge(i)) return nullptr;
     std::vector<GlyphSegment> segments;

@@ -51,6 +51,6 @@ Result<std::shared_ptr<const std::vector<glm::vec4>>> buildOutline(const Node& n
 // distance there; the polygon's own would be 0 along the whole axis. nullptr for any other
 // polygon.
 std::shared_ptr<const std::vector<glm::vec4>> revolvedOutline(std::span<const glm::vec2> points,
-                                                             float axis);
+                                                              float axis);
 
 } // namespace sdfcsg::detail

@@ -521,7 +521,8 @@ void closeRevolvedProfiles(Scene& scene) {
         if (child.kind != NodeKind::Polygon || !child.outline ||
             child.transform.rotate != glm::vec3(0.0f) || child.transform.scale != glm::vec3(1.0f))
             continue;
-        if (auto outline = revolvedOutline(child.points, -node.params[0] - child.transform.translate.x))
+        if (auto outline =
+                revolvedOutline(child.points, -node.params[0] - child.transform.translate.x))
             child.outline = std::move(outline);
     }
 }

@@ -23,11 +23,20 @@ std::string describeValue(const ParamInfo& p) {
     if (p.type == ValueType::Points) return "[[x, y], ...]";
     std::string kind = p.type == ValueType::Vec3 ? "[x, y, z]" : "number";
     switch (p.check) {
-    case Check::Any: break;
-    case Check::Positive: kind += p.type == ValueType::Vec3 ? ", each > 0" : ", > 0"; break;
-    case Check::NonNegative: kind += p.type == ValueType::Vec3 ? ", each >= 0" : ", >= 0"; break;
-    case Check::NonZero: kind += ", not zero"; break;
-    case Check::Count: kind += p.type == ValueType::Vec3 ? ", each a whole number >= 1" : ", whole >= 1"; break;
+    case Check::Any:
+        break;
+    case Check::Positive:
+        kind += p.type == ValueType::Vec3 ? ", each > 0" : ", > 0";
+        break;
+    case Check::NonNegative:
+        kind += p.type == ValueType::Vec3 ? ", each >= 0" : ", >= 0";
+        break;
+    case Check::NonZero:
+        kind += ", not zero";
+        break;
+    case Check::Count:
+        kind += p.type == ValueType::Vec3 ? ", each a whole number >= 1" : ", whole >= 1";
+        break;
     }
     if (p.maximum < 3.4e38f) kind += ", <= " + number(p.maximum);
     return kind;
