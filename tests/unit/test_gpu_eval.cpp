@@ -1,7 +1,7 @@
 // The generated GLSL against the CPU reference evaluator: shaders/probe.comp evaluates
 // sceneSample at thousands of points, for every primitive kind, the operations, and every bundled
 // scene, with bounds skipping on and off, and with the bounds tests left out of the code.
-#include "codegen/gpu_nodes.h"
+#include "codegen/scene_buffers.h"
 #include "field/prune.h"
 #include "gpu/vk.h"
 #include "gpu_test.h"
@@ -70,11 +70,9 @@ std::vector<glm::vec4> probeGpu(Context& context, const Scene& scene,
     VkDescriptorSet set = detail::allocateDescriptorSet(ctx, pool, setLayout);
 
     Evaluator evaluator(scene);
-    std::vector<detail::GpuNode> nodes = detail::packNodes(evaluator);
+    detail::SceneBuffers sceneBuffers(ctx);
+    EXPECT_TRUE(sceneBuffers.create(evaluator));
     const VkDeviceSize bytes = points.size() * sizeof(glm::vec4);
-    detail::Buffer nodeBuffer =
-        *detail::createBuffer(ctx, nodes.size() * sizeof(detail::GpuNode),
-                              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, detail::MemoryUse::Upload);
     detail::Buffer in = *detail::createBuffer(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                               detail::MemoryUse::Upload);
     detail::Buffer out = *detail::createBuffer(
@@ -86,13 +84,13 @@ std::vector<glm::vec4> probeGpu(Context& context, const Scene& scene,
     if (!source.data)
         staging = *detail::createBuffer(ctx, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                         detail::MemoryUse::Staging);
-    detail::uploadBuffer(ctx, nodeBuffer, nodes.data(), nodes.size() * sizeof(detail::GpuNode));
     detail::uploadBuffer(ctx, in, points.data(), bytes);
-    detail::Buffer field;
-    auto words = detail::fieldWords(scene, evaluator, codegen.evaluation);
+    auto words = detail::SceneBuffers::fieldWords(scene, evaluator, codegen.evaluation);
     EXPECT_TRUE(words) << words.error().str();
-    EXPECT_TRUE(detail::uploadField(ctx, field, words ? *words : detail::emptyField()));
-    const detail::Buffer* buffers[] = {&nodeBuffer, &in, &out, &field};
+    if (words) {
+        EXPECT_TRUE(sceneBuffers.uploadField(*words));
+    }
+    const detail::Buffer* buffers[] = {&sceneBuffers.nodes(), &in, &out, &sceneBuffers.field()};
     detail::writeDescriptorSet(ctx, set, bindings, buffers);
 
     uint32_t count = uint32_t(points.size());
@@ -106,7 +104,7 @@ std::vector<glm::vec4> probeGpu(Context& context, const Scene& scene,
     const auto* result = static_cast<const glm::vec4*>(detail::readback(ctx, source, &staging));
     std::vector<glm::vec4> samples(result, result + points.size());
 
-    for (detail::Buffer* b : {&nodeBuffer, &in, &out, &staging, &field})
+    for (detail::Buffer* b : {&in, &out, &staging})
         detail::destroyBuffer(ctx, *b);
     vkDestroyPipeline(ctx.device, pipeline, nullptr);
     vkDestroyDescriptorPool(ctx.device, pool, nullptr);

@@ -1,6 +1,5 @@
 #include "codegen/gpu_nodes.h"
 
-#include "field/prune.h"
 #include "shared.h"
 
 #include <algorithm>
@@ -53,44 +52,6 @@ std::vector<GpuNode> packNodes(const Evaluator& evaluator) {
         out.push_back(g);
     }
     return out;
-}
-
-std::vector<uint32_t> emptyField() {
-    return std::vector<uint32_t>(kFieldHeaderWords, 0u);
-}
-
-Result<std::vector<uint32_t>> fieldWords(const Scene& scene, const Evaluator& evaluator,
-                                         Evaluation evaluation) {
-    if (usesTapes(scene, evaluation)) {
-        const PrunedField field = pruneField(evaluator);
-        if (const double mean = field.meanActiveLength(); mean > kMaxMeanCellInstructions)
-            return Error(ErrorKind::Limit,
-                         Diagnostic{scene.file, "root",
-                                    "the tree prunes too little to render or mesh in bounded "
-                                    "time: near its surface, a region evaluates " +
-                                        std::to_string(uint32_t(mean)) +
-                                        " instructions on average, above the limit of " +
-                                        std::to_string(kMaxMeanCellInstructions) +
-                                        " (many primitives that all overlap in one smooth "
-                                        "operation do this)"});
-        return packField(field, evaluator.nodes());
-    }
-    return emptyField();
-}
-
-Result<bool> uploadField(Context::Impl& ctx, Buffer& buffer, std::span<const uint32_t> words) {
-    const VkDeviceSize bytes = words.size() * sizeof(uint32_t);
-    bool made = false;
-    if (!buffer.buffer || buffer.size < bytes) {
-        auto grown =
-            createBuffer(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::Upload);
-        if (!grown) return grown.error();
-        destroyBuffer(ctx, buffer);
-        buffer = *grown;
-        made = true;
-    }
-    uploadBuffer(ctx, buffer, words.data(), size_t(bytes));
-    return made;
 }
 
 } // namespace sdfcsg::detail

@@ -1,13 +1,11 @@
-// The node buffer: one GpuNode per scene node, index-aligned, read by the generated scene code.
+// The node buffer's layout: one GpuNode per scene node, index-aligned, read by the generated scene
+// code (the inlined scene code holds the same values as literals). SceneBuffers uploads it.
 #pragma once
 
-#include "gpu/vk.h"
-#include "sdfcsg/compile.h"
 #include "sdfcsg/eval.h"
 
 #include <glm/vec4.hpp>
 
-#include <span>
 #include <vector>
 
 namespace sdfcsg::detail {
@@ -24,18 +22,5 @@ static_assert(sizeof(GpuNode) == 128, "GpuNode must match the std430 Node in nod
 
 // Everything numeric the shaders need, so that changing values needs only a re-upload.
 std::vector<GpuNode> packNodes(const Evaluator& evaluator);
-
-// What shaders/tape.glsl reads (binding SDFCSG_BINDING_FIELD): the scene's pruned field where
-// its kernels run tapes (refused past kMaxMeanCellInstructions), a header alone otherwise (the
-// binding must still hold a buffer). Host work only, so it may run while the kernels build:
-// they do not depend on it.
-Result<std::vector<uint32_t>> fieldWords(const Scene& scene, const Evaluator& evaluator,
-                                         Evaluation evaluation);
-// A header alone: a field that no kernel evaluates yet (their warm-ups run no invocation).
-std::vector<uint32_t> emptyField();
-
-// Grows `buffer` when the words no longer fit and uploads them; returns true when it made a new
-// one, whose descriptors the caller then writes again.
-Result<bool> uploadField(Context::Impl& ctx, Buffer& buffer, std::span<const uint32_t> words);
 
 } // namespace sdfcsg::detail

@@ -18,7 +18,7 @@
 // Vertices and triangles come out in brick order, so the mesh is the same on every run.
 #include "sdfcsg/mesh.h"
 
-#include "codegen/gpu_nodes.h"
+#include "codegen/scene_buffers.h"
 #include "codegen/shader_compile.h"
 #include "gpu/vk.h"
 #include "mesh/mc_tables.h"
@@ -230,11 +230,13 @@ struct Mesher::Impl {
     VkDescriptorPool pool = VK_NULL_HANDLE;
     VkDescriptorSet set = VK_NULL_HANDLE;
 
-    // Indexed by binding order in kBindings. Buffers that an extraction sizes are freed at its
-    // end (placeholders of 4 bytes stay, so the descriptor set is always complete).
+    detail::SceneBuffers sceneBuffers; // the node buffer and the field
+    // Indexed by binding order in kBindings; those of the node buffer and the field stay empty
+    // (sceneBuffers holds them). Buffers that an extraction sizes are freed at its end
+    // (placeholders of 4 bytes stay, so the descriptor set is always complete).
     Buffer buffers[kBindingCount];
 
-    explicit Impl(Context::Impl& c) : ctx(c) {}
+    explicit Impl(Context::Impl& c) : ctx(c), sceneBuffers(c) {}
     // No work of this mesher is pending between calls (submitAndWait() waits for it), and the
     // device may be busy with other threads' work: nothing to wait for.
     ~Impl() {
@@ -331,7 +333,9 @@ struct Mesher::Impl {
     void writeDescriptors() {
         const Buffer* list[kBindingCount];
         for (size_t i = 0; i < kBindingCount; ++i)
-            list[i] = &buffers[i];
+            list[i] = kBindings[i].binding == SDFCSG_BINDING_NODES   ? &sceneBuffers.nodes()
+                      : kBindings[i].binding == SDFCSG_BINDING_FIELD ? &sceneBuffers.field()
+                                                                     : &buffers[i];
         detail::writeDescriptorSet(ctx, set, kBindings, list);
     }
 
@@ -353,7 +357,7 @@ struct Mesher::Impl {
     }
 
     uint64_t heldBytes() const {
-        uint64_t total = 0;
+        uint64_t total = sceneBuffers.heldBytes();
         for (const Buffer& b : buffers)
             total += b.size;
         return total;
@@ -399,6 +403,10 @@ struct Mesher::Impl {
     // than distance somewhere, and its result is wrong.
     bool skippedSurface = false;
     Result<Mesh> run(const MeshOptions& options, MeshStats& stats, bool cullBricks);
+
+    // Mesher::create's steps: every binding's buffer, and the passes' pipelines.
+    Status createBuffers();
+    Status buildPasses(const std::string& sceneGlsl);
 };
 
 Mesher::Mesher(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -411,8 +419,9 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
     Impl& m = *impl;
     m.evaluator = std::make_unique<Evaluator>(scene);
     // Pruned on the host while the kernels build, as in Renderer::create.
-    auto fieldWords = std::async(
-        std::launch::async, [&] { return detail::fieldWords(scene, *m.evaluator, evaluation); });
+    auto fieldWords = std::async(std::launch::async, [&] {
+        return detail::SceneBuffers::fieldWords(scene, *m.evaluator, evaluation);
+    });
 
     CodegenOptions codegen;
     codegen.inlineParams = true;
@@ -423,36 +432,42 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
     m.pipelineLayout = detail::createPipelineLayout(m.ctx, m.setLayout, sizeof(MeshPush));
     m.pool = detail::createDescriptorPool(m.ctx, kBindings);
     m.set = detail::allocateDescriptorSet(m.ctx, m.pool, m.setLayout);
-    std::vector<detail::GpuNode> nodes = detail::packNodes(*m.evaluator);
-    std::vector<uint32_t> tables = packTables();
+    if (auto made = m.createBuffers(); !made) return made.error();
+    if (auto built = m.buildPasses(sceneGlsl); !built) return built.error();
+
+    auto words = fieldWords.get();
+    if (!words) return words.error();
+    auto made = m.sceneBuffers.uploadField(*words);
+    if (!made) return made.error();
+    if (*made) m.writeDescriptors();
+    return std::unique_ptr<Mesher>(new Mesher(std::move(impl)));
+}
+
+Status Mesher::Impl::createBuffers() {
+    const std::vector<uint32_t> tables = packTables();
     for (const detail::Binding& b : kBindings) {
-        uint64_t bytes = b.binding == SDFCSG_BINDING_MESH_GRID     ? sizeof(MeshGrid)
-                         : b.binding == SDFCSG_BINDING_NODES       ? nodes.size() * sizeof nodes[0]
-                         : b.binding == SDFCSG_BINDING_MESH_TABLES ? tables.size() * 4
-                         : b.binding == SDFCSG_BINDING_MESH_STATUS ? 8
-                         : b.binding == SDFCSG_BINDING_FIELD       ? 0 // uploadField() makes it
-                                                                   : 4;
-        if (b.binding == SDFCSG_BINDING_FIELD) continue;
-        auto made = detail::createBuffer(m.ctx, bytes,
+        if (b.binding == SDFCSG_BINDING_NODES || b.binding == SDFCSG_BINDING_FIELD) continue;
+        const uint64_t bytes = b.binding == SDFCSG_BINDING_MESH_GRID     ? sizeof(MeshGrid)
+                               : b.binding == SDFCSG_BINDING_MESH_TABLES ? tables.size() * 4
+                               : b.binding == SDFCSG_BINDING_MESH_STATUS ? 8
+                                                                         : 4;
+        auto made = detail::createBuffer(ctx, bytes,
                                          b.type == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER
                                              ? VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT
                                              : VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                         Impl::memoryUse(b.binding));
+                                         memoryUse(b.binding));
         if (!made) return made.error();
-        m.buffer(b.binding) = *made;
+        buffer(b.binding) = *made;
     }
-    detail::uploadBuffer(m.ctx, m.buffer(SDFCSG_BINDING_NODES), nodes.data(),
-                         nodes.size() * sizeof nodes[0]);
-    detail::uploadBuffer(m.ctx, m.buffer(SDFCSG_BINDING_MESH_TABLES), tables.data(),
-                         tables.size() * 4);
-    if (auto made =
-            detail::uploadField(m.ctx, m.buffer(SDFCSG_BINDING_FIELD), detail::emptyField());
-        !made)
-        return made.error();
+    if (auto made = sceneBuffers.create(*evaluator); !made) return made;
+    detail::uploadBuffer(ctx, buffer(SDFCSG_BINDING_MESH_TABLES), tables.data(), tables.size() * 4);
     MeshGrid empty = {};
-    detail::uploadBuffer(m.ctx, m.buffer(SDFCSG_BINDING_MESH_GRID), &empty, sizeof empty);
-    m.writeDescriptors();
+    detail::uploadBuffer(ctx, buffer(SDFCSG_BINDING_MESH_GRID), &empty, sizeof empty);
+    writeDescriptors();
+    return Ok{};
+}
 
+Status Mesher::Impl::buildPasses(const std::string& sceneGlsl) {
     // The kernels build on two threads. On llvmpipe, which makes a pipeline's machine code at its
     // first dispatch, on the one queue's thread, the other thread has the compile helper make the
     // dual pass (the longest compile, about as long as the three field passes together) while
@@ -468,42 +483,36 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
             passesError = spirv.error();
             return;
         }
-        const Impl::Spec dual = m.dualSpec();
+        const Spec dual = dualSpec();
         if (fresh) {
             const detail::Precompile job{*spirv, dual};
-            helperMs = detail::precompileElsewhere(m.ctx, {&job, 1}, kBindings, sizeof(MeshPush));
+            helperMs = detail::precompileElsewhere(ctx, {&job, 1}, kBindings, sizeof(MeshPush));
         }
-        m.passes = detail::createShaderModule(m.ctx, *spirv);
-        m.dualPass = m.pipeline(m.passes, dual);
+        passes = detail::createShaderModule(ctx, *spirv);
+        dualPass = pipeline(passes, dual);
     });
     bool fresh = false;
     auto spirv = detail::compileKernel("mesh_field.comp", sceneGlsl, fresh);
     if (spirv) {
-        m.field = detail::createShaderModule(m.ctx, *spirv);
-        m.cull = m.pipeline(m.field, m.spec(SDFCSG_MESH_PASS_CULL, SDFCSG_MESH_GROUP_X));
-        m.classify = m.pipeline(m.field, m.spec(SDFCSG_MESH_PASS_CLASSIFY, SDFCSG_MESH_BRICK));
-        m.vertices = m.pipeline(m.field, m.spec(SDFCSG_MESH_PASS_VERTICES, SDFCSG_MESH_GROUP_X));
+        field = detail::createShaderModule(ctx, *spirv);
+        cull = pipeline(field, spec(SDFCSG_MESH_PASS_CULL, SDFCSG_MESH_GROUP_X));
+        classify = pipeline(field, spec(SDFCSG_MESH_PASS_CLASSIFY, SDFCSG_MESH_BRICK));
+        vertices = pipeline(field, spec(SDFCSG_MESH_PASS_VERTICES, SDFCSG_MESH_GROUP_X));
         // Every pipeline runs once on an empty batch, so drivers that compile at first use
         // (llvmpipe) have done so before the first extraction is timed.
-        for (VkPipeline p : {m.cull, m.classify, m.vertices})
-            m.warmUp(p);
+        for (VkPipeline p : {cull, classify, vertices})
+            warmUp(p);
     }
     other.join();
     if (!spirv) return spirv.error();
     if (passesError) return *passesError;
     const auto start = std::chrono::steady_clock::now();
-    m.warmUp(m.dualPass);
+    warmUp(dualPass);
     const std::chrono::duration<double, std::milli> dualMs =
         std::chrono::steady_clock::now() - start;
     // Loading the helper's machine code takes a tenth of its compile or less.
-    if (helperMs > 0.0 && dualMs.count() > 0.25 * helperMs) detail::compileHelperMissed(m.ctx);
-
-    auto words = fieldWords.get();
-    if (!words) return words.error();
-    auto made = detail::uploadField(m.ctx, m.buffer(SDFCSG_BINDING_FIELD), *words);
-    if (!made) return made.error();
-    if (*made) m.writeDescriptors();
-    return std::unique_ptr<Mesher>(new Mesher(std::move(impl)));
+    if (helperMs > 0.0 && dualMs.count() > 0.25 * helperMs) detail::compileHelperMissed(ctx);
+    return Ok{};
 }
 
 Result<Mesh> Mesher::extract(const MeshOptions& options, MeshStats* stats) {
@@ -520,100 +529,145 @@ Result<Mesh> Mesher::extract(const MeshOptions& options, MeshStats* stats) {
     return mesh;
 }
 
-Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, bool cullBricks) {
+namespace {
+
+Error cancelled() {
+    return Error::message(ErrorKind::Cancelled, "<mesh>", "cancelled");
+}
+
+// One run of the passes over one grid (Mesher::Impl::run), and what its steps share.
+struct Extraction {
     using Clock = std::chrono::steady_clock;
-    const auto start = Clock::now();
-    skippedSurface = false;
-    auto grid = planGrid(*evaluator, options);
-    if (!grid) return grid.error();
-    const Grid& g = *grid;
-    stats.cells = g.cells;
-    stats.voxelSize = g.h;
-    stats.bounds = Aabb{g.origin, g.origin + g.h * glm::vec3(g.cells)};
-    stats.bricks = g.brickCount;
-    auto stage = [&](const char* name, Clock::time_point t0) {
-        double seconds = secondsSince(t0);
+
+    Mesher::Impl& m;
+    const MeshOptions& options;
+    MeshStats& stats;
+    const Grid g;
+    const bool dual = options.method == MeshMethod::DualContouring;
+    // Marching cubes' index triples are the totals' y, dual contouring's their w.
+    const int triangleKind = dual ? 3 : 1;
+    size_t peak = 0; // bytes held at most
+    // Progress: the cull counts one unit, each batch two (classify, vertices) and one for its
+    // triangles.
+    double progressTotal = 1, progressDone = 0;
+    // Brick to slot (SDFCSG_MESH_NO_BRICK where it holds no surface), and slot to brick.
+    std::vector<uint32_t> map, active;
+    uint32_t activeCount = 0, batches = 0;
+    uint64_t fixedBytes = 0; // what the bricks hold for the whole extraction
+    // Per active brick: the first edge point, marching-cubes triangle, dual vertex and dual
+    // triangle it makes.
+    std::vector<glm::uvec4> bases;
+    glm::u64vec4 totals{0};
+    Mesh mesh;
+    std::vector<glm::vec3> smooth; // dual contouring: where foldQuads moves folding vertices
+
+    void stage(const char* name, Clock::time_point t0) {
+        const double seconds = secondsSince(t0);
         for (MeshStats::Stage& st : stats.stages)
             if (st.name == name) {
                 st.seconds += seconds;
                 return;
             }
         stats.stages.push_back({name, seconds});
-    };
-    size_t peak = 0;
-    auto notePeak = [&](uint64_t extra) { peak = std::max<size_t>(peak, heldBytes() + extra); };
-
-    // Known before any work: the brick map, on the device and on the host.
-    const uint64_t mapBytes = g.brickCount * 4 * 2;
-    if (g.brickCount >= SDFCSG_MESH_NO_BRICK || mapBytes > options.memoryBudget)
-        return overBudget(g, "its brick map", mapBytes, options.memoryBudget);
-
-    // Progress: the cull counts one unit, each batch two (classify, vertices) and one for its
-    // triangles.
-    double progressTotal = 1, progressDone = 0;
-    auto progress = [&](double units) {
+    }
+    void notePeak(uint64_t extra) { peak = std::max<size_t>(peak, m.heldBytes() + extra); }
+    bool progress(double units) {
         progressDone += units;
         return !options.progress || options.progress(float(progressDone / progressTotal));
-    };
-    const Error cancelled = Error::message(ErrorKind::Cancelled, "<mesh>", "cancelled");
+    }
+    MeshPush batchOf(uint32_t batch) const {
+        MeshPush push;
+        push.first = batch * kBatchBricks;
+        push.count = std::min(kBatchBricks, activeCount - push.first);
+        return push;
+    }
+    // The [first, end) range of bases[.][k] over the batch of `push`.
+    std::pair<uint32_t, uint64_t> batchRange(const MeshPush& push, int k) const {
+        const uint64_t end =
+            push.first + push.count < activeCount ? bases[push.first + push.count][k] : totals[k];
+        return {bases[push.first][k], end};
+    }
+
+    Status begin(bool cullBricks);
+    Status cull();
+    Status reserveBricks();
+    Status classify(MeshPush& push);
+    Status vertices(MeshPush push);
+    void beginTriangles();
+    Status triangles(uint32_t batch);
+    void finish();
+};
+
+// The grid's numbers: in the stats, checked against the budget (the brick map is known before
+// any work), and uploaded; the marching-cubes triangle pass, made at its first use.
+Status Extraction::begin(bool cullBricks) {
+    stats.cells = g.cells;
+    stats.voxelSize = g.h;
+    stats.bounds = Aabb{g.origin, g.origin + g.h * glm::vec3(g.cells)};
+    stats.bricks = g.brickCount;
+    const uint64_t mapBytes = g.brickCount * 4 * 2; // on the device and on the host
+    if (g.brickCount >= SDFCSG_MESH_NO_BRICK || mapBytes > options.memoryBudget)
+        return overBudget(g, "its brick map", mapBytes, options.memoryBudget);
 
     MeshGrid gridUniform;
     gridUniform.origin = glm::vec4(g.origin, g.h);
     gridUniform.cells = glm::uvec4(g.cells, options.refineSteps);
     gridUniform.bricks = glm::uvec4(g.bricks, 0);
     const float halfDiagonal = 0.5f * std::sqrt(3.0f) * float(kBrick) * g.h;
-    const bool dual = options.method == MeshMethod::DualContouring;
     gridUniform.cull =
         glm::vec4(cullBricks ? halfDiagonal * 1.001f : INFINITY, dual ? kDualNormalOffset : 0.0f,
                   dual ? kDualNormalTaps : kNormalTaps, 0);
-    detail::uploadBuffer(ctx, buffer(SDFCSG_BINDING_MESH_GRID), &gridUniform, sizeof gridUniform);
+    detail::uploadBuffer(m.ctx, m.buffer(SDFCSG_BINDING_MESH_GRID), &gridUniform,
+                         sizeof gridUniform);
     const uint32_t zero[2] = {0, 0};
-    detail::uploadBuffer(ctx, buffer(SDFCSG_BINDING_MESH_STATUS), zero, sizeof zero);
+    detail::uploadBuffer(m.ctx, m.buffer(SDFCSG_BINDING_MESH_STATUS), zero, sizeof zero);
 
-    auto t0 = Clock::now();
-    if (!dual && !triangles) { // the marching-cubes triangle pass, made at its first use
-        triangles = pipeline(passes, spec(SDFCSG_MESH_PASS_TRIANGLES, SDFCSG_MESH_BRICK));
-        warmUp(triangles);
+    const auto t0 = Clock::now();
+    if (!dual && !m.triangles) {
+        m.triangles = m.pipeline(m.passes, m.spec(SDFCSG_MESH_PASS_TRIANGLES, SDFCSG_MESH_BRICK));
+        m.warmUp(m.triangles);
         stage("compile", t0);
     }
+    return Ok{};
+}
 
-    // Cull.
-    t0 = Clock::now();
-    if (auto ok = reserve(SDFCSG_BINDING_MESH_MAP, g.brickCount * 4); !ok) return ok.error();
-    {
-        VkCommandBuffer cmd = begin(cull);
-        const uint64_t chunk = uint64_t(kMaxGroups) * SDFCSG_MESH_GROUP_X;
-        for (uint64_t first = 0; first < g.brickCount; first += chunk) {
-            MeshPush push;
-            push.first = uint32_t(first);
-            push.count = uint32_t(std::min(chunk, g.brickCount - first));
-            dispatch(cmd, push, detail::groupCount(push.count, SDFCSG_MESH_GROUP_X));
-        }
-        finish(cmd);
+// The cull pass, and the list of bricks that may hold surface that the host makes of it.
+Status Extraction::cull() {
+    const auto t0 = Clock::now();
+    if (auto ok = m.reserve(SDFCSG_BINDING_MESH_MAP, g.brickCount * 4); !ok) return ok;
+    VkCommandBuffer cmd = m.begin(m.cull);
+    const uint64_t chunk = uint64_t(kMaxGroups) * SDFCSG_MESH_GROUP_X;
+    for (uint64_t first = 0; first < g.brickCount; first += chunk) {
+        MeshPush push;
+        push.first = uint32_t(first);
+        push.count = uint32_t(std::min(chunk, g.brickCount - first));
+        m.dispatch(cmd, push, detail::groupCount(push.count, SDFCSG_MESH_GROUP_X));
     }
-    std::vector<uint32_t> map(g.brickCount), active;
-    {
-        const uint32_t* flags = mapped<uint32_t>(SDFCSG_BINDING_MESH_MAP);
-        for (uint64_t b = 0; b < g.brickCount; ++b) {
-            map[b] = flags[b] ? uint32_t(active.size()) : SDFCSG_MESH_NO_BRICK;
-            if (flags[b]) active.push_back(uint32_t(b));
-        }
+    m.finish(cmd);
+    map.resize(g.brickCount);
+    const uint32_t* flags = m.mapped<uint32_t>(SDFCSG_BINDING_MESH_MAP);
+    for (uint64_t b = 0; b < g.brickCount; ++b) {
+        map[b] = flags[b] ? uint32_t(active.size()) : SDFCSG_MESH_NO_BRICK;
+        if (flags[b]) active.push_back(uint32_t(b));
     }
     stage("cull", t0);
     stats.activeBricks = active.size();
-    const uint32_t activeCount = uint32_t(active.size());
-    const uint32_t batches = (activeCount + kBatchBricks - 1) / kBatchBricks;
-    const uint32_t batchBricks = std::min(activeCount, kBatchBricks);
+    activeCount = uint32_t(active.size());
+    batches = (activeCount + kBatchBricks - 1) / kBatchBricks;
     progressTotal += 3.0 * batches;
-    if (!progress(1)) return cancelled;
+    if (!progress(1)) return cancelled();
+    return Ok{};
+}
 
-    // Known once the bricks are culled: what the bricks hold for the whole extraction.
-    const uint64_t fixedBytes =
-        mapBytes + activeCount * kBytesPerActive + batchBricks * kBytesPerBatchBrick;
+// Known once the bricks are culled: what the bricks hold for the whole extraction.
+Status Extraction::reserveBricks() {
+    const uint32_t batchBricks = std::min(activeCount, kBatchBricks);
+    const uint64_t mapBytes = g.brickCount * 4 * 2;
+    fixedBytes = mapBytes + activeCount * kBytesPerActive + batchBricks * kBytesPerBatchBrick;
     if (activeCount > kMaxActive || fixedBytes > options.memoryBudget)
         return overBudget(g, "the " + std::to_string(activeCount) + " bricks that hold surface",
                           fixedBytes, options.memoryBudget);
-    detail::uploadBuffer(ctx, buffer(SDFCSG_BINDING_MESH_MAP), map.data(), map.size() * 4);
+    detail::uploadBuffer(m.ctx, m.buffer(SDFCSG_BINDING_MESH_MAP), map.data(), map.size() * 4);
     for (auto [binding, bytes] :
          {std::pair{SDFCSG_BINDING_MESH_ACTIVE, activeCount * 4ull},
           {SDFCSG_BINDING_MESH_RECORDS, activeCount * uint64_t(SDFCSG_MESH_RECORD) * 4},
@@ -621,144 +675,141 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
           {SDFCSG_BINDING_MESH_BASES, activeCount * 16ull},
           {SDFCSG_BINDING_MESH_SAMPLES, batchBricks * uint64_t(SDFCSG_MESH_BRICK_BLOCK) * 4},
           {SDFCSG_BINDING_MESH_EDGES, batchBricks * uint64_t(SDFCSG_MESH_BRICK_EDGES) * 4}})
-        if (auto ok = reserve(binding, bytes); !ok) return ok.error();
+        if (auto ok = m.reserve(binding, bytes); !ok) return ok;
     if (activeCount)
-        detail::uploadBuffer(ctx, buffer(SDFCSG_BINDING_MESH_ACTIVE), active.data(),
+        detail::uploadBuffer(m.ctx, m.buffer(SDFCSG_BINDING_MESH_ACTIVE), active.data(),
                              active.size() * 4);
     notePeak(map.size() * 4);
+    bases.resize(activeCount);
+    return Ok{};
+}
 
-    // Per active brick: the first edge point, marching-cubes triangle, dual vertex and dual
-    // triangle it makes.
-    std::vector<glm::uvec4> bases(activeCount);
-    glm::u64vec4 totals(0);
-    auto batchOf = [&](uint32_t batch) {
-        MeshPush push;
-        push.first = batch * kBatchBricks;
-        push.count = std::min(kBatchBricks, activeCount - push.first);
-        return push;
-    };
-    // The [first, end) range of bases[.][k] over the batch of `push`.
-    auto batchRange = [&](const MeshPush& push, int k) {
-        const uint64_t end =
-            push.first + push.count < activeCount ? bases[push.first + push.count][k] : totals[k];
-        return std::pair<uint32_t, uint64_t>(bases[push.first][k], end);
-    };
-    Mesh mesh;
-    for (uint32_t batch = 0; batch < batches; ++batch) {
-        MeshPush push = batchOf(batch);
-        t0 = Clock::now();
-        VkCommandBuffer cmd = begin(classify);
-        dispatch(cmd, push, push.count);
-        finish(cmd);
-        const glm::uvec4* counts = mapped<glm::uvec4>(SDFCSG_BINDING_MESH_COUNTS);
-        for (uint32_t i = push.first; i < push.first + push.count; ++i) {
-            bases[i] = glm::uvec4(totals);
-            totals += glm::u64vec4(counts[i]);
-        }
-        push.vertexBase = bases[push.first].x;
-        stage("classify", t0);
-        if (!progress(1)) return cancelled;
-
-        const uint64_t batchVertices = totals.x - push.vertexBase;
-        const uint64_t meshBytes = dual ? totals.x * kBytesPerVertex + totals.z * kBytesPerVertex +
-                                              totals.w * kBytesPerTriangle
-                                        : totals.x * kBytesPerVertex + totals.y * kBytesPerTriangle;
-        if (totals.x > UINT32_MAX || totals.z > UINT32_MAX ||
-            fixedBytes + meshBytes > options.memoryBudget)
-            return overBudget(g, "the mesh", fixedBytes + meshBytes, options.memoryBudget);
-
-        t0 = Clock::now();
-        detail::uploadBuffer(ctx, buffer(SDFCSG_BINDING_MESH_BASES), bases.data(),
-                             bases.size() * 16);
-        // Marching cubes takes the batch's vertices; dual contouring keeps every edge point.
-        if (dual) push.vertexBase = 0;
-        if (auto ok = dual ? grow(SDFCSG_BINDING_MESH_VERTICES, totals.x * 48)
-                           : reserve(SDFCSG_BINDING_MESH_VERTICES, batchVertices * 48);
-            !ok)
-            return ok.error();
-        cmd = begin(vertices);
-        dispatch(cmd, push, push.count);
-        finish(cmd);
-        stage("vertices", t0);
-
-        t0 = Clock::now();
-        if (!dual) {
-            const float* v = mapped<float>(SDFCSG_BINDING_MESH_VERTICES);
-            mesh.positions.resize(totals.x);
-            mesh.normals.resize(totals.x);
-            mesh.colors.resize(totals.x);
-            for (uint64_t i = 0; i < batchVertices; ++i, v += 12) { // as in mesh_field.comp
-                uint64_t o = push.vertexBase + i;
-                mesh.positions[o] = glm::vec3(v[0], v[1], v[2]);
-                mesh.normals[o] = glm::vec3(v[4], v[5], v[6]);
-                mesh.colors[o] = glm::vec3(v[3], v[7], v[11]);
-            }
-        }
-        stage("download", t0);
-        notePeak(map.size() * 4 + mesh.positions.capacity() * 36);
-        if (!progress(1)) return cancelled;
+// The classify pass over a batch, and its bricks' bases from their counts; sets the batch's
+// first vertex.
+Status Extraction::classify(MeshPush& push) {
+    const auto t0 = Clock::now();
+    VkCommandBuffer cmd = m.begin(m.classify);
+    m.dispatch(cmd, push, push.count);
+    m.finish(cmd);
+    const glm::uvec4* counts = m.mapped<glm::uvec4>(SDFCSG_BINDING_MESH_COUNTS);
+    for (uint32_t i = push.first; i < push.first + push.count; ++i) {
+        bases[i] = glm::uvec4(totals);
+        totals += glm::u64vec4(counts[i]);
     }
+    push.vertexBase = bases[push.first].x;
+    stage("classify", t0);
+    if (!progress(1)) return cancelled();
 
-    const int triangleKind = dual ? 3 : 1;
-    std::vector<glm::vec3> smooth; // dual contouring: where foldQuads moves folding vertices
+    const uint64_t meshBytes = dual ? totals.x * kBytesPerVertex + totals.z * kBytesPerVertex +
+                                          totals.w * kBytesPerTriangle
+                                    : totals.x * kBytesPerVertex + totals.y * kBytesPerTriangle;
+    if (totals.x > UINT32_MAX || totals.z > UINT32_MAX ||
+        fixedBytes + meshBytes > options.memoryBudget)
+        return overBudget(g, "the mesh", fixedBytes + meshBytes, options.memoryBudget);
+    return Ok{};
+}
+
+// The vertices pass over a classified batch. Marching cubes takes the batch's vertices; dual
+// contouring keeps every edge point for its dual pass.
+Status Extraction::vertices(MeshPush push) {
+    const uint64_t batchVertices = totals.x - push.vertexBase;
+    auto t0 = Clock::now();
+    detail::uploadBuffer(m.ctx, m.buffer(SDFCSG_BINDING_MESH_BASES), bases.data(),
+                         bases.size() * 16);
+    if (dual) push.vertexBase = 0;
+    if (auto ok = dual ? m.grow(SDFCSG_BINDING_MESH_VERTICES, totals.x * 48)
+                       : m.reserve(SDFCSG_BINDING_MESH_VERTICES, batchVertices * 48);
+        !ok)
+        return ok;
+    VkCommandBuffer cmd = m.begin(m.vertices);
+    m.dispatch(cmd, push, push.count);
+    m.finish(cmd);
+    stage("vertices", t0);
+
+    t0 = Clock::now();
+    if (!dual) {
+        const float* v = m.mapped<float>(SDFCSG_BINDING_MESH_VERTICES);
+        mesh.positions.resize(totals.x);
+        mesh.normals.resize(totals.x);
+        mesh.colors.resize(totals.x);
+        for (uint64_t i = 0; i < batchVertices; ++i, v += 12) { // as in mesh_field.comp
+            uint64_t o = push.vertexBase + i;
+            mesh.positions[o] = glm::vec3(v[0], v[1], v[2]);
+            mesh.normals[o] = glm::vec3(v[4], v[5], v[6]);
+            mesh.colors[o] = glm::vec3(v[3], v[7], v[11]);
+        }
+    }
+    stage("download", t0);
+    notePeak(map.size() * 4 + mesh.positions.capacity() * 36);
+    if (!progress(1)) return cancelled();
+    return Ok{};
+}
+
+// After every batch is classified: the mesh's index triples, and for dual contouring its
+// vertices, which the dual pass writes where the vertices pass wrote the edge data it reads.
+void Extraction::beginTriangles() {
     mesh.indices.resize(totals[triangleKind] * 3);
+    if (!dual) return;
+    std::swap(m.buffer(SDFCSG_BINDING_MESH_VERTICES), m.buffer(SDFCSG_BINDING_MESH_HERMITE));
+    m.writeDescriptors();
+    mesh.positions.resize(totals.z);
+    mesh.normals.resize(totals.z);
+    mesh.colors.resize(totals.z);
+    smooth.resize(totals.z);
+}
+
+// The triangles (marching cubes) or dual (dual contouring) pass over a batch.
+Status Extraction::triangles(uint32_t batch) {
+    MeshPush push = batchOf(batch);
+    auto [first, end] = batchRange(push, triangleKind);
+    push.triangleBase = first;
+    const uint64_t batchTriangles = end - first;
+    auto [firstVertex, endVertex] = batchRange(push, 2);
+    push.vertexBase = firstVertex;
+
+    auto t0 = Clock::now();
+    if (auto ok = m.reserve(SDFCSG_BINDING_MESH_INDICES, batchTriangles * 12); !ok) return ok;
     if (dual) {
-        std::swap(buffer(SDFCSG_BINDING_MESH_VERTICES), buffer(SDFCSG_BINDING_MESH_HERMITE));
-        writeDescriptors();
-        mesh.positions.resize(totals.z);
-        mesh.normals.resize(totals.z);
-        mesh.colors.resize(totals.z);
-        smooth.resize(totals.z);
+        if (auto ok = m.reserve(SDFCSG_BINDING_MESH_VERTICES, (endVertex - firstVertex) * 48); !ok)
+            return ok;
     }
-    for (uint32_t batch = 0; batch < batches; ++batch) {
-        MeshPush push = batchOf(batch);
-        auto [first, end] = batchRange(push, triangleKind);
-        push.triangleBase = first;
-        const uint64_t batchTriangles = end - first;
-        auto [firstVertex, endVertex] = batchRange(push, 2);
-        push.vertexBase = firstVertex;
+    VkCommandBuffer cmd = m.begin(dual ? m.dualPass : m.triangles);
+    m.dispatch(cmd, push, push.count);
+    m.finish(cmd);
+    stage(dual ? "dual" : "triangles", t0);
 
-        t0 = Clock::now();
-        if (auto ok = reserve(SDFCSG_BINDING_MESH_INDICES, batchTriangles * 12); !ok)
-            return ok.error();
-        if (dual) {
-            if (auto ok = reserve(SDFCSG_BINDING_MESH_VERTICES, (endVertex - firstVertex) * 48);
-                !ok)
-                return ok.error();
+    t0 = Clock::now();
+    if (dual) {
+        const float* v = m.mapped<float>(SDFCSG_BINDING_MESH_VERTICES);
+        for (uint64_t o = firstVertex; o < endVertex; ++o, v += 12) {
+            mesh.positions[o] = glm::vec3(v[0], v[1], v[2]);
+            mesh.normals[o] = glm::vec3(v[3], v[4], v[5]);
+            mesh.colors[o] = glm::vec3(v[6], v[7], v[8]);
+            smooth[o] = glm::vec3(v[9], v[10], v[11]);
         }
-        VkCommandBuffer cmd = begin(dual ? dualPass : triangles);
-        dispatch(cmd, push, push.count);
-        finish(cmd);
-        stage(dual ? "dual" : "triangles", t0);
-
-        t0 = Clock::now();
-        if (dual) {
-            const float* v = mapped<float>(SDFCSG_BINDING_MESH_VERTICES);
-            for (uint64_t o = firstVertex; o < endVertex; ++o, v += 12) {
-                mesh.positions[o] = glm::vec3(v[0], v[1], v[2]);
-                mesh.normals[o] = glm::vec3(v[3], v[4], v[5]);
-                mesh.colors[o] = glm::vec3(v[6], v[7], v[8]);
-                smooth[o] = glm::vec3(v[9], v[10], v[11]);
-            }
-        }
-        std::memcpy(mesh.indices.data() + uint64_t(first) * 3,
-                    mapped<uint32_t>(SDFCSG_BINDING_MESH_INDICES), batchTriangles * 12);
-        stage("download", t0);
-        notePeak(map.size() * 4 + mesh.positions.capacity() * 36 + smooth.capacity() * 12 +
-                 mesh.indices.capacity() * 4);
-        if (!progress(1)) return cancelled;
     }
+    std::memcpy(mesh.indices.data() + uint64_t(first) * 3,
+                m.mapped<uint32_t>(SDFCSG_BINDING_MESH_INDICES), batchTriangles * 12);
+    stage("download", t0);
+    notePeak(map.size() * 4 + mesh.positions.capacity() * 36 + smooth.capacity() * 12 +
+             mesh.indices.capacity() * 4);
+    if (!progress(1)) return cancelled();
+    return Ok{};
+}
 
-    const uint32_t* status = mapped<uint32_t>(SDFCSG_BINDING_MESH_STATUS);
-    skippedSurface = status[1] != 0;
-    if (dual && !skippedSurface) {
-        t0 = Clock::now();
+// What the passes reported, and dual contouring's host step on quads that fold.
+void Extraction::finish() {
+    const uint32_t* status = m.mapped<uint32_t>(SDFCSG_BINDING_MESH_STATUS);
+    m.skippedSurface = status[1] != 0;
+    if (dual && !m.skippedSurface) {
+        const auto t0 = Clock::now();
         // The field where a few triangles need it: on scenes of pruned tapes, the CPU's whole
         // tree is too slow and its own pruned field would be a second prune (forest_10k at 256:
         // 1.6 -> 2.6 s), so there the vertices' normals alone decide.
         detail::Distance distance;
-        if (evaluator->nodes().size() < kTapeMinNodes)
-            distance = [&](glm::vec3 p) { return evaluator->distance(p); };
+        const Evaluator& evaluator = *m.evaluator;
+        if (evaluator.nodes().size() < kTapeMinNodes)
+            distance = [&](glm::vec3 p) { return evaluator.distance(p); };
         detail::foldQuads(mesh, smooth, distance, g.h);
         stage("quads", t0);
     }
@@ -766,8 +817,30 @@ Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, boo
     stats.vertices = mesh.vertexCount();
     stats.triangles = mesh.triangleCount();
     stats.peakBytes = peak;
+}
+
+} // namespace
+
+Result<Mesh> Mesher::Impl::run(const MeshOptions& options, MeshStats& stats, bool cullBricks) {
+    const auto start = std::chrono::steady_clock::now();
+    skippedSurface = false;
+    auto grid = planGrid(*evaluator, options);
+    if (!grid) return grid.error();
+    Extraction x{*this, options, stats, *grid};
+    if (auto ok = x.begin(cullBricks); !ok) return ok.error();
+    if (auto ok = x.cull(); !ok) return ok.error();
+    if (auto ok = x.reserveBricks(); !ok) return ok.error();
+    for (uint32_t batch = 0; batch < x.batches; ++batch) {
+        MeshPush push = x.batchOf(batch);
+        if (auto ok = x.classify(push); !ok) return ok.error();
+        if (auto ok = x.vertices(push); !ok) return ok.error();
+    }
+    x.beginTriangles();
+    for (uint32_t batch = 0; batch < x.batches; ++batch)
+        if (auto ok = x.triangles(batch); !ok) return ok.error();
+    x.finish();
     stats.totalSeconds = secondsSince(start);
-    return mesh;
+    return std::move(x.mesh);
 }
 
 Result<Mesh> extractMesh(Context& context, const Scene& scene, const MeshOptions& options,

@@ -4,7 +4,7 @@
 // per-pixel info.
 #include "sdfcsg/render.h"
 
-#include "codegen/gpu_nodes.h"
+#include "codegen/scene_buffers.h"
 #include "codegen/shader_compile.h"
 #include "field/prune.h"
 #include "gpu/vk.h"
@@ -125,6 +125,34 @@ Error usage(std::string text) {
 // Samples per submission (see Renderer::render).
 constexpr uint32_t kBandSamples = 1u << 16;
 
+// Bands of whole workgroup rows, about kBandSamples samples each: a heavy scene or a huge image
+// never becomes one long dispatch (GPU drivers reset a device whose work runs for seconds), and
+// the caller can follow progress and stop between bands.
+struct BandPlan {
+    uint64_t pixels = 0;      // of the image
+    uint32_t aa = 1;          // samples per pixel along each axis
+    uint32_t bandGroups = 0;  // workgroup rows per band
+    uint64_t bandSamples = 0; // samples per band
+    uint64_t groupsX = 0;     // workgroups along a row of samples
+    uint32_t groupsY = 0;     // workgroup rows of pixels in the image
+};
+
+// A frame's pipelines, null for the passes it does not run.
+struct FramePasses {
+    VkPipeline clip = VK_NULL_HANDLE, march = VK_NULL_HANDLE, shade = VK_NULL_HANDLE,
+               light = VK_NULL_HANDLE, ends = VK_NULL_HANDLE, resolve = VK_NULL_HANDLE,
+               overlay = VK_NULL_HANDLE;
+};
+
+// Workgroups whose rays cannot meet a surface are not marched (with `culling`); the band is
+// filled with the colour and info of a miss first.
+struct MissFill {
+    bool culling = false;
+    std::vector<detail::ScreenRect> rects; // where rays may meet a surface
+    uint32_t color = 0;                    // RGBA8
+    uint32_t info = 0;                     // the bits of t = -1
+};
+
 Result<std::shared_ptr<SharedPasses>> sharedPasses(Context::Impl& ctx) {
     std::lock_guard lock(ctx.rendererSharedMutex);
     if (ctx.rendererShared) return std::static_pointer_cast<SharedPasses>(ctx.rendererShared);
@@ -161,6 +189,18 @@ bool sameStructure(const Scene& a, const Scene& b) {
     return true;
 }
 
+// The options' errors that the caller can fix, if any.
+static std::optional<Error> checkRenderOptions(const RenderOptions& options, uint32_t nodeCount) {
+    if (options.width == 0 || options.height == 0)
+        return usage("the image must be at least 1 x 1 pixels");
+    if (options.aa == 0 || options.aa > 16) return usage("aa must be in 1..16");
+    if (options.boxes == BoxOverlay::Selected &&
+        (options.selectedNode < 0 || uint32_t(options.selectedNode) >= nodeCount))
+        return usage("selectedNode " + std::to_string(options.selectedNode) +
+                     " is not a node of the scene (it has " + std::to_string(nodeCount) + ")");
+    return std::nullopt;
+}
+
 struct Renderer::Impl {
     Context::Impl& ctx;
     RendererOptions options;
@@ -181,23 +221,24 @@ struct Renderer::Impl {
     VkDescriptorPool pool = VK_NULL_HANDLE;
     VkDescriptorSet set = VK_NULL_HANDLE;
 
+    detail::SceneBuffers sceneBuffers; // the node buffer and the field
     // The image (pixels, info), and per band: the samples' colours (with several per pixel),
     // the workgroups to march and the hits to shade.
-    Buffer frame, control, nodes, pixels, info, pixelsStaging, infoStaging, samples, hits, tiles,
-        surfaces, ranges, field;
+    Buffer frame, control, pixels, info, pixelsStaging, infoStaging, samples, hits, tiles, surfaces,
+        ranges;
     uint32_t capacity = 0;         // pixels the image buffers hold
     uint32_t sampleCapacity = 0;   // samples the band buffers hold
     uint32_t tileCapacity = 0;     // workgroups the tile list holds
     bool samplesArePixels = false; // what the SAMPLES binding points at
     std::vector<PixelInfo> lastInfo;
 
-    explicit Impl(Context::Impl& c) : ctx(c) {}
+    explicit Impl(Context::Impl& c) : ctx(c), sceneBuffers(c) {}
     // No work of this renderer is pending between calls (submitAndWait() waits for it), and the
     // device may be busy with other threads' work: nothing to wait for.
     ~Impl() {
         VkDevice device = ctx.device;
-        for (Buffer* b : {&frame, &control, &nodes, &pixels, &info, &pixelsStaging, &infoStaging,
-                          &samples, &hits, &tiles, &surfaces, &ranges, &field})
+        for (Buffer* b : {&frame, &control, &pixels, &info, &pixelsStaging, &infoStaging, &samples,
+                          &hits, &tiles, &surfaces, &ranges})
             detail::destroyBuffer(ctx, *b);
         destroyKernel();
         if (pool) vkDestroyDescriptorPool(device, pool, nullptr);
@@ -396,11 +437,9 @@ struct Renderer::Impl {
         detail::submitAndWait(ctx);
     }
 
-    // The node buffer, and the field (detail::fieldWords()).
-    Status uploadNodes(std::span<const uint32_t> fieldWords) {
-        std::vector<detail::GpuNode> packed = detail::packNodes(*evaluator);
-        detail::uploadBuffer(ctx, nodes, packed.data(), packed.size() * sizeof(detail::GpuNode));
-        auto made = detail::uploadField(ctx, field, fieldWords);
+    // The field (SceneBuffers::fieldWords()), and the descriptors when its buffer is new.
+    Status uploadField(std::span<const uint32_t> words) {
+        auto made = sceneBuffers.uploadField(words);
         if (!made) return made.error();
         if (*made) writeDescriptors();
         return Ok{};
@@ -410,8 +449,17 @@ struct Renderer::Impl {
     void writeDescriptors() {
         if (!pixels.buffer || !samples.buffer) return;
         const Buffer* colors = samplesArePixels ? &pixels : &samples;
-        const Buffer* buffers[] = {&frame, &nodes,   &pixels,   &info,   colors, &hits,
-                                   &tiles, &control, &surfaces, &ranges, &field};
+        const Buffer* buffers[] = {&frame,
+                                   &sceneBuffers.nodes(),
+                                   &pixels,
+                                   &info,
+                                   colors,
+                                   &hits,
+                                   &tiles,
+                                   &control,
+                                   &surfaces,
+                                   &ranges,
+                                   &sceneBuffers.field()};
         detail::writeDescriptorSet(ctx, set, kBindings, buffers);
     }
 
@@ -492,6 +540,191 @@ struct Renderer::Impl {
         capacity = count;
         writeDescriptors();
         return Ok{};
+    }
+
+    // The image's bands (see BandPlan), or an error where the device cannot hold them.
+    Result<BandPlan> planBands(const RenderOptions& render) const {
+        const VkPhysicalDeviceLimits& limits = ctx.properties.limits;
+        BandPlan b;
+        b.pixels = uint64_t(render.width) * render.height;
+        b.aa = render.aa;
+        const uint64_t rowGroupSamples =
+            uint64_t(render.width) * b.aa * b.aa * SDFCSG_RAYMARCH_GROUP_Y;
+        b.bandGroups = uint32_t(std::max<uint64_t>(1, kBandSamples / rowGroupSamples));
+        b.bandSamples = rowGroupSamples * b.bandGroups;
+        const uint64_t sampleColumns = uint64_t(render.width) * b.aa;
+        b.groupsY = detail::groupCount(render.height, SDFCSG_RAYMARCH_GROUP_Y);
+        b.groupsX = (sampleColumns + SDFCSG_RAYMARCH_GROUP_X - 1) / SDFCSG_RAYMARCH_GROUP_X;
+        if (b.pixels * 8 > limits.maxStorageBufferRange ||
+            kHitsHeader + b.bandSamples * 8 > limits.maxStorageBufferRange ||
+            b.groupsX > limits.maxComputeWorkGroupCount[0] || b.groupsX > 0xffff ||
+            uint64_t(b.bandGroups) * b.aa > 0xffff || // the tile list packs x | y << 16
+            uint64_t(b.bandGroups) * b.aa > limits.maxComputeWorkGroupCount[1] ||
+            b.bandSamples / kGroupSize > limits.maxComputeWorkGroupCount[0])
+            return Error::message(
+                ErrorKind::Limit, "<render>",
+                "an image of " + std::to_string(render.width) + " x " +
+                    std::to_string(render.height) + " pixels" +
+                    (b.aa > 1 ? " at aa " + std::to_string(b.aa) : std::string()) +
+                    " is too large for " + ctx.properties.deviceName);
+        return b;
+    }
+
+    // The image and band buffers for `plan`, and where the samples go: with one per pixel, the
+    // passes write the image directly and no resolve runs.
+    Status reserveFor(const BandPlan& plan) {
+        if (auto reserved = reserve(uint32_t(plan.pixels)); !reserved) return reserved;
+        if (auto reserved = reserveSamples(uint32_t(plan.bandSamples),
+                                           uint32_t(plan.groupsX) * plan.bandGroups * plan.aa);
+            !reserved)
+            return reserved;
+        if (samplesArePixels != (plan.aa == 1)) {
+            samplesArePixels = plan.aa == 1;
+            writeDescriptors();
+        }
+        return Ok{};
+    }
+
+    // The pipelines of the passes that the render ask for, compiling the scene's kernels for
+    // their skipping choice on first use.
+    Result<FramePasses> framePasses(const RenderOptions& render) {
+        const bool skipping = render.boundsSkipping.value_or(defaultSkipping());
+        if (auto made = kernels(skipping); !made) return made.error();
+        const bool shading =
+            render.mode == RenderMode::Shaded || render.mode == RenderMode::Normals;
+        const bool overlays = render.grid || render.boxes != BoxOverlay::None;
+        FramePasses p;
+        p.clip = pipeline(SDFCSG_RAYMARCH_PASS_CLIP, false);
+        p.march = pipeline(SDFCSG_RAYMARCH_PASS_MARCH, skipping);
+        if (shading) p.shade = pipeline(SDFCSG_RAYMARCH_PASS_SHADE, skipping);
+        if (shading) p.light = pipeline(SDFCSG_RAYMARCH_PASS_LIGHT, false);
+        if (shading && render.mode == RenderMode::Shaded && render.shadows)
+            p.ends = pipeline(SDFCSG_RAYMARCH_PASS_ENDS, false);
+        if (render.aa > 1) p.resolve = pipeline(SDFCSG_RAYMARCH_PASS_RESOLVE, false);
+        if (overlays) p.overlay = pipeline(SDFCSG_RAYMARCH_PASS_OVERLAY, false);
+        return p;
+    }
+
+    // The steps mode colours misses by their steps, so it traces every ray: no culling there.
+    MissFill missFill(const RenderOptions& render, const detail::RayCamera& rc,
+                      const detail::ClipVolume& clip) const {
+        MissFill miss;
+        miss.culling = render.mode != RenderMode::Steps &&
+                       detail::surfaceRects(rc, clip, render.width, render.height, miss.rects);
+        const glm::vec3 c = render.mode == RenderMode::Shaded ? scene.background : glm::vec3(0.0f);
+        const glm::uvec3 u(glm::clamp(c, 0.0f, 1.0f) * 255.0f + 0.5f);
+        miss.color = u.r | (u.g << 8) | (u.b << 16) | (255u << 24);
+        const float missInfo = -1.0f; // the steps word too, read back as 0
+        std::memcpy(&miss.info, &missInfo, sizeof miss.info);
+        return miss;
+    }
+
+    // One submission per band, reporting progress after each; stops when the caller cancels.
+    Status renderBands(const RenderOptions& render, const BandPlan& plan, const FramePasses& passes,
+                       const MissFill& miss) {
+        std::vector<uint32_t> tileList;
+        for (uint32_t firstGroup = 0; firstGroup < plan.groupsY; firstGroup += plan.bandGroups) {
+            const uint32_t groups = std::min(plan.bandGroups, plan.groupsY - firstGroup);
+            listTiles(plan, firstGroup, groups, miss, tileList);
+            if (!tileList.empty())
+                detail::uploadBuffer(ctx, tiles, tileList.data(),
+                                     tileList.size() * sizeof(uint32_t));
+            const bool last = firstGroup + groups == plan.groupsY;
+            VkCommandBuffer cmd = detail::beginCommands(ctx);
+            recordBand(cmd, render, passes, miss, firstGroup, groups, uint32_t(tileList.size()));
+            if (last) {
+                detail::recordReadback(cmd, pixels, &pixelsStaging);
+                detail::recordReadback(cmd, info, &infoStaging);
+            }
+            detail::submitAndWait(ctx);
+            const float done = float(firstGroup + groups) / float(plan.groupsY);
+            if (render.progress && !render.progress(done) && !last)
+                return Error::message(ErrorKind::Cancelled, "<render>", "cancelled");
+        }
+        return Ok{};
+    }
+
+    // The workgroups of a band (`groups` workgroup rows from `firstGroup`) whose samples may
+    // meet a surface, as x | y << 16: all of them without culling.
+    void listTiles(const BandPlan& plan, uint32_t firstGroup, uint32_t groups, const MissFill& miss,
+                   std::vector<uint32_t>& out) const {
+        const uint32_t firstRow = firstGroup * SDFCSG_RAYMARCH_GROUP_Y;
+        const uint32_t aa = plan.aa;
+        out.clear();
+        for (uint32_t ty = 0; ty < groups * aa; ++ty) {
+            const float y0 = float(firstRow) + float(ty * SDFCSG_RAYMARCH_GROUP_Y) / float(aa);
+            const float y1 = y0 + float(SDFCSG_RAYMARCH_GROUP_Y) / float(aa);
+            for (uint32_t tx = 0; tx < plan.groupsX; ++tx) {
+                const float x0 = float(tx * SDFCSG_RAYMARCH_GROUP_X) / float(aa);
+                const float x1 = x0 + float(SDFCSG_RAYMARCH_GROUP_X) / float(aa);
+                bool visible = !miss.culling;
+                for (const detail::ScreenRect& q : miss.rects)
+                    visible = visible || (x0 < q.x1 && x1 > q.x0 && y0 < q.y1 && y1 > q.y0);
+                if (visible) out.push_back(tx | ty << 16);
+            }
+        }
+    }
+
+    // A band's passes: the miss fill, then per listed workgroup the clip and march passes, per
+    // listed hit the ends, shade and light passes, and per pixel the resolve and overlay passes.
+    void recordBand(VkCommandBuffer cmd, const RenderOptions& render, const FramePasses& passes,
+                    const MissFill& miss, uint32_t firstGroup, uint32_t groups,
+                    uint32_t tileCount) {
+        const uint32_t aa = render.aa;
+        const uint32_t firstRow = firstGroup * SDFCSG_RAYMARCH_GROUP_Y;
+        const BandConstants band = {firstRow, aa == 1 ? firstRow * render.width : 0u};
+        const uint32_t rows = std::min(groups * SDFCSG_RAYMARCH_GROUP_Y, render.height - firstRow);
+        if (miss.culling) {
+            const VkDeviceSize first = VkDeviceSize(firstRow) * render.width;
+            const VkDeviceSize pixelsInBand = VkDeviceSize(rows) * render.width;
+            if (aa == 1)
+                vkCmdFillBuffer(cmd, pixels.buffer, first * 4, pixelsInBand * 4, miss.color);
+            else
+                vkCmdFillBuffer(cmd, samples.buffer, 0, pixelsInBand * aa * aa * 4, miss.color);
+            vkCmdFillBuffer(cmd, info.buffer, first * 8, pixelsInBand * 8, miss.info);
+        }
+        vkCmdFillBuffer(cmd, hits.buffer, 0, 8, 0); // count, and the shade dispatch's x
+        vkCmdFillBuffer(cmd, hits.buffer, 8, 8, 1); // its y and z
+        detail::recordComputeBarrier(cmd);
+        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipelineLayout, 0, 1, &set, 0,
+                                nullptr);
+        vkCmdPushConstants(cmd, pipelineLayout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof band, &band);
+        if (tileCount > 0) { // the listed workgroups' samples
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, passes.clip);
+            vkCmdDispatch(cmd, tileCount, 1, 1);
+            detail::recordComputeBarrier(cmd);
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, passes.march);
+            vkCmdDispatch(cmd, tileCount, 1, 1);
+        }
+        for (VkPipeline perHit : {passes.ends, passes.shade, passes.light}) {
+            if (!perHit) continue;
+            detail::recordComputeBarrier(cmd);
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, perHit);
+            vkCmdDispatchIndirect(cmd, hits.buffer, 4);
+        }
+        for (VkPipeline perPixel : {passes.resolve, passes.overlay}) {
+            if (!perPixel) continue;
+            detail::recordComputeBarrier(cmd);
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, perPixel);
+            vkCmdDispatch(cmd, detail::groupCount(render.width, SDFCSG_RAYMARCH_GROUP_X), groups,
+                          1);
+        }
+    }
+
+    // The read-back image, and its per-pixel info for lastPixelInfo().
+    Image readImage(uint32_t width, uint32_t height) {
+        const uint64_t count = uint64_t(width) * height;
+        Image image;
+        image.width = width;
+        image.height = height;
+        image.rgba.resize(count * 4);
+        std::memcpy(image.rgba.data(), detail::readback(ctx, pixels, &pixelsStaging), count * 4);
+        const auto* words = static_cast<const float*>(detail::readback(ctx, info, &infoStaging));
+        lastInfo.resize(count);
+        for (uint64_t i = 0; i < count; ++i)
+            lastInfo[i] =
+                PixelInfo{words[2 * i], words[2 * i + 1] > 0.0f ? uint32_t(words[2 * i + 1]) : 0u};
+        return image;
     }
 
     // The frame's values (f) and those that its branches read (fc).
@@ -601,7 +834,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene
     // Pruned on the host while the kernels build (with tapes, they are the same for every
     // scene): on the forest benchmark scene, most of the prune's time.
     auto fieldWords = std::async(std::launch::async, [&] {
-        return detail::fieldWords(scene, *r.evaluator, options.evaluation);
+        return detail::SceneBuffers::fieldWords(scene, *r.evaluator, options.evaluation);
     });
 
     auto shared = sharedPasses(r.ctx);
@@ -619,12 +852,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene
         r.ctx, sizeof(FrameControl), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, detail::MemoryUse::Upload);
     if (!control) return control.error();
     r.control = *control;
-    auto nodes = detail::createBuffer(
-        r.ctx, detail::packNodes(*r.evaluator).size() * sizeof(detail::GpuNode),
-        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, detail::MemoryUse::Upload);
-    if (!nodes) return nodes.error();
-    r.nodes = *nodes;
-    if (auto uploaded = r.uploadNodes(detail::emptyField()); !uploaded) return uploaded.error();
+    if (auto made = r.sceneBuffers.create(*r.evaluator); !made) return made.error();
     if (auto reserved = r.reserve(64 * 64); !reserved) return reserved.error();
     if (auto reserved = r.reserveSamples(64 * 64, 64); !reserved) return reserved.error();
     if (auto built = r.buildKernels(); !built) return built.error();
@@ -636,7 +864,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene
     r.pipeline(SDFCSG_RAYMARCH_PASS_LIGHT, false);
     auto words = fieldWords.get();
     if (!words) return words.error();
-    if (auto uploaded = r.uploadNodes(*words); !uploaded) return uploaded.error();
+    if (auto uploaded = r.uploadField(*words); !uploaded) return uploaded.error();
     return std::unique_ptr<Renderer>(new Renderer(std::move(impl)));
 }
 
@@ -646,7 +874,7 @@ Status Renderer::updateValues(const Scene& scene) {
                      "the compiled one; create a new Renderer instead");
     Impl& r = *impl_;
     auto evaluator = std::make_unique<Evaluator>(scene);
-    auto words = detail::fieldWords(scene, *evaluator, r.options.evaluation);
+    auto words = detail::SceneBuffers::fieldWords(scene, *evaluator, r.options.evaluation);
     if (!words) return words.error();
     const bool balls = r.readsBalls(*evaluator);
     Scene previous = std::move(r.scene);
@@ -659,7 +887,9 @@ Status Renderer::updateValues(const Scene& scene) {
         r.balls = balls;
     }
     r.evaluator = std::move(evaluator);
-    return r.uploadNodes(*words); // no render is in flight: render() waits for its fence
+    // No render is in flight: render() waits for its fence.
+    r.sceneBuffers.uploadNodes(*r.evaluator);
+    return r.uploadField(*words);
 }
 
 bool Renderer::uploads(const Scene& scene) const {
@@ -675,66 +905,16 @@ bool Renderer::followsValues() const {
 
 Result<Image> Renderer::render(const RenderOptions& options) {
     Impl& r = *impl_;
-    const VkPhysicalDeviceLimits& limits = r.ctx.properties.limits;
-    if (options.width == 0 || options.height == 0)
-        return usage("the image must be at least 1 x 1 pixels");
-    if (options.aa == 0 || options.aa > 16) return usage("aa must be in 1..16");
-    if (options.boxes == BoxOverlay::Selected &&
-        (options.selectedNode < 0 || uint32_t(options.selectedNode) >= r.nodeCount))
-        return usage("selectedNode " + std::to_string(options.selectedNode) +
-                     " is not a node of the scene (it has " + std::to_string(r.nodeCount) + ")");
-    // Bands of whole workgroup rows, about kBandSamples samples each: a heavy scene or a huge
-    // image never becomes one long dispatch (GPU drivers reset a device whose work runs for
-    // seconds), and the caller can follow progress and stop between bands.
-    const uint64_t count = uint64_t(options.width) * options.height;
-    const uint32_t aa = options.aa;
-    const uint64_t rowGroupSamples = uint64_t(options.width) * aa * aa * SDFCSG_RAYMARCH_GROUP_Y;
-    const uint32_t bandGroups = uint32_t(std::max<uint64_t>(1, kBandSamples / rowGroupSamples));
-    const uint64_t bandSamples = rowGroupSamples * bandGroups;
-    const uint64_t sampleColumns = uint64_t(options.width) * aa;
-    const uint32_t groupsY = detail::groupCount(options.height, SDFCSG_RAYMARCH_GROUP_Y);
-    const uint64_t groupsX =
-        (sampleColumns + SDFCSG_RAYMARCH_GROUP_X - 1) / SDFCSG_RAYMARCH_GROUP_X;
-    if (count * 8 > limits.maxStorageBufferRange ||
-        kHitsHeader + bandSamples * 8 > limits.maxStorageBufferRange ||
-        groupsX > limits.maxComputeWorkGroupCount[0] || groupsX > 0xffff ||
-        uint64_t(bandGroups) * aa > 0xffff || // the tile list packs x | y << 16
-        uint64_t(bandGroups) * aa > limits.maxComputeWorkGroupCount[1] ||
-        bandSamples / kGroupSize > limits.maxComputeWorkGroupCount[0])
-        return Error::message(ErrorKind::Limit, "<render>",
-                              "an image of " + std::to_string(options.width) + " x " +
-                                  std::to_string(options.height) + " pixels" +
-                                  (aa > 1 ? " at aa " + std::to_string(aa) : std::string()) +
-                                  " is too large for " + r.ctx.properties.deviceName);
-    if (auto reserved = r.reserve(uint32_t(count)); !reserved) return reserved.error();
-    if (auto reserved =
-            r.reserveSamples(uint32_t(bandSamples), uint32_t(groupsX) * bandGroups * aa);
-        !reserved)
-        return reserved.error();
-    // One sample per pixel: the passes write the image directly and no resolve runs.
-    if (r.samplesArePixels != (aa == 1)) {
-        r.samplesArePixels = aa == 1;
-        r.writeDescriptors();
-    }
-
-    float aspect = float(options.width) / float(options.height);
-    Camera camera = options.camera   ? *options.camera
-                    : r.scene.camera ? *r.scene.camera
-                                     : frameCamera(*r.evaluator, aspect);
-    const bool skipping = options.boundsSkipping.value_or(r.defaultSkipping());
-    if (auto made = r.kernels(skipping); !made) return made.error();
-    const bool shading = options.mode == RenderMode::Shaded || options.mode == RenderMode::Normals;
-    VkPipeline clipRays = r.pipeline(SDFCSG_RAYMARCH_PASS_CLIP, false);
-    VkPipeline march = r.pipeline(SDFCSG_RAYMARCH_PASS_MARCH, skipping);
-    VkPipeline shade = shading ? r.pipeline(SDFCSG_RAYMARCH_PASS_SHADE, skipping) : VK_NULL_HANDLE;
-    VkPipeline light = shading ? r.pipeline(SDFCSG_RAYMARCH_PASS_LIGHT, false) : VK_NULL_HANDLE;
-    VkPipeline ends = shading && options.mode == RenderMode::Shaded && options.shadows
-                          ? r.pipeline(SDFCSG_RAYMARCH_PASS_ENDS, false)
-                          : VK_NULL_HANDLE;
-    VkPipeline resolve = aa > 1 ? r.pipeline(SDFCSG_RAYMARCH_PASS_RESOLVE, false) : VK_NULL_HANDLE;
-    const bool overlays = options.grid || options.boxes != BoxOverlay::None;
-    VkPipeline overlay =
-        overlays ? r.pipeline(SDFCSG_RAYMARCH_PASS_OVERLAY, false) : VK_NULL_HANDLE;
+    if (auto bad = checkRenderOptions(options, r.nodeCount)) return *bad;
+    auto plan = r.planBands(options);
+    if (!plan) return plan.error();
+    if (auto reserved = r.reserveFor(*plan); !reserved) return reserved.error();
+    const float aspect = float(options.width) / float(options.height);
+    const Camera camera = options.camera   ? *options.camera
+                          : r.scene.camera ? *r.scene.camera
+                                           : frameCamera(*r.evaluator, aspect);
+    auto passes = r.framePasses(options);
+    if (!passes) return passes.error();
     const detail::RayCamera rc = detail::makeRayCamera(camera, options.width, options.height);
     const detail::ClipVolume clip = detail::makeClipVolume(*r.evaluator, rc.eye);
     FrameUniform f;
@@ -742,104 +922,10 @@ Result<Image> Renderer::render(const RenderOptions& options) {
     r.frameValues(options, rc, clip, f, control);
     detail::uploadBuffer(r.ctx, r.frame, &f, sizeof(f));
     detail::uploadBuffer(r.ctx, r.control, &control, sizeof(control));
-
-    // Workgroups whose rays cannot meet a surface are not marched; the band is filled with the
-    // colour and info of a miss first (t = -1; the steps word too, read back as 0). The steps
-    // mode colours misses by their steps, so it traces every ray.
-    std::vector<detail::ScreenRect> rects;
-    const bool culling = options.mode != RenderMode::Steps &&
-                         detail::surfaceRects(rc, clip, options.width, options.height, rects);
-    auto packed = [](glm::vec3 c) {
-        glm::uvec3 u(glm::clamp(c, 0.0f, 1.0f) * 255.0f + 0.5f);
-        return u.r | (u.g << 8) | (u.b << 16) | (255u << 24);
-    };
-    const uint32_t missColor =
-        packed(options.mode == RenderMode::Shaded ? r.scene.background : glm::vec3(0.0f));
-    const float missInfo = -1.0f;
-    uint32_t missInfoBits;
-    std::memcpy(&missInfoBits, &missInfo, sizeof missInfoBits);
-    std::vector<uint32_t> tiles;
-
-    for (uint32_t firstGroup = 0; firstGroup < groupsY; firstGroup += bandGroups) {
-        const uint32_t groups = std::min(bandGroups, groupsY - firstGroup);
-        const uint32_t firstRow = firstGroup * SDFCSG_RAYMARCH_GROUP_Y;
-        const BandConstants band = {firstRow, aa == 1 ? firstRow * options.width : 0u};
-        const uint32_t rows = std::min(groups * SDFCSG_RAYMARCH_GROUP_Y, options.height - firstRow);
-        tiles.clear();
-        for (uint32_t ty = 0; ty < groups * aa; ++ty) {
-            const float y0 = float(firstRow) + float(ty * SDFCSG_RAYMARCH_GROUP_Y) / float(aa);
-            const float y1 = y0 + float(SDFCSG_RAYMARCH_GROUP_Y) / float(aa);
-            for (uint32_t tx = 0; tx < groupsX; ++tx) {
-                const float x0 = float(tx * SDFCSG_RAYMARCH_GROUP_X) / float(aa);
-                const float x1 = x0 + float(SDFCSG_RAYMARCH_GROUP_X) / float(aa);
-                bool visible = !culling;
-                for (const detail::ScreenRect& q : rects)
-                    visible = visible || (x0 < q.x1 && x1 > q.x0 && y0 < q.y1 && y1 > q.y0);
-                if (visible) tiles.push_back(tx | ty << 16);
-            }
-        }
-        if (!tiles.empty())
-            detail::uploadBuffer(r.ctx, r.tiles, tiles.data(), tiles.size() * sizeof(uint32_t));
-
-        VkCommandBuffer cmd = detail::beginCommands(r.ctx);
-        if (culling) {
-            const VkDeviceSize first = VkDeviceSize(firstRow) * options.width;
-            const VkDeviceSize pixelsInBand = VkDeviceSize(rows) * options.width;
-            if (aa == 1)
-                vkCmdFillBuffer(cmd, r.pixels.buffer, first * 4, pixelsInBand * 4, missColor);
-            else
-                vkCmdFillBuffer(cmd, r.samples.buffer, 0, pixelsInBand * aa * aa * 4, missColor);
-            vkCmdFillBuffer(cmd, r.info.buffer, first * 8, pixelsInBand * 8, missInfoBits);
-        }
-        vkCmdFillBuffer(cmd, r.hits.buffer, 0, 8, 0); // count, and the shade dispatch's x
-        vkCmdFillBuffer(cmd, r.hits.buffer, 8, 8, 1); // its y and z
-        detail::recordComputeBarrier(cmd);
-        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r.pipelineLayout, 0, 1, &r.set,
-                                0, nullptr);
-        vkCmdPushConstants(cmd, r.pipelineLayout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof band,
-                           &band);
-        if (!tiles.empty()) { // the listed workgroups' samples
-            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, clipRays);
-            vkCmdDispatch(cmd, uint32_t(tiles.size()), 1, 1);
-            detail::recordComputeBarrier(cmd);
-            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, march);
-            vkCmdDispatch(cmd, uint32_t(tiles.size()), 1, 1);
-        }
-        for (VkPipeline perHit : {ends, shade, light}) { // one invocation per listed hit
-            if (!perHit) continue;
-            detail::recordComputeBarrier(cmd);
-            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, perHit);
-            vkCmdDispatchIndirect(cmd, r.hits.buffer, 4);
-        }
-        for (VkPipeline perPixel : {resolve, overlay}) {
-            if (!perPixel) continue;
-            detail::recordComputeBarrier(cmd);
-            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, perPixel);
-            vkCmdDispatch(cmd, detail::groupCount(options.width, SDFCSG_RAYMARCH_GROUP_X), groups,
-                          1);
-        }
-        const bool last = firstGroup + groups == groupsY;
-        if (last) {
-            detail::recordReadback(cmd, r.pixels, &r.pixelsStaging);
-            detail::recordReadback(cmd, r.info, &r.infoStaging);
-        }
-        detail::submitAndWait(r.ctx);
-        const float done = float(firstGroup + groups) / float(groupsY);
-        if (options.progress && !options.progress(done) && !last)
-            return Error::message(ErrorKind::Cancelled, "<render>", "cancelled");
-    }
-
-    Image image;
-    image.width = options.width;
-    image.height = options.height;
-    image.rgba.resize(count * 4);
-    std::memcpy(image.rgba.data(), detail::readback(r.ctx, r.pixels, &r.pixelsStaging), count * 4);
-    const auto* info = static_cast<const float*>(detail::readback(r.ctx, r.info, &r.infoStaging));
-    r.lastInfo.resize(count);
-    for (uint64_t i = 0; i < count; ++i)
-        r.lastInfo[i] =
-            PixelInfo{info[2 * i], info[2 * i + 1] > 0.0f ? uint32_t(info[2 * i + 1]) : 0u};
-    return image;
+    const MissFill miss = r.missFill(options, rc, clip);
+    if (auto marched = r.renderBands(options, *plan, *passes, miss); !marched)
+        return marched.error();
+    return r.readImage(options.width, options.height);
 }
 
 const std::vector<PixelInfo>& Renderer::lastPixelInfo() const {
