@@ -334,63 +334,52 @@ void RenderWorker::highlight(RenderOutput& out, int node) {
     drawHighlight(out.image, mask);
 }
 
-MeshWorker::~MeshWorker() {
-    cancel_ = true;
-    if (thread_.joinable()) thread_.join();
-}
-
 bool MeshWorker::start(std::shared_ptr<const Scene> scene, MeshOptions options, float simplify) {
-    if (running_) return false;
-    if (thread_.joinable()) thread_.join();
-    running_ = true;
-    cancel_ = false;
+    if (job_.running()) return false;
     progress_ = 0.0f;
-    thread_ = std::thread(
-        [this, scene = std::move(scene), options = std::move(options), simplify]() mutable {
-            options.progress = [this](float done) {
-                progress_ = done;
-                return !cancel_.load();
-            };
-            MeshStats stats;
-            Result<ExtractedMesh> out = [&]() -> Result<ExtractedMesh> {
-                auto mesher = Mesher::create(context_, *scene);
-                if (!mesher) return mesher.error();
-                auto mesh = (*mesher)->extract(options, &stats);
-                if (!mesh) return mesh.error();
-                ExtractedMesh extracted{std::move(*mesh), std::nullopt};
-                const Evaluator evaluator(*scene);
-                if (simplify > 0.0f && !cancel_) {
-                    SimplifyOptions fewer;
-                    fewer.maxError = simplify * stats.voxelSize;
-                    fewer.progress = [this](float) { return !cancel_.load(); };
-                    auto simplified = simplifyMesh(extracted.mesh, evaluator, fewer, &stats);
-                    if (!simplified) return simplified.error();
-                    extracted.mesh = std::move(*simplified);
-                }
-                if (extracted.mesh.triangleCount() <= previewThreshold_ || cancel_)
-                    return extracted;
-                SimplifyOptions preview;
-                preview.targetTriangles = previewThreshold_;
-                preview.progress = [this](float) { return !cancel_.load(); };
-                if (auto copy = simplifyMesh(extracted.mesh, evaluator, preview); copy)
-                    extracted.preview = std::move(*copy);
-                return extracted;
-            }();
-            if (cancel_ && out) out = Error::message(ErrorKind::Cancelled, "<mesh>", "cancelled");
-            {
-                std::lock_guard lock(mutex_);
-                done_ = std::move(out);
-                stats_ = stats;
-            }
-            running_ = false;
-        });
-    return true;
+    return job_.start([this, scene = std::move(scene), options = std::move(options), simplify] {
+        Result<ExtractedMesh> out = extract(*scene, options, simplify);
+        if (job_.cancelled() && out)
+            out = Error::message(ErrorKind::Cancelled, "<mesh>", "cancelled");
+        return out;
+    });
 }
 
-std::optional<Result<ExtractedMesh>> MeshWorker::take() {
+// On the job's thread.
+Result<ExtractedMesh> MeshWorker::extract(const Scene& scene, MeshOptions options, float simplify) {
+    auto going = [this](float) { return !job_.cancelled(); };
+    options.progress = [this](float done) {
+        progress_ = done;
+        return !job_.cancelled();
+    };
+    MeshStats stats;
+    Result<ExtractedMesh> out = [&]() -> Result<ExtractedMesh> {
+        auto mesher = Mesher::create(context_, scene);
+        if (!mesher) return mesher.error();
+        auto mesh = (*mesher)->extract(options, &stats);
+        if (!mesh) return mesh.error();
+        ExtractedMesh extracted{std::move(*mesh), std::nullopt};
+        const Evaluator evaluator(scene);
+        if (simplify > 0.0f && !job_.cancelled()) {
+            SimplifyOptions fewer;
+            fewer.maxError = simplify * stats.voxelSize;
+            fewer.progress = going;
+            auto simplified = simplifyMesh(extracted.mesh, evaluator, fewer, &stats);
+            if (!simplified) return simplified.error();
+            extracted.mesh = std::move(*simplified);
+        }
+        if (extracted.mesh.triangleCount() <= previewThreshold_ || job_.cancelled())
+            return extracted;
+        SimplifyOptions preview;
+        preview.targetTriangles = previewThreshold_;
+        preview.progress = going;
+        if (auto copy = simplifyMesh(extracted.mesh, evaluator, preview); copy)
+            extracted.preview = std::move(*copy);
+        return extracted;
+    }();
+    // Before the result is handed over, so that its taker reads these stats.
     std::lock_guard lock(mutex_);
-    auto out = std::move(done_);
-    done_.reset();
+    stats_ = stats;
     return out;
 }
 
@@ -399,43 +388,15 @@ MeshStats MeshWorker::stats() const {
     return stats_;
 }
 
-ExportWorker::~ExportWorker() {
-    if (thread_.joinable()) thread_.join();
-}
-
 bool ExportWorker::start(std::shared_ptr<const Mesh> mesh, std::filesystem::path path,
                          MeshFormat format, LengthUnit unit) {
-    if (running_) return false;
-    if (thread_.joinable()) thread_.join();
-    running_ = true;
-    thread_ = std::thread([this, mesh = std::move(mesh), path = std::move(path), format, unit] {
-        Status written = writeMesh(*mesh, path, format, unit);
-        {
-            std::lock_guard lock(mutex_);
-            done_ = std::move(written);
-        }
-        running_ = false;
+    return job_.start([mesh = std::move(mesh), path = std::move(path), format, unit] {
+        return writeMesh(*mesh, path, format, unit);
     });
-    return true;
-}
-
-std::optional<Status> ExportWorker::take() {
-    std::lock_guard lock(mutex_);
-    auto out = std::move(done_);
-    done_.reset();
-    return out;
-}
-
-GenerateWorker::~GenerateWorker() {
-    cancel_ = true;
-    if (thread_.joinable()) thread_.join();
 }
 
 bool GenerateWorker::start(std::string request, std::string currentScene, GenerateOptions options) {
-    if (running_) return false;
-    if (thread_.joinable()) thread_.join();
-    running_ = true;
-    cancel_ = false;
+    if (job_.running()) return false;
     {
         std::lock_guard lock(mutex_);
         message_.clear();
@@ -447,30 +408,19 @@ bool GenerateWorker::start(std::string request, std::string currentScene, Genera
         std::lock_guard lock(mutex_);
         message_ = p.message;
     };
-    options.cancelled = [this] { return cancel_.load(); };
-    thread_ = std::thread([this, request = std::move(request), options = std::move(options)] {
+    options.cancelled = [this] { return job_.cancelled(); };
+    return job_.start([this, request = std::move(request), options = std::move(options)] {
         GenerateStats stats;
         Result<Generated> generated = generateScene(request, options, &stats);
-        {
-            std::lock_guard lock(mutex_);
-            done_ = std::move(generated);
-            stats_ = stats;
-        }
-        running_ = false;
+        std::lock_guard lock(mutex_); // before the result is handed over, as in MeshWorker
+        stats_ = stats;
+        return generated;
     });
-    return true;
 }
 
 GenerateStatus GenerateWorker::status() const {
     std::lock_guard lock(mutex_);
     return {message_, secondsSince(start_)};
-}
-
-std::optional<Result<Generated>> GenerateWorker::take() {
-    std::lock_guard lock(mutex_);
-    auto out = std::move(done_);
-    done_.reset();
-    return out;
 }
 
 GenerateStats GenerateWorker::stats() const {

@@ -179,6 +179,55 @@ class RenderWorker {
     std::thread thread_;
 };
 
+// One job at a time on a thread of its own, its result handed over once: what the mesh, export
+// and generation workers share. A worker holds one as its last member, so that the job, which may
+// use the worker's other members, has stopped before they are destroyed.
+template <class T> class BackgroundJob {
+  public:
+    BackgroundJob() = default;
+    ~BackgroundJob() { // cancels a running job and waits for it
+        cancel_ = true;
+        if (thread_.joinable()) thread_.join();
+    }
+    BackgroundJob(const BackgroundJob&) = delete;
+    BackgroundJob& operator=(const BackgroundJob&) = delete;
+
+    // Starts job() on the thread unless a job is running (false then); what it returns is kept
+    // for take().
+    template <class Job> bool start(Job job) {
+        if (running_) return false;
+        if (thread_.joinable()) thread_.join();
+        running_ = true;
+        cancel_ = false;
+        thread_ = std::thread([this, job = std::move(job)]() mutable {
+            T result = job();
+            {
+                std::lock_guard lock(mutex_);
+                done_ = std::move(result);
+            }
+            running_ = false;
+        });
+        return true;
+    }
+    // Asks the job to stop; a job that polls cancelled() does so soon, others finish.
+    void cancel() { cancel_ = true; }
+    bool cancelled() const { return cancel_; }
+    bool running() const { return running_; }
+    // The finished job's result, once.
+    std::optional<T> take() {
+        std::lock_guard lock(mutex_);
+        std::optional<T> out = std::move(done_);
+        done_.reset();
+        return out;
+    }
+
+  private:
+    std::thread thread_;
+    std::atomic<bool> running_{false}, cancel_{false};
+    std::mutex mutex_;
+    std::optional<T> done_;
+};
+
 // An extraction as the mesh view shows it: the mesh asked for (simplified, when asked) and, when
 // that one is too large to redraw at interactive rates, a simplified copy to draw while the
 // camera moves.
@@ -197,7 +246,6 @@ class MeshWorker {
     // Meshes of more than `previewThreshold` triangles get a preview.
     explicit MeshWorker(Context& context, size_t previewThreshold = kPreviewMeshTriangles)
         : context_(context), previewThreshold_(previewThreshold) {}
-    ~MeshWorker();
 
     // Starts an extraction unless one is running (false then). With `simplify` > 0 the mesh is
     // simplified to within that many cells of the surface (simplifyMesh). A large mesh is then
@@ -205,47 +253,39 @@ class MeshWorker {
     // given), before the result is handed over: no second extraction, and the preview keeps the
     // mesh's outline and colours.
     bool start(std::shared_ptr<const Scene> scene, MeshOptions options, float simplify = 0.0f);
-    void cancel() { cancel_ = true; }
-    bool running() const { return running_; }
+    void cancel() { job_.cancel(); }
+    bool running() const { return job_.running(); }
     float progress() const { return progress_; }
     // The finished extraction, once (an Error when it failed or was cancelled; a preview that
     // fails or is cancelled is only left out).
-    std::optional<Result<ExtractedMesh>> take();
+    std::optional<Result<ExtractedMesh>> take() { return job_.take(); }
     MeshStats stats() const; // of the mesh (and its simplification), not of its preview
 
   private:
+    Result<ExtractedMesh> extract(const Scene& scene, MeshOptions options, float simplify);
+
     Context& context_;
     size_t previewThreshold_;
-    std::thread thread_;
-    std::atomic<bool> running_{false}, cancel_{false};
     std::atomic<float> progress_{0.0f};
-    mutable std::mutex mutex_;
-    std::optional<Result<ExtractedMesh>> done_;
+    mutable std::mutex mutex_; // guards stats_
     MeshStats stats_;
+    BackgroundJob<Result<ExtractedMesh>> job_; // last: see BackgroundJob
 };
 
 // writeMesh() on a thread: encoding and writing a fine mesh takes a second or more (an OBJ of
 // 2.3 million triangles about 1.2 s). The file is written atomically, as writeMesh() does.
 class ExportWorker {
   public:
-    ExportWorker() = default;
-    ~ExportWorker(); // waits for a write in progress
-    ExportWorker(const ExportWorker&) = delete;
-    ExportWorker& operator=(const ExportWorker&) = delete;
-
     // Starts writing unless a write is running (false then). The mesh is shared, not copied: it
     // stays alive while the write needs it, even when the caller replaces its own.
     bool start(std::shared_ptr<const Mesh> mesh, std::filesystem::path path, MeshFormat format,
                LengthUnit unit = LengthUnit::Millimeter);
-    bool running() const { return running_; }
+    bool running() const { return job_.running(); }
     // The finished write's outcome, once.
-    std::optional<Status> take();
+    std::optional<Status> take() { return job_.take(); }
 
   private:
-    std::thread thread_;
-    std::atomic<bool> running_{false};
-    mutable std::mutex mutex_;
-    std::optional<Status> done_;
+    BackgroundJob<Status> job_; // its destructor waits for a write in progress
 };
 
 // What a running generation is doing, for the panel.
@@ -258,31 +298,26 @@ struct GenerateStatus {
 // handed over: applying it to the document is the caller's choice.
 class GenerateWorker {
   public:
-    GenerateWorker() = default;
-    ~GenerateWorker(); // cancels a running generation and waits for it (about a second)
-    GenerateWorker(const GenerateWorker&) = delete;
-    GenerateWorker& operator=(const GenerateWorker&) = delete;
-
     // Starts generating unless a generation is running (false then). A non-empty currentScene
     // (a scene's JSON) asks for that scene changed as `request` says. The worker sets
     // options.progress and options.cancelled itself.
     bool start(std::string request, std::string currentScene, GenerateOptions options);
     // The generation stops within about a second; take() then gives ErrorKind::Cancelled.
-    void cancel() { cancel_ = true; }
-    bool running() const { return running_; }
+    void cancel() { job_.cancel(); }
+    bool running() const { return job_.running(); }
     GenerateStatus status() const;
     // The finished generation, once (an Error when it failed or was cancelled).
-    std::optional<Result<Generated>> take();
+    std::optional<Result<Generated>> take() { return job_.take(); }
     GenerateStats stats() const; // of the last finished generation
 
   private:
-    std::thread thread_;
-    std::atomic<bool> running_{false}, cancel_{false};
-    mutable std::mutex mutex_;
+    mutable std::mutex mutex_; // guards the three below
     std::string message_;
     std::chrono::steady_clock::time_point start_;
-    std::optional<Result<Generated>> done_;
     GenerateStats stats_;
+    // Last: destroying the worker cancels a running generation and waits for it (about a
+    // second).
+    BackgroundJob<Result<Generated>> job_;
 };
 
 // Internal resolution while the camera moves: the fraction of the full size along each axis
