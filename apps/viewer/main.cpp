@@ -95,35 +95,28 @@ bool parseArgs(int argc, char** argv, Args& args, std::string& error) {
     return true;
 }
 
-} // namespace
-
-int main(int argc, char** argv) {
-    Args args;
-    std::string error;
-    if (!parseArgs(argc, argv, args, error)) {
-        std::fprintf(stderr, "sdfcsg-viewer: %s\n%s", error.c_str(), kUsage);
+// --script: the commands, parsed and checked before anything starts. 0, or the exit code.
+int loadScript(const Args& args, Viewer& v) {
+    if (args.script.empty()) return 0;
+    std::ifstream in(args.script, std::ios::binary);
+    if (!in) {
+        std::fprintf(stderr, "%s: cannot read the file\n", args.script.string().c_str());
+        return 3;
+    }
+    std::stringstream text;
+    text << in.rdbuf();
+    auto parsed = parseScript(text.str(), args.script.string());
+    if (!parsed) {
+        std::fprintf(stderr, "%s\n", parsed.error().str().c_str());
         return 2;
     }
-    Viewer v;
-    if (!args.script.empty()) {
-        std::ifstream in(args.script, std::ios::binary);
-        if (!in) {
-            std::fprintf(stderr, "%s: cannot read the file\n", args.script.string().c_str());
-            return 3;
-        }
-        std::stringstream text;
-        text << in.rdbuf();
-        auto parsed = parseScript(text.str(), args.script.string());
-        if (!parsed) {
-            std::fprintf(stderr, "%s\n", parsed.error().str().c_str());
-            return 2;
-        }
-        v.script.assign(parsed->begin(), parsed->end());
-        v.scriptFile = args.script.string();
-    }
-    v.showUi = !args.noUi;
-    v.recent = loadRecent(recentFilesPath());
+    v.script.assign(parsed->begin(), parsed->end());
+    v.scriptFile = args.script.string();
+    return 0;
+}
 
+// The engine's contexts and the background workers. 0, or the exit code.
+int startWorkers(Viewer& v) {
     auto context = Context::create();
     if (!context) {
         std::fprintf(stderr, "%s\n", context.error().str().c_str());
@@ -138,16 +131,11 @@ int main(int argc, char** argv) {
     v.exporter = std::make_unique<ExportWorker>();
     v.generator = std::make_unique<GenerateWorker>();
     describeEndpoint(v);
-    v.startedEmpty = args.scene.empty();
+    return 0;
+}
 
-    if (!args.scene.empty()) {
-        openFile(v, args.scene);
-        if (!v.doc.loaded() && (!args.screenshot.empty() || !args.script.empty())) {
-            std::fprintf(stderr, "%s\n", v.doc.error()->str().c_str());
-            return 1;
-        }
-    }
-
+// The window, ImGui and the presenter that draws into the window. 0, or the exit code.
+int openWindow(Viewer& v, const Args& args) {
     glfwSetErrorCallback([](int code, const char* text) {
         std::fprintf(stderr, "GLFW error %d: %s\n", code, text);
     });
@@ -167,18 +155,101 @@ int main(int argc, char** argv) {
     ImGui::GetIO().IniFilename = nullptr; // the same layout every run, no file beside the scene
     ImGui::StyleColorsDark();
     ImGui_ImplGlfw_InitForVulkan(v.window, true);
+    std::string error;
     v.presenter = createPresenter(v.window, error);
     if (!v.presenter) {
         std::fprintf(stderr, "sdfcsg-viewer: %s\n", error.c_str());
         return 4;
     }
+    return 0;
+}
 
-    v.framesLeft = args.frames;
-    if (!args.screenshot.empty()) {
-        v.pendingShot = args.screenshot;
-        v.exitAfterShot = true;
-        v.waitStart = now();
+// Live reload: the scene's file changed on disk.
+void pollReload(Viewer& v) {
+    const std::shared_ptr<const Scene> before = v.scene;
+    if (!v.doc.pollReload()) return;
+    v.status = v.doc.error() ? "reload failed" : "reloaded " + v.doc.path().string();
+    // Node numbers change with the file: the selection follows its node.
+    if (!v.doc.error() && before && v.selected >= 0) {
+        auto same = sameNode(*before, uint32_t(v.selected), v.doc.scene());
+        v.selected = same ? int(*same) : -1;
     }
+    ++v.reloads;
+}
+
+// Input and the panels, then the image they ask for.
+void updateUi(Viewer& v) {
+    ImGui_ImplVulkan_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    ImGui::NewFrame();
+    handleInput(v);
+    syncScene(v);
+    if (v.showUi) panels(v);
+    ImGui::Render();
+    syncScene(v);
+    updateImage(v);
+}
+
+MeshView meshViewOf(const Viewer& v) {
+    MeshView meshView;
+    meshView.camera = toCamera(v.camera);
+    meshView.wireframe = v.wireframe;
+    meshView.closed = !v.meshStats.surfaceCut;
+    // As updateImage() chose: screenshots wait for a settled view, which draws the full mesh.
+    meshView.preview = v.shown.meshPreview;
+    if (v.grid && v.evaluator) meshView.grid = groundGrid(*v.evaluator);
+    return meshView;
+}
+
+// Writes the pending screenshot; false when that fails (v.exitCode says so).
+bool writeShot(Viewer& v, Image& capture, bool drawsMesh) {
+    if (capture.rgba.empty()) {
+        // This surface cannot be read back: the scene image alone is the next best.
+        capture = v.last.image;
+    }
+    auto written = writePng(capture, v.pendingShot);
+    if (!written) {
+        std::fprintf(stderr, "%s\n", written.error().str().c_str());
+        v.exitCode = 3;
+        return false;
+    }
+    // With the mesh's device time, so scripts can time the mesh view.
+    if (drawsMesh && v.meshDrawMs >= 0.0)
+        std::printf("wrote %s (%u x %u), mesh drawn in %.1f ms\n", v.pendingShot.string().c_str(),
+                    capture.width, capture.height, v.meshDrawMs);
+    else
+        std::printf("wrote %s (%u x %u)\n", v.pendingShot.string().c_str(), capture.width,
+                    capture.height);
+    v.pendingShot.clear();
+    return true;
+}
+
+// Draws the window, and writes the pending screenshot once the view has settled. False when the
+// run ends here: the screenshot failed, or it was the one that ends the run.
+bool drawWindow(Viewer& v) {
+    Image capture;
+    // One settled frame more, so the panels show the numbers of the image they sit on.
+    v.settledFrames = settled(v) ? v.settledFrames + 1 : 0;
+    bool shoot = !v.pendingShot.empty() && v.settledFrames >= 2 && v.framesLeft <= 1;
+    float bg[3] = {0.1f, 0.1f, 0.1f};
+    if (v.scene)
+        bg[0] = v.scene->background.r, bg[1] = v.scene->background.g, bg[2] = v.scene->background.b;
+    MeshView meshView = meshViewOf(v);
+    const bool drawsMesh = v.meshView && v.mesh;
+    const double frameStart = now();
+    bool drawn = drawFrame(*v.presenter, ImGui::GetDrawData(), bg, drawsMesh ? &meshView : nullptr,
+                           shoot ? &capture : nullptr);
+    if (drawn && drawsMesh) {
+        v.meshFrameMs = (now() - frameStart) * 1000.0;
+        v.meshDrawMs = meshDrawMilliseconds(*v.presenter);
+    }
+    if (drawn && v.framesLeft > 0) --v.framesLeft;
+    if (!shoot || !drawn) return true;
+    return writeShot(v, capture, drawsMesh) && !v.exitAfterShot;
+}
+
+// Until the window closes, the script has run, or a screenshot ends the run.
+void runLoop(Viewer& v, const Args& args) {
     bool automated = !args.screenshot.empty() || !args.script.empty();
     double lastPoll = 0;
     while (!glfwWindowShouldClose(v.window)) {
@@ -188,78 +259,14 @@ int main(int argc, char** argv) {
             glfwPollEvents();
         else
             glfwWaitEventsTimeout(0.1);
-        if (now() - lastPoll > 0.25) { // live reload
+        if (now() - lastPoll > 0.25) {
             lastPoll = now();
-            const std::shared_ptr<const Scene> before = v.scene;
-            if (v.doc.pollReload()) {
-                v.status = v.doc.error() ? "reload failed" : "reloaded " + v.doc.path().string();
-                // Node numbers change with the file: the selection follows its node.
-                if (!v.doc.error() && before && v.selected >= 0) {
-                    auto same = sameNode(*before, uint32_t(v.selected), v.doc.scene());
-                    v.selected = same ? int(*same) : -1;
-                }
-                ++v.reloads;
-            }
+            pollReload(v);
         }
         syncScene(v);
         if (!finishGeneration(v) || !finishMesh(v) || !runScript(v)) break;
-
-        ImGui_ImplVulkan_NewFrame();
-        ImGui_ImplGlfw_NewFrame();
-        ImGui::NewFrame();
-        handleInput(v);
-        syncScene(v);
-        if (v.showUi) panels(v);
-        ImGui::Render();
-        syncScene(v);
-        updateImage(v);
-
-        Image capture;
-        // One settled frame more, so the panels show the numbers of the image they sit on.
-        v.settledFrames = settled(v) ? v.settledFrames + 1 : 0;
-        bool shoot = !v.pendingShot.empty() && v.settledFrames >= 2 && v.framesLeft <= 1;
-        float bg[3] = {0.1f, 0.1f, 0.1f};
-        if (v.scene)
-            bg[0] = v.scene->background.r, bg[1] = v.scene->background.g,
-            bg[2] = v.scene->background.b;
-        MeshView meshView;
-        meshView.camera = toCamera(v.camera);
-        meshView.wireframe = v.wireframe;
-        meshView.closed = !v.meshStats.surfaceCut;
-        // As updateImage() chose: screenshots wait for a settled view, which draws the full mesh.
-        meshView.preview = v.shown.meshPreview;
-        if (v.grid && v.evaluator) meshView.grid = groundGrid(*v.evaluator);
-        const bool drawsMesh = v.meshView && v.mesh;
-        const double frameStart = now();
-        bool drawn = drawFrame(*v.presenter, ImGui::GetDrawData(), bg,
-                               drawsMesh ? &meshView : nullptr, shoot ? &capture : nullptr);
-        if (drawn && drawsMesh) {
-            v.meshFrameMs = (now() - frameStart) * 1000.0;
-            v.meshDrawMs = meshDrawMilliseconds(*v.presenter);
-        }
-        if (drawn && v.framesLeft > 0) --v.framesLeft;
-        if (shoot && drawn) {
-            if (capture.rgba.empty()) {
-                // This surface cannot be read back: the scene image alone is the next best.
-                capture = v.last.image;
-            }
-            auto written = writePng(capture, v.pendingShot);
-            if (!written) {
-                std::fprintf(stderr, "%s\n", written.error().str().c_str());
-                v.exitCode = 3;
-                break;
-            }
-            // With the mesh's device time, so scripts can time the mesh view.
-            if (drawsMesh && v.meshDrawMs >= 0.0)
-                std::printf("wrote %s (%u x %u), mesh drawn in %.1f ms\n",
-                            v.pendingShot.string().c_str(), capture.width, capture.height,
-                            v.meshDrawMs);
-            else
-                std::printf("wrote %s (%u x %u)\n", v.pendingShot.string().c_str(), capture.width,
-                            capture.height);
-            v.pendingShot.clear();
-            if (v.exitAfterShot) break;
-        }
+        updateUi(v);
+        if (!drawWindow(v)) break;
         if (!v.pendingShot.empty() && automated && now() - v.waitStart > 300.0) {
             std::fprintf(stderr, "sdfcsg-viewer: no image after 300 s\n");
             v.exitCode = 1;
@@ -269,18 +276,24 @@ int main(int argc, char** argv) {
             v.meshScript.empty() && v.exportScript.empty() && !v.exitAfterShot)
             break;
     }
-    if (automated && v.renderError && v.exitCode == 0) {
+}
+
+// An automated run fails on a render error or, under the tests' validation layer, on any
+// message: the window's device, the renderer's and the live renderer's own.
+void checkAutomatedRun(Viewer& v) {
+    if (v.renderError && v.exitCode == 0) {
         std::fprintf(stderr, "%s\n", v.renderError->str().c_str());
         v.exitCode = 1;
     }
-    // Under the tests' validation layer, any message fails an automated run: the window's
-    // device, the renderer's and the live renderer's own.
-    if (automated && v.exitCode == 0 &&
+    if (v.exitCode == 0 &&
         (presenterValidationMessages(*v.presenter) || v.context->validationMessageCount() ||
          (v.liveContext && v.liveContext->validationMessageCount()))) {
         std::fprintf(stderr, "sdfcsg-viewer: the validation layer reported problems\n");
         v.exitCode = 1;
     }
+}
+
+int shutDown(Viewer& v) {
     glfwHideWindow(v.window);
     v.exporter.reset();  // waits for a file being written
     v.generator.reset(); // cancels a generation in flight
@@ -300,4 +313,38 @@ int main(int argc, char** argv) {
     glfwDestroyWindow(v.window);
     glfwTerminate();
     return v.exitCode;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    Args args;
+    std::string error;
+    if (!parseArgs(argc, argv, args, error)) {
+        std::fprintf(stderr, "sdfcsg-viewer: %s\n%s", error.c_str(), kUsage);
+        return 2;
+    }
+    Viewer v;
+    if (int code = loadScript(args, v)) return code;
+    v.showUi = !args.noUi;
+    v.recent = loadRecent(recentFilesPath());
+    if (int code = startWorkers(v)) return code;
+    v.startedEmpty = args.scene.empty();
+    if (!args.scene.empty()) {
+        openFile(v, args.scene);
+        if (!v.doc.loaded() && (!args.screenshot.empty() || !args.script.empty())) {
+            std::fprintf(stderr, "%s\n", v.doc.error()->str().c_str());
+            return 1;
+        }
+    }
+    if (int code = openWindow(v, args)) return code;
+    v.framesLeft = args.frames;
+    if (!args.screenshot.empty()) {
+        v.pendingShot = args.screenshot;
+        v.exitAfterShot = true;
+        v.waitStart = now();
+    }
+    runLoop(v, args);
+    if (!args.screenshot.empty() || !args.script.empty()) checkAutomatedRun(v);
+    return shutDown(v);
 }

@@ -92,15 +92,10 @@ template <typename Record> void submitNow(Presenter& p, Record record) {
 
 } // namespace
 
-void createMeshPipeline(Presenter& p) {
-    VkPushConstantRange push = {VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
-                                sizeof(MeshConstants)};
-    VkPipelineLayoutCreateInfo layoutInfo = {VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-    layoutInfo.pushConstantRangeCount = 1;
-    layoutInfo.pPushConstantRanges = &push;
-    VK_CHECK(vkCreatePipelineLayout(p.device, &layoutInfo, nullptr, &p.meshLayout));
+namespace {
 
-    // Colour cleared to the background and left ready for the blit; depth cleared, never kept.
+// Colour cleared to the background and left ready for the blit; depth cleared, never kept.
+void createMeshPass(Presenter& p) {
     p.depthFormat = chooseDepthFormat(p.physical);
     VkAttachmentDescription attachments[2] = {};
     attachments[0].format = VK_FORMAT_R8G8B8A8_UNORM; // as the engine's image
@@ -151,20 +146,12 @@ void createMeshPipeline(Presenter& p) {
     passInfo.dependencyCount = 2;
     passInfo.pDependencies = dependencies;
     VK_CHECK(vkCreateRenderPass(p.device, &passInfo, nullptr, &p.meshPass));
+}
 
-    VkShaderModule vert = createShader(p.device, kMeshVert, sizeof kMeshVert);
-    VkShaderModule frag = createShader(p.device, kMeshFrag, sizeof kMeshFrag);
-    VkShaderModule gridVert = createShader(p.device, kGridVert, sizeof kGridVert);
-    VkShaderModule gridFrag = createShader(p.device, kGridFrag, sizeof kGridFrag);
+// The state of the mesh pipelines, which the grid's changes (grid()): they point at each
+// other, so it stays where it was made.
+struct PipelineState {
     VkPipelineShaderStageCreateInfo stages[2] = {};
-    stages[0] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
-    stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
-    stages[0].module = vert;
-    stages[0].pName = "main";
-    stages[1] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
-    stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
-    stages[1].module = frag;
-    stages[1].pName = "main";
     VkVertexInputBindingDescription binding = {0, sizeof(MeshVertex), VK_VERTEX_INPUT_RATE_VERTEX};
     VkVertexInputAttributeDescription attributes[3] = {
         {0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(MeshVertex, position)},
@@ -172,43 +159,60 @@ void createMeshPipeline(Presenter& p) {
         {2, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(MeshVertex, color)}};
     VkPipelineVertexInputStateCreateInfo vertexInput = {
         VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+    VkPipelineVertexInputStateCreateInfo noInput = {
+        VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+    VkPipelineInputAssemblyStateCreateInfo assembly = {
+        VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+    VkPipelineViewportStateCreateInfo viewport = {
+        VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
+    VkPipelineRasterizationStateCreateInfo raster = {
+        VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
+    VkPipelineMultisampleStateCreateInfo multisample = {
+        VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
+    VkPipelineDepthStencilStateCreateInfo depth = {
+        VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
+    VkPipelineColorBlendAttachmentState blendAttachment = {};
+    VkPipelineColorBlendStateCreateInfo blend = {
+        VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+    VkDynamicState dynamicStates[2] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+    VkPipelineDynamicStateCreateInfo dynamic = {
+        VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
+    VkGraphicsPipelineCreateInfo info = {VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
+
+    PipelineState(const Presenter& p, VkShaderModule vert, VkShaderModule frag);
+    PipelineState(const PipelineState&) = delete;
+    PipelineState& operator=(const PipelineState&) = delete;
+    // The grid: lines blended over the mesh, hidden behind it, writing no depth.
+    void grid(VkShaderModule vert, VkShaderModule frag);
+};
+
+PipelineState::PipelineState(const Presenter& p, VkShaderModule vert, VkShaderModule frag) {
+    for (int i = 0; i < 2; ++i) {
+        stages[i] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+        stages[i].stage = i == 0 ? VK_SHADER_STAGE_VERTEX_BIT : VK_SHADER_STAGE_FRAGMENT_BIT;
+        stages[i].module = i == 0 ? vert : frag;
+        stages[i].pName = "main";
+    }
     vertexInput.vertexBindingDescriptionCount = 1;
     vertexInput.pVertexBindingDescriptions = &binding;
     vertexInput.vertexAttributeDescriptionCount = 3;
     vertexInput.pVertexAttributeDescriptions = attributes;
-    VkPipelineInputAssemblyStateCreateInfo assembly = {
-        VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
     assembly.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
-    VkPipelineViewportStateCreateInfo viewport = {
-        VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
     viewport.viewportCount = 1;
     viewport.scissorCount = 1;
-    VkPipelineRasterizationStateCreateInfo raster = {
-        VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
     raster.polygonMode = VK_POLYGON_MODE_FILL;
     raster.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE; // seen from outside, as y points down
     raster.lineWidth = 1.0f;
-    VkPipelineMultisampleStateCreateInfo multisample = {
-        VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
     multisample.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
-    VkPipelineDepthStencilStateCreateInfo depth = {
-        VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
     depth.depthTestEnable = VK_TRUE;
     depth.depthWriteEnable = VK_TRUE;
     depth.depthCompareOp = VK_COMPARE_OP_GREATER; // reversed depth: nearer is larger
-    VkPipelineColorBlendAttachmentState blendAttachment = {};
     blendAttachment.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
                                      VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
-    VkPipelineColorBlendStateCreateInfo blend = {
-        VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
     blend.attachmentCount = 1;
     blend.pAttachments = &blendAttachment;
-    VkDynamicState dynamicStates[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
-    VkPipelineDynamicStateCreateInfo dynamic = {
-        VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
     dynamic.dynamicStateCount = 2;
     dynamic.pDynamicStates = dynamicStates;
-    VkGraphicsPipelineCreateInfo info = {VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
     info.stageCount = 2;
     info.pStages = stages;
     info.pVertexInputState = &vertexInput;
@@ -221,14 +225,9 @@ void createMeshPipeline(Presenter& p) {
     info.pDynamicState = &dynamic;
     info.layout = p.meshLayout;
     info.renderPass = p.meshPass;
-    // Culling back faces halves the triangles a CPU device sets up; only a closed mesh may,
-    // since where bounds cut the surface open its inside shows.
-    for (int cull = 0; cull < 2; ++cull) {
-        raster.cullMode = cull ? VK_CULL_MODE_BACK_BIT : VK_CULL_MODE_NONE;
-        VK_CHECK(vkCreateGraphicsPipelines(p.device, VK_NULL_HANDLE, 1, &info, nullptr,
-                                           &p.meshPipelines[cull]));
-    }
-    // The grid: blended over the mesh, hidden behind it, writing no depth.
+}
+
+void PipelineState::grid(VkShaderModule vert, VkShaderModule frag) {
     raster.cullMode = VK_CULL_MODE_NONE;
     assembly.topology = VK_PRIMITIVE_TOPOLOGY_LINE_LIST;
     depth.depthWriteEnable = VK_FALSE;
@@ -239,16 +238,13 @@ void createMeshPipeline(Presenter& p) {
     blendAttachment.srcAlphaBlendFactor = VK_BLEND_FACTOR_ZERO;
     blendAttachment.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
     blendAttachment.alphaBlendOp = VK_BLEND_OP_ADD;
-    VkPipelineVertexInputStateCreateInfo noInput = {
-        VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
     info.pVertexInputState = &noInput;
-    stages[0].module = gridVert;
-    stages[1].module = gridFrag;
-    VK_CHECK(
-        vkCreateGraphicsPipelines(p.device, VK_NULL_HANDLE, 1, &info, nullptr, &p.gridPipeline));
-    for (VkShaderModule m : {vert, frag, gridVert, gridFrag})
-        vkDestroyShaderModule(p.device, m, nullptr);
+    stages[0].module = vert;
+    stages[1].module = frag;
+}
 
+// Timestamps around the mesh's draw, where the queue has them (meshDrawMilliseconds()).
+void createTimestamps(Presenter& p) {
     uint32_t familyCount = 0;
     vkGetPhysicalDeviceQueueFamilyProperties(p.physical, &familyCount, nullptr);
     std::vector<VkQueueFamilyProperties> families(familyCount);
@@ -261,6 +257,37 @@ void createMeshPipeline(Presenter& p) {
         query.queryCount = 2;
         VK_CHECK(vkCreateQueryPool(p.device, &query, nullptr, &p.timestamps));
     }
+}
+
+} // namespace
+
+void createMeshPipeline(Presenter& p) {
+    VkPushConstantRange push = {VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                                sizeof(MeshConstants)};
+    VkPipelineLayoutCreateInfo layoutInfo = {VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    layoutInfo.pushConstantRangeCount = 1;
+    layoutInfo.pPushConstantRanges = &push;
+    VK_CHECK(vkCreatePipelineLayout(p.device, &layoutInfo, nullptr, &p.meshLayout));
+    createMeshPass(p);
+
+    VkShaderModule vert = createShader(p.device, kMeshVert, sizeof kMeshVert);
+    VkShaderModule frag = createShader(p.device, kMeshFrag, sizeof kMeshFrag);
+    VkShaderModule gridVert = createShader(p.device, kGridVert, sizeof kGridVert);
+    VkShaderModule gridFrag = createShader(p.device, kGridFrag, sizeof kGridFrag);
+    PipelineState state(p, vert, frag);
+    // Culling back faces halves the triangles a CPU device sets up; only a closed mesh may,
+    // since where bounds cut the surface open its inside shows.
+    for (int cull = 0; cull < 2; ++cull) {
+        state.raster.cullMode = cull ? VK_CULL_MODE_BACK_BIT : VK_CULL_MODE_NONE;
+        VK_CHECK(vkCreateGraphicsPipelines(p.device, VK_NULL_HANDLE, 1, &state.info, nullptr,
+                                           &p.meshPipelines[cull]));
+    }
+    state.grid(gridVert, gridFrag);
+    VK_CHECK(vkCreateGraphicsPipelines(p.device, VK_NULL_HANDLE, 1, &state.info, nullptr,
+                                       &p.gridPipeline));
+    for (VkShaderModule m : {vert, frag, gridVert, gridFrag})
+        vkDestroyShaderModule(p.device, m, nullptr);
+    createTimestamps(p);
 }
 
 void destroyMeshTarget(Presenter& p) {

@@ -228,6 +228,14 @@ void barrier(VkCommandBuffer cmd, VkImage image, VkImageLayout from, VkImageLayo
     vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 0, nullptr, 0, nullptr, 1, &b);
 }
 
+// createPresenter's steps after the instance and the window's surface (defined below it).
+bool pickDevice(Presenter& p, std::string& error);
+void createDevice(Presenter& p);
+void chooseFormat(Presenter& p);
+void createRenderPass(Presenter& p);
+void createCommands(Presenter& p);
+void initImGui(Presenter& p);
+
 } // namespace
 
 PresenterPtr createPresenter(GLFWwindow* window, std::string& error) {
@@ -277,11 +285,28 @@ PresenterPtr createPresenter(GLFWwindow* window, std::string& error) {
         error = "could not create a Vulkan surface for the window";
         return nullptr;
     }
-    // Any device that can draw to this window; a discrete GPU first.
+    if (!pickDevice(*p, error)) return nullptr;
+    createDevice(*p);
+    chooseFormat(*p);
+    createRenderPass(*p);
+    VkPhysicalDeviceProperties properties;
+    vkGetPhysicalDeviceProperties(p->physical, &properties);
+    p->limits = properties.limits;
+    createMeshPipeline(*p);
+    createCommands(*p);
+    initImGui(*p);
+    return p;
+}
+
+namespace {
+
+// Any device that can draw to the window's surface; a discrete GPU first. False (and the
+// error) when none can.
+bool pickDevice(Presenter& p, std::string& error) {
     uint32_t count = 0;
-    vkEnumeratePhysicalDevices(p->instance, &count, nullptr);
+    vkEnumeratePhysicalDevices(p.instance, &count, nullptr);
     std::vector<VkPhysicalDevice> devices(count);
-    vkEnumeratePhysicalDevices(p->instance, &count, devices.data());
+    vkEnumeratePhysicalDevices(p.instance, &count, devices.data());
     int bestScore = -1;
     for (VkPhysicalDevice d : devices) {
         uint32_t families = 0;
@@ -290,7 +315,7 @@ PresenterPtr createPresenter(GLFWwindow* window, std::string& error) {
         vkGetPhysicalDeviceQueueFamilyProperties(d, &families, props.data());
         for (uint32_t f = 0; f < families; ++f) {
             VkBool32 present = VK_FALSE;
-            vkGetPhysicalDeviceSurfaceSupportKHR(d, f, p->surface, &present);
+            vkGetPhysicalDeviceSurfaceSupportKHR(d, f, p.surface, &present);
             if (!(props[f].queueFlags & VK_QUEUE_GRAPHICS_BIT) || !present) continue;
             VkPhysicalDeviceProperties dp;
             vkGetPhysicalDeviceProperties(d, &dp);
@@ -299,21 +324,25 @@ PresenterPtr createPresenter(GLFWwindow* window, std::string& error) {
                                                                                   : 1;
             if (score > bestScore) {
                 bestScore = score;
-                p->physical = d;
-                p->family = f;
-                p->deviceName = dp.deviceName;
+                p.physical = d;
+                p.family = f;
+                p.deviceName = dp.deviceName;
             }
             break;
         }
     }
-    if (!p->physical) {
+    if (!p.physical) {
         error = "no Vulkan device can present to this window";
-        return nullptr;
+        return false;
     }
-    vkGetPhysicalDeviceMemoryProperties(p->physical, &p->memoryProperties);
+    return true;
+}
+
+void createDevice(Presenter& p) {
+    vkGetPhysicalDeviceMemoryProperties(p.physical, &p.memoryProperties);
     float priority = 1.0f;
     VkDeviceQueueCreateInfo queueInfo = {VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
-    queueInfo.queueFamilyIndex = p->family;
+    queueInfo.queueFamilyIndex = p.family;
     queueInfo.queueCount = 1;
     queueInfo.pQueuePriorities = &priority;
     const char* deviceExtensions[] = {VK_KHR_SWAPCHAIN_EXTENSION_NAME};
@@ -322,26 +351,30 @@ PresenterPtr createPresenter(GLFWwindow* window, std::string& error) {
     deviceInfo.pQueueCreateInfos = &queueInfo;
     deviceInfo.enabledExtensionCount = 1;
     deviceInfo.ppEnabledExtensionNames = deviceExtensions;
-    VK_CHECK(vkCreateDevice(p->physical, &deviceInfo, nullptr, &p->device));
-    vkGetDeviceQueue(p->device, p->family, 0, &p->queue);
+    VK_CHECK(vkCreateDevice(p.physical, &deviceInfo, nullptr, &p.device));
+    vkGetDeviceQueue(p.device, p.family, 0, &p.queue);
+}
 
-    // A UNORM format, so the engine's bytes reach the screen (and screenshots) unchanged.
+// A UNORM format, so the engine's bytes reach the screen (and screenshots) unchanged.
+void chooseFormat(Presenter& p) {
     uint32_t formatCount = 0;
-    vkGetPhysicalDeviceSurfaceFormatsKHR(p->physical, p->surface, &formatCount, nullptr);
+    vkGetPhysicalDeviceSurfaceFormatsKHR(p.physical, p.surface, &formatCount, nullptr);
     std::vector<VkSurfaceFormatKHR> formats(formatCount);
-    vkGetPhysicalDeviceSurfaceFormatsKHR(p->physical, p->surface, &formatCount, formats.data());
-    p->format = formats.empty() ? VkSurfaceFormatKHR{VK_FORMAT_B8G8R8A8_UNORM,
-                                                     VK_COLOR_SPACE_SRGB_NONLINEAR_KHR}
-                                : formats[0];
+    vkGetPhysicalDeviceSurfaceFormatsKHR(p.physical, p.surface, &formatCount, formats.data());
+    p.format = formats.empty()
+                   ? VkSurfaceFormatKHR{VK_FORMAT_B8G8R8A8_UNORM, VK_COLOR_SPACE_SRGB_NONLINEAR_KHR}
+                   : formats[0];
     for (const VkSurfaceFormatKHR& f : formats)
         if (f.format == VK_FORMAT_B8G8R8A8_UNORM || f.format == VK_FORMAT_R8G8B8A8_UNORM) {
-            p->format = f;
+            p.format = f;
             break;
         }
+}
 
-    // ImGui draws over the blitted image: load, not clear.
+// ImGui draws over the blitted image: load, not clear.
+void createRenderPass(Presenter& p) {
     VkAttachmentDescription attachment = {};
-    attachment.format = p->format.format;
+    attachment.format = p.format.format;
     attachment.samples = VK_SAMPLE_COUNT_1_BIT;
     attachment.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
     attachment.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
@@ -370,64 +403,66 @@ PresenterPtr createPresenter(GLFWwindow* window, std::string& error) {
     passInfo.pSubpasses = &subpass;
     passInfo.dependencyCount = 1;
     passInfo.pDependencies = &dependency;
-    VK_CHECK(vkCreateRenderPass(p->device, &passInfo, nullptr, &p->renderPass));
-    VkPhysicalDeviceProperties properties;
-    vkGetPhysicalDeviceProperties(p->physical, &properties);
-    p->limits = properties.limits;
-    createMeshPipeline(*p);
+    VK_CHECK(vkCreateRenderPass(p.device, &passInfo, nullptr, &p.renderPass));
+}
 
+// The descriptor pool for ImGui, and the frame's command buffer, fence and semaphores.
+void createCommands(Presenter& p) {
     VkDescriptorPoolSize poolSize = {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 16};
     VkDescriptorPoolCreateInfo poolInfo = {VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
     poolInfo.flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT;
     poolInfo.maxSets = 16;
     poolInfo.poolSizeCount = 1;
     poolInfo.pPoolSizes = &poolSize;
-    VK_CHECK(vkCreateDescriptorPool(p->device, &poolInfo, nullptr, &p->descriptorPool));
+    VK_CHECK(vkCreateDescriptorPool(p.device, &poolInfo, nullptr, &p.descriptorPool));
 
     VkCommandPoolCreateInfo cmdPool = {VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
     cmdPool.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-    cmdPool.queueFamilyIndex = p->family;
-    VK_CHECK(vkCreateCommandPool(p->device, &cmdPool, nullptr, &p->commandPool));
+    cmdPool.queueFamilyIndex = p.family;
+    VK_CHECK(vkCreateCommandPool(p.device, &cmdPool, nullptr, &p.commandPool));
     VkCommandBufferAllocateInfo cmdInfo = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-    cmdInfo.commandPool = p->commandPool;
+    cmdInfo.commandPool = p.commandPool;
     cmdInfo.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
     cmdInfo.commandBufferCount = 1;
-    VK_CHECK(vkAllocateCommandBuffers(p->device, &cmdInfo, &p->cmd));
+    VK_CHECK(vkAllocateCommandBuffers(p.device, &cmdInfo, &p.cmd));
     VkFenceCreateInfo fenceInfo = {VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-    VK_CHECK(vkCreateFence(p->device, &fenceInfo, nullptr, &p->fence));
+    VK_CHECK(vkCreateFence(p.device, &fenceInfo, nullptr, &p.fence));
     VkSemaphoreCreateInfo semInfo = {VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
-    VK_CHECK(vkCreateSemaphore(p->device, &semInfo, nullptr, &p->acquired));
-    VK_CHECK(vkCreateSemaphore(p->device, &semInfo, nullptr, &p->rendered));
+    VK_CHECK(vkCreateSemaphore(p.device, &semInfo, nullptr, &p.acquired));
+    VK_CHECK(vkCreateSemaphore(p.device, &semInfo, nullptr, &p.rendered));
+}
 
+// ImGui's Vulkan backend, and its fonts, uploaded once.
+void initImGui(Presenter& p) {
     VkSurfaceCapabilitiesKHR caps;
-    VK_CHECK(vkGetPhysicalDeviceSurfaceCapabilitiesKHR(p->physical, p->surface, &caps));
+    VK_CHECK(vkGetPhysicalDeviceSurfaceCapabilitiesKHR(p.physical, p.surface, &caps));
     ImGui_ImplVulkan_InitInfo init = {};
-    init.Instance = p->instance;
-    init.PhysicalDevice = p->physical;
-    init.Device = p->device;
-    init.QueueFamily = p->family;
-    init.Queue = p->queue;
-    init.DescriptorPool = p->descriptorPool;
+    init.Instance = p.instance;
+    init.PhysicalDevice = p.physical;
+    init.Device = p.device;
+    init.QueueFamily = p.family;
+    init.Queue = p.queue;
+    init.DescriptorPool = p.descriptorPool;
     init.MinImageCount = std::max(2u, caps.minImageCount);
     init.ImageCount = std::max(init.MinImageCount, 3u);
     init.MSAASamples = VK_SAMPLE_COUNT_1_BIT;
     init.CheckVkResultFn = imguiCheck;
-    ImGui_ImplVulkan_Init(&init, p->renderPass);
+    ImGui_ImplVulkan_Init(&init, p.renderPass);
 
-    // Fonts, once.
     VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    VK_CHECK(vkBeginCommandBuffer(p->cmd, &begin));
-    ImGui_ImplVulkan_CreateFontsTexture(p->cmd);
-    VK_CHECK(vkEndCommandBuffer(p->cmd));
+    VK_CHECK(vkBeginCommandBuffer(p.cmd, &begin));
+    ImGui_ImplVulkan_CreateFontsTexture(p.cmd);
+    VK_CHECK(vkEndCommandBuffer(p.cmd));
     VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
     submit.commandBufferCount = 1;
-    submit.pCommandBuffers = &p->cmd;
-    VK_CHECK(vkQueueSubmit(p->queue, 1, &submit, VK_NULL_HANDLE));
-    VK_CHECK(vkDeviceWaitIdle(p->device));
+    submit.pCommandBuffers = &p.cmd;
+    VK_CHECK(vkQueueSubmit(p.queue, 1, &submit, VK_NULL_HANDLE));
+    VK_CHECK(vkDeviceWaitIdle(p.device));
     ImGui_ImplVulkan_DestroyFontUploadObjects();
-    return p;
 }
+
+} // namespace
 
 void destroyPresenter(Presenter* p) {
     if (!p) return;
@@ -477,6 +512,153 @@ void setImage(Presenter& p, const Image& image) {
     p.hasScene = true;
 }
 
+namespace {
+
+// The engine's new image, from the staging buffer into the scene image.
+void recordSceneUpload(Presenter& p) {
+    barrier(p.cmd, p.sceneImage, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
+            VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
+            VK_PIPELINE_STAGE_TRANSFER_BIT);
+    VkBufferImageCopy region = {};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    region.imageExtent = {p.sceneWidth, p.sceneHeight, 1};
+    vkCmdCopyBufferToImage(p.cmd, p.staging.buffer, p.sceneImage,
+                           VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    barrier(p.cmd, p.sceneImage, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+            VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
+            VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+            VK_PIPELINE_STAGE_TRANSFER_BIT);
+    p.sceneDirty = false;
+}
+
+// The window's image cleared to the background, and the scene image or the mesh view blitted
+// over it.
+void recordBackground(Presenter& p, VkImage target, const float background[3], bool drawsMesh) {
+    barrier(p.cmd, target, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
+            VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+            VK_PIPELINE_STAGE_TRANSFER_BIT);
+    VkClearColorValue clear = {{background[0], background[1], background[2], 1.0f}};
+    VkImageSubresourceRange range = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    vkCmdClearColorImage(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &clear, 1, &range);
+    if (p.hasScene || drawsMesh) {
+        // The engine renders at the window's aspect ratio, at full or reduced size; stretching
+        // fills the window either way. Same size (always so for the mesh): a plain copy of
+        // every pixel.
+        const VkImage source = drawsMesh ? p.meshColor.image : p.sceneImage;
+        const uint32_t width = drawsMesh ? p.meshExtent.width : p.sceneWidth;
+        const uint32_t height = drawsMesh ? p.meshExtent.height : p.sceneHeight;
+        barrier(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
+                VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                VK_PIPELINE_STAGE_TRANSFER_BIT);
+        VkImageBlit blit = {};
+        blit.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+        blit.srcOffsets[1] = {int32_t(width), int32_t(height), 1};
+        blit.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+        blit.dstOffsets[1] = {int32_t(p.extent.width), int32_t(p.extent.height), 1};
+        bool same = width == p.extent.width && height == p.extent.height;
+        vkCmdBlitImage(p.cmd, source, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, target,
+                       VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &blit,
+                       same ? VK_FILTER_NEAREST : VK_FILTER_LINEAR);
+    }
+}
+
+// ImGui over the image, in the window's render pass, which leaves it ready to present.
+void recordUi(Presenter& p, VkImage target, uint32_t index, ImDrawData* ui) {
+    barrier(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+            VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
+            VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
+            VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT);
+    VkRenderPassBeginInfo pass = {VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
+    pass.renderPass = p.renderPass;
+    pass.framebuffer = p.framebuffers[index];
+    pass.renderArea.extent = p.extent;
+    vkCmdBeginRenderPass(p.cmd, &pass, VK_SUBPASS_CONTENTS_INLINE);
+    if (ui) ImGui_ImplVulkan_RenderDrawData(ui, p.cmd);
+    vkCmdEndRenderPass(p.cmd);
+}
+
+// The presented image, copied to the readback buffer for the host.
+void recordCapture(Presenter& p, VkImage target) {
+    ensureBuffer(p, p.readback, VkDeviceSize(p.extent.width) * p.extent.height * 4,
+                 VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    barrier(p.cmd, target, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+            VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT,
+            VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
+    VkBufferImageCopy region = {};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    region.imageExtent = {p.extent.width, p.extent.height, 1};
+    vkCmdCopyImageToBuffer(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, p.readback.buffer,
+                           1, &region);
+    barrier(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
+            VK_ACCESS_TRANSFER_READ_BIT, 0, VK_PIPELINE_STAGE_TRANSFER_BIT,
+            VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT);
+    VkBufferMemoryBarrier host = {VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
+    host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    host.srcQueueFamilyIndex = host.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    host.buffer = p.readback.buffer;
+    host.size = VK_WHOLE_SIZE;
+    vkCmdPipelineBarrier(p.cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 0,
+                         nullptr, 1, &host, 0, nullptr);
+}
+
+// Submits the frame and presents it, then waits for it: one frame in flight, as the image takes
+// ~ms to draw and the engine's render is the slow part.
+void submitAndPresent(Presenter& p, uint32_t index) {
+    VkPipelineStageFlags waitStage = VK_PIPELINE_STAGE_TRANSFER_BIT;
+    VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    submit.waitSemaphoreCount = 1;
+    submit.pWaitSemaphores = &p.acquired;
+    submit.pWaitDstStageMask = &waitStage;
+    submit.commandBufferCount = 1;
+    submit.pCommandBuffers = &p.cmd;
+    submit.signalSemaphoreCount = 1;
+    submit.pSignalSemaphores = &p.rendered;
+    VK_CHECK(vkQueueSubmit(p.queue, 1, &submit, p.fence));
+    VkPresentInfoKHR present = {VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
+    present.waitSemaphoreCount = 1;
+    present.pWaitSemaphores = &p.rendered;
+    present.swapchainCount = 1;
+    present.pSwapchains = &p.swapchain;
+    present.pImageIndices = &index;
+    VkResult presented = vkQueuePresentKHR(p.queue, &present);
+    if (presented == VK_ERROR_OUT_OF_DATE_KHR || presented == VK_SUBOPTIMAL_KHR)
+        p.rebuild = true;
+    else
+        VK_CHECK(presented);
+    VK_CHECK(vkWaitForFences(p.device, 1, &p.fence, VK_TRUE, UINT64_MAX));
+    VK_CHECK(vkResetFences(p.device, 1, &p.fence));
+}
+
+// The mesh's drawing time, from the timestamps around it.
+void readMeshTime(Presenter& p) {
+    p.meshMs = -1.0;
+    if (!p.timestamps) return;
+    uint64_t ticks[2];
+    VK_CHECK(vkGetQueryPoolResults(p.device, p.timestamps, 0, 2, sizeof ticks, ticks,
+                                   sizeof(uint64_t),
+                                   VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+    p.meshMs =
+        double((ticks[1] - ticks[0]) & p.timestampMask) * double(p.limits.timestampPeriod) * 1e-6;
+}
+
+// The captured window as RGBA8, from the readback buffer.
+void readCapture(const Presenter& p, Image& capture) {
+    capture.width = p.extent.width;
+    capture.height = p.extent.height;
+    capture.rgba.resize(size_t(p.extent.width) * p.extent.height * 4);
+    std::memcpy(capture.rgba.data(), p.readback.mapped, capture.rgba.size());
+    bool bgra =
+        p.format.format == VK_FORMAT_B8G8R8A8_UNORM || p.format.format == VK_FORMAT_B8G8R8A8_SRGB;
+    for (size_t i = 0; i < capture.rgba.size(); i += 4) {
+        if (bgra) std::swap(capture.rgba[i], capture.rgba[i + 2]);
+        capture.rgba[i + 3] = 255;
+    }
+}
+
+} // namespace
+
 bool drawFrame(Presenter& p, ImDrawData* ui, const float background[3], const MeshView* mesh,
                Image* capture) {
     if (p.rebuild && !createSwapchain(p)) return false;
@@ -505,134 +687,18 @@ bool drawFrame(Presenter& p, ImDrawData* ui, const float background[3], const Me
             p.meshDrawn = meshDrawn = true;
         }
     }
-    if (p.sceneDirty) {
-        barrier(p.cmd, p.sceneImage, VK_IMAGE_LAYOUT_UNDEFINED,
-                VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0, VK_ACCESS_TRANSFER_WRITE_BIT,
-                VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
-        VkBufferImageCopy region = {};
-        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-        region.imageExtent = {p.sceneWidth, p.sceneHeight, 1};
-        vkCmdCopyBufferToImage(p.cmd, p.staging.buffer, p.sceneImage,
-                               VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-        barrier(p.cmd, p.sceneImage, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
-                VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                VK_PIPELINE_STAGE_TRANSFER_BIT);
-        p.sceneDirty = false;
-    }
-    barrier(p.cmd, target, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
-            VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-            VK_PIPELINE_STAGE_TRANSFER_BIT);
-    VkClearColorValue clear = {{background[0], background[1], background[2], 1.0f}};
-    VkImageSubresourceRange range = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    vkCmdClearColorImage(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &clear, 1, &range);
-    if (p.hasScene || drawsMesh) {
-        // The engine renders at the window's aspect ratio, at full or reduced size; stretching
-        // fills the window either way. Same size (always so for the mesh): a plain copy of
-        // every pixel.
-        const VkImage source = drawsMesh ? p.meshColor.image : p.sceneImage;
-        const uint32_t width = drawsMesh ? p.meshExtent.width : p.sceneWidth;
-        const uint32_t height = drawsMesh ? p.meshExtent.height : p.sceneHeight;
-        barrier(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
-                VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                VK_PIPELINE_STAGE_TRANSFER_BIT);
-        VkImageBlit blit = {};
-        blit.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-        blit.srcOffsets[1] = {int32_t(width), int32_t(height), 1};
-        blit.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-        blit.dstOffsets[1] = {int32_t(p.extent.width), int32_t(p.extent.height), 1};
-        bool same = width == p.extent.width && height == p.extent.height;
-        vkCmdBlitImage(p.cmd, source, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, target,
-                       VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &blit,
-                       same ? VK_FILTER_NEAREST : VK_FILTER_LINEAR);
-    }
-    barrier(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-            VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
-            VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
-            VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT);
-    VkRenderPassBeginInfo pass = {VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
-    pass.renderPass = p.renderPass;
-    pass.framebuffer = p.framebuffers[index];
-    pass.renderArea.extent = p.extent;
-    vkCmdBeginRenderPass(p.cmd, &pass, VK_SUBPASS_CONTENTS_INLINE);
-    if (ui) ImGui_ImplVulkan_RenderDrawData(ui, p.cmd);
-    vkCmdEndRenderPass(p.cmd);
+    if (p.sceneDirty) recordSceneUpload(p);
+    recordBackground(p, target, background, drawsMesh);
+    recordUi(p, target, index, ui);
     bool capturing = capture && p.canCapture;
-    if (capturing) {
-        ensureBuffer(p, p.readback, VkDeviceSize(p.extent.width) * p.extent.height * 4,
-                     VK_BUFFER_USAGE_TRANSFER_DST_BIT);
-        barrier(p.cmd, target, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
-                VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
-                VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
-                VK_PIPELINE_STAGE_TRANSFER_BIT);
-        VkBufferImageCopy region = {};
-        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-        region.imageExtent = {p.extent.width, p.extent.height, 1};
-        vkCmdCopyImageToBuffer(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                               p.readback.buffer, 1, &region);
-        barrier(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_ACCESS_TRANSFER_READ_BIT, 0,
-                VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT);
-        VkBufferMemoryBarrier host = {VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
-        host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-        host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-        host.srcQueueFamilyIndex = host.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        host.buffer = p.readback.buffer;
-        host.size = VK_WHOLE_SIZE;
-        vkCmdPipelineBarrier(p.cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0,
-                             0, nullptr, 1, &host, 0, nullptr);
-    }
+    if (capturing) recordCapture(p, target);
     VK_CHECK(vkEndCommandBuffer(p.cmd));
-
-    VkPipelineStageFlags waitStage = VK_PIPELINE_STAGE_TRANSFER_BIT;
-    VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
-    submit.waitSemaphoreCount = 1;
-    submit.pWaitSemaphores = &p.acquired;
-    submit.pWaitDstStageMask = &waitStage;
-    submit.commandBufferCount = 1;
-    submit.pCommandBuffers = &p.cmd;
-    submit.signalSemaphoreCount = 1;
-    submit.pSignalSemaphores = &p.rendered;
-    VK_CHECK(vkQueueSubmit(p.queue, 1, &submit, p.fence));
-    VkPresentInfoKHR present = {VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
-    present.waitSemaphoreCount = 1;
-    present.pWaitSemaphores = &p.rendered;
-    present.swapchainCount = 1;
-    present.pSwapchains = &p.swapchain;
-    present.pImageIndices = &index;
-    VkResult presented = vkQueuePresentKHR(p.queue, &present);
-    if (presented == VK_ERROR_OUT_OF_DATE_KHR || presented == VK_SUBOPTIMAL_KHR)
-        p.rebuild = true;
-    else
-        VK_CHECK(presented);
-    // One frame in flight: the image takes ~ms to draw, the engine's render is the slow part.
-    VK_CHECK(vkWaitForFences(p.device, 1, &p.fence, VK_TRUE, UINT64_MAX));
-    VK_CHECK(vkResetFences(p.device, 1, &p.fence));
-    if (meshDrawn) p.meshMs = -1.0;
-    if (meshDrawn && p.timestamps) {
-        uint64_t ticks[2];
-        VK_CHECK(vkGetQueryPoolResults(p.device, p.timestamps, 0, 2, sizeof ticks, ticks,
-                                       sizeof(uint64_t),
-                                       VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
-        p.meshMs = double((ticks[1] - ticks[0]) & p.timestampMask) *
-                   double(p.limits.timestampPeriod) * 1e-6;
-    }
-
-    if (capturing) {
-        capture->width = p.extent.width;
-        capture->height = p.extent.height;
-        capture->rgba.resize(size_t(p.extent.width) * p.extent.height * 4);
-        std::memcpy(capture->rgba.data(), p.readback.mapped, capture->rgba.size());
-        bool bgra = p.format.format == VK_FORMAT_B8G8R8A8_UNORM ||
-                    p.format.format == VK_FORMAT_B8G8R8A8_SRGB;
-        for (size_t i = 0; i < capture->rgba.size(); i += 4) {
-            if (bgra) std::swap(capture->rgba[i], capture->rgba[i + 2]);
-            capture->rgba[i + 3] = 255;
-        }
-    } else if (capture) {
+    submitAndPresent(p, index);
+    if (meshDrawn) readMeshTime(p);
+    if (capturing)
+        readCapture(p, *capture);
+    else if (capture)
         capture->width = capture->height = 0; // this surface cannot be read back
-    }
     return true;
 }
 
