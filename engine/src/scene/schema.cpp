@@ -244,19 +244,10 @@ void kind(JsonWriter& w, const KindInfo& k) {
 
 } // namespace
 
-std::string sceneJsonSchema() {
-    JsonWriter w;
-    w.beginObject();
-    w.key("$schema");
-    w.string("https://json-schema.org/draft/2020-12/schema");
-    w.key("title");
-    w.string("sdfcsg scene");
-    w.key("description");
-    w.string("An sdfcsg scene, format version " + std::to_string(kSceneVersion) +
-             ". Lengths are in scene units, angles in degrees, colours in 0..1. Generated from "
-             "the node kind table by sceneJsonSchema() (`sdfcsg schema`); do not edit by hand.");
-    w.key("type");
-    w.string("object");
+namespace {
+
+// The scene object's own keys.
+void topProperties(JsonWriter& w) {
     w.key("properties");
     w.beginObject();
     w.key("version");
@@ -297,24 +288,9 @@ std::string sceneJsonSchema() {
     ref(w, "background", "#/$defs/color", "Background colour.");
     ref(w, "root", "#/$defs/node", "The top node of the scene tree.");
     w.endObject();
-    w.key("required");
-    strings(w, {"version", "root"});
-    w.key("additionalProperties");
-    w.boolean(false);
+}
 
-    w.key("$defs");
-    w.beginObject();
-    w.key("vec3");
-    w.beginObject();
-    vec3Body(w, Check::Any);
-    w.endObject();
-    // The keys every node may have, referenced from each kind.
-    for (const CommonKey& c : commonNodeKeys()) {
-        if (c.name == "type") continue;
-        w.key(c.name);
-        fragment(w, c.schemaType, c.doc);
-    }
-
+void cameraDef(JsonWriter& w) {
     w.key("camera");
     w.beginObject();
     w.key("description");
@@ -355,7 +331,9 @@ std::string sceneJsonSchema() {
     w.key("additionalProperties");
     w.boolean(false);
     w.endObject();
+}
 
+void lightDef(JsonWriter& w) {
     w.key("light");
     w.beginObject();
     w.key("description");
@@ -385,7 +363,10 @@ std::string sceneJsonSchema() {
     w.key("additionalProperties");
     w.boolean(false);
     w.endObject();
+}
 
+// A node: one of the kinds, each defined by kind().
+void nodeDef(JsonWriter& w) {
     w.key("node");
     w.beginObject();
     w.key("description");
@@ -402,6 +383,45 @@ std::string sceneJsonSchema() {
     w.endObject();
     for (const KindInfo& k : nodeKinds())
         kind(w, k);
+}
+
+} // namespace
+
+std::string sceneJsonSchema() {
+    JsonWriter w;
+    w.beginObject();
+    w.key("$schema");
+    w.string("https://json-schema.org/draft/2020-12/schema");
+    w.key("title");
+    w.string("sdfcsg scene");
+    w.key("description");
+    w.string("An sdfcsg scene, format version " + std::to_string(kSceneVersion) +
+             ". Lengths are in scene units, angles in degrees, colours in 0..1. Generated from "
+             "the node kind table by sceneJsonSchema() (`sdfcsg schema`); do not edit by hand.");
+    w.key("type");
+    w.string("object");
+    topProperties(w);
+    w.key("required");
+    strings(w, {"version", "root"});
+    w.key("additionalProperties");
+    w.boolean(false);
+
+    w.key("$defs");
+    w.beginObject();
+    w.key("vec3");
+    w.beginObject();
+    vec3Body(w, Check::Any);
+    w.endObject();
+    // The keys every node may have, referenced from each kind.
+    for (const CommonKey& c : commonNodeKeys()) {
+        if (c.name == "type") continue;
+        w.key(c.name);
+        fragment(w, c.schemaType, c.doc);
+    }
+
+    cameraDef(w);
+    lightDef(w);
+    nodeDef(w);
     w.endObject();
 
     w.endObject();
