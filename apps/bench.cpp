@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -228,6 +229,15 @@ struct Row {
     double skip = 0, noSkip = 0, cold = 0, coldOneDevice = 0, newProcess = 0, first = 0, warm = 0;
     double edit = NAN;                  // scenes of pruned tapes
     double buffer = 0, bufferBuild = 0; // with --buffer
+
+    // The build columns' medians: cold, one device, new process and first, then warm.
+    void builds(const std::vector<double> (&coldRuns)[4], const std::vector<double>& warmRuns) {
+        cold = median(coldRuns[0]);
+        coldOneDevice = median(coldRuns[1]);
+        newProcess = median(coldRuns[2]);
+        first = median(coldRuns[3]);
+        warm = median(warmRuns);
+    }
 };
 
 // The reference scenes of the mesh benchmark come with bounds of their own; every other scene
@@ -283,34 +293,39 @@ std::pair<float, float> surfaceError(const Mesh& mesh, const Evaluator& evaluato
     return {*std::max_element(errors.begin(), errors.end()), errors[p99]};
 }
 
-int runMeshBench(int argc, char** argv) {
+// The arguments of the mesh benchmark.
+struct MeshArgs {
     fs::path dir = "assets/scenes";
     std::vector<uint32_t> resolutions = {128, 256, 512};
     uint32_t runs = 3;
     MeshMethod method = MeshMethod::DualContouring;
     bool measureError = false;
     float simplifyCells = 0; // 0: no simplification
+};
+
+// Reads the arguments; an exit code where the run ends here (a bad argument).
+std::optional<int> parseMeshArgs(int argc, char** argv, MeshArgs& args) {
     for (int i = 0; i < argc; ++i) {
         std::string_view a = argv[i];
         bool ok = true;
         if (a == "--mesh")
             continue;
         else if (a == "--error")
-            measureError = true;
+            args.measureError = true;
         else if (i + 1 < argc && a == "--method" && std::string_view(argv[i + 1]) == "dc")
-            method = MeshMethod::DualContouring, ++i;
+            args.method = MeshMethod::DualContouring, ++i;
         else if (i + 1 < argc && a == "--method" && std::string_view(argv[i + 1]) == "mc")
-            method = MeshMethod::MarchingCubes, ++i;
+            args.method = MeshMethod::MarchingCubes, ++i;
         else if (i + 1 < argc && a == "--simplify") {
             char* end = nullptr;
-            simplifyCells = std::strtof(argv[++i], &end);
-            ok = *argv[i] && !*end && std::isfinite(simplifyCells) && simplifyCells > 0;
+            args.simplifyCells = std::strtof(argv[++i], &end);
+            ok = *argv[i] && !*end && std::isfinite(args.simplifyCells) && args.simplifyCells > 0;
         } else if (i + 1 < argc && a == "--scenes")
-            dir = argv[++i];
+            args.dir = argv[++i];
         else if (i + 1 < argc && a == "--resolutions")
-            ok = parseList(argv[++i], resolutions);
+            ok = parseList(argv[++i], args.resolutions);
         else if (i + 1 < argc && a == "--runs")
-            ok = parseCount(argv[++i], 1, 1000, runs);
+            ok = parseCount(argv[++i], 1, 1000, args.runs);
         else
             ok = false;
         if (!ok) {
@@ -319,102 +334,87 @@ int runMeshBench(int argc, char** argv) {
             return 2;
         }
     }
-    std::vector<fs::path> scenes = findScenes(dir);
-    if (scenes.empty()) return 3;
-    auto context = Context::create();
-    if (!context) {
-        std::fprintf(stderr, "%s\n", context.error().str().c_str());
-        return 4;
-    }
-    std::printf("device: %s, median of %u extraction%s (1 warm-up per scene)\n",
-                (*context)->deviceName().c_str(), runs, runs == 1 ? "" : "s");
+    return std::nullopt;
+}
 
-    std::vector<std::string> stageNames; // in the order the mesher reports them
-    std::vector<MeshRow> rows;
-    int status = 0;
-    for (const fs::path& path : scenes) {
-        const std::string name = path.stem().string();
-        auto failed = [&](const Error& e) {
-            std::fprintf(stderr, "%s: %s\n", path.string().c_str(), e.str().c_str());
-            status = e.kind == ErrorKind::Io ? 3 : e.kind == ErrorKind::Limit ? 1 : 4;
-        };
-        auto scene = loadScene(path);
-        if (!scene) {
-            failed(scene.error());
-            break;
+// A row: the median of args.runs extractions at options.resolution (simplified with
+// --simplify), per stage in the order of stageNames, which takes the stages it has not seen.
+Status measureMeshRow(Mesher& mesher, const Evaluator& evaluator, const MeshOptions& options,
+                      const MeshArgs& args, std::vector<std::string>& stageNames, MeshRow& row) {
+    std::vector<std::vector<double>> stageTimes;
+    std::vector<double> totals;
+    for (uint32_t run = 0; run < args.runs; ++run) {
+        MeshStats stats;
+        auto mesh = mesher.extract(options, &stats);
+        if (mesh && args.simplifyCells > 0) {
+            SimplifyOptions simplify;
+            simplify.maxError = args.simplifyCells * stats.voxelSize;
+            mesh = simplifyMesh(*mesh, evaluator, simplify, &stats);
+            row.unsimplified = stats.unsimplifiedTriangles;
         }
-        auto mesher = Mesher::create(**context, *scene);
-        if (!mesher) {
-            failed(mesher.error());
-            break;
+        if (!mesh) return mesh.error();
+        if (args.measureError && run == 0)
+            std::tie(row.maxError, row.p99Error) = surfaceError(*mesh, evaluator, stats.voxelSize);
+        row.cells = stats.cells;
+        row.triangles = stats.triangles;
+        totals.push_back(stats.totalSeconds);
+        for (const MeshStats::Stage& stage : stats.stages) {
+            auto it = std::find(stageNames.begin(), stageNames.end(), stage.name);
+            const size_t k = size_t(it - stageNames.begin());
+            if (it == stageNames.end()) stageNames.push_back(stage.name);
+            if (stageTimes.size() <= k) stageTimes.resize(k + 1);
+            stageTimes[k].push_back(stage.seconds);
         }
-        Evaluator evaluator(*scene);
-        MeshOptions options;
-        options.method = method;
-        for (const ReferenceBounds& r : kReferenceBounds)
-            if (name == r.scene) options.bounds = r.bounds;
-        options.resolution = resolutions.front();
-        if (auto warm = (*mesher)->extract(options); !warm) {
-            failed(warm.error());
-            break;
-        }
-        for (uint32_t resolution : resolutions) {
-            options.resolution = resolution;
-            MeshRow row;
-            row.scene = name;
-            row.resolution = resolution;
-            std::vector<std::vector<double>> stageTimes;
-            std::vector<double> totals;
-            for (uint32_t run = 0; run < runs && status == 0; ++run) {
-                MeshStats stats;
-                auto mesh = (*mesher)->extract(options, &stats);
-                if (mesh && simplifyCells > 0) {
-                    SimplifyOptions simplify;
-                    simplify.maxError = simplifyCells * stats.voxelSize;
-                    mesh = simplifyMesh(*mesh, evaluator, simplify, &stats);
-                    row.unsimplified = stats.unsimplifiedTriangles;
-                }
-                if (!mesh) {
-                    failed(mesh.error());
-                    break;
-                }
-                if (measureError && run == 0)
-                    std::tie(row.maxError, row.p99Error) =
-                        surfaceError(*mesh, evaluator, stats.voxelSize);
-                row.cells = stats.cells;
-                row.triangles = stats.triangles;
-                totals.push_back(stats.totalSeconds);
-                for (const MeshStats::Stage& stage : stats.stages) {
-                    auto it = std::find(stageNames.begin(), stageNames.end(), stage.name);
-                    const size_t k = size_t(it - stageNames.begin());
-                    if (it == stageNames.end()) stageNames.push_back(stage.name);
-                    if (stageTimes.size() <= k) stageTimes.resize(k + 1);
-                    stageTimes[k].push_back(stage.seconds);
-                }
-            }
-            if (status != 0) break;
-            for (const auto& times : stageTimes) // NaN: the stage did not run for this scene
-                row.stages.push_back(times.empty() ? std::nan("") : median(times));
-            row.total = median(totals);
-            std::fprintf(stderr, "  %s at %u done\n", name.c_str(), resolution);
-            rows.push_back(row);
-        }
-        if (status != 0) break;
     }
+    for (const auto& times : stageTimes) // NaN: the stage did not run for this scene
+        row.stages.push_back(times.empty() ? std::nan("") : median(times));
+    row.total = median(totals);
+    return Ok{};
+}
 
+// A scene's rows, one per resolution, after a warm-up extraction at the first.
+Status measureMeshScene(Context& context, const fs::path& path, const MeshArgs& args,
+                        std::vector<std::string>& stageNames, std::vector<MeshRow>& rows) {
+    const std::string name = path.stem().string();
+    auto scene = loadScene(path);
+    if (!scene) return scene.error();
+    auto mesher = Mesher::create(context, *scene);
+    if (!mesher) return mesher.error();
+    Evaluator evaluator(*scene);
+    MeshOptions options;
+    options.method = args.method;
+    for (const ReferenceBounds& r : kReferenceBounds)
+        if (name == r.scene) options.bounds = r.bounds;
+    options.resolution = args.resolutions.front();
+    if (auto warm = (*mesher)->extract(options); !warm) return warm.error();
+    for (uint32_t resolution : args.resolutions) {
+        options.resolution = resolution;
+        MeshRow row;
+        row.scene = name;
+        row.resolution = resolution;
+        if (auto ok = measureMeshRow(**mesher, evaluator, options, args, stageNames, row); !ok)
+            return ok;
+        std::fprintf(stderr, "  %s at %u done\n", name.c_str(), resolution);
+        rows.push_back(row);
+    }
+    return Ok{};
+}
+
+void printMeshRows(const std::vector<MeshRow>& rows, const std::vector<std::string>& stageNames,
+                   const MeshArgs& args) {
     std::printf("\n%-16s %5s %16s %10s", "scene", "res", "cells", "triangles");
-    if (simplifyCells > 0) std::printf(" %10s", "before");
+    if (args.simplifyCells > 0) std::printf(" %10s", "before");
     for (const std::string& stage : stageNames)
         std::printf(" %*s", int(std::max<size_t>(stage.size(), 8)), stage.c_str());
     std::printf(" %8s", "total s");
-    if (measureError) std::printf(" %9s %9s", "max err", "p99 err");
+    if (args.measureError) std::printf(" %9s %9s", "max err", "p99 err");
     std::printf("\n");
     for (const MeshRow& r : rows) {
         const std::string cells = std::to_string(r.cells.x) + "x" + std::to_string(r.cells.y) +
                                   "x" + std::to_string(r.cells.z);
         std::printf("%-16s %5u %16s %10llu", r.scene.c_str(), r.resolution, cells.c_str(),
                     static_cast<unsigned long long>(r.triangles));
-        if (simplifyCells > 0)
+        if (args.simplifyCells > 0)
             std::printf(" %10llu", static_cast<unsigned long long>(r.unsimplified));
         for (size_t k = 0; k < stageNames.size(); ++k) {
             const int width = int(std::max<size_t>(stageNames[k].size(), 8));
@@ -424,29 +424,50 @@ int runMeshBench(int argc, char** argv) {
                 std::printf(" %*s", width, "-");
         }
         std::printf(" %8.3f", r.total);
-        if (measureError) std::printf(" %9.3f %9.3f", r.maxError, r.p99Error);
+        if (args.measureError) std::printf(" %9.3f %9.3f", r.maxError, r.p99Error);
         std::printf("\n");
     }
     std::printf(
         "\nSeconds, median per stage and in total, from a compiled scene to an indexed mesh "
         "in host memory. res: cells along the longest axis of the bounds.\n");
+}
+
+int runMeshBench(int argc, char** argv) {
+    MeshArgs args;
+    if (auto exit = parseMeshArgs(argc, argv, args)) return *exit;
+    std::vector<fs::path> scenes = findScenes(args.dir);
+    if (scenes.empty()) return 3;
+    auto context = Context::create();
+    if (!context) {
+        std::fprintf(stderr, "%s\n", context.error().str().c_str());
+        return 4;
+    }
+    std::printf("device: %s, median of %u extraction%s (1 warm-up per scene)\n",
+                (*context)->deviceName().c_str(), args.runs, args.runs == 1 ? "" : "s");
+    std::vector<std::string> stageNames; // in the order the mesher reports them
+    std::vector<MeshRow> rows;
+    int status = 0;
+    for (const fs::path& path : scenes)
+        if (auto ok = measureMeshScene(**context, path, args, stageNames, rows); !ok) {
+            const Error& e = ok.error();
+            std::fprintf(stderr, "%s: %s\n", path.string().c_str(), e.str().c_str());
+            status = e.kind == ErrorKind::Io ? 3 : e.kind == ErrorKind::Limit ? 1 : 4;
+            break;
+        }
+    printMeshRows(rows, stageNames, args);
     return status;
 }
 
-} // namespace
-
-int runBench(int argc, char** argv) {
-    for (int i = 0; i < argc; ++i)
-        if (std::string_view(argv[i]) == "--mesh") {
-            for (int j = 0; j < argc; ++j)
-                if (std::string_view(argv[j]) == "--help" || std::string_view(argv[j]) == "-h")
-                    return std::fputs(kHelp, stdout), 0;
-            return runMeshBench(argc, argv);
-        }
+// The arguments of the render benchmark.
+struct RenderArgs {
     fs::path dir = "assets/scenes";
     uint32_t width = 1280, height = 720, frames = 5;
     bool buffer = false;
     Evaluation evaluation = Evaluation::Auto;
+};
+
+// Reads the arguments; an exit code where the run ends here (help, or a bad argument).
+std::optional<int> parseRenderArgs(int argc, char** argv, RenderArgs& args) {
     for (int i = 0; i < argc; ++i) {
         std::string_view a = argv[i];
         if (a == "--help" || a == "-h") {
@@ -454,24 +475,24 @@ int runBench(int argc, char** argv) {
             return 0;
         }
         if (a == "--buffer") {
-            buffer = true;
+            args.buffer = true;
             continue;
         }
         bool ok = i + 1 < argc;
         if (ok && a == "--scenes")
-            dir = argv[++i];
+            args.dir = argv[++i];
         else if (ok && a == "--width")
-            ok = parseCount(argv[++i], 1, 16384, width);
+            ok = parseCount(argv[++i], 1, 16384, args.width);
         else if (ok && a == "--height")
-            ok = parseCount(argv[++i], 1, 16384, height);
+            ok = parseCount(argv[++i], 1, 16384, args.height);
         else if (ok && a == "--frames")
-            ok = parseCount(argv[++i], 1, 1000, frames);
+            ok = parseCount(argv[++i], 1, 1000, args.frames);
         else if (ok && a == "--evaluation") {
             const std::string_view v = argv[++i];
             ok = v == "auto" || v == "inlined" || v == "tapes";
-            evaluation = v == "inlined" ? Evaluation::Inlined
-                         : v == "tapes" ? Evaluation::Tapes
-                                        : Evaluation::Auto;
+            args.evaluation = v == "inlined" ? Evaluation::Inlined
+                              : v == "tapes" ? Evaluation::Tapes
+                                             : Evaluation::Auto;
         } else
             ok = false;
         if (!ok) {
@@ -480,6 +501,112 @@ int runBench(int argc, char** argv) {
             return 2;
         }
     }
+    return std::nullopt;
+}
+
+// The frame columns: with and without bounds skipping, and for scenes of pruned tapes a value
+// edit's frame.
+Status measureFrames(Renderer& renderer, const std::string& json, const std::string& file,
+                     const RenderArgs& args, RenderOptions options, Row& row) {
+    options.boundsSkipping = true;
+    auto skip = medianFrameMs(renderer, options, args.frames);
+    if (!skip) return skip.error();
+    options.boundsSkipping = false;
+    auto noSkip = medianFrameMs(renderer, options, args.frames);
+    if (!noSkip) return noSkip.error();
+    row.skip = *skip;
+    row.noSkip = *noSkip;
+    if (auto scene = parseScene(json, file); scene && usesTapes(*scene, args.evaluation)) {
+        options.boundsSkipping.reset();
+        auto edit = medianEditMs(renderer, *scene, options, args.frames);
+        if (!edit) return edit.error();
+        row.edit = *edit;
+    }
+    return Ok{};
+}
+
+// The buffer columns (--buffer): a renderer that reads the values from the node buffer, built on
+// `coldContext`, and its frame.
+Status measureBuffer(Context& coldContext, const std::string& json, const std::string& file,
+                     const RenderArgs& args, RenderOptions options, Row& row) {
+    auto scene = parseScene(json, file);
+    if (!scene) return scene.error();
+    RendererOptions values;
+    values.inlineValues = false;
+    values.evaluation = args.evaluation;
+    auto start = Clock::now();
+    auto built = Renderer::create(coldContext, *scene, values);
+    if (!built) return built.error();
+    row.bufferBuild = msSince(start);
+    options.boundsSkipping.reset();
+    auto frame = medianFrameMs(**built, options, args.frames);
+    if (!frame) return frame.error();
+    row.buffer = *frame;
+    return Ok{};
+}
+
+void printRenderRows(const std::vector<Row>& rows, bool buffer) {
+    std::printf("\n%-13s %5s %8s %10s %7s %15s %10s %11s %6s %5s", "scene", "nodes", "skip ms",
+                "no-skip ms", "speedup", "json->pipe cold", "one device", "new process", "first",
+                "warm");
+    std::printf(" %7s", "edit ms");
+    if (buffer) std::printf(" %10s %16s", "buffer ms", "buffer build ms");
+    std::printf("\n");
+    for (const Row& r : rows) {
+        std::printf("%-13s %5zu %8.1f %10.1f %6.2fx %15.1f %10.1f %11.1f %6.1f %5.1f",
+                    r.name.c_str(), r.nodes, r.skip, r.noSkip, r.noSkip / std::max(r.skip, 1e-9),
+                    r.cold, r.coldOneDevice, r.newProcess, r.first, r.warm);
+        if (std::isnan(r.edit))
+            std::printf(" %7s", "-");
+        else
+            std::printf(" %7.1f", r.edit);
+        if (buffer) std::printf(" %10.1f %16.1f", r.buffer, r.bufferBuild);
+        std::printf("\n");
+    }
+    std::printf(
+        "\njson->pipe ms: parse + codegen + GLSL compile + pipelines ready to run. cold: a new "
+        "scene, its kernels cached nowhere, in a context that has built another; one device: "
+        "the same without the compile helper; new process: the same in a new context (the disk "
+        "caches hold the other scene's build); first: a new context, nothing cached at all; "
+        "warm: SPIR-V and driver disk caches filled, in-process cache cleared. edit ms (scenes "
+        "of pruned tapes): a value edit as the viewer makes one, the field pruned again and "
+        "uploaded, and the frame after it.\n"
+        "Renders use bounds skipping by default on GPUs and not on CPU devices (lavapipe runs both "
+        "sides of every branch, so there the bounds tests only add work).\n");
+}
+
+// A new folder under the temporary one; empty, with a message, when it cannot be made.
+fs::path temporaryFolder() {
+    std::string name = (fs::temp_directory_path() / "sdfcsg-bench-XXXXXX").string();
+    if (!::mkdtemp(name.data())) {
+        std::fprintf(stderr, "sdfcsg bench: cannot create a temporary cache folder\n");
+        return {};
+    }
+    return name;
+}
+
+std::string readText(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+}
+
+} // namespace
+
+int runBench(int argc, char** argv) {
+    if (std::find(argv, argv + argc, std::string_view("--mesh")) != argv + argc) {
+        for (int j = 0; j < argc; ++j)
+            if (std::string_view(argv[j]) == "--help" || std::string_view(argv[j]) == "-h")
+                return std::fputs(kHelp, stdout), 0;
+        return runMeshBench(argc, argv);
+    }
+    RenderArgs args;
+    if (auto exit = parseRenderArgs(argc, argv, args)) return *exit;
+    const fs::path& dir = args.dir;
+    const uint32_t width = args.width, height = args.height, frames = args.frames;
+    const bool buffer = args.buffer;
+    const Evaluation evaluation = args.evaluation;
 
     std::error_code ec;
     std::vector<fs::path> scenes = findScenes(dir);
@@ -492,12 +619,8 @@ int runBench(int argc, char** argv) {
     }
     // A private disk cache, so "warm" means exactly this run's compiles; below it, an empty
     // folder for Mesa's disk cache for every cold build.
-    std::string cacheTemplate = (fs::temp_directory_path() / "sdfcsg-bench-XXXXXX").string();
-    if (!::mkdtemp(cacheTemplate.data())) {
-        std::fprintf(stderr, "sdfcsg bench: cannot create a temporary cache folder\n");
-        return 3;
-    }
-    const fs::path cacheDir = cacheTemplate;
+    const fs::path cacheDir = temporaryFolder();
+    if (cacheDir.empty()) return 3;
     constexpr int kPipelineRuns = 3;
     int coldRuns = 0;
     // The other scene of the cold column's contexts.
@@ -542,10 +665,7 @@ int runBench(int argc, char** argv) {
     std::vector<Row> rows;
     int status = 0;
     for (const fs::path& path : scenes) {
-        std::ifstream in(path, std::ios::binary);
-        std::stringstream text;
-        text << in.rdbuf();
-        const std::string json = text.str(), file = path.string();
+        const std::string json = readText(path), file = path.string();
         Row row;
         row.name = path.stem().string();
 
@@ -584,51 +704,19 @@ int runBench(int argc, char** argv) {
             }
         }
         if (status != 0) break;
-        row.cold = median(cold[0]);
-        row.coldOneDevice = median(cold[1]);
-        row.newProcess = median(cold[2]);
-        row.first = median(cold[3]);
-        row.warm = median(warm);
+        row.builds(cold, warm);
         if (auto scene = parseScene(json, file)) row.nodes = scene->nodes.size();
 
         RenderOptions options;
         options.width = width;
         options.height = height;
-        options.boundsSkipping = true;
-        auto skip = medianFrameMs(*renderer, options, frames);
-        options.boundsSkipping = false;
-        auto noSkip = skip ? medianFrameMs(*renderer, options, frames) : skip;
-        if (!skip || !noSkip) {
-            fail(!skip ? skip.error() : noSkip.error());
+        if (auto ok = measureFrames(*renderer, json, file, args, options, row); !ok) {
+            fail(ok.error());
             break;
         }
-        row.skip = *skip;
-        row.noSkip = *noSkip;
-        if (auto scene = parseScene(json, file); scene && usesTapes(*scene, evaluation)) {
-            options.boundsSkipping.reset();
-            auto edit = medianEditMs(*renderer, *scene, options, frames);
-            if (!edit) {
-                fail(edit.error());
-                break;
-            }
-            row.edit = *edit;
-        }
         if (buffer) {
-            auto ok = withColdContext(true, Seed::None, [&](Context& coldContext) -> Status {
-                auto scene = parseScene(json, file);
-                if (!scene) return scene.error();
-                RendererOptions values;
-                values.inlineValues = false;
-                values.evaluation = evaluation;
-                auto start = Clock::now();
-                auto built = Renderer::create(coldContext, *scene, values);
-                if (!built) return built.error();
-                row.bufferBuild = msSince(start);
-                options.boundsSkipping.reset();
-                auto frame = medianFrameMs(**built, options, frames);
-                if (!frame) return frame.error();
-                row.buffer = *frame;
-                return Ok{};
+            auto ok = withColdContext(true, Seed::None, [&](Context& coldContext) {
+                return measureBuffer(coldContext, json, file, args, options, row);
             });
             if (!ok) {
                 fail(ok.error());
@@ -640,33 +728,7 @@ int runBench(int argc, char** argv) {
     }
     fs::remove_all(cacheDir, ec);
 
-    std::printf("\n%-13s %5s %8s %10s %7s %15s %10s %11s %6s %5s", "scene", "nodes", "skip ms",
-                "no-skip ms", "speedup", "json->pipe cold", "one device", "new process", "first",
-                "warm");
-    std::printf(" %7s", "edit ms");
-    if (buffer) std::printf(" %10s %16s", "buffer ms", "buffer build ms");
-    std::printf("\n");
-    for (const Row& r : rows) {
-        std::printf("%-13s %5zu %8.1f %10.1f %6.2fx %15.1f %10.1f %11.1f %6.1f %5.1f",
-                    r.name.c_str(), r.nodes, r.skip, r.noSkip, r.noSkip / std::max(r.skip, 1e-9),
-                    r.cold, r.coldOneDevice, r.newProcess, r.first, r.warm);
-        if (std::isnan(r.edit))
-            std::printf(" %7s", "-");
-        else
-            std::printf(" %7.1f", r.edit);
-        if (buffer) std::printf(" %10.1f %16.1f", r.buffer, r.bufferBuild);
-        std::printf("\n");
-    }
-    std::printf(
-        "\njson->pipe ms: parse + codegen + GLSL compile + pipelines ready to run. cold: a new "
-        "scene, its kernels cached nowhere, in a context that has built another; one device: "
-        "the same without the compile helper; new process: the same in a new context (the disk "
-        "caches hold the other scene's build); first: a new context, nothing cached at all; "
-        "warm: SPIR-V and driver disk caches filled, in-process cache cleared. edit ms (scenes "
-        "of pruned tapes): a value edit as the viewer makes one, the field pruned again and "
-        "uploaded, and the frame after it.\n"
-        "Renders use bounds skipping by default on GPUs and not on CPU devices (lavapipe runs both "
-        "sides of every branch, so there the bounds tests only add work).\n");
+    printRenderRows(rows, buffer);
     if (status == 0 && !runRepeatBench(**context, width, height, frames)) status = 4;
     return status;
 }
