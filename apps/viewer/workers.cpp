@@ -215,112 +215,127 @@ RenderOutput RenderWorker::process(const RenderJob& job) {
     out.id = job.id;
     adoptBuilds(job);
     if (live_ && !live_->uploads(*job.scene)) live_.reset(), drawn_.reset();
-
-    // A still frame is drawn live unless recompiling and drawing baked is expected to be
-    // sooner: on lavapipe a small scene's inlined kernel compiles in a fraction of a second
-    // and draws several times faster, so at full resolution the live frame can come later.
-    // Until the live renderer has drawn, its speed is guessed from the baked one's (on
-    // lavapipe the house's live frame took 6 times as long; a scene evaluated from pruned
-    // tapes reads its values from buffers either way).
     const bool tapes = usesTapes(*job.scene, Evaluation::Auto);
-    const double pixels = double(job.options.width) * double(job.options.height);
-    const double guess = context_.cpuDevice() ? (tapes ? 1.5 : 6.0) : 1.0;
-    const double liveRate = liveRate_ > 0 ? liveRate_ : bakedRate_ * guess;
-    const bool bakeSooner =
-        !job.preview && bakedRate_ > 0 && bakeSeconds_ + bakedRate_ * pixels < liveRate * pixels;
-    // A scene evaluated from pruned tapes reads every value from buffers, so its baked renderer
-    // takes value edits itself, previews and still frames alike, but for one that its kernel
-    // follows (a sphere scaled differently per axis, or no longer, where it reads spheres as
-    // balls): the live renderer draws that one, once built, and the bake follows as a
-    // refinement.
-    const bool uploads =
-        tapes && baked_ && bakedVersion_ != job.sceneVersion && baked_->uploads(*job.scene);
-    if (tapes && baked_ && bakedVersion_ != job.sceneVersion &&
-        sameStructure(*bakedScene_, *job.scene) && (uploads || !live_)) {
-        auto start = std::chrono::steady_clock::now();
-        compilingHere_ = !uploads;
-        auto updated = baked_->updateValues(*job.scene);
-        compilingHere_ = false;
-        if (!uploads) out.compileSeconds = secondsSince(start);
-        if (updated) {
-            bakedScene_ = job.scene;
-            bakedVersion_ = job.sceneVersion;
-            drawn_.reset();
-            failure_.reset();
-        } else {
-            failure_ = updated.error();
-        }
-    }
+    if (tapes) updateBaked(job, out);
     Renderer* renderer = nullptr;
-    if (baked_ && bakedVersion_ == job.sceneVersion) {
+    if (baked_ && bakedVersion_ == job.sceneVersion)
         renderer = baked_.get();
-    } else if (live_ && !bakeSooner) {
-        if (liveVersion_ != job.sceneVersion) {
-            drawn_.reset();
-            if (auto updated = live_->updateValues(*job.scene); updated)
-                liveVersion_ = job.sceneVersion;
-            else
-                failure_ = updated.error();
-        }
-        if (liveVersion_ == job.sceneVersion) {
-            renderer = live_.get();
-            out.live = true;
-            failure_.reset();
-            // The edit shows now; its baked kernel follows, for the caller to swap in.
-            if (!job.preview) bakeBuilder_->request(job.scene, job.sceneVersion);
-        }
-    } else if (failedVersion_ != job.sceneVersion) { // a scene that failed waits for a change
-        auto start = std::chrono::steady_clock::now();
-        compilingHere_ = true;
-        auto created = create_(context_, *job.scene, RendererOptions{});
-        compilingHere_ = false;
-        out.compileSeconds = secondsSince(start);
-        if (created) {
-            bakeSeconds_ = out.compileSeconds;
-            baked_ = std::move(*created);
-            bakedScene_ = job.scene;
-            bakedVersion_ = job.sceneVersion;
-            drawn_.reset();
-            failedVersion_.reset();
-            failure_.reset();
-            renderer = baked_.get();
-            // A structure on screen: its live renderer is built now, so that the first value
-            // edit is already an upload.
-            if (baked_->followsValues() && !live_ && !liveBuilder_->pendingStructure(*job.scene))
-                liveBuilder_->request(job.scene, job.sceneVersion);
-        } else {
-            failedVersion_ = job.sceneVersion;
-            failure_ = created.error();
-        }
-    }
+    else if (live_ && !bakeSooner(job, tapes))
+        renderer = updateLive(job, out);
+    else if (failedVersion_ != job.sceneVersion) // a scene that failed waits for a change
+        renderer = compileBaked(job, out);
     out.error = failure_;
     // A scene that does not compile leaves the last one that did on screen.
     if (!renderer) renderer = baked_.get();
-    if (!renderer) return out;
+    if (renderer) draw(job, *renderer, out);
+    return out;
+}
+
+// A still frame is drawn live unless recompiling and drawing baked is expected to be sooner: on
+// lavapipe a small scene's inlined kernel compiles in a fraction of a second and draws several
+// times faster, so at full resolution the live frame can come later. Until the live renderer
+// has drawn, its speed is guessed from the baked one's (on lavapipe the house's live frame took
+// 6 times as long; a scene evaluated from pruned tapes reads its values from buffers either
+// way).
+bool RenderWorker::bakeSooner(const RenderJob& job, bool tapes) const {
+    const double pixels = double(job.options.width) * double(job.options.height);
+    const double guess = context_.cpuDevice() ? (tapes ? 1.5 : 6.0) : 1.0;
+    const double liveRate = liveRate_ > 0 ? liveRate_ : bakedRate_ * guess;
+    return !job.preview && bakedRate_ > 0 && bakeSeconds_ + bakedRate_ * pixels < liveRate * pixels;
+}
+
+// A scene evaluated from pruned tapes reads every value from buffers, so its baked renderer
+// takes value edits itself, previews and still frames alike, but for one that its kernel follows
+// (a sphere scaled differently per axis, or no longer, where it reads spheres as balls): the live
+// renderer draws that one, once built, and the bake follows as a refinement.
+void RenderWorker::updateBaked(const RenderJob& job, RenderOutput& out) {
+    if (!baked_ || bakedVersion_ == job.sceneVersion) return;
+    const bool uploads = baked_->uploads(*job.scene);
+    if (!sameStructure(*bakedScene_, *job.scene) || !(uploads || !live_)) return;
+    auto start = std::chrono::steady_clock::now();
+    compilingHere_ = !uploads;
+    auto updated = baked_->updateValues(*job.scene);
+    compilingHere_ = false;
+    if (!uploads) out.compileSeconds = secondsSince(start);
+    if (updated) {
+        bakedScene_ = job.scene;
+        bakedVersion_ = job.sceneVersion;
+        drawn_.reset();
+        failure_.reset();
+    } else {
+        failure_ = updated.error();
+    }
+}
+
+// The live renderer with the job's values, or null where they do not upload.
+Renderer* RenderWorker::updateLive(const RenderJob& job, RenderOutput& out) {
+    if (liveVersion_ != job.sceneVersion) {
+        drawn_.reset();
+        if (auto updated = live_->updateValues(*job.scene); updated)
+            liveVersion_ = job.sceneVersion;
+        else
+            failure_ = updated.error();
+    }
+    if (liveVersion_ != job.sceneVersion) return nullptr;
+    out.live = true;
+    failure_.reset();
+    // The edit shows now; its baked kernel follows, for the caller to swap in.
+    if (!job.preview) bakeBuilder_->request(job.scene, job.sceneVersion);
+    return live_.get();
+}
+
+// A new baked renderer for the job's scene, compiled here; null where it fails.
+Renderer* RenderWorker::compileBaked(const RenderJob& job, RenderOutput& out) {
+    auto start = std::chrono::steady_clock::now();
+    compilingHere_ = true;
+    auto created = create_(context_, *job.scene, RendererOptions{});
+    compilingHere_ = false;
+    out.compileSeconds = secondsSince(start);
+    if (!created) {
+        failedVersion_ = job.sceneVersion;
+        failure_ = created.error();
+        return nullptr;
+    }
+    bakeSeconds_ = out.compileSeconds;
+    baked_ = std::move(*created);
+    bakedScene_ = job.scene;
+    bakedVersion_ = job.sceneVersion;
+    drawn_.reset();
+    failedVersion_.reset();
+    failure_.reset();
+    // A structure on screen: its live renderer is built now, so that the first value edit is
+    // already an upload.
+    if (baked_->followsValues() && !live_ && !liveBuilder_->pendingStructure(*job.scene))
+        liveBuilder_->request(job.scene, job.sceneVersion);
+    return baked_.get();
+}
+
+// The frame, drawn by `renderer` unless only its highlight changed, then the highlight.
+void RenderWorker::draw(const RenderJob& job, Renderer& renderer, RenderOutput& out) {
     out.scene = out.live ? job.scene : bakedScene_;
     out.options = job.options;
     if (out.options.selectedNode >= int(out.scene->nodes.size())) out.options.selectedNode = -1;
     const uint64_t version = out.live ? liveVersion_ : bakedVersion_;
-    if (drawn_ && drawn_->renderer == renderer && drawn_->version == version &&
+    if (drawn_ && drawn_->renderer == &renderer && drawn_->version == version &&
         sameView(drawn_->options, out.options)) {
         out.image = drawn_->image; // only the highlight changed
         out.pixels = drawn_->pixels;
     } else {
+        const double pixels = double(job.options.width) * double(job.options.height);
         auto start = std::chrono::steady_clock::now();
-        auto image = renderer->render(out.options);
+        auto image = renderer.render(out.options);
         out.renderSeconds = secondsSince(start);
         (out.live ? liveRate_ : bakedRate_) = out.renderSeconds / pixels;
         if (!image) {
             out.error = image.error();
             drawn_.reset();
-            return out;
+            return;
         }
         out.image = std::move(*image);
-        out.pixels = renderer->lastPixelInfo();
-        drawn_ = Drawn{renderer, version, out.options, out.image, out.pixels};
+        out.pixels = renderer.lastPixelInfo();
+        drawn_ = Drawn{&renderer, version, out.options, out.image, out.pixels};
     }
     if (!job.preview) highlight(out, job.highlight);
-    return out;
 }
 
 void RenderWorker::highlight(RenderOutput& out, int node) {

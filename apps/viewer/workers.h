@@ -141,8 +141,14 @@ class RenderWorker {
 
   private:
     void run();
+    // process()'s steps, in order.
     RenderOutput process(const RenderJob& job);
     void adoptBuilds(const RenderJob& job);
+    void updateBaked(const RenderJob& job, RenderOutput& out);
+    bool bakeSooner(const RenderJob& job, bool tapes) const;
+    Renderer* updateLive(const RenderJob& job, RenderOutput& out);
+    Renderer* compileBaked(const RenderJob& job, RenderOutput& out);
+    void draw(const RenderJob& job, Renderer& renderer, RenderOutput& out);
     void highlight(RenderOutput& out, int node);
 
     Context& context_;
