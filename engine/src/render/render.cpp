@@ -253,78 +253,23 @@ struct Renderer::Impl {
     Status buildKernels() {
         const bool skipping = defaultSkipping();
         const std::string glsl = sceneGlsl(skipping);
-        struct Built {
-            std::optional<Error> error;
-            VkShaderModule module = VK_NULL_HANDLE;
-            VkPipeline pipeline = VK_NULL_HANDLE;
-        };
-        auto build = [&](const Result<std::vector<uint32_t>>& spirv, uint32_t pass) {
-            Built b;
-            if (!spirv) {
-                b.error = spirv.error();
-                return b;
-            }
-            b.module = detail::createShaderModule(ctx, *spirv);
-            b.pipeline = createPipeline(b.module, pass, skipping);
-            return b;
-        };
         // While this device compiles the shade kernel, the other thread makes the march kernel:
         // on llvmpipe, its machine code on the helper device (if it is a new kernel), and this
         // device's pipeline beside that, which at its first dispatch loads the helper's work.
-        // In a context's first build the passes that do not depend on the scene are most likely
-        // new too: the helper then compiles the clip and ends passes after the march kernel, and
-        // this device the light pass after the shade kernel (about as long on either side).
-        std::vector<uint32_t> clipSpirv, endsSpirv;
-        {
-            std::lock_guard lock(shared->mutex);
-            if (!shared->pipelines[SDFCSG_RAYMARCH_PASS_CLIP])
-                clipSpirv = std::exchange(shared->freshClip, {});
-            if (!shared->pipelines[SDFCSG_RAYMARCH_PASS_ENDS])
-                endsSpirv = std::exchange(shared->freshLight, {});
-        }
-        Built march;
+        BuiltKernel march;
         double helperMs = 0.0; // the helper's compile of the march kernel
-        std::thread other([&] {
-            detail::makeCompileHelper(ctx); // the last build used it up
-            bool fresh = false;
-            auto spirv = detail::compileKernel("march.comp", glsl, fresh);
-            const auto marchSpec = specConstants(SDFCSG_RAYMARCH_PASS_MARCH, skipping);
-            const auto clipSpec = specConstants(SDFCSG_RAYMARCH_PASS_CLIP, false);
-            const auto endsSpec = specConstants(SDFCSG_RAYMARCH_PASS_ENDS, false);
-            std::vector<detail::Precompile> jobs;
-            if (spirv && fresh) jobs.push_back({*spirv, marchSpec});
-            if (!clipSpirv.empty()) jobs.push_back({clipSpirv, clipSpec});
-            if (!endsSpirv.empty()) jobs.push_back({endsSpirv, endsSpec});
-            // This device's pipeline translates the kernel (SPIR-V to the driver's IR, a tenth of
-            // the compile). Beside the helper's compile of the march kernel alone, which ends
-            // before the shade kernel's, that would take the shade kernel's core from it: after
-            // it. Beside a first build's longer list, which ends later.
-            auto translate = [&] { march = build(spirv, SDFCSG_RAYMARCH_PASS_MARCH); };
-            std::thread beside;
-            if (jobs.size() > 1) beside = std::thread(translate);
-            const double ms =
-                detail::precompileElsewhere(ctx, jobs, kBindings, sizeof(BandConstants));
-            if (spirv && fresh) helperMs = ms;
-            if (beside.joinable())
-                beside.join();
-            else
-                translate();
-            // The first renderer of a context makes the passes that do not depend on the scene
-            // (their machine code, in a first build, from the helper): their translations too,
-            // beside the shade kernel's compile. Their warm-ups follow (pipeline()).
-            for (uint32_t pass : {SDFCSG_RAYMARCH_PASS_CLIP, SDFCSG_RAYMARCH_PASS_ENDS}) {
-                std::lock_guard lock(shared->mutex);
-                shared->created(pass);
-            }
+        std::thread other([&, fresh = freshSharedSpirv()] {
+            march = buildMarch(glsl, skipping, fresh, helperMs);
         });
-        Built shade = build(compileKernel("shade.comp", glsl), SDFCSG_RAYMARCH_PASS_SHADE);
+        BuiltKernel shade =
+            buildKernel(compileKernel("shade.comp", glsl), SDFCSG_RAYMARCH_PASS_SHADE, skipping);
         if (!shade.error) {
             warmUp(shade.pipeline);
             pipeline(SDFCSG_RAYMARCH_PASS_LIGHT, false); // made once per context
         }
         other.join();
         if (march.error || shade.error) {
-            for (Built* b : {&march, &shade}) {
+            for (BuiltKernel* b : {&march, &shade}) {
                 if (b->pipeline) vkDestroyPipeline(ctx.device, b->pipeline, nullptr);
                 if (b->module) vkDestroyShaderModule(ctx.device, b->module, nullptr);
             }
@@ -343,6 +288,77 @@ struct Renderer::Impl {
         // less; compiling it again takes about as long as the helper did.
         if (helperMs > 0.0 && marchMs.count() > 0.25 * helperMs) detail::compileHelperMissed(ctx);
         return Ok{};
+    }
+
+    // A kernel's module and its pipeline for a pass, or why it could not be made.
+    struct BuiltKernel {
+        std::optional<Error> error;
+        VkShaderModule module = VK_NULL_HANDLE;
+        VkPipeline pipeline = VK_NULL_HANDLE;
+    };
+    BuiltKernel buildKernel(const Result<std::vector<uint32_t>>& spirv, uint32_t pass,
+                            bool skipping) {
+        BuiltKernel b;
+        if (!spirv) {
+            b.error = spirv.error();
+            return b;
+        }
+        b.module = detail::createShaderModule(ctx, *spirv);
+        b.pipeline = createPipeline(b.module, pass, skipping);
+        return b;
+    }
+
+    // In a context's first build the passes that do not depend on the scene are most likely new
+    // too: their SPIR-V, where glslang made it and their pipelines are still to make (the clip
+    // pass's, then the ends pass's), for the helper to compile after the march kernel.
+    std::array<std::vector<uint32_t>, 2> freshSharedSpirv() {
+        std::array<std::vector<uint32_t>, 2> fresh;
+        std::lock_guard lock(shared->mutex);
+        if (!shared->pipelines[SDFCSG_RAYMARCH_PASS_CLIP])
+            fresh[0] = std::exchange(shared->freshClip, {});
+        if (!shared->pipelines[SDFCSG_RAYMARCH_PASS_ENDS])
+            fresh[1] = std::exchange(shared->freshLight, {});
+        return fresh;
+    }
+
+    // On buildKernels()' other thread: the march kernel, whose machine code (with that of the
+    // fresh shared passes) the helper device compiles where it is new (helperMs: how long the
+    // march kernel took there), then the shared passes' pipelines. This device compiles the
+    // light pass after the shade kernel meanwhile (about as long on either side).
+    BuiltKernel buildMarch(const std::string& glsl, bool skipping,
+                           const std::array<std::vector<uint32_t>, 2>& fresh, double& helperMs) {
+        detail::makeCompileHelper(ctx); // the last build used it up
+        bool compiled = false;
+        auto spirv = detail::compileKernel("march.comp", glsl, compiled);
+        const auto marchSpec = specConstants(SDFCSG_RAYMARCH_PASS_MARCH, skipping);
+        const auto clipSpec = specConstants(SDFCSG_RAYMARCH_PASS_CLIP, false);
+        const auto endsSpec = specConstants(SDFCSG_RAYMARCH_PASS_ENDS, false);
+        std::vector<detail::Precompile> jobs;
+        if (spirv && compiled) jobs.push_back({*spirv, marchSpec});
+        if (!fresh[0].empty()) jobs.push_back({fresh[0], clipSpec});
+        if (!fresh[1].empty()) jobs.push_back({fresh[1], endsSpec});
+        // This device's pipeline translates the kernel (SPIR-V to the driver's IR, a tenth of
+        // the compile). Beside the helper's compile of the march kernel alone, which ends
+        // before the shade kernel's, that would take the shade kernel's core from it: after
+        // it. Beside a first build's longer list, which ends later.
+        BuiltKernel march;
+        auto translate = [&] { march = buildKernel(spirv, SDFCSG_RAYMARCH_PASS_MARCH, skipping); };
+        std::thread beside;
+        if (jobs.size() > 1) beside = std::thread(translate);
+        const double ms = detail::precompileElsewhere(ctx, jobs, kBindings, sizeof(BandConstants));
+        if (spirv && compiled) helperMs = ms;
+        if (beside.joinable())
+            beside.join();
+        else
+            translate();
+        // The first renderer of a context makes the passes that do not depend on the scene
+        // (their machine code, in a first build, from the helper): their translations too,
+        // beside the shade kernel's compile. Their warm-ups follow (pipeline()).
+        for (uint32_t pass : {SDFCSG_RAYMARCH_PASS_CLIP, SDFCSG_RAYMARCH_PASS_ENDS}) {
+            std::lock_guard lock(shared->mutex);
+            shared->created(pass);
+        }
+        return march;
     }
 
     // The scene's kernels and their pipelines.
