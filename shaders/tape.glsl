@@ -32,7 +32,7 @@ layout(std430, set = 0, binding = SDFCSG_BINDING_FIELD) readonly buffer FieldBal
 // work of a tape of spheres (molecule_1k), as each is a gather on CPU devices.
 float tapePrimitive(uint kind, uint i, vec3 p) {
 #if SDFCSG_TAPE_BALLS
-    if (kind == 0u || SDFCSG_TAPE_KINDS == 0u) {
+    if (kind == kKindSphere || SDFCSG_TAPE_KINDS == 0u) {
         vec4 ball = fieldBalls[3u + i];
         return length(p - ball.xyz) - ball.w;
     }
@@ -41,7 +41,7 @@ float tapePrimitive(uint kind, uint i, vec3 p) {
            nodes[i].color.w;
 }
 
-const uint kTapeUnion = uint(SDFCSG_TAPE_FIRST_OPERATION), kTapeIntersection = kTapeUnion + 1u;
+const uint kTapeUnion = kKindUnion, kTapeIntersection = kKindIntersection;
 
 // One blend for the three operations, which the compiler would otherwise all evaluate and
 // select from: intersection(a, b) is -union(-a, -b) and difference(a, b) intersection(a, -b),

@@ -31,13 +31,13 @@ namespace sdfcsg::detail {
 // operation pops b, then a, and pushes op(a, b) with its blend radius and profile.
 inline constexpr uint32_t kTapeNodeBits = SDFCSG_TAPE_NODE_BITS;
 inline constexpr uint32_t kTapeKindShift = SDFCSG_TAPE_KIND_SHIFT;
-static_assert(uint32_t(NodeKind::Union) == SDFCSG_TAPE_FIRST_OPERATION);
 // A domain operation's child is the tape between the operation's own instruction (which sets
 // the point the child is evaluated at) and this one (which takes the child's value, and runs the
 // child again at the operation's next candidate point, if any: sdf.glsl, domainPoint). Pruning
 // keeps the two and all between them whole. A value operation (shell, offset) is one
 // instruction after its child's.
 inline constexpr uint32_t kTapeDomainEnd = SDFCSG_TAPE_DOMAIN_END;
+static_assert(kNodeKindCount <= int(kTapeDomainEnd), "an instruction's kind has 6 bits");
 inline constexpr uint32_t kTapeNodeMask = (1u << kTapeNodeBits) - 1u;
 // A leaf cell entry (x, y): near a surface, the cell's tape [x, x + y) in PrunedField::tape;
 // far from every surface, x holds the root value at the centre of the cell of level
