@@ -32,8 +32,8 @@ END
 insert_before shaders/sdf.glsl '    if (SDF_IS(kKindCircle)) return sdCircle(q, a.x);' <<'END'
     if (SDF_IS(kKindDummy)) return sdDummy(q, a.x);
 END
-# 3. Its table entry.
-insert_before engine/src/scene/nodes.cpp '    {NodeKind::Circle, "circle", false, kCircle,' <<'END'
+# 3. Its table entry, in the kinds' order.
+insert_before engine/src/scene/nodes.cpp '    {NodeKind::CappedTorus, "capped_torus", false, kCappedTorus,' <<'END'
     {NodeKind::Dummy, "dummy", false, kSphere, "A ball, to check that kinds are added in one place.",
      R"("radius": 0.7)", "sdDummy", kA0, [](const Params& v) -> Params { return {v[0]}; },
      [](const Params& k, vec3& lo, vec3& hi) { return symmetric(vec3(k[0]), lo, hi); }},
