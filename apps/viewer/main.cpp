@@ -122,7 +122,8 @@ int main(int argc, char** argv) {
         v.scriptFile = args.script.string();
     }
     v.showUi = !args.noUi;
-    v.recent = loadRecent(recentFilesPath());
+    v.recentFile = recentFilesPath(std::getenv("XDG_CONFIG_HOME"), std::getenv("HOME"));
+    v.recent = loadRecent(v.recentFile);
 
     auto context = Context::create();
     if (!context) {
@@ -167,7 +168,7 @@ int main(int argc, char** argv) {
     ImGui::GetIO().IniFilename = nullptr; // the same layout every run, no file beside the scene
     ImGui::StyleColorsDark();
     ImGui_ImplGlfw_InitForVulkan(v.window, true);
-    v.presenter = createPresenter(v.window, error);
+    v.presenter = createPresenter(v.window, v.context->validationEnabled(), error);
     if (!v.presenter) {
         std::fprintf(stderr, "sdfcsg-viewer: %s\n", error.c_str());
         return 4;

@@ -42,7 +42,7 @@ constexpr Probe kProbes[] = {
 // Runs probe.comp over `points`; returns (rgb colour, distance) per point.
 std::vector<glm::vec4> probeGpu(Context& context, const Scene& scene,
                                 const std::vector<glm::vec4>& points, const Probe& probe) {
-    Context::Impl& ctx = context.impl();
+    Context::Impl& ctx = detail::contextImpl(context);
     CodegenOptions codegen;
     codegen.boundsTests = probe.boundsTests;
     codegen.evaluation = probe.tapes ? Evaluation::Tapes : Evaluation::Inlined;

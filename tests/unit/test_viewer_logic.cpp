@@ -79,6 +79,7 @@ constexpr const char* kBadBall = R"({"version": 1, "root": {"type": "sphere", "r
 GenerateOptions fakeModel(const FakeServer& server) {
     GenerateOptions o;
     o.llm.baseUrl = server.url();
+    o.llm.proxy = ""; // none from the environment, in front of the loopback
     o.llm.model = "test-model";
     o.llm.timeoutSeconds = 20;
     o.sleep = [](double) {}; // no back-off between retries
@@ -754,11 +755,9 @@ TEST(ViewerFiles, RecentFilesPersist) {
     EXPECT_EQ(loadRecent(file, 1), std::vector<std::string>{"/a/one.json"});
     writeText(dir / "blocker", "a file, not a folder");
     saveRecent(dir / "blocker" / "recent", {"a"}); // cannot be written: ignored
-    const char* old = std::getenv("XDG_CONFIG_HOME");
-    const std::string saved = old ? old : "";
-    setenv("XDG_CONFIG_HOME", (dir / "config").c_str(), 1);
-    EXPECT_EQ(recentFilesPath(), file);
-    old ? setenv("XDG_CONFIG_HOME", saved.c_str(), 1) : unsetenv("XDG_CONFIG_HOME");
+    EXPECT_EQ(recentFilesPath((dir / "config").c_str(), "/home/someone"), file);
+    EXPECT_EQ(recentFilesPath("", "/home/someone"), "/home/someone/.config/sdfcsg/recent");
+    EXPECT_EQ(recentFilesPath(nullptr, nullptr), fs::path());
 }
 
 TEST(ViewerFiles, ABrokenFirstFileIsWatched) {

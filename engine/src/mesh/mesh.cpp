@@ -407,7 +407,7 @@ Mesher::~Mesher() = default;
 Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& scene,
                                                Evaluation evaluation) {
     if (scene.nodes.empty()) return usage("the scene has no nodes");
-    auto impl = std::make_unique<Impl>(context.impl());
+    auto impl = std::make_unique<Impl>(detail::contextImpl(context));
     Impl& m = *impl;
     m.evaluator = std::make_unique<Evaluator>(scene);
     // Pruned on the host while the kernels build, as in Renderer::create.
@@ -463,7 +463,7 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
     double helperMs = 0.0; // the helper's compile of the dual pass
     std::thread other([&] {
         bool fresh = false; // glslang made the SPIR-V: the driver has most likely not compiled it
-        auto spirv = detail::compileKernel("mesh_triangles.comp", "", fresh);
+        auto spirv = detail::compileKernel("mesh_triangles.comp", "", m.ctx.compile, fresh);
         if (!spirv) {
             passesError = spirv.error();
             return;
@@ -477,7 +477,7 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
         m.dualPass = m.pipeline(m.passes, dual);
     });
     bool fresh = false;
-    auto spirv = detail::compileKernel("mesh_field.comp", sceneGlsl, fresh);
+    auto spirv = detail::compileKernel("mesh_field.comp", sceneGlsl, m.ctx.compile, fresh);
     if (spirv) {
         m.field = detail::createShaderModule(m.ctx, *spirv);
         m.cull = m.pipeline(m.field, m.spec(SDFCSG_MESH_PASS_CULL, SDFCSG_MESH_GROUP_X));
