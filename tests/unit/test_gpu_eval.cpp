@@ -203,9 +203,15 @@ std::vector<std::pair<std::string, std::string>> examples(bool (*wanted)(const K
         if (wanted(kind)) out.emplace_back(std::string(kind.name), std::string(kind.example));
     return out;
 }
-bool isPrimitive(const KindInfo& k) { return k.role == Role::Primitive && !isProfile(k.kind); }
-bool isProfileKind(const KindInfo& k) { return isProfile(k.kind); }
-bool isValueOrDomain(const KindInfo& k) { return k.role == Role::Value || k.role == Role::Domain; }
+bool isPrimitive(const KindInfo& k) {
+    return k.role == Role::Primitive && !isProfile(k.kind);
+}
+bool isProfileKind(const KindInfo& k) {
+    return isProfile(k.kind);
+}
+bool isValueOrDomain(const KindInfo& k) {
+    return k.role == Role::Value || k.role == Role::Domain;
+}
 
 // Each profile extruded (with rounded edges) and revolved, transformed in the plane, beside a
 // sphere in a smooth union; their outlines travel after the nodes in the node buffer.

@@ -78,7 +78,9 @@ std::vector<BadInput> badInputs() {
     // Every kind's name in the table's order: "sphere, box, ..., extrude or revolve".
     std::string kinds;
     for (const KindInfo& k : nodeKinds())
-        kinds += (kinds.empty() ? "" : k.kind == NodeKind(kNodeKindCount - 1) ? " or " : ", ") +
+        kinds += (kinds.empty()                            ? ""
+                  : k.kind == NodeKind(kNodeKindCount - 1) ? " or "
+                                                           : ", ") +
                  std::string(k.name);
     return {
         // JSON syntax: line and column of the first problem.
