@@ -104,7 +104,7 @@ template <class V> class Machine {
     }
 
   private:
-    static constexpr uint kTapeUnion = uint(NodeKind::Union);
+    static constexpr uint kTapeUnion = kKindUnion, kTapeIntersection = kKindIntersection;
 
     const FlatNode* nodes_ = nullptr;
     const uint32_t* field = nullptr;
@@ -116,9 +116,9 @@ template <class V> class Machine {
     // The three operations as eval.cpp folds them; tape.glsl's one blend for all three gives
     // the same bits.
     static V tapeOp(uint kind, V a, V b, float k, uint blend) {
-        return kind == kTapeUnion        ? opUnion(a, b, k, blend)
-               : kind == kTapeUnion + 1u ? opIntersection(a, b, k, blend)
-                                         : opDifference(a, b, k, blend);
+        return kind == kTapeUnion          ? opUnion(a, b, k, blend)
+               : kind == kTapeIntersection ? opIntersection(a, b, k, blend)
+                                           : opDifference(a, b, k, blend);
     }
     static float uintBitsToFloat(uint bits) { return std::bit_cast<float>(bits); }
     vec3 toLocal(uint i, vec3 p) const { return nodeLocalPoint(nodes_[i], p); }
