@@ -1,7 +1,8 @@
 // The scene as data: the stack machine that runs a cell's pruned tape (engine/src/field/prune.h), the
 // scene code of scenes too large to inline. Kernels built this way are the same for every such
 // scene; the tapes, the cells and the node buffer carry everything that is the scene's own.
-// PrunedField::distance and sample in engine/src/field/prune.cpp are this file in C++.
+// PrunedField::distance and sample in engine/src/field/prune.cpp find the cell as tapeCell does
+// and run the same loop, tape_run.glsl compiled as C++.
 //
 // The generated scene code defines, before it includes this file, what the scene's tapes need,
 // so that the machine holds no code for the rest (a CPU driver runs every branch of its loop
@@ -61,6 +62,17 @@ vec4 tapeOp(uint kind, vec4 a, vec4 b, float k, uint blend) {
     vec4 u = opUnion(vec4(a.rgb, s * a.w), vec4(b.rgb, s * c), k, blend);
     return vec4(u.rgb, s * u.w);
 }
+
+// What the loop reads of node i in the node buffer (nodes.glsl), and its arrays.
+#define TAPE_A(i) nodes[i].p0
+#define TAPE_B(i) nodes[i].p1
+#define TAPE_SCALE(i) nodes[i].color.w
+#define TAPE_MIN(i) nodes[i].bmin.xyz
+#define TAPE_MAX(i) nodes[i].bmax.xyz
+#define TAPE_CHILD(i) uint(nodes[i].bmax.w)
+#define TAPE_ARRAY(T, name, n) T name[n]
+// A swizzle, one shuffle; vec3(v) compiles to three extracts and a construct.
+#define TAPE_XYZ(v) (v).xyz
 
 #define TAPE_VALUE float
 #define TAPE_RUN tapeDistanceRun
