@@ -3,10 +3,6 @@
 // times per stage at several resolutions instead.
 #include "bench.h"
 
-#include "codegen/shader_compile.h"
-#include "gpu/scoped_env.h"
-#include "mesh/mesh_simplify.h"
-
 #include <sdfcsg/sdfcsg.h>
 
 #include <algorithm>
@@ -27,7 +23,30 @@ namespace sdfcsg::app {
 namespace {
 
 namespace fs = std::filesystem;
-using detail::ScopedEnv;
+
+// Points Mesa's disk cache of machine code at a folder for a scope, then restores the variable.
+// Mesa reads MESA_SHADER_CACHE_DIR whenever a device is made (a context's, and its compile
+// helper's after each use) and offers no other way in. The benchmark does one thing at a time, so
+// no thread of the library reads the environment while it changes.
+class DriverCacheDir {
+  public:
+    explicit DriverCacheDir(const fs::path& dir) {
+        if (const char* old = std::getenv(kName)) old_ = old;
+        ::setenv(kName, dir.c_str(), 1);
+    }
+    ~DriverCacheDir() {
+        if (old_)
+            ::setenv(kName, old_->c_str(), 1);
+        else
+            ::unsetenv(kName);
+    }
+    DriverCacheDir(const DriverCacheDir&) = delete;
+    DriverCacheDir& operator=(const DriverCacheDir&) = delete;
+
+  private:
+    static constexpr const char* kName = "MESA_SHADER_CACHE_DIR";
+    std::optional<std::string> old_;
+};
 
 // The scenes (*.json) in `dir`, sorted; empty, with a message, when there are none.
 std::vector<fs::path> findScenes(const fs::path& dir) {
@@ -275,7 +294,7 @@ struct MeshRow {
     double total = 0;
 };
 
-// The distance from the surface, in cells of edge h, of the points detail::kTriangleSamples of
+// The distance from the surface, in cells of edge h, of the points kTriangleSamples of
 // every triangle.
 std::pair<float, float> surfaceError(const Mesh& mesh, const Evaluator& evaluator, float h) {
     std::vector<float> errors;
@@ -284,7 +303,7 @@ std::pair<float, float> surfaceError(const Mesh& mesh, const Evaluator& evaluato
         const glm::vec3 a = mesh.positions[mesh.indices[t]],
                         b = mesh.positions[mesh.indices[t + 1]],
                         c = mesh.positions[mesh.indices[t + 2]];
-        for (const glm::vec3& w : detail::kTriangleSamples)
+        for (const glm::vec3& w : kTriangleSamples)
             errors.push_back(std::abs(evaluator.distance(w.x * a + w.y * b + w.z * c)) / h);
     }
     if (errors.empty()) return {0.0f, 0.0f};
@@ -612,15 +631,18 @@ int runBench(int argc, char** argv) {
     std::vector<fs::path> scenes = findScenes(dir);
     if (scenes.empty()) return 3;
 
-    auto context = Context::create();
-    if (!context) {
-        std::fprintf(stderr, "%s\n", context.error().str().c_str());
-        return 4;
-    }
     // A private disk cache, so "warm" means exactly this run's compiles; below it, an empty
     // folder for Mesa's disk cache for every cold build.
     const fs::path cacheDir = temporaryFolder();
     if (cacheDir.empty()) return 3;
+    ContextOptions warmOptions;
+    warmOptions.shaderCacheDir = cacheDir;
+    auto context = Context::create(warmOptions);
+    if (!context) {
+        std::fprintf(stderr, "%s\n", context.error().str().c_str());
+        fs::remove_all(cacheDir, ec);
+        return 4;
+    }
     constexpr int kPipelineRuns = 3;
     int coldRuns = 0;
     // The other scene of the cold column's contexts.
@@ -630,21 +652,21 @@ int runBench(int argc, char** argv) {
     // context (Seed::Earlier: as a new process finds them on a machine that has run sdfcsg
     // before) or in this one (Seed::Same: as the viewer has them when it opens another scene).
     // Mesa reads its folder when a device is made (the compile helper's too, after each use), so
-    // the variables stay set throughout.
+    // its variable stays set throughout.
     enum class Seed { None, Earlier, Same };
     auto withColdContext = [&](bool helper, Seed seed, auto&& work) -> Status {
         const fs::path runDir = cacheDir / ("cold-" + std::to_string(coldRuns++));
         std::error_code made;
         fs::create_directories(runDir, made); // Mesa makes only the last folder of its path
-        ScopedEnv driverCache("MESA_SHADER_CACHE_DIR", (runDir / "mesa").string());
-        ScopedEnv spirvCache("SDFCSG_CACHE_DIR", (runDir / "spirv").string());
+        const DriverCacheDir driverCache(runDir / "mesa");
         ContextOptions contextOptions;
         contextOptions.compileHelper = helper;
+        contextOptions.shaderCacheDir = runDir / "spirv";
         auto buildOther = [&](Context& c) -> Status {
-            detail::clearShaderMemoryCache();
+            clearShaderMemoryCache();
             auto other = buildFromJson(c, kOtherScene, "<other scene>");
             if (!other) return other.error();
-            detail::clearShaderMemoryCache();
+            clearShaderMemoryCache();
             return Ok{};
         };
         if (seed == Seed::Earlier) {
@@ -656,7 +678,7 @@ int runBench(int argc, char** argv) {
         if (!coldContext) return coldContext.error();
         if (seed == Seed::Same)
             if (auto ok = buildOther(**coldContext); !ok) return ok;
-        detail::clearShaderMemoryCache();
+        clearShaderMemoryCache();
         return work(**coldContext);
     };
 
@@ -690,18 +712,15 @@ int runBench(int argc, char** argv) {
             auto ok = withColdContext(column != 1, seeds[column], build);
             if (!ok) fail(ok.error());
         }
-        {
-            ScopedEnv disk("SDFCSG_CACHE_DIR", cacheDir.string());
-            for (int i = 0; i <= kPipelineRuns && status == 0; ++i) {
-                detail::clearShaderMemoryCache();
-                auto start = Clock::now();
-                auto built = buildFromJson(**context, json, file, evaluation);
-                if (!built)
-                    fail(built.error());
-                else if (i > 0)
-                    warm.push_back(msSince(start)); // run 0 fills the disk cache
-                if (built) renderer = std::move(*built);
-            }
+        for (int i = 0; i <= kPipelineRuns && status == 0; ++i) { // on cacheDir's SPIR-V
+            clearShaderMemoryCache();
+            auto start = Clock::now();
+            auto built = buildFromJson(**context, json, file, evaluation);
+            if (!built)
+                fail(built.error());
+            else if (i > 0)
+                warm.push_back(msSince(start)); // run 0 fills the disk cache
+            if (built) renderer = std::move(*built);
         }
         if (status != 0) break;
         row.builds(cold, warm);

@@ -8,7 +8,7 @@ PACKAGES="build-essential cmake ninja-build pkg-config git
   libcurl4-openssl-dev libcpp-httplib-dev
   libglfw3-dev libimgui-dev xvfb xauth
   libfreetype-dev fonts-dejavu-core zlib1g-dev libmeshoptimizer-dev
-  clang-14 libclang-rt-14-dev"
+  clang-14 libclang-rt-14-dev clang-format"
 missing=""
 for p in $PACKAGES; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"

@@ -6,12 +6,15 @@
 // Exact distance functions after Inigo Quilez (https://iquilezles.org/articles/distfunctions/,
 // .../smin/). Every primitive is centred at the origin of its local frame and takes the kernel
 // parameters that its table entry's kernel() derives (engine/src/scene/nodes.cpp: half extents, half
-// heights), not the JSON values. Adding a primitive: its table entry, its formula here and its
-// line in sdPrimitive() below (docs/vocabulary.md).
+// heights), not the JSON values. Adding a primitive: its line in engine/include/sdfcsg/kinds.h,
+// its table entry, its formula here and its line in sdPrimitive() below (docs/vocabulary.md).
 
 #ifndef SDF_FN
 #define SDF_FN
 #endif
+
+// NodeKind's numbers, kKindSphere ... (generated from engine/include/sdfcsg/kinds.h).
+#include "kinds.glsl"
 
 // Polygon and text read their outlines from data beside the nodes: in GLSL the node buffer seen
 // as vec4s (their records follow the nodes, engine/src/codegen/gpu_nodes.cpp), in C++ the node's own
@@ -462,39 +465,33 @@ SDF_FN vec3 tetraTap(int i) {
 // it leaves a kernel the formulas of its scene's kinds alone.
 #define SDF_IS(n) (kind == n && ((kinds >> n) & 1u) != 0u)
 SDF_FN float sdPrimitive(uint kind, vec3 q, vec4 a, vec4 b, uint kinds SDF_DATA_PARAM) {
-    if (SDF_IS(0u)) return sdSphere(q, a.x);
-    if (SDF_IS(1u)) return sdBox(q, vec3(a));
-    if (SDF_IS(2u)) return sdRoundBox(q, vec3(a), a.w);
-    if (SDF_IS(3u)) return sdPlane(q, vec3(a), a.w);
-    if (SDF_IS(4u)) return sdTriangularPrism(q, a.x, a.y, a.z);
-    if (SDF_IS(5u)) return sdTorus(q, a.x, a.y);
-    if (SDF_IS(6u)) return sdCylinder(q, a.x, a.y);
-    if (SDF_IS(7u)) return sdCone(q, a.x, a.y, a.z);
-    if (SDF_IS(8u)) return sdCapsule(q, vec3(a), vec3(b), a.w);
-    if (SDF_IS(9u)) return sdEllipsoid(q, vec3(a), a.w);
-    if (SDF_IS(10u)) return sdHexPrism(q, a.x, a.y);
-    if (SDF_IS(11u)) return sdOctahedron(q, a.x);
-    if (SDF_IS(12u)) return sdPyramid(q, a.x, a.y, a.z);
-    if (SDF_IS(13u)) return sdRoundedCylinder(q, a.x, a.y, a.z);
-    if (SDF_IS(14u)) return sdRoundCone(q, a.x, a.y, a.z, a.w, b.x);
-    if (SDF_IS(15u)) return sdLink(q, a.x, a.y, a.z);
-    if (SDF_IS(16u)) return sdCappedTorus(q, a.x, a.y, a.z, a.w);
-    if (SDF_IS(17u)) return sdCircle(q, a.x);
-    if (SDF_IS(18u)) return sdRectangle(q, a.x, a.y, a.z);
-    if (SDF_IS(19u)) return sdRegularPolygon(q, a.x, a.y, a.z, a.w);
-    if (SDF_IS(20u) || SDF_IS(21u))
+    if (SDF_IS(kKindSphere)) return sdSphere(q, a.x);
+    if (SDF_IS(kKindBox)) return sdBox(q, vec3(a));
+    if (SDF_IS(kKindRoundBox)) return sdRoundBox(q, vec3(a), a.w);
+    if (SDF_IS(kKindPlane)) return sdPlane(q, vec3(a), a.w);
+    if (SDF_IS(kKindTriangularPrism)) return sdTriangularPrism(q, a.x, a.y, a.z);
+    if (SDF_IS(kKindTorus)) return sdTorus(q, a.x, a.y);
+    if (SDF_IS(kKindCylinder)) return sdCylinder(q, a.x, a.y);
+    if (SDF_IS(kKindCone)) return sdCone(q, a.x, a.y, a.z);
+    if (SDF_IS(kKindCapsule)) return sdCapsule(q, vec3(a), vec3(b), a.w);
+    if (SDF_IS(kKindEllipsoid)) return sdEllipsoid(q, vec3(a), a.w);
+    if (SDF_IS(kKindHexPrism)) return sdHexPrism(q, a.x, a.y);
+    if (SDF_IS(kKindOctahedron)) return sdOctahedron(q, a.x);
+    if (SDF_IS(kKindPyramid)) return sdPyramid(q, a.x, a.y, a.z);
+    if (SDF_IS(kKindRoundedCylinder)) return sdRoundedCylinder(q, a.x, a.y, a.z);
+    if (SDF_IS(kKindRoundCone)) return sdRoundCone(q, a.x, a.y, a.z, a.w, b.x);
+    if (SDF_IS(kKindLink)) return sdLink(q, a.x, a.y, a.z);
+    if (SDF_IS(kKindCappedTorus)) return sdCappedTorus(q, a.x, a.y, a.z, a.w);
+    if (SDF_IS(kKindCircle)) return sdCircle(q, a.x);
+    if (SDF_IS(kKindRectangle)) return sdRectangle(q, a.x, a.y, a.z);
+    if (SDF_IS(kKindRegularPolygon)) return sdRegularPolygon(q, a.x, a.y, a.z, a.w);
+    if (SDF_IS(kKindPolygon) || SDF_IS(kKindText))
         return sdOutline(q, a.x, a.y, vec2(a.z, a.w), vec2(b.x, b.y), b.z, b.w SDF_DATA_ARG);
     return 1e30f;
 }
 #undef SDF_IS
 
-// ---- Value and domain operations (NodeKind's numbering; kernel parameters from their table
-// entries' kernelAround) ----
-
-// NodeKind's numbers of the operations (engine/src/field/sdf.h checks them).
-const uint kKindShell = 25u, kKindOffset = 26u, kKindRepeat = 27u, kKindPolarRepeat = 28u;
-const uint kKindMirror = 29u, kKindElongate = 30u, kKindTwist = 31u, kKindBend = 32u;
-const uint kKindTaper = 33u, kKindExtrude = 34u, kKindRevolve = 35u;
+// ---- Value and domain operations (kernel parameters from their table entries' kernelAround) ----
 
 // Shell: a skin of half thickness a.x about the surface; offset: moved out by a.x.
 SDF_FN float valueOp(uint kind, float d, vec4 a) {

@@ -29,14 +29,13 @@
 
 // A tape instruction (engine/src/field/prune.h, shaders/tape.glsl): the node's index in the low
 // bits and its kind (NodeKind) above them. In the packed tapes, a primitive whose operation follows
-// at once also carries that operation (its kind less SDFCSG_TAPE_FIRST_OPERATION, plus 1) and its
+// at once also carries that operation (its kind less NodeKind::Union, plus 1) and its
 // blend profile, and the next word holds the blend radius.
 #define SDFCSG_TAPE_NODE_BITS 20
-#define SDFCSG_TAPE_KIND_SHIFT 20      // 6 bits
-#define SDFCSG_TAPE_FOLD_SHIFT 26      // 2 bits
-#define SDFCSG_TAPE_BLEND_SHIFT 28     // 2 bits
-#define SDFCSG_TAPE_FIRST_OPERATION 22 // NodeKind::Union; then intersection, difference
-#define SDFCSG_TAPE_DOMAIN_END 63      // the kind of the instruction that ends a domain's child
+#define SDFCSG_TAPE_KIND_SHIFT 20  // 6 bits
+#define SDFCSG_TAPE_FOLD_SHIFT 26  // 2 bits
+#define SDFCSG_TAPE_BLEND_SHIFT 28 // 2 bits
+#define SDFCSG_TAPE_DOMAIN_END 63  // the kind of the instruction that ends a domain's child
 
 // Mesh extraction (engine/src/mesh/mesh.cpp, shaders/mesh_*.comp). The grid's samples are split
 // into bricks of SDFCSG_MESH_BRICK^3; a brick also reads the samples one step past its far faces,

@@ -1,7 +1,8 @@
 // The scene as data: the stack machine that runs a cell's pruned tape (engine/src/field/prune.h), the
 // scene code of scenes too large to inline. Kernels built this way are the same for every such
 // scene; the tapes, the cells and the node buffer carry everything that is the scene's own.
-// PrunedField::distance and sample in engine/src/field/prune.cpp are this file in C++.
+// PrunedField::distance and sample in engine/src/field/prune.cpp find the cell as tapeCell does
+// and run the same loop, tape_run.glsl compiled as C++.
 //
 // The generated scene code defines, before it includes this file, what the scene's tapes need,
 // so that the machine holds no code for the rest (a CPU driver runs every branch of its loop
@@ -32,7 +33,7 @@ layout(std430, set = 0, binding = SDFCSG_BINDING_FIELD) readonly buffer FieldBal
 // work of a tape of spheres (molecule_1k), as each is a gather on CPU devices.
 float tapePrimitive(uint kind, uint i, vec3 p) {
 #if SDFCSG_TAPE_BALLS
-    if (kind == 0u || SDFCSG_TAPE_KINDS == 0u) {
+    if (kind == kKindSphere || SDFCSG_TAPE_KINDS == 0u) {
         vec4 ball = fieldBalls[3u + i];
         return length(p - ball.xyz) - ball.w;
     }
@@ -41,7 +42,7 @@ float tapePrimitive(uint kind, uint i, vec3 p) {
            nodes[i].color.w;
 }
 
-const uint kTapeUnion = uint(SDFCSG_TAPE_FIRST_OPERATION), kTapeIntersection = kTapeUnion + 1u;
+const uint kTapeUnion = kKindUnion, kTapeIntersection = kKindIntersection;
 
 // One blend for the three operations, which the compiler would otherwise all evaluate and
 // select from: intersection(a, b) is -union(-a, -b) and difference(a, b) intersection(a, -b),
@@ -61,6 +62,17 @@ vec4 tapeOp(uint kind, vec4 a, vec4 b, float k, uint blend) {
     vec4 u = opUnion(vec4(a.rgb, s * a.w), vec4(b.rgb, s * c), k, blend);
     return vec4(u.rgb, s * u.w);
 }
+
+// What the loop reads of node i in the node buffer (nodes.glsl), and its arrays.
+#define TAPE_A(i) nodes[i].p0
+#define TAPE_B(i) nodes[i].p1
+#define TAPE_SCALE(i) nodes[i].color.w
+#define TAPE_MIN(i) nodes[i].bmin.xyz
+#define TAPE_MAX(i) nodes[i].bmax.xyz
+#define TAPE_CHILD(i) uint(nodes[i].bmax.w)
+#define TAPE_ARRAY(T, name, n) T name[n]
+// A swizzle, one shuffle; vec3(v) compiles to three extracts and a construct.
+#define TAPE_XYZ(v) (v).xyz
 
 #define TAPE_VALUE float
 #define TAPE_RUN tapeDistanceRun

@@ -1,7 +1,18 @@
-// The tape machine's loop (tape.glsl), included once per value type: TAPE_VALUE (float, or vec4
-// with colour), TAPE_RUN (the function's name), TAPE_LEAF(i, d) (a primitive's value),
-// TAPE_DIST(v) and TAPE_WITH(v, d) (a value's distance, and v with another). prune.cpp's run() is
-// this loop in C++.
+// The tape machine's loop, one source for both languages: shaders/tape.glsl includes it as GLSL
+// once per value type, and engine/src/field/prune.cpp includes it as C++ (tape::Machine, GLM
+// standing in for GLSL as in engine/src/field/sdf.h), so the CPU runs the instructions the
+// kernels run. It is written in the dialect that sdf.glsl keeps to: float literals with an f
+// suffix, no swizzles (TAPE_XYZ(v): v's first three components).
+//
+// The includer defines TAPE_VALUE (float, or vec4 with colour), TAPE_RUN (the function's name),
+// TAPE_LEAF(i, d) (a primitive's value), TAPE_DIST(v) and TAPE_WITH(v, d) (a value's distance,
+// and v with another), TAPE_ARRAY(T, name, n) (a local array of n T; in C++ one of the machine's
+// own, sized for its tapes), what the loop reads of node i (TAPE_A(i) and TAPE_B(i): its kernel
+// parameters; TAPE_SCALE(i); TAPE_MIN(i) and TAPE_MAX(i): its bounds; TAPE_CHILD(i): a domain
+// operation's child), field[] (the instructions), tapePrimitive, tapeOp, kTapeUnion and the node
+// helpers of nodes.glsl, and the counts SDFCSG_TAPE_STACK, SDFCSG_TAPE_OPERATIONS and
+// SDFCSG_TAPE_DOMAINS (tape.glsl). The C++ side compiles every branch in and runs the unpacked
+// tapes, where no primitive carries a fold: every operation takes its left operand off the stack.
 //
 // The top of the stack stays in `acc`; a primitive that its operation folds in at once (most
 // of them: a left fold is primitive, operation, primitive, operation...) goes straight into
@@ -9,17 +20,20 @@
 // indexes on its own, and makes nearly every iteration take the same path.
 TAPE_VALUE TAPE_RUN(uint begin, uint end, vec3 p) {
 #if SDFCSG_TAPE_STACK > 0
-    TAPE_VALUE stack[SDFCSG_TAPE_STACK];
+    TAPE_ARRAY(TAPE_VALUE, stack, SDFCSG_TAPE_STACK);
     int top = -1;
 #endif
-    TAPE_VALUE acc = TAPE_VALUE(0.0);
+    TAPE_VALUE acc = TAPE_VALUE(0.0f);
 #if SDFCSG_TAPE_DOMAINS > 0
     // Open domain operations: the point outside, the local point, the least candidate value,
     // the candidate, their count, the child's first instruction and the operation's kind.
-    vec3 outer[SDFCSG_TAPE_DOMAINS], local[SDFCSG_TAPE_DOMAINS];
-    TAPE_VALUE best[SDFCSG_TAPE_DOMAINS];
-    uint candidate[SDFCSG_TAPE_DOMAINS], count[SDFCSG_TAPE_DOMAINS];
-    uint body[SDFCSG_TAPE_DOMAINS], domainKind[SDFCSG_TAPE_DOMAINS];
+    TAPE_ARRAY(vec3, outer, SDFCSG_TAPE_DOMAINS);
+    TAPE_ARRAY(vec3, local, SDFCSG_TAPE_DOMAINS);
+    TAPE_ARRAY(TAPE_VALUE, best, SDFCSG_TAPE_DOMAINS);
+    TAPE_ARRAY(uint, candidate, SDFCSG_TAPE_DOMAINS);
+    TAPE_ARRAY(uint, count, SDFCSG_TAPE_DOMAINS);
+    TAPE_ARRAY(uint, body, SDFCSG_TAPE_DOMAINS);
+    TAPE_ARRAY(uint, domainKind, SDFCSG_TAPE_DOMAINS);
     int depth = -1;
 #endif
     for (uint at = begin; at < end; ++at) {
@@ -46,7 +60,7 @@ TAPE_VALUE TAPE_RUN(uint begin, uint end, vec3 p) {
 #endif
 #if (SDFCSG_TAPE_OPERATIONS & 24) != 0
         else if (kind < kTapeUnion + 5u) {
-            acc = TAPE_WITH(acc, valueOp(kind, TAPE_DIST(acc), nodes[i].p0));
+            acc = TAPE_WITH(acc, valueOp(kind, TAPE_DIST(acc), TAPE_A(i)));
         }
 #endif
 #if SDFCSG_TAPE_DOMAINS > 0
@@ -54,32 +68,32 @@ TAPE_VALUE TAPE_RUN(uint begin, uint end, vec3 p) {
             // A domain operation: its child runs next, at the first candidate point.
             ++depth;
             outer[depth] = p;
-            local[depth] = toLocal(i, domainClamps(kind) ? clamp(p, nodes[i].bmin.xyz,
-                                                                 nodes[i].bmax.xyz)
-                                                         : p);
-            best[depth] = TAPE_WITH(acc, 1e30);
+            local[depth] =
+                toLocal(i, domainClamps(kind) ? clamp(p, TAPE_MIN(i), TAPE_MAX(i)) : p);
+            best[depth] = TAPE_WITH(acc, 1e30f);
             candidate[depth] = 0u;
-            count[depth] = domainCount(kind, nodes[i].p0, nodes[i].p1);
+            count[depth] = domainCount(kind, TAPE_A(i), TAPE_B(i));
             body[depth] = at + 1u;
             domainKind[depth] = kind;
-            p = domainPoint(kind, local[depth], nodes[i].p0, nodes[i].p1, 0u).xyz;
+            p = TAPE_XYZ(domainPoint(kind, local[depth], TAPE_A(i), TAPE_B(i), 0u));
         } else {
             // The child's value: the least so far; the child again at the next candidate whose
             // bounds could lower it, or the operation's value.
             if (TAPE_DIST(acc) < TAPE_DIST(best[depth])) best[depth] = acc;
             acc = stack[top--];
-            uint k = domainKind[depth], child = uint(nodes[i].bmax.w);
+            uint k = domainKind[depth], child = TAPE_CHILD(i);
             bool again = false;
             while (!again && ++candidate[depth] < count[depth]) {
-                vec4 q = domainPoint(k, local[depth], nodes[i].p0, nodes[i].p1, candidate[depth]);
-                again = q.w == 0.0 && nodeBoundsDistance(child, q.xyz) < TAPE_DIST(best[depth]);
-                if (again) p = q.xyz;
+                vec4 q = domainPoint(k, local[depth], TAPE_A(i), TAPE_B(i), candidate[depth]);
+                again = q.w == 0.0f &&
+                        nodeBoundsDistance(child, TAPE_XYZ(q)) < TAPE_DIST(best[depth]);
+                if (again) p = TAPE_XYZ(q);
             }
             if (again) {
                 at = body[depth] - 1u;
             } else {
-                float v = domainFinish(k, local[depth], TAPE_DIST(best[depth]), nodes[i].p0,
-                                       nodes[i].p1) * nodes[i].color.w;
+                float v = domainFinish(k, local[depth], TAPE_DIST(best[depth]), TAPE_A(i),
+                                       TAPE_B(i)) * TAPE_SCALE(i);
                 if (domainClamps(k)) v = max(v, nodeBoundsDistance(i, outer[depth]));
                 stack[++top] = acc;
                 acc = TAPE_WITH(best[depth], v);

@@ -2,7 +2,6 @@
 
 #include <sdfcsg/io.h>
 
-#include <cstdlib>
 #include <fstream>
 #include <system_error>
 
@@ -28,11 +27,10 @@ bool FileWatcher::poll() {
     return now.exists;
 }
 
-std::filesystem::path recentFilesPath() {
-    if (const char* xdg = std::getenv("XDG_CONFIG_HOME"); xdg && *xdg)
-        return std::filesystem::path(xdg) / "sdfcsg" / "recent";
-    if (const char* home = std::getenv("HOME"); home && *home)
-        return std::filesystem::path(home) / ".config" / "sdfcsg" / "recent";
+std::filesystem::path recentFilesPath(const char* xdgConfigHome, const char* home) {
+    if (xdgConfigHome && *xdgConfigHome)
+        return std::filesystem::path(xdgConfigHome) / "sdfcsg" / "recent";
+    if (home && *home) return std::filesystem::path(home) / ".config" / "sdfcsg" / "recent";
     return {};
 }
 

@@ -43,8 +43,9 @@ class FileWatcher {
 };
 
 // The recent-files list, one path a line: $XDG_CONFIG_HOME/sdfcsg/recent, else
-// ~/.config/sdfcsg/recent; empty when neither variable is set.
-std::filesystem::path recentFilesPath();
+// ~/.config/sdfcsg/recent, from the values of those two variables (null or empty: unset); empty
+// when neither is set.
+std::filesystem::path recentFilesPath(const char* xdgConfigHome, const char* home);
 // Missing or unreadable: an empty list. At most `limit` entries.
 std::vector<std::string> loadRecent(const std::filesystem::path& file, size_t limit = 10);
 // Written atomically, its folder made as needed; failures are ignored (a convenience only).

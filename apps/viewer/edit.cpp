@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <string>
 
 namespace sdfcsg::viewer {
@@ -22,45 +24,21 @@ Error badNode(const Scene& scene, uint32_t node) {
                               std::to_string(scene.nodes.size()) + ")");
 }
 
-// Sizes a new or converted primitive starts with: about a unit across, so it is visible next
-// to the bundled scenes.
+// A new or converted node starts as its kind's example (KindInfo::example), about a unit across.
 void defaultParams(Node& node) {
     const KindInfo& info = kindInfo(node.kind);
-    node.params.fill(0.0f);
-    for (const ParamInfo& p : info.params) {
-        float v[3] = {p.fallback[0], p.fallback[1], p.fallback[2]};
-        if (p.required) {
-            float x = p.check == Check::NonNegative ? 0.1f : 0.5f;
-            if (p.name == "minor_radius") x = 0.15f;
-            if (p.name == "top_radius") x = 0.25f;
-            if (p.unit == "degrees") x = 270.0f;
-            if (p.name == "size" || p.name == "height" || p.name == "length" || p.name == "width")
-                x = 1.0f;
-            if (p.check == Check::Count) x = p.type == ValueType::Number ? 6.0f : 3.0f;
-            if (p.unit == "degrees per unit length") x = 45.0f;
-            if (p.name == "spacing") x = 1.5f;
-            if (p.name == "thickness" || p.name == "distance") x = 0.05f;
-            if (node.kind == NodeKind::Elongate) x = 0.25f;
-            v[0] = v[1] = v[2] = x;
-            if (p.name == "a") v[0] = 0.0f, v[1] = -0.5f, v[2] = 0.0f;
-            if (p.name == "b") v[0] = 0.0f, v[1] = 0.5f, v[2] = 0.0f;
-            if (p.type == ValueType::Number && p.name == "radius" && node.kind == NodeKind::Capsule)
-                v[0] = 0.2f;
-        }
-        if (p.type == ValueType::Text) {
-            if (p.required) node.strings[p.slot] = "Text";
-            continue;
-        }
-        if (p.type == ValueType::Points) {
-            node.points = {{-0.5f, -0.4f}, {0.5f, -0.4f}, {0.0f, 0.5f}};
-            continue;
-        }
-        int n = p.type == ValueType::Vec3 ? 3 : 1;
-        for (int k = 0; k < n; ++k)
-            node.params[p.slot + k] = v[k];
+    std::string root = exampleNodeJson(info);
+    if (isProfile(node.kind)) // profiles stand only inside extrude or revolve
+        root = R"({"type": "extrude", "height": 1, "children": [)" + root + "]}";
+    auto example = parseScene(R"({"version": 1, "root": )" + root + "}", "example");
+    if (!example) { // the table is ours: a bad example is a bug
+        std::fprintf(stderr, "%s\n", example.error().str().c_str());
+        std::abort();
     }
-    if (node.kind == NodeKind::RegularPolygon) node.params[1] = 6.0f;
-    if (node.kind == NodeKind::Text) node.params[0] = 0.5f;
+    const Node& n = example->nodes[isProfile(node.kind) ? 1 : 0];
+    node.params = n.params;
+    node.points = n.points;
+    node.strings = n.strings;
 }
 
 // Whether the node is an extrude or a revolve or lies inside one (where 2D profiles may go).

@@ -156,7 +156,7 @@ int openWindow(Viewer& v, const Args& args) {
     ImGui::StyleColorsDark();
     ImGui_ImplGlfw_InitForVulkan(v.window, true);
     std::string error;
-    v.presenter = createPresenter(v.window, error);
+    v.presenter = createPresenter(v.window, v.context->validationEnabled(), error);
     if (!v.presenter) {
         std::fprintf(stderr, "sdfcsg-viewer: %s\n", error.c_str());
         return 4;
@@ -327,7 +327,8 @@ int main(int argc, char** argv) {
     Viewer v;
     if (int code = loadScript(args, v)) return code;
     v.showUi = !args.noUi;
-    v.recent = loadRecent(recentFilesPath());
+    v.recentFile = recentFilesPath(std::getenv("XDG_CONFIG_HOME"), std::getenv("HOME"));
+    v.recent = loadRecent(v.recentFile);
     if (int code = startWorkers(v)) return code;
     v.startedEmpty = args.scene.empty();
     if (!args.scene.empty()) {

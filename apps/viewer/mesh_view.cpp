@@ -2,7 +2,7 @@
 // image of the window's size that drawFrame() (presenter.cpp) blits as it does the engine's.
 #include "presenter_internal.h"
 
-#include "render/camera.h"
+#include <sdfcsg/camera.h> // the ray marcher's camera, so the mesh lines up with its images
 
 #include <algorithm>
 #include <cstddef>
@@ -486,7 +486,7 @@ void drawMesh(Presenter& p, const MeshView& view, const float background[3]) {
     VkRect2D scissor = {{0, 0}, p.extent};
     vkCmdSetViewport(p.cmd, 0, 1, &viewport);
     vkCmdSetScissor(p.cmd, 0, 1, &scissor);
-    detail::RayCamera rc = detail::makeRayCamera(view.camera, p.extent.width, p.extent.height);
+    const RayCamera rc = makeRayCamera(view.camera, p.extent.width, p.extent.height);
     glm::vec3 right = rc.right / (rc.tanHalfFov * rc.aspect), up = rc.up / rc.tanHalfFov;
     // Reversed float depth is precise at any distance, so the near plane can sit very close.
     float nearPlane = std::max(1e-6f, 1e-4f * glm::length(view.camera.target - view.camera.eye));

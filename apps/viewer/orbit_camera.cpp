@@ -1,7 +1,5 @@
 #include "orbit_camera.h"
 
-#include "render/camera.h" // finiteSceneBounds(), as the mesher uses
-
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
@@ -98,9 +96,9 @@ Aabb framedBounds(const Evaluator& evaluator, int node) {
         const Aabb& box = evaluator.nodes()[node].bounds;
         if (!box.empty() && box.finite()) return box;
     }
-    if (evaluator.nodes().empty()) return detail::finiteSceneBounds(evaluator);
+    if (evaluator.nodes().empty()) return evaluator.finiteBounds();
     Aabb box = finitePart(evaluator, 0);
-    return box.empty() ? detail::finiteSceneBounds(evaluator) : box;
+    return box.empty() ? evaluator.finiteBounds() : box;
 }
 
 } // namespace sdfcsg::viewer

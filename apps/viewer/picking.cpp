@@ -1,6 +1,6 @@
 #include "picking.h"
 
-#include "render/camera.h" // the renderer's own ray formulas, so picks match the pixels
+#include <sdfcsg/camera.h> // the renderer's own ray formulas, so picks match the pixels
 
 #include <algorithm>
 #include <cmath>
@@ -16,27 +16,20 @@ std::optional<glm::vec3> pickPoint(const Camera& camera, uint32_t width, uint32_
     uint32_t i = uint32_t(x), j = uint32_t(y);
     float t = pixels[size_t(j) * width + i].depth;
     if (!(t >= 0.0f)) return std::nullopt;
-    detail::RayCamera rc = detail::makeRayCamera(camera, width, height);
+    RayCamera rc = makeRayCamera(camera, width, height);
     // The depth belongs to the ray through the pixel's centre (the first sample).
-    glm::vec3 dir = detail::rayDirection(rc, float(i) + 0.5f, float(j) + 0.5f, width, height);
+    glm::vec3 dir = rayDirection(rc, float(i) + 0.5f, float(j) + 0.5f, width, height);
     return rc.eye + t * dir;
 }
 
 std::optional<glm::vec3> castRay(const Evaluator& evaluator, const Camera& camera, uint32_t width,
                                  uint32_t height, float x, float y) {
     if (x < 0.0f || y < 0.0f || x >= float(width) || y >= float(height)) return std::nullopt;
-    detail::RayCamera rc = detail::makeRayCamera(camera, width, height);
-    glm::vec3 dir = detail::rayDirection(rc, x, y, width, height);
-    const detail::ClipVolume clip = detail::makeClipVolume(evaluator, rc.eye);
-    float t, tFar;
-    if (!detail::rayInterval(clip, rc.eye, dir, t, tFar)) return std::nullopt;
-    // The loop of march() in shaders/march.comp.
-    for (uint32_t i = 0; i < SDFCSG_MAX_STEPS && t <= tFar; ++i) {
-        float d = evaluator.distance(rc.eye + t * dir);
-        if (d < detail::hitEpsilon(rc, t)) return rc.eye + t * dir;
-        t += d;
-    }
-    return std::nullopt;
+    const RayCamera rc = makeRayCamera(camera, width, height);
+    const glm::vec3 dir = rayDirection(rc, x, y, width, height);
+    const std::optional<float> t = marchRay(evaluator, rc, dir);
+    if (!t) return std::nullopt;
+    return rc.eye + *t * dir;
 }
 
 int nearestPrimitive(const Evaluator& evaluator, glm::vec3 p) {
@@ -56,7 +49,7 @@ PixelRect projectedRect(const Camera& camera, uint32_t width, uint32_t height, c
     if (box.empty()) return {};
     if (!box.finite()) return whole;
     // The inverse of rayDirection(): a point's offsets along right and up over its depth.
-    detail::RayCamera rc = detail::makeRayCamera(camera, width, height);
+    RayCamera rc = makeRayCamera(camera, width, height);
     float x0 = std::numeric_limits<float>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
     for (int corner = 0; corner < 8; ++corner) {
         glm::vec3 p(corner & 1 ? box.max.x : box.min.x, corner & 2 ? box.max.y : box.min.y,
@@ -87,19 +80,17 @@ std::vector<uint8_t> selectionMask(const Evaluator& evaluator, uint32_t node, co
     if (r.empty()) return mask;
     r.x0 = std::max(r.x0 - 2, 0), r.y0 = std::max(r.y0 - 2, 0);
     r.x1 = std::min(r.x1 + 2, int(width)), r.y1 = std::min(r.y1 + 2, int(height));
-    detail::RayCamera rc = detail::makeRayCamera(camera, width, height);
+    RayCamera rc = makeRayCamera(camera, width, height);
     for (int j = r.y0; j < r.y1; ++j)
         for (int i = r.x0; i < r.x1; ++i) {
             const size_t k = size_t(j) * width + size_t(i);
             const float t = pixels[k].depth;
             if (!(t >= 0.0f)) continue;
-            glm::vec3 dir =
-                detail::rayDirection(rc, float(i) + 0.5f, float(j) + 0.5f, width, height);
+            glm::vec3 dir = rayDirection(rc, float(i) + 0.5f, float(j) + 0.5f, width, height);
             // The march stops within half a footprint of the scene's surface; the node's own
             // surface is that one where it shows, and farther where another node's shows, except
             // within a pixel or two of where the two meet.
-            const float tolerance =
-                std::max(2.0f * t * rc.footprint, 4.0f * detail::kMinHitEpsilon);
+            const float tolerance = std::max(2.0f * t * rc.footprint, 4.0f * kMinHitEpsilon);
             if (std::abs(evaluator.distance(rc.eye + t * dir, node)) <= tolerance) mask[k] = 1;
         }
     return mask;

@@ -41,11 +41,7 @@ VKAPI_ATTR VkBool32 VKAPI_CALL debugCallback(VkDebugUtilsMessageSeverityFlagBits
     return VK_FALSE;
 }
 
-// As for the engine's context: SDFCSG_VALIDATION (set by the tests) turns the validation layer
-// on, here for the window's device, when the layer is installed.
-bool wantValidation() {
-    const char* env = std::getenv("SDFCSG_VALIDATION");
-    if (!env || !*env || std::string_view(env) == "0") return false;
+bool validationLayerInstalled() {
     uint32_t count = 0;
     vkEnumerateInstanceLayerProperties(&count, nullptr);
     std::vector<VkLayerProperties> layers(count);
@@ -238,7 +234,7 @@ void initImGui(Presenter& p);
 
 } // namespace
 
-PresenterPtr createPresenter(GLFWwindow* window, std::string& error) {
+PresenterPtr createPresenter(GLFWwindow* window, bool validationWanted, std::string& error) {
     PresenterPtr p(new Presenter);
     p->window = window;
     uint32_t extensionCount = 0;
@@ -251,7 +247,7 @@ PresenterPtr createPresenter(GLFWwindow* window, std::string& error) {
     app.pApplicationName = "sdfcsg-viewer";
     app.apiVersion = VK_API_VERSION_1_1;
     std::vector<const char*> instanceExtensions(extensions, extensions + extensionCount);
-    const bool validation = wantValidation();
+    const bool validation = validationWanted && validationLayerInstalled();
     const char* layer = "VK_LAYER_KHRONOS_validation";
     VkDebugUtilsMessengerCreateInfoEXT messengerInfo = {
         VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};

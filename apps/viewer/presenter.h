@@ -25,9 +25,10 @@ struct PresenterDeleter {
 };
 using PresenterPtr = std::unique_ptr<Presenter, PresenterDeleter>;
 
-// Also initialises the ImGui Vulkan backend (the ImGui context must exist). nullptr and a
-// message on failure.
-PresenterPtr createPresenter(GLFWwindow* window, std::string& error);
+// Also initialises the ImGui Vulkan backend (the ImGui context must exist). `validation`: the
+// window's device uses the validation layer where it is installed (as the engine's context does,
+// Context::validationEnabled()). nullptr and a message on failure.
+PresenterPtr createPresenter(GLFWwindow* window, bool validation, std::string& error);
 
 // The image to show from the next frame on (copied).
 void setImage(Presenter& presenter, const Image& image);
@@ -66,8 +67,7 @@ double meshDrawMilliseconds(const Presenter& presenter);
 
 std::string presenterDeviceName(const Presenter& presenter);
 
-// Messages from the validation layer about the window's device so far (the layer is on when
-// SDFCSG_VALIDATION is set, as for the engine's context).
+// Messages from the validation layer about the window's device so far (see createPresenter).
 uint32_t presenterValidationMessages(const Presenter& presenter);
 
 } // namespace sdfcsg::viewer

@@ -30,7 +30,7 @@ void addRecent(Viewer& v, const fs::path& path) {
     v.recent.erase(std::remove(v.recent.begin(), v.recent.end(), p), v.recent.end());
     v.recent.insert(v.recent.begin(), p);
     if (v.recent.size() > 10) v.recent.resize(10);
-    saveRecent(recentFilesPath(), v.recent);
+    saveRecent(v.recentFile, v.recent);
 }
 
 } // namespace

@@ -131,6 +131,7 @@ struct Viewer {
     char savePath[512] = "";
     char shotPath[512] = "viewer.png";
     std::vector<std::string> recent;
+    std::filesystem::path recentFile; // recentFilesPath(), from the environment at the start
     std::filesystem::path browseDir = std::filesystem::current_path();
     bool browserOpen = false;
     std::vector<std::filesystem::directory_entry> browseEntries; // the listing of browseListed

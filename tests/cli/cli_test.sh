@@ -1,10 +1,13 @@
 #!/bin/sh
 # End-to-end checks of the sdfcsg command line: exit codes, messages, atomic outputs.
-# Usage: cli_test.sh SDFCSG_BINARY SOURCE_DIR WORK_DIR
+# Usage: cli_test.sh SDFCSG_BINARY SOURCE_DIR WORK_DIR CASE, where CASE names one of the case_
+# functions below; it runs in WORK_DIR/CASE, so cases may run in parallel. tests/CMakeLists.txt
+# registers each case as a test of its own, cli.CASE. Exits 77 (skipped) when a case cannot run.
 set -u
-bin=$1 src=$2 work=$3
-rm -rf "$work" && mkdir -p "$work" && cd "$work" || exit 1
+bin=$1 src=$2 work=$3 test_case=$4
 failures=0 passed=0
+mesh_a="$src/assets/scenes/mesh_a.json"
+box=-1.1,-1.1,-1.1,1.1,1.1,1.1
 
 check() { # check NAME EXPECTED_EXIT COMMAND...
     name=$1 expected=$2
@@ -27,178 +30,200 @@ expect_text() { # expect_text NAME FILE TEXT: FILE holds TEXT as a whole line
     fi
 }
 
-for c in render mesh validate glsl convert schema bench; do
-    check "$c --help" 0 "$bin" "$c" --help
-    grep -q "^Usage: sdfcsg $c" out.txt || { echo "FAIL $c --help text"; failures=$((failures + 1)); }
-done
-check "no command" 2 "$bin"
-check "unknown command" 2 "$bin" frobnicate
-expect_text "unknown command message" err.txt "sdfcsg: unknown command 'frobnicate'"
+case_help() {
+    for c in render mesh validate glsl convert schema bench; do
+        check "$c --help" 0 "$bin" "$c" --help
+        grep -q "^Usage: sdfcsg $c" out.txt || { echo "FAIL $c --help text"; failures=$((failures + 1)); }
+    done
+    check "no command" 2 "$bin"
+    check "unknown command" 2 "$bin" frobnicate
+    expect_text "unknown command message" err.txt "sdfcsg: unknown command 'frobnicate'"
+}
 
-check "validate bundled" 0 "$bin" validate "$src"/assets/scenes/*.json
-expect_text "validate ok line" out.txt "$src/assets/scenes/house.json: ok (34 nodes)"
-printf '{"version": 1, "root": {"type": "sphere", "radius": 1}}' >one.json
-check "validate one node" 0 "$bin" validate one.json
-expect_text "validate counts in the singular" out.txt "one.json: ok (1 node)"
+case_validate() {
+    check "validate bundled" 0 "$bin" validate "$src"/assets/scenes/*.json
+    expect_text "validate ok line" out.txt "$src/assets/scenes/house.json: ok (34 nodes)"
+    printf '{"version": 1, "root": {"type": "sphere", "radius": 1}}' >one.json
+    check "validate one node" 0 "$bin" validate one.json
+    expect_text "validate counts in the singular" out.txt "one.json: ok (1 node)"
 
-printf '{"version": 1, "root": {"type": "sphere", "radius": -1}}' >bad.json
-check "validate bad" 1 "$bin" validate bad.json
-expect_text "validate bad message" err.txt "bad.json: root.radius: expected a positive number, got -1"
-check "validate missing file" 3 "$bin" validate does-not-exist.json
+    printf '{"version": 1, "root": {"type": "sphere", "radius": -1}}' >bad.json
+    check "validate bad" 1 "$bin" validate bad.json
+    expect_text "validate bad message" err.txt "bad.json: root.radius: expected a positive number, got -1"
+    check "validate missing file" 3 "$bin" validate does-not-exist.json
+}
 
-check "render usage" 2 "$bin" render "$src/assets/scenes/house.json"
-check "render bad mode" 2 "$bin" render "$src/assets/scenes/house.json" -o x.png --mode fancy
-check "render bad scene" 1 "$bin" render bad.json -o bad.png
-[ ! -e bad.png ] || { echo "FAIL render bad scene left an output"; failures=$((failures + 1)); }
-check "render house" 0 "$bin" render "$src/assets/scenes/house.json" -o house.png --width 96 --height 64
-[ "$(head -c 8 house.png | od -An -tx1 | tr -d ' \n')" = "89504e470d0a1a0a" ] ||
-    { echo "FAIL house.png is not a PNG"; failures=$((failures + 1)); }
-check "render to a missing directory" 3 "$bin" render "$src/assets/scenes/house.json" -o no/such/dir.png --width 8 --height 8
-ls | grep -q '\.tmp-' && { echo "FAIL a temporary file was left behind"; failures=$((failures + 1)); }
+case_render() {
+    printf '{"version": 1, "root": {"type": "sphere", "radius": -1}}' >bad.json
+    check "render usage" 2 "$bin" render "$src/assets/scenes/house.json"
+    check "render bad mode" 2 "$bin" render "$src/assets/scenes/house.json" -o x.png --mode fancy
+    check "render bad scene" 1 "$bin" render bad.json -o bad.png
+    [ ! -e bad.png ] || { echo "FAIL render bad scene left an output"; failures=$((failures + 1)); }
+    check "render house" 0 "$bin" render "$src/assets/scenes/house.json" -o house.png --width 96 --height 64
+    [ "$(head -c 8 house.png | od -An -tx1 | tr -d ' \n')" = "89504e470d0a1a0a" ] ||
+        { echo "FAIL house.png is not a PNG"; failures=$((failures + 1)); }
+    check "render to a missing directory" 3 "$bin" render "$src/assets/scenes/house.json" -o no/such/dir.png --width 8 --height 8
+    ls | grep -q '\.tmp-' && { echo "FAIL a temporary file was left behind"; failures=$((failures + 1)); }
+}
 
 # Meshes: every format, with counts that agree with --stats; exit codes; no temporaries.
-mesh_a="$src/assets/scenes/mesh_a.json"
-box=-1.1,-1.1,-1.1,1.1,1.1,1.1
-for f in ply obj stl glb; do
-    check "mesh $f" 0 "$bin" mesh "$mesh_a" -o "part.$f" --resolution 24 --bounds $box --stats
-    expect_text "mesh $f closed" out.txt "surface:   inside the bounds (the mesh is closed)"
-    grep '^mesh:' out.txt >"counts.$f.txt"
-done
-for f in obj stl glb; do
-    cmp -s counts.ply.txt "counts.$f.txt" || { echo "FAIL mesh counts differ between ply and $f"; failures=$((failures + 1)); }
-done
-vertices=$(sed 's/^mesh: *\([0-9]*\) vertices.*/\1/' counts.ply.txt)
-triangles=$(sed 's/.*, \([0-9]*\) triangles$/\1/' counts.ply.txt)
-[ "${triangles:-0}" -gt 100 ] || { echo "FAIL mesh --stats reports no triangles"; failures=$((failures + 1)); }
-[ "$(head -n 1 part.ply)" = "ply" ] && grep -aqx "element vertex $vertices" part.ply &&
-    grep -aqx "element face $triangles" part.ply ||
-    { echo "FAIL part.ply header does not match the stats"; failures=$((failures + 1)); }
-[ "$(grep -c '^v ' part.obj)" -eq "$vertices" ] && [ "$(grep -c '^vn ' part.obj)" -eq "$vertices" ] &&
-    [ "$(grep -c '^f ' part.obj)" -eq "$triangles" ] ||
-    { echo "FAIL part.obj counts do not match the stats"; failures=$((failures + 1)); }
-[ "$(wc -c < part.stl)" -eq $((84 + 50 * triangles)) ] ||
-    { echo "FAIL part.stl size does not match the stats"; failures=$((failures + 1)); }
-[ "$(head -c 4 part.glb)" = "glTF" ] && [ "$(wc -c < part.glb)" -eq "$(od -An -tu4 -j8 -N4 part.glb | tr -d ' ')" ] ||
-    { echo "FAIL part.glb header"; failures=$((failures + 1)); }
-check "mesh cut by the bounds" 0 "$bin" mesh "$mesh_a" -o cut.stl --resolution 16 --bounds 0,0,0,1,1,1 --stats
-expect_text "mesh cut stats" out.txt "surface:   cut by the bounds (the mesh is open there)"
-check "mesh nothing in the bounds" 0 "$bin" mesh "$mesh_a" -o empty.glb --resolution 8 --bounds 5,5,5,6,6,6
-[ "$(head -c 4 empty.glb)" = "glTF" ] || { echo "FAIL empty.glb is not a GLB"; failures=$((failures + 1)); }
-check "mesh voxel size" 0 "$bin" mesh "$mesh_a" -o voxel.ply --voxel-size 0.1
-check "mesh usage" 2 "$bin" mesh "$mesh_a"
-check "mesh bad extension" 2 "$bin" mesh "$mesh_a" -o part.txt
-expect_text "mesh bad extension message" err.txt "sdfcsg mesh: the output must end in .ply, .obj, .stl, .glb or .3mf, got 'part.txt'"
-# 3MF, read back by Python's own ZIP and XML readers against the PLY of the same mesh.
-check "mesh 3mf" 0 "$bin" mesh "$mesh_a" -o part.3mf --resolution 24 --bounds $box --unit cm
-if command -v python3 >/dev/null 2>&1; then
-    python3 "$src/tests/cli/read_3mf.py" part.3mf part.ply centimeter >out.txt 2>&1 &&
-        grep -q "^3mf: $vertices vertices, $triangles triangles, 2 colours" out.txt ||
-        { echo "FAIL part.3mf:"; cat out.txt; failures=$((failures + 1)); }
-else
-    echo "skipped reading part.3mf back: python3 not found"
-fi
-check "mesh unit for another format" 2 "$bin" mesh "$mesh_a" -o bad.ply --unit cm
-expect_text "mesh unit for another format message" err.txt "sdfcsg mesh: --unit applies to .3mf output only"
-check "mesh bad unit" 2 "$bin" mesh "$mesh_a" -o bad.3mf --unit furlong
-expect_text "mesh bad unit message" err.txt "sdfcsg mesh: --unit expects mm, cm, m or inch"
+case_mesh() {
+    for f in ply obj stl glb; do
+        check "mesh $f" 0 "$bin" mesh "$mesh_a" -o "part.$f" --resolution 24 --bounds $box --stats
+        expect_text "mesh $f closed" out.txt "surface:   inside the bounds (the mesh is closed)"
+        grep '^mesh:' out.txt >"counts.$f.txt"
+    done
+    for f in obj stl glb; do
+        cmp -s counts.ply.txt "counts.$f.txt" || { echo "FAIL mesh counts differ between ply and $f"; failures=$((failures + 1)); }
+    done
+    vertices=$(sed 's/^mesh: *\([0-9]*\) vertices.*/\1/' counts.ply.txt)
+    triangles=$(sed 's/.*, \([0-9]*\) triangles$/\1/' counts.ply.txt)
+    [ "${triangles:-0}" -gt 100 ] || { echo "FAIL mesh --stats reports no triangles"; failures=$((failures + 1)); }
+    [ "$(head -n 1 part.ply)" = "ply" ] && grep -aqx "element vertex $vertices" part.ply &&
+        grep -aqx "element face $triangles" part.ply ||
+        { echo "FAIL part.ply header does not match the stats"; failures=$((failures + 1)); }
+    [ "$(grep -c '^v ' part.obj)" -eq "$vertices" ] && [ "$(grep -c '^vn ' part.obj)" -eq "$vertices" ] &&
+        [ "$(grep -c '^f ' part.obj)" -eq "$triangles" ] ||
+        { echo "FAIL part.obj counts do not match the stats"; failures=$((failures + 1)); }
+    [ "$(wc -c < part.stl)" -eq $((84 + 50 * triangles)) ] ||
+        { echo "FAIL part.stl size does not match the stats"; failures=$((failures + 1)); }
+    [ "$(head -c 4 part.glb)" = "glTF" ] && [ "$(wc -c < part.glb)" -eq "$(od -An -tu4 -j8 -N4 part.glb | tr -d ' ')" ] ||
+        { echo "FAIL part.glb header"; failures=$((failures + 1)); }
+    check "mesh cut by the bounds" 0 "$bin" mesh "$mesh_a" -o cut.stl --resolution 16 --bounds 0,0,0,1,1,1 --stats
+    expect_text "mesh cut stats" out.txt "surface:   cut by the bounds (the mesh is open there)"
+    check "mesh nothing in the bounds" 0 "$bin" mesh "$mesh_a" -o empty.glb --resolution 8 --bounds 5,5,5,6,6,6
+    [ "$(head -c 4 empty.glb)" = "glTF" ] || { echo "FAIL empty.glb is not a GLB"; failures=$((failures + 1)); }
+    check "mesh voxel size" 0 "$bin" mesh "$mesh_a" -o voxel.ply --voxel-size 0.1
+    check "mesh usage" 2 "$bin" mesh "$mesh_a"
+    check "mesh bad extension" 2 "$bin" mesh "$mesh_a" -o part.txt
+    expect_text "mesh bad extension message" err.txt "sdfcsg mesh: the output must end in .ply, .obj, .stl, .glb or .3mf, got 'part.txt'"
+    # 3MF, read back by Python's own ZIP and XML readers against the PLY of the same mesh.
+    check "mesh 3mf" 0 "$bin" mesh "$mesh_a" -o part.3mf --resolution 24 --bounds $box --unit cm
+    if command -v python3 >/dev/null 2>&1; then
+        python3 "$src/tests/cli/read_3mf.py" part.3mf part.ply centimeter >out.txt 2>&1 &&
+            grep -q "^3mf: $vertices vertices, $triangles triangles, 2 colours" out.txt ||
+            { echo "FAIL part.3mf:"; cat out.txt; failures=$((failures + 1)); }
+    else
+        echo "skipped reading part.3mf back: python3 not found"
+    fi
+    check "mesh unit for another format" 2 "$bin" mesh "$mesh_a" -o bad.ply --unit cm
+    expect_text "mesh unit for another format message" err.txt "sdfcsg mesh: --unit applies to .3mf output only"
+    check "mesh bad unit" 2 "$bin" mesh "$mesh_a" -o bad.3mf --unit furlong
+    expect_text "mesh bad unit message" err.txt "sdfcsg mesh: --unit expects mm, cm, m or inch"
+}
+
 # Simplification: far fewer triangles, still closed, the file as --stats says; bad values.
-check "mesh simplify" 0 "$bin" mesh "$mesh_a" -o simple.ply --resolution 48 --bounds $box \
-    --simplify 0.005 --stats
-expect_text "mesh simplify closed" out.txt "surface:   inside the bounds (the mesh is closed)"
-before=$(sed -n 's/^simplify: *\([0-9]*\) -> [0-9]* triangles.*/\1/p' out.txt)
-after=$(sed -n 's/^simplify: *[0-9]* -> \([0-9]*\) triangles.*/\1/p' out.txt)
-[ "${after:-0}" -gt 100 ] && [ $((${after:-0} * 3)) -lt "${before:-0}" ] &&
-    grep -aqx "element face $after" simple.ply ||
-    { echo "FAIL mesh --simplify: $before -> $after triangles"; failures=$((failures + 1)); }
-check "mesh target triangles" 0 "$bin" mesh "$mesh_a" -o target.obj --resolution 48 --bounds $box \
-    --target-triangles 3000 --stats
-after=$(sed -n 's/^simplify: *[0-9]* -> \([0-9]*\) triangles.*/\1/p' out.txt)
-[ "${after:-0}" -gt 2000 ] && [ "${after:-0}" -le 3000 ] &&
-    [ "$(grep -c '^f ' target.obj)" -eq "$after" ] ||
-    { echo "FAIL mesh --target-triangles 3000: $after triangles"; failures=$((failures + 1)); }
-for v in x 0 -1 nan inf; do
-    check "mesh bad simplify $v" 2 "$bin" mesh "$mesh_a" -o bad.ply --simplify "$v"
-    expect_text "mesh bad simplify $v message" err.txt "sdfcsg mesh: --simplify expects a distance greater than 0, got '$v'"
-done
-for v in x 0 -5 2.5 99999999999999999999999; do
-    check "mesh bad target triangles $v" 2 "$bin" mesh "$mesh_a" -o bad.ply --target-triangles "$v"
-    expect_text "mesh bad target triangles $v message" err.txt "sdfcsg mesh: --target-triangles expects a positive integer, got '$v'"
-done
-mkdir -p benchscenes && cp "$mesh_a" benchscenes/
-check "bench mesh simplify" 0 "$bin" bench --mesh --scenes benchscenes --resolutions 24 --runs 1 \
-    --simplify 0.1 --error
-grep -q '^scene .* triangles  *before .* simplify .* max err' out.txt ||
-    { echo "FAIL bench --mesh --simplify columns:"; cat out.txt; failures=$((failures + 1)); }
-check "bench bad simplify" 2 "$bin" bench --mesh --simplify 0
-check "mesh bad bounds" 2 "$bin" mesh "$mesh_a" -o bad.ply --bounds 1,1,1,0,0,0
-check "mesh short bounds" 2 "$bin" mesh "$mesh_a" -o bad.ply --bounds 0,0,0,1,1
-check "mesh resolution and voxel size" 2 "$bin" mesh "$mesh_a" -o bad.ply --resolution 8 --voxel-size 0.1
-check "mesh bad resolution" 2 "$bin" mesh "$mesh_a" -o bad.ply --resolution 0
-check "mesh missing scene" 3 "$bin" mesh does-not-exist.json -o bad.ply
-check "mesh bad scene" 1 "$bin" mesh bad.json -o bad.ply
-check "mesh too large for memory" 1 "$bin" mesh "$mesh_a" -o bad.ply --resolution 100000
-check "mesh to a missing directory" 3 "$bin" mesh "$mesh_a" -o no/such/dir.ply --resolution 8
-[ ! -e bad.ply ] || { echo "FAIL a failed mesh left an output"; failures=$((failures + 1)); }
-ls | grep -q '\.tmp-' && { echo "FAIL mesh left a temporary file behind"; failures=$((failures + 1)); }
+case_mesh_simplify() {
+    check "mesh simplify" 0 "$bin" mesh "$mesh_a" -o simple.ply --resolution 48 --bounds $box \
+        --simplify 0.005 --stats
+    expect_text "mesh simplify closed" out.txt "surface:   inside the bounds (the mesh is closed)"
+    before=$(sed -n 's/^simplify: *\([0-9]*\) -> [0-9]* triangles.*/\1/p' out.txt)
+    after=$(sed -n 's/^simplify: *[0-9]* -> \([0-9]*\) triangles.*/\1/p' out.txt)
+    [ "${after:-0}" -gt 100 ] && [ $((${after:-0} * 3)) -lt "${before:-0}" ] &&
+        grep -aqx "element face $after" simple.ply ||
+        { echo "FAIL mesh --simplify: $before -> $after triangles"; failures=$((failures + 1)); }
+    check "mesh target triangles" 0 "$bin" mesh "$mesh_a" -o target.obj --resolution 48 --bounds $box \
+        --target-triangles 3000 --stats
+    after=$(sed -n 's/^simplify: *[0-9]* -> \([0-9]*\) triangles.*/\1/p' out.txt)
+    [ "${after:-0}" -gt 2000 ] && [ "${after:-0}" -le 3000 ] &&
+        [ "$(grep -c '^f ' target.obj)" -eq "$after" ] ||
+        { echo "FAIL mesh --target-triangles 3000: $after triangles"; failures=$((failures + 1)); }
+    for v in x 0 -1 nan inf; do
+        check "mesh bad simplify $v" 2 "$bin" mesh "$mesh_a" -o bad.ply --simplify "$v"
+        expect_text "mesh bad simplify $v message" err.txt "sdfcsg mesh: --simplify expects a distance greater than 0, got '$v'"
+    done
+    for v in x 0 -5 2.5 99999999999999999999999; do
+        check "mesh bad target triangles $v" 2 "$bin" mesh "$mesh_a" -o bad.ply --target-triangles "$v"
+        expect_text "mesh bad target triangles $v message" err.txt "sdfcsg mesh: --target-triangles expects a positive integer, got '$v'"
+    done
+    mkdir -p benchscenes && cp "$mesh_a" benchscenes/
+    check "bench mesh simplify" 0 "$bin" bench --mesh --scenes benchscenes --resolutions 24 --runs 1 \
+        --simplify 0.1 --error
+    grep -q '^scene .* triangles  *before .* simplify .* max err' out.txt ||
+        { echo "FAIL bench --mesh --simplify columns:"; cat out.txt; failures=$((failures + 1)); }
+    check "bench bad simplify" 2 "$bin" bench --mesh --simplify 0
+}
 
-check "glsl" 0 "$bin" glsl "$src/assets/scenes/csg_part.json"
-grep -q "float sceneDistance(vec3 p)" out.txt || { echo "FAIL glsl has no sceneDistance"; failures=$((failures + 1)); }
-grep -q "hole x" out.txt || { echo "FAIL glsl does not name the nodes"; failures=$((failures + 1)); }
-grep -q "Needs(" out.txt || { echo "FAIL glsl has no bounds tests"; failures=$((failures + 1)); }
-check "glsl without bounds tests" 0 "$bin" glsl "$src/assets/scenes/csg_part.json" --no-bounds-tests
-grep -q "Needs(" out.txt && { echo "FAIL glsl --no-bounds-tests has bounds tests"; failures=$((failures + 1)); }
-grep -q "hole x" out.txt || { echo "FAIL glsl --no-bounds-tests does not name the nodes"; failures=$((failures + 1)); }
+case_mesh_errors() {
+    printf '{"version": 1, "root": {"type": "sphere", "radius": -1}}' >bad.json
+    check "mesh bad bounds" 2 "$bin" mesh "$mesh_a" -o bad.ply --bounds 1,1,1,0,0,0
+    check "mesh short bounds" 2 "$bin" mesh "$mesh_a" -o bad.ply --bounds 0,0,0,1,1
+    check "mesh resolution and voxel size" 2 "$bin" mesh "$mesh_a" -o bad.ply --resolution 8 --voxel-size 0.1
+    check "mesh bad resolution" 2 "$bin" mesh "$mesh_a" -o bad.ply --resolution 0
+    check "mesh missing scene" 3 "$bin" mesh does-not-exist.json -o bad.ply
+    check "mesh bad scene" 1 "$bin" mesh bad.json -o bad.ply
+    check "mesh too large for memory" 1 "$bin" mesh "$mesh_a" -o bad.ply --resolution 100000
+    check "mesh to a missing directory" 3 "$bin" mesh "$mesh_a" -o no/such/dir.ply --resolution 8
+    [ ! -e bad.ply ] || { echo "FAIL a failed mesh left an output"; failures=$((failures + 1)); }
+    ls | grep -q '\.tmp-' && { echo "FAIL mesh left a temporary file behind"; failures=$((failures + 1)); }
+}
 
-check "convert legacy" 0 "$bin" convert "$src/tests/data/legacy/csg.json" -o converted.json
-check "converted validates" 0 "$bin" validate converted.json
-check "convert round trip" 0 "$bin" convert converted.json -o again.json
-cmp -s converted.json again.json || { echo "FAIL convert is not idempotent"; failures=$((failures + 1)); }
+case_glsl() {
+    check "glsl" 0 "$bin" glsl "$src/assets/scenes/csg_part.json"
+    grep -q "float sceneDistance(vec3 p)" out.txt || { echo "FAIL glsl has no sceneDistance"; failures=$((failures + 1)); }
+    grep -q "hole x" out.txt || { echo "FAIL glsl does not name the nodes"; failures=$((failures + 1)); }
+    grep -q "Needs(" out.txt || { echo "FAIL glsl has no bounds tests"; failures=$((failures + 1)); }
+    check "glsl without bounds tests" 0 "$bin" glsl "$src/assets/scenes/csg_part.json" --no-bounds-tests
+    grep -q "Needs(" out.txt && { echo "FAIL glsl --no-bounds-tests has bounds tests"; failures=$((failures + 1)); }
+    grep -q "hole x" out.txt || { echo "FAIL glsl --no-bounds-tests does not name the nodes"; failures=$((failures + 1)); }
+}
 
-check "schema" 0 "$bin" schema -o schema.json
-cmp -s schema.json "$src/assets/scene.schema.json" || { echo "FAIL schema differs from assets/scene.schema.json"; failures=$((failures + 1)); }
+case_convert() {
+    check "convert legacy" 0 "$bin" convert "$src/tests/data/legacy/csg.json" -o converted.json
+    check "converted validates" 0 "$bin" validate converted.json
+    check "convert round trip" 0 "$bin" convert converted.json -o again.json
+    cmp -s converted.json again.json || { echo "FAIL convert is not idempotent"; failures=$((failures + 1)); }
+}
+
+case_schema() {
+    check "schema" 0 "$bin" schema -o schema.json
+    cmp -s schema.json "$src/assets/scene.schema.json" || { echo "FAIL schema differs from assets/scene.schema.json"; failures=$((failures + 1)); }
+}
 
 # Scenes from a language model, without a network: the prompt, the request, and a recorded
 # conversation (a scene that loads after one repair round) replayed.
-for c in generate edit eval-prompts; do
-    check "$c --help" 0 "$bin" "$c" --help
-    grep -q "^Usage: sdfcsg $c" out.txt || { echo "FAIL $c --help text"; failures=$((failures + 1)); }
-done
-recording="$src/tests/data/llm/snowman.recording.json"
-export no_proxy=127.0.0.1,localhost
-llm="--base-url http://127.0.0.1:9/v1 --model test-model"
-check "generate --print-prompt" 0 "$bin" generate "a red sphere" --print-prompt
-expect_text "generate prompt request" out.txt "Request: a red sphere"
-check "generate --dry-run" 0 env SDFCSG_LLM_API_KEY=sk-cli-secret "$bin" generate "a red sphere" $llm --dry-run
-expect_text "generate --dry-run url" out.txt "POST http://127.0.0.1:9/v1/chat/completions"
-grep -q "sk-cli-secret" out.txt err.txt && { echo "FAIL --dry-run printed the API key"; failures=$((failures + 1)); }
-check "generate usage" 2 "$bin" generate -o x.json
-check "generate record and replay" 2 "$bin" generate "x" -o x.json --record a --replay b
-check "generate bad base URL" 2 "$bin" generate "x" -o x.json --base-url localhost:9 --model m
-check "generate unreachable" 5 "$bin" generate "x" -o x.json $llm --timeout 5
-[ ! -e x.json ] || { echo "FAIL a failed generate left an output"; failures=$((failures + 1)); }
-check "generate replay" 0 "$bin" generate "A snowman" -o snow.json $llm --replay "$recording" --render snow.png
-grep -q "^snow.json: 8 nodes, valid after 1 repair round (json_schema, 2 requests, 8000 + 600 tokens" err.txt ||
-    { echo "FAIL generate summary"; cat err.txt; failures=$((failures + 1)); }
-check "generated scene validates" 0 "$bin" validate snow.json
-[ "$(head -c 8 snow.png | od -An -tx1 | tr -d ' \n')" = "89504e470d0a1a0a" ] ||
-    { echo "FAIL snow.png is not a PNG"; failures=$((failures + 1)); }
-check "generate replay without repairs" 1 "$bin" generate "A snowman" -o bad-snow.json $llm --replay "$recording" --max-repairs 0
-expect_text "generate problems" err.txt "answer: root.children[1].radius: expected a positive number, got -0.6"
-[ ! -e bad-snow.json ] || { echo "FAIL an invalid answer was written"; failures=$((failures + 1)); }
-check "edit replay" 0 "$bin" edit snow.json "make the hat red" -o edited.json $llm --replay "$recording"
-printf '# one prompt\n\nA snowman\n' >prompts.txt
-check "eval-prompts replay" 0 "$bin" eval-prompts prompts.txt --out eval $llm --replay "$recording"
-expect_text "eval first try" eval/report.txt "first-try validity: 0 of 1 (0%)"
-expect_text "eval after repair" eval/report.txt "validity after repair: 1 of 1 (100%)"
-[ -s eval/01.json ] && [ -s eval/01.png ] && [ -s eval/contact-sheet.png ] ||
-    { echo "FAIL eval-prompts outputs"; ls eval; failures=$((failures + 1)); }
-expect_text "eval contact sheet" eval/report.txt "contact sheet: the prompts' renders in order, 1 tile a row, each numbered in its top-left corner; red: no scene"
-# A prompt without a scene shows the problems, not only the line that introduces them; a prompt
-# that repeats an example's request is named.
-printf 'A snowman\nA spur gear: 12 teeth by polar_repeat, a hub\n' >prompts.txt
-check "eval-prompts replay without repairs" 0 "$bin" eval-prompts prompts.txt --out eval-bad $llm --replay "$recording" --max-repairs 0
-expect_text "eval problems" eval-bad/report.txt "           answer: root.children[1].radius: expected a positive number, got -0.6"
-expect_text "eval repeated example" eval-bad/report.txt "note: prompt 2 nearly repeats the request of an example in the system prompt (\"A spur gear: 12 teeth by polar_repeat, a hub, and 6 lightening holes by a second polar_repeat.\"), so its first-try validity is inflated"
+case_generate() {
+    for c in generate edit eval-prompts; do
+        check "$c --help" 0 "$bin" "$c" --help
+        grep -q "^Usage: sdfcsg $c" out.txt || { echo "FAIL $c --help text"; failures=$((failures + 1)); }
+    done
+    recording="$src/tests/data/llm/snowman.recording.json"
+    export no_proxy=127.0.0.1,localhost
+    llm="--base-url http://127.0.0.1:9/v1 --model test-model"
+    check "generate --print-prompt" 0 "$bin" generate "a red sphere" --print-prompt
+    expect_text "generate prompt request" out.txt "Request: a red sphere"
+    check "generate --dry-run" 0 env SDFCSG_LLM_API_KEY=sk-cli-secret "$bin" generate "a red sphere" $llm --dry-run
+    expect_text "generate --dry-run url" out.txt "POST http://127.0.0.1:9/v1/chat/completions"
+    grep -q "sk-cli-secret" out.txt err.txt && { echo "FAIL --dry-run printed the API key"; failures=$((failures + 1)); }
+    check "generate usage" 2 "$bin" generate -o x.json
+    check "generate record and replay" 2 "$bin" generate "x" -o x.json --record a --replay b
+    check "generate bad base URL" 2 "$bin" generate "x" -o x.json --base-url localhost:9 --model m
+    check "generate unreachable" 5 "$bin" generate "x" -o x.json $llm --timeout 5
+    [ ! -e x.json ] || { echo "FAIL a failed generate left an output"; failures=$((failures + 1)); }
+    check "generate replay" 0 "$bin" generate "A snowman" -o snow.json $llm --replay "$recording" --render snow.png
+    grep -q "^snow.json: 8 nodes, valid after 1 repair round (json_schema, 2 requests, 8000 + 600 tokens" err.txt ||
+        { echo "FAIL generate summary"; cat err.txt; failures=$((failures + 1)); }
+    check "generated scene validates" 0 "$bin" validate snow.json
+    [ "$(head -c 8 snow.png | od -An -tx1 | tr -d ' \n')" = "89504e470d0a1a0a" ] ||
+        { echo "FAIL snow.png is not a PNG"; failures=$((failures + 1)); }
+    check "generate replay without repairs" 1 "$bin" generate "A snowman" -o bad-snow.json $llm --replay "$recording" --max-repairs 0
+    expect_text "generate problems" err.txt "answer: root.children[1].radius: expected a positive number, got -0.6"
+    [ ! -e bad-snow.json ] || { echo "FAIL an invalid answer was written"; failures=$((failures + 1)); }
+    check "edit replay" 0 "$bin" edit snow.json "make the hat red" -o edited.json $llm --replay "$recording"
+    printf '# one prompt\n\nA snowman\n' >prompts.txt
+    check "eval-prompts replay" 0 "$bin" eval-prompts prompts.txt --out eval $llm --replay "$recording"
+    expect_text "eval first try" eval/report.txt "first-try validity: 0 of 1 (0%)"
+    expect_text "eval after repair" eval/report.txt "validity after repair: 1 of 1 (100%)"
+    [ -s eval/01.json ] && [ -s eval/01.png ] && [ -s eval/contact-sheet.png ] ||
+        { echo "FAIL eval-prompts outputs"; ls eval; failures=$((failures + 1)); }
+    expect_text "eval contact sheet" eval/report.txt "contact sheet: the prompts' renders in order, 1 tile a row, each numbered in its top-left corner; red: no scene"
+    # A prompt without a scene shows the problems, not only the line that introduces them; a prompt
+    # that repeats an example's request is named.
+    printf 'A snowman\nA spur gear: 12 teeth by polar_repeat, a hub\n' >prompts.txt
+    check "eval-prompts replay without repairs" 0 "$bin" eval-prompts prompts.txt --out eval-bad $llm --replay "$recording" --max-repairs 0
+    expect_text "eval problems" eval-bad/report.txt "           answer: root.children[1].radius: expected a positive number, got -0.6"
+    expect_text "eval repeated example" eval-bad/report.txt "note: prompt 2 nearly repeats the request of an example in the system prompt (\"A spur gear: 12 teeth by polar_repeat, a hub, and 6 lightening holes by a second polar_repeat.\"), so its first-try validity is inflated"
+}
 
 # Ctrl-C and SIGTERM: long work stops at its next progress check, and work that cannot be
 # cancelled (a kernel build inside the driver) is ended by a watchdog; either way the command
@@ -224,20 +249,27 @@ interrupt() { # interrupt NAME SIGNAL OUTPUT COMMAND...: sends SIGNAL two second
         passed=$((passed + 1))
     fi
 }
-interrupt "mesh interrupted" INT big.ply "$bin" mesh "$src/assets/scenes/house.json" -o big.ply \
-    --resolution 2048
-interrupt "render interrupted" TERM big.png "$bin" render "$src/assets/scenes/house.json" \
-    -o big.png --width 4096 --height 4096 --aa 2
+
+case_interrupt() {
+    interrupt "mesh interrupted" INT big.ply "$bin" mesh "$src/assets/scenes/house.json" -o big.ply \
+        --resolution 2048
+    interrupt "render interrupted" TERM big.png "$bin" render "$src/assets/scenes/house.json" \
+        -o big.png --width 4096 --height 4096 --aa 2
+}
+
 # Inlined, the 1,000 spheres of molecule_1k take far longer than two seconds to compile.
-interrupt "kernel build interrupted" TERM big.ply env SDFCSG_CACHE_DIR=off \
-    MESA_SHADER_CACHE_DISABLE=true "$bin" mesh "$src/assets/bench/molecule_1k.json" -o big.ply \
-    --evaluation inlined
-expect_text "kernel build interrupted message" err.txt "sdfcsg: interrupted; nothing was written"
+case_interrupt_kernel_build() {
+    interrupt "kernel build interrupted" TERM big.ply env SDFCSG_CACHE_DIR=off \
+        MESA_SHADER_CACHE_DISABLE=true "$bin" mesh "$src/assets/bench/molecule_1k.json" -o big.ply \
+        --evaluation inlined
+    expect_text "kernel build interrupted message" err.txt "sdfcsg: interrupted; nothing was written"
+}
 
 # Ctrl-C while a language model is awaited (skipped without python3): a stand-in answers the
 # first request and holds the next. generate keeps the exchanges so far in its --record file;
 # eval-prompts reports the prompts done.
-if command -v python3 >/dev/null 2>&1; then
+case_interrupt_generate() {
+    command -v python3 >/dev/null 2>&1 || { echo "SKIPPED: python3 not found"; exit 77; }
     echo '{"version": 1, "root": {"type": "sphere", "radius": -1}}' >answer.json
     slow_llm() { # slow_llm ANSWERED: starts the stand-in, sets $llm_pid and $slow
         rm -f port.txt
@@ -261,9 +293,10 @@ if command -v python3 >/dev/null 2>&1; then
     [ -s eval-int/01.json ] && [ -s eval-int/contact-sheet.png ] ||
         { echo "FAIL eval-prompts interrupted outputs"; ls eval-int; failures=$((failures + 1)); }
     kill "$llm_pid"
-else
-    echo "skipped the interrupted generation: python3 not found"
-fi
+}
 
+type "case_$test_case" >/dev/null 2>&1 || { echo "no such case: $test_case"; exit 2; }
+rm -rf "${work:?}/$test_case" && mkdir -p "$work/$test_case" && cd "$work/$test_case" || exit 1
+"case_$test_case"
 echo "$passed passed, $failures failed"
 [ "$failures" -eq 0 ]

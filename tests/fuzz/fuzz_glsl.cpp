@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <string>
 #include <string_view>
 
@@ -44,7 +45,6 @@ void report() {
 } // namespace
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
-    setenv("SDFCSG_CACHE_DIR", "off", 1);
     std::atexit(report);
     return 0;
 }
@@ -84,7 +84,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         kernel = "mesh_field.comp";
     }
     const std::string glsl = sdfcsg::generateSceneGlsl(*scene, options);
-    auto spirv = sdfcsg::compileKernel(kernel, glsl);
+    const sdfcsg::CompileOptions memoryOnly{std::filesystem::path()}; // no disk cache
+    auto spirv = sdfcsg::compileKernel(kernel, glsl, memoryOnly);
     if (!spirv) {
         std::fprintf(stderr, "fuzz_glsl: a valid scene's GLSL does not compile (%.*s)\n%s\n%s\n",
                      int(kernel.size()), kernel.data(), spirv.error().str().c_str(), glsl.c_str());

@@ -1,9 +1,8 @@
 // Mesa's disk cache of machine code, for the tests that look at what lavapipe compiled.
 #pragma once
 
-#include "codegen/shader_compile.h"
-#include "gpu/scoped_env.h"
 #include "gpu/vk.h"
+#include "scoped_env.h"
 
 #include <sdfcsg/sdfcsg.h>
 
@@ -47,24 +46,27 @@ class DriverCacheFolder {
 
   private:
     std::filesystem::path dir_;
-    detail::ScopedEnv folder_, on_;
+    ScopedEnv folder_, on_;
 };
 
 inline std::filesystem::path testFolder(const std::string& name) {
     return std::filesystem::temp_directory_path() / (name + "-" + std::to_string(::getpid()));
 }
 
-// Runs `use(context)` on a new context with the validation layer on (and the compile helper as
-// given), expects no message from the layer, and destroys the context, which finishes the
-// driver cache's writes.
-template <class Use> void onNewContext(bool helper, Use&& use) {
-    ContextOptions contextOptions;
-    contextOptions.validation = 1;
-    contextOptions.compileHelper = helper;
-    auto ctx = Context::create(contextOptions);
+// Runs `use(context)` on a new context with `options` and the validation layer on, expects no
+// message from the layer, and destroys the context, which finishes the driver cache's writes.
+template <class Use> void onNewContext(ContextOptions options, Use&& use) {
+    options.validation = 1;
+    auto ctx = Context::create(options);
     ASSERT_TRUE(ctx) << ctx.error().str();
     use(**ctx);
     EXPECT_EQ((*ctx)->validationMessageCount(), 0u);
+}
+// The same with the compile helper as given.
+template <class Use> void onNewContext(bool helper, Use&& use) {
+    ContextOptions options;
+    options.compileHelper = helper;
+    onNewContext(options, std::forward<Use>(use));
 }
 
 // On lavapipe the compile helper compiles some pipelines while the context's device compiles
@@ -77,14 +79,16 @@ template <class Use> void onNewContext(bool helper, Use&& use) {
 // the context did not take its hand-over to have failed.
 template <class Use>
 void expectHelperHandsOver(const DriverCacheFolder& cache, uint32_t helperPipelines, Use&& use) {
-    detail::ScopedEnv noSpirvCache("SDFCSG_CACHE_DIR", "off");
     size_t cached[2] = {};
     for (int helper : {0, 1}) {
         SCOPED_TRACE(helper ? "with the helper" : "without the helper");
         cache.clear();
-        detail::clearShaderMemoryCache();
-        onNewContext(helper, [&](Context& ctx) {
-            Context::Impl& impl = ctx.impl();
+        clearShaderMemoryCache();
+        ContextOptions options;
+        options.compileHelper = helper;
+        options.shaderCacheDir = std::filesystem::path();
+        onNewContext(options, [&](Context& ctx) {
+            Context::Impl& impl = detail::contextImpl(ctx);
             ASSERT_EQ(impl.helperWanted, bool(helper));
             use(ctx, helper);
             EXPECT_EQ(impl.helperCompiles.load(), helper ? helperPipelines : 0u);

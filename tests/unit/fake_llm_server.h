@@ -34,9 +34,9 @@ struct Received {
 
 class FakeServer {
   public:
+    // Requests to it set LlmConfig::proxy to "", so that no proxy from the environment stands
+    // between the client and the loopback.
     FakeServer() {
-        // A proxy from the environment must not stand between the client and the loopback.
-        ::setenv("no_proxy", "127.0.0.1,localhost", 1);
         server_.Post(".*", [this](const httplib::Request& req, httplib::Response& res) {
             Scripted next{500, R"({"error": {"message": "no scripted response left"}})"};
             {

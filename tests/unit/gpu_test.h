@@ -1,4 +1,4 @@
-// Shared fixture for tests that use Vulkan: one Context per test program, validation layer on,
+// Shared fixture for tests that use Vulkan: one Context per test process, validation layer on,
 // and any message the layer reports during a test fails that test.
 #pragma once
 
@@ -32,20 +32,26 @@
 
 namespace sdfcsg::test {
 
+// The context is made by the first GPU test that runs, not at the program's start: ctest runs
+// each suite as a process of its own (tests/CMakeLists.txt), and one whose tests need no device
+// then pays nothing for it.
 class GpuEnvironment : public ::testing::Environment {
   public:
-    static Context* context() { return context_.get(); }
+    // Made on the first call; nullptr if that failed, and error() says why (not retried).
+    static Context* context() {
+        if (!context_ && error_.empty()) {
+            ContextOptions options;
+            options.validation = 1;
+            auto created = Context::create(options);
+            if (created)
+                context_ = std::move(*created);
+            else
+                error_ = created.error().str();
+        }
+        return context_.get();
+    }
     static const std::string& error() { return error_; }
 
-    void SetUp() override {
-        ContextOptions options;
-        options.validation = 1;
-        auto created = Context::create(options);
-        if (created)
-            context_ = std::move(*created);
-        else
-            error_ = created.error().str();
-    }
     // Before static destruction, while the driver is certainly still loaded.
     void TearDown() override { context_.reset(); }
 

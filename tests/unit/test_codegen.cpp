@@ -1,8 +1,9 @@
 // Scene -> GLSL -> SPIR-V without a GPU: the generated code's shape (one line per node, nothing
 // pasted twice, linear size), that it compiles in both modes through compileKernel, compile
-// errors as values, and the SPIR-V cache in memory and on disk.
+// errors as values, the SPIR-V cache in memory and on disk, and the settings the library takes from
+// the environment.
 #include "codegen/shader_compile.h"
-#include "gpu/scoped_env.h"
+#include "gpu/environment.h"
 #include "scene_build_util.h"
 
 #include <sdfcsg/compile.h>
@@ -15,6 +16,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <optional>
 #include <regex>
 #include <sstream>
@@ -25,7 +27,6 @@ namespace sdfcsg {
 namespace {
 
 using namespace sdfcsg::test;
-using sdfcsg::detail::ScopedEnv;
 namespace fs = std::filesystem;
 
 double seconds(std::chrono::steady_clock::time_point since) {
@@ -159,7 +160,7 @@ TEST(Codegen, GeneratedCodeCompilesInBothModes) {
 TEST(Codegen, BundledScenesCompile) {
     std::vector<fs::path> paths = bundledScenePaths();
     ASSERT_GE(paths.size(), 6u);
-    ScopedEnv off("SDFCSG_CACHE_DIR", "off");
+    const CompileOptions noDiskCache{fs::path()};
     for (const fs::path& path : paths) {
         auto scene = loadScene(path);
         ASSERT_TRUE(scene) << scene.error().str();
@@ -168,9 +169,9 @@ TEST(Codegen, BundledScenesCompile) {
             options.inlineParams = inlineParams;
             std::string glsl = generateSceneGlsl(*scene, options);
             for (const char* kernel : {"probe.comp", "march.comp", "shade.comp"}) {
-                detail::clearShaderMemoryCache();
+                clearShaderMemoryCache();
                 auto start = std::chrono::steady_clock::now();
-                auto spirv = compileKernel(kernel, glsl);
+                auto spirv = compileKernel(kernel, glsl, noDiskCache);
                 ASSERT_TRUE(spirv) << path << " " << kernel << ": " << spirv.error().str();
                 std::printf(
                     "%-18s %3zu nodes %-6s %-14s %6zu B GLSL -> %6zu B SPIR-V in %5.1f ms\n",
@@ -229,10 +230,9 @@ TEST(Codegen, SizeAndCompileTimeAreLinear) {
         text += line.size() - std::min(line.size(), line.find_first_not_of(' '));
     EXPECT_LT(text, 2u * 127 * 300);
 
-    ScopedEnv off("SDFCSG_CACHE_DIR", "off");
-    detail::clearShaderMemoryCache();
+    clearShaderMemoryCache();
     auto start = std::chrono::steady_clock::now();
-    auto spirv = compileKernel("probe.comp", large);
+    auto spirv = compileKernel("probe.comp", large, CompileOptions{fs::path()}); // no disk cache
     double elapsed = seconds(start);
     ASSERT_TRUE(spirv) << spirv.error().str();
     std::printf("2000 smoothly united spheres: %zu bytes of GLSL, compiled in %.0f ms\n",
@@ -290,19 +290,19 @@ TEST(Codegen, CompileErrorsComeBackWithTheLog) {
 TEST(Codegen, SpirvIsCachedInMemoryAndOnDisk) {
     fs::path dir = fs::path(SDFCSG_TEST_OUTPUT_DIR) / "codegen-cache";
     fs::remove_all(dir);
-    ScopedEnv cacheDir("SDFCSG_CACHE_DIR", dir.string());
+    const CompileOptions cache{dir};
     // A scene no other test (or earlier run) compiles.
     std::string glsl = generateSceneGlsl(randomScene(99, 30));
     glsl +=
         "// " + std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) + "\n";
 
     auto before = detail::shaderCacheStats();
-    auto first = compileKernel("probe.comp", glsl);
+    auto first = compileKernel("probe.comp", glsl, cache);
     ASSERT_TRUE(first) << first.error().str();
     auto afterFirst = detail::shaderCacheStats();
     EXPECT_EQ(afterFirst.compiles, before.compiles + 1);
 
-    auto second = compileKernel("probe.comp", glsl);
+    auto second = compileKernel("probe.comp", glsl, cache);
     ASSERT_TRUE(second);
     EXPECT_EQ(*second, *first);
     EXPECT_EQ(detail::shaderCacheStats().memoryHits, afterFirst.memoryHits + 1);
@@ -314,9 +314,9 @@ TEST(Codegen, SpirvIsCachedInMemoryAndOnDisk) {
         files.push_back(entry.path());
     ASSERT_EQ(files.size(), 1u) << "one entry, no temporary files left behind";
     EXPECT_EQ(files[0].extension(), ".spv");
-    detail::clearShaderMemoryCache();
+    clearShaderMemoryCache();
     auto diskHits = detail::shaderCacheStats().diskHits;
-    auto third = compileKernel("probe.comp", glsl);
+    auto third = compileKernel("probe.comp", glsl, cache);
     ASSERT_TRUE(third);
     EXPECT_EQ(*third, *first);
     EXPECT_EQ(detail::shaderCacheStats().diskHits, diskHits + 1);
@@ -332,26 +332,61 @@ TEST(Codegen, SpirvIsCachedInMemoryAndOnDisk) {
             f.seekp(100);
             f.put(char(byte ^ 0x5a));
         }
-        detail::clearShaderMemoryCache();
+        clearShaderMemoryCache();
         auto compiles = detail::shaderCacheStats().compiles;
-        auto again = compileKernel("probe.comp", glsl);
+        auto again = compileKernel("probe.comp", glsl, cache);
         ASSERT_TRUE(again);
         EXPECT_EQ(*again, *first);
         EXPECT_EQ(detail::shaderCacheStats().compiles, compiles + 1);
-        detail::clearShaderMemoryCache();
+        clearShaderMemoryCache();
         diskHits = detail::shaderCacheStats().diskHits;
-        EXPECT_TRUE(compileKernel("probe.comp", glsl));
+        EXPECT_TRUE(compileKernel("probe.comp", glsl, cache));
         EXPECT_EQ(detail::shaderCacheStats().diskHits, diskHits + 1) << "rewritten";
     }
 
-    // "off" disables the disk cache.
-    {
-        fs::remove_all(dir);
-        ScopedEnv off("SDFCSG_CACHE_DIR", "off");
-        detail::clearShaderMemoryCache();
-        EXPECT_TRUE(compileKernel("probe.comp", glsl));
-        EXPECT_FALSE(fs::exists(dir));
-    }
+    // An empty path disables the disk cache.
+    fs::remove_all(dir);
+    clearShaderMemoryCache();
+    EXPECT_TRUE(compileKernel("probe.comp", glsl, CompileOptions{fs::path()}));
+    EXPECT_FALSE(fs::exists(dir));
+}
+
+// The variables of sdfcsg/context.h, as the library reads them once (gpu/environment.h).
+TEST(Codegen, SettingsFromTheEnvironment) {
+    std::map<std::string, std::string> environment;
+    auto read = [&] {
+        return detail::readEnvironment([&](const char* name) -> const char* {
+            auto it = environment.find(name);
+            return it == environment.end() ? nullptr : it->second.c_str();
+        });
+    };
+    detail::Environment e = read();
+    EXPECT_EQ(e.validation, -1);
+    EXPECT_EQ(e.device, "");
+    EXPECT_EQ(e.shaderCacheDir, fs::path()) << "no disk cache without a home";
+
+    environment = {{"HOME", "/home/someone"}, {"SDFCSG_VALIDATION", "0"}};
+    e = read();
+    EXPECT_EQ(e.validation, 0);
+    EXPECT_EQ(e.shaderCacheDir, fs::path("/home/someone/.cache/sdfcsg"));
+
+    environment["XDG_CACHE_HOME"] = "/cache";
+    environment["SDFCSG_VALIDATION"] = "1";
+    environment["SDFCSG_DEVICE"] = "llvmpipe";
+    e = read();
+    EXPECT_EQ(e.validation, 1);
+    EXPECT_EQ(e.device, "llvmpipe");
+    EXPECT_EQ(e.shaderCacheDir, fs::path("/cache/sdfcsg"));
+
+    environment["SDFCSG_CACHE_DIR"] = "/spirv";
+    EXPECT_EQ(read().shaderCacheDir, fs::path("/spirv"));
+    environment["SDFCSG_CACHE_DIR"] = "off";
+    EXPECT_EQ(read().shaderCacheDir, fs::path());
+    environment["SDFCSG_CACHE_DIR"] = ""; // empty is unset
+    environment["SDFCSG_VALIDATION"] = "";
+    e = read();
+    EXPECT_EQ(e.shaderCacheDir, fs::path("/cache/sdfcsg"));
+    EXPECT_EQ(e.validation, -1);
 }
 
 } // namespace

@@ -6,6 +6,7 @@
 
 #include "fake_llm_server.h"
 #include "scene/json_writer.h"
+#include "scoped_env.h"
 
 #include <gtest/gtest.h>
 
@@ -18,6 +19,7 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -59,6 +61,7 @@ struct Generate : ::testing::Test {
         o.llm.apiKey = kKey;
         o.llm.timeoutSeconds = 20;
         o.llm.retryBaseSeconds = 0.5;
+        o.llm.proxy = ""; // none from the environment, in front of the loopback
         o.sleep = [this](double s) { sleeps.push_back(s); };
         o.progress = [this](const GenerateProgress& p) {
             if (!p.waiting) progress.push_back(p.message);
@@ -558,23 +561,29 @@ TEST_F(Generate, ServerErrorsGiveUp) {
     EXPECT_EQ(sleeps, (std::vector<double>{0.5, 1.0}));
 }
 
-// The standard proxy variables are curl's: a request for a host outside no_proxy goes to the
-// proxy named by http_proxy, in absolute form.
-TEST_F(Generate, RequestsGoThroughTheProxyVariables) {
-    server.script({openAi(kSphere)});
-    const std::string saved = std::getenv("http_proxy") ? std::getenv("http_proxy") : "";
-    ::setenv("http_proxy", server.url("").c_str(), 1);
-    GenerateOptions o = options();
-    o.llm.baseUrl = "http://llm.example.invalid/v1";
-    auto g = generateScene("a sphere", o);
-    if (saved.empty())
-        ::unsetenv("http_proxy");
-    else
-        ::setenv("http_proxy", saved.c_str(), 1);
-    ASSERT_TRUE(g) << g.error().str();
-    auto received = server.received();
-    ASSERT_EQ(received.size(), 1u);
-    EXPECT_EQ(received[0].path, "http://llm.example.invalid/v1/chat/completions");
+// A request goes to the proxy that LlmConfig::proxy names, in absolute form; where that is
+// unset, to the one that curl's standard variables name (http_proxy, for a host outside
+// no_proxy), which curl reads at each request.
+TEST_F(Generate, RequestsGoThroughTheProxy) {
+    for (bool fromEnvironment : {false, true}) {
+        SCOPED_TRACE(fromEnvironment ? "http_proxy" : "LlmConfig::proxy");
+        server.script({openAi(kSphere)});
+        GenerateOptions o = options();
+        o.llm.baseUrl = "http://llm.example.invalid/v1";
+        std::optional<ScopedEnv> proxy, noProxy;
+        if (fromEnvironment) {
+            o.llm.proxy.reset();
+            proxy.emplace("http_proxy", server.url(""));
+            noProxy.emplace("no_proxy", "127.0.0.1,localhost");
+        } else {
+            o.llm.proxy = server.url("");
+        }
+        auto g = generateScene("a sphere", o);
+        ASSERT_TRUE(g) << g.error().str();
+        auto received = server.received();
+        ASSERT_EQ(received.size(), fromEnvironment ? 2u : 1u);
+        EXPECT_EQ(received.back().path, "http://llm.example.invalid/v1/chat/completions");
+    }
 }
 
 TEST_F(Generate, Timeout) {
@@ -864,37 +873,32 @@ TEST(GenerateConfig, EndpointWithTheDefaultsApplied) {
 }
 
 TEST(GenerateConfig, Environment) {
-    // Restored afterwards, for the live test in this process.
-    const char* names[] = {"OPENAI_BASE_URL",     "OPENAI_API_KEY",     "SDFCSG_LLM_MODEL",
-                           "SDFCSG_LLM_BASE_URL", "SDFCSG_LLM_API_KEY", "SDFCSG_LLM_API"};
-    std::vector<std::optional<std::string>> saved;
-    for (const char* name : names)
-        saved.push_back(std::getenv(name) ? std::optional<std::string>(std::getenv(name))
-                                          : std::nullopt);
-    ::setenv("OPENAI_BASE_URL", "http://openai.example/v1", 1);
-    ::setenv("OPENAI_API_KEY", "openai-key", 1);
-    ::setenv("SDFCSG_LLM_MODEL", "some-model", 1);
-    ::unsetenv("SDFCSG_LLM_BASE_URL");
-    ::unsetenv("SDFCSG_LLM_API_KEY");
-    ::unsetenv("SDFCSG_LLM_API");
-    LlmConfig c = llmConfigFromEnvironment();
+    std::map<std::string, std::string> environment;
+    auto lookup = [&](const char* name) -> const char* {
+        auto it = environment.find(name);
+        return it == environment.end() ? nullptr : it->second.c_str();
+    };
+    LlmConfig c = llmConfigFromEnvironment(lookup);
+    EXPECT_EQ(c.baseUrl, "https://api.openai.com/v1");
+    EXPECT_EQ(c.apiKey, "");
+    EXPECT_EQ(c.model, "");
+    environment = {{"OPENAI_BASE_URL", "http://openai.example/v1"},
+                   {"OPENAI_API_KEY", "openai-key"},
+                   {"SDFCSG_LLM_MODEL", "some-model"}};
+    c = llmConfigFromEnvironment(lookup);
     EXPECT_EQ(c.baseUrl, "http://openai.example/v1");
     EXPECT_EQ(c.apiKey, "openai-key");
     EXPECT_EQ(c.model, "some-model");
     EXPECT_EQ(c.api, LlmApi::Auto);
-    ::setenv("SDFCSG_LLM_BASE_URL", "http://local:8080/v1", 1);
-    ::setenv("SDFCSG_LLM_API_KEY", "local-key", 1);
-    ::setenv("SDFCSG_LLM_API", "ollama", 1);
-    c = llmConfigFromEnvironment();
+    environment["SDFCSG_LLM_BASE_URL"] = "http://local:8080/v1";
+    environment["SDFCSG_LLM_API_KEY"] = "local-key";
+    environment["SDFCSG_LLM_API"] = "ollama";
+    c = llmConfigFromEnvironment(lookup);
     EXPECT_EQ(c.baseUrl, "http://local:8080/v1");
     EXPECT_EQ(c.apiKey, "local-key");
     EXPECT_EQ(c.api, LlmApi::Ollama);
-    for (size_t i = 0; i < saved.size(); ++i) {
-        if (saved[i])
-            ::setenv(names[i], saved[i]->c_str(), 1);
-        else
-            ::unsetenv(names[i]);
-    }
+    environment["SDFCSG_LLM_API"] = "openai";
+    EXPECT_EQ(llmConfigFromEnvironment(lookup).api, LlmApi::OpenAI);
 }
 
 // Against a real endpoint, only on request: SDFCSG_LLM_LIVE=1 with SDFCSG_LLM_BASE_URL or

@@ -75,13 +75,13 @@ std::vector<BadInput> badInputs() {
     std::string fiveLights = R"({"direction": [0, -1, 0]})";
     for (int i = 0; i < 4; ++i)
         fiveLights += R"(, {"direction": [0, -1, 0]})";
-    const std::string kinds =
-        "sphere, box, round_box, plane, triangular_prism, torus, cylinder, "
-        "cone, capsule, ellipsoid, hex_prism, octahedron, pyramid, "
-        "rounded_cylinder, round_cone, link, capped_torus, circle, rectangle, "
-        "regular_polygon, polygon, text, union, intersection, difference, "
-        "shell, offset, repeat, polar_repeat, mirror, elongate, twist, bend, "
-        "taper, extrude or revolve";
+    // Every kind's name in the table's order: "sphere, box, ..., extrude or revolve".
+    std::string kinds;
+    for (const KindInfo& k : nodeKinds())
+        kinds += (kinds.empty()                            ? ""
+                  : k.kind == NodeKind(kNodeKindCount - 1) ? " or "
+                                                           : ", ") +
+                 std::string(k.name);
     return {
         // JSON syntax: line and column of the first problem.
         {"empty", "", "scene.json:1:1: expected a JSON value, got end of input"},

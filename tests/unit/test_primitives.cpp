@@ -459,7 +459,9 @@ TEST(Primitives, EllipsoidIsABoundWithinItsFactor) {
             EXPECT_EQ(value < 0, truth < 0) << p.x << " " << p.y << " " << p.z;
             EXPECT_LE(std::abs(value), std::abs(truth) + tolerance);
             EXPECT_GE(std::abs(value), std::abs(truth) * factor - tolerance);
-            if (factor == 1.0) EXPECT_NEAR(value, truth, tolerance);
+            if (factor == 1.0) { // a sphere: exact (braces, as EXPECT_NEAR is an if-else)
+                EXPECT_NEAR(value, truth, tolerance);
+            }
         }
         EXPECT_GT(inside, 20);
     }

@@ -103,6 +103,44 @@ TEST(Prune, FullTapeRunsTheWholeTree) {
         EXPECT_EQ(field.distance(ev.nodes(), p), ev.distance(p));
 }
 
+// The C++ tape machine (shaders/tape_run.glsl, compiled in prune.cpp) sizes its arrays for the
+// tape: a stack of 41 values, where a right-leaning chain of unions and differences keeps every
+// left operand until its end, inside five domain operations nested in one another and value
+// operations between them. The whole tape gives the tree's bits. (The pruner's runs of domain
+// operations are the bundled scenes' part.)
+TEST(Prune, TheMachineRunsDeepStacksInNestedDomains) {
+    std::string chain = R"({"type": "sphere", "radius": 0.3})";
+    for (int i = 0; i < 40; ++i) {
+        const float x = 0.05f * float(i % 7) - 0.15f, y = 0.04f * float(i % 5) - 0.1f;
+        chain = std::string(R"({"type": ")") + (i % 3 == 2 ? "difference" : "union") +
+                R"(", "smooth": )" + (i % 2 ? "0.05" : "0") + R"(, "children": [{"type": "box", )" +
+                R"("size": [0.2, 0.3, 0.25], "translate": [)" + std::to_string(x) + ", " +
+                std::to_string(y) + R"(, 0.1], "color": [0.9, 0.2, 0.1]}, )" + chain + "]}";
+    }
+    const Scene scene = parseRoot(
+        R"({"type": "repeat", "count": [3, 1, 2], "spacing": [2.5, 1, 2.5], "children": [
+            {"type": "polar_repeat", "count": 5, "radius": 0.6, "children": [
+            {"type": "offset", "distance": 0.02, "children": [
+            {"type": "mirror", "axes": "x", "children": [
+            {"type": "twist", "angle": 40, "children": [
+            {"type": "shell", "thickness": 0.03, "children": [
+            {"type": "elongate", "length": [0.2, 0, 0.1], "children": [)" +
+        chain + "]}]}]}]}]}]}]}");
+    ASSERT_FALSE(scene.nodes.empty());
+    const Evaluator ev(scene);
+    detail::PruneOptions whole;
+    whole.levels = 0;
+    const detail::PrunedField field = detail::pruneField(ev, whole);
+    EXPECT_EQ(field.domainDepth, 5u);
+    EXPECT_GE(field.stackDepth, 41u);
+    for (glm::vec3 p : points(ev, 400, 13)) {
+        const Sample s = field.sample(ev.nodes(), p), full = ev.sample(p);
+        ASSERT_EQ(field.distance(ev.nodes(), p), ev.distance(p));
+        ASSERT_EQ(s.distance, full.distance);
+        ASSERT_EQ(s.color, full.color);
+    }
+}
+
 TEST(Prune, BundledScenesMatchTheWholeTree) {
     for (const fs::path& path : bundledScenePaths()) {
         auto scene = loadScene(path);

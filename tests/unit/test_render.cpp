@@ -2,10 +2,10 @@
 // same clipping, same epsilon rule. Plus modes, bounds skipping, value updates and PNG output.
 #include "codegen/shader_compile.h"
 #include "driver_cache.h"
-#include "gpu/scoped_env.h"
 #include "gpu/vk.h"
 #include "gpu_test.h"
 #include "render/camera.h"
+#include "scoped_env.h"
 #include "shared.h"
 
 #include <glm/common.hpp>
@@ -22,7 +22,6 @@ namespace sdfcsg::test {
 namespace {
 
 namespace fs = std::filesystem;
-using detail::ScopedEnv;
 
 constexpr uint32_t kSize = 128;
 
@@ -841,7 +840,7 @@ TEST_F(Render, CompileHelperHandsMachineCodeOver) {
     contextOptions.validation = 1;
     auto ctx = Context::create(contextOptions);
     ASSERT_TRUE(ctx) << ctx.error().str();
-    EXPECT_FALSE((*ctx)->impl().helperWanted);
+    EXPECT_FALSE(detail::contextImpl(**ctx).helperWanted);
 }
 
 // Mesa turns its disk cache off where it cannot make its folder, which the environment does not
@@ -849,16 +848,16 @@ TEST_F(Render, CompileHelperHandsMachineCodeOver) {
 TEST_F(Render, CompileHelperStopsWhereTheCacheHandsNothingOver) {
     if (!onLavapipe(context())) GTEST_SKIP() << "lavapipe only; " << context().deviceName();
     const DriverCacheFolder cache(testFolder("sdfcsg-no-folder") / "mesa");
-    ScopedEnv noSpirvCache("SDFCSG_CACHE_DIR", "off");
     ContextOptions contextOptions;
     contextOptions.validation = 1;
+    contextOptions.shaderCacheDir = fs::path(); // glslang runs, so the helper is asked to compile
     auto ctx = Context::create(contextOptions);
     ASSERT_TRUE(ctx) << ctx.error().str();
-    Context::Impl& impl = (*ctx)->impl();
+    Context::Impl& impl = detail::contextImpl(**ctx);
     ASSERT_TRUE(impl.helperWanted);
     for (const char* name : {"robot.json", "snowman.json"}) {
         SCOPED_TRACE(name);
-        detail::clearShaderMemoryCache();
+        clearShaderMemoryCache();
         auto renderer = Renderer::create(**ctx, loadOrDie(scenePath(name)));
         ASSERT_TRUE(renderer) << renderer.error().str();
         // The first build's march kernel, clip and ends passes.

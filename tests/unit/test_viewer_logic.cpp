@@ -79,6 +79,7 @@ constexpr const char* kBadBall = R"({"version": 1, "root": {"type": "sphere", "r
 GenerateOptions fakeModel(const FakeServer& server) {
     GenerateOptions o;
     o.llm.baseUrl = server.url();
+    o.llm.proxy = ""; // none from the environment, in front of the loopback
     o.llm.model = "test-model";
     o.llm.timeoutSeconds = 20;
     o.sleep = [](double) {}; // no back-off between retries
@@ -388,11 +389,13 @@ TEST(ViewerEdit, StructuralEditsKeepTheSceneValid) {
     auto kind = changeKind(scene, *findNode(scene, "left"), NodeKind::Box);
     ASSERT_TRUE(kind) << kind.error().str();
     EXPECT_EQ(kind->nodes[*findNode(*kind, "left")].kind, NodeKind::Box);
-    // Comparable sizes, not the defaults: the sphere of radius 0.5 becomes a box 1 across, and
-    // back to a sphere of radius 0.5; a box 1 across becomes a torus about as wide.
+    // Comparable sizes, not the example's: the sphere of radius 0.5 becomes a box 1 across at
+    // its widest, and back to a sphere of radius 0.5; a box 1 across becomes a torus about as
+    // wide.
     Evaluator sized(*kind);
     Aabb box = sized.nodes()[*findNode(*kind, "left")].bounds;
-    EXPECT_NEAR(box.max.x - box.min.x, 1.0f, 0.01f);
+    const glm::vec3 across = box.max - box.min;
+    EXPECT_NEAR(std::max({across.x, across.y, across.z}), 1.0f, 0.01f);
     auto back = changeKind(*kind, *findNode(*kind, "left"), NodeKind::Sphere);
     ASSERT_TRUE(back);
     EXPECT_FLOAT_EQ(back->nodes[*findNode(*back, "left")].params[0], 0.5f);
@@ -400,7 +403,8 @@ TEST(ViewerEdit, StructuralEditsKeepTheSceneValid) {
     auto tiny = setValue(scene, *findNode(scene, "left"), "radius", std::span(&small, 1));
     auto tinyBox = changeKind(*tiny, *findNode(*tiny, "left"), NodeKind::Box);
     ASSERT_TRUE(tinyBox);
-    EXPECT_FLOAT_EQ(tinyBox->nodes[*findNode(*tinyBox, "left")].params[0], 0.2f);
+    const Params& tinySize = tinyBox->nodes[*findNode(*tinyBox, "left")].params;
+    EXPECT_FLOAT_EQ(std::max({tinySize[0], tinySize[1], tinySize[2]}), 0.2f);
     auto torus = changeKind(scene, *findNode(scene, "block"), NodeKind::Torus);
     ASSERT_TRUE(torus);
     Aabb ring = Evaluator(*torus).nodes()[*findNode(*torus, "block")].bounds;
@@ -751,11 +755,9 @@ TEST(ViewerFiles, RecentFilesPersist) {
     EXPECT_EQ(loadRecent(file, 1), std::vector<std::string>{"/a/one.json"});
     writeText(dir / "blocker", "a file, not a folder");
     saveRecent(dir / "blocker" / "recent", {"a"}); // cannot be written: ignored
-    const char* old = std::getenv("XDG_CONFIG_HOME");
-    const std::string saved = old ? old : "";
-    setenv("XDG_CONFIG_HOME", (dir / "config").c_str(), 1);
-    EXPECT_EQ(recentFilesPath(), file);
-    old ? setenv("XDG_CONFIG_HOME", saved.c_str(), 1) : unsetenv("XDG_CONFIG_HOME");
+    EXPECT_EQ(recentFilesPath((dir / "config").c_str(), "/home/someone"), file);
+    EXPECT_EQ(recentFilesPath("", "/home/someone"), "/home/someone/.config/sdfcsg/recent");
+    EXPECT_EQ(recentFilesPath(nullptr, nullptr), fs::path());
 }
 
 TEST(ViewerFiles, ABrokenFirstFileIsWatched) {

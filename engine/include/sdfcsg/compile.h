@@ -12,6 +12,8 @@
 #include "sdfcsg/scene.h"
 
 #include <cstdint>
+#include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -51,10 +53,21 @@ std::string generateSceneGlsl(const Scene& scene, const CodegenOptions& options 
 // Source of an embedded shader file (e.g. "sdf.glsl", "march.comp"); empty if unknown.
 std::string_view shaderSource(std::string_view name);
 
+struct CompileOptions {
+    // The folder of the SPIR-V disk cache, made where missing; an empty path: no disk cache.
+    // Unset: the environment's, SDFCSG_CACHE_DIR ("off": none), else $XDG_CACHE_HOME/sdfcsg, else
+    // ~/.cache/sdfcsg, as the library read it once (sdfcsg/context.h).
+    std::optional<std::filesystem::path> cacheDir;
+};
+
 // Compiles an embedded kernel with `scene.glsl` resolving to `sceneGlsl`. SPIR-V is cached by a
-// hash of the full preprocessed input, in memory and on disk ($XDG_CACHE_HOME/sdfcsg or
-// ~/.cache/sdfcsg; SDFCSG_CACHE_DIR overrides, "off" disables). Errors carry the compiler log.
-// Thread-safe.
-Result<std::vector<uint32_t>> compileKernel(std::string_view kernel, std::string_view sceneGlsl);
+// hash of everything that reaches the compiler, in this process's memory and in the disk cache
+// of `options`. Errors carry the compiler log. Thread-safe.
+Result<std::vector<uint32_t>> compileKernel(std::string_view kernel, std::string_view sceneGlsl,
+                                            const CompileOptions& options = {});
+
+// Forgets the SPIR-V kept in this process's memory (the disk caches stay), so that the next
+// compile of each kernel reads a disk cache or runs the compiler: for measuring build times.
+void clearShaderMemoryCache();
 
 } // namespace sdfcsg

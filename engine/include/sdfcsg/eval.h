@@ -80,6 +80,13 @@ class Evaluator {
     float prunedDistance(glm::vec3 p) const;
     // Bounds of the whole solid; infinite along axes where a plane reaches.
     const Aabb& bounds() const { return nodes_[0].bounds; }
+    // The finite box the solid lies in, as tight as the bounds know it: bounds() on every side
+    // where they are finite (a difference lies within its first operand, whatever it subtracts),
+    // elsewhere the box around the finite primitives (a ground plane makes bounds() infinite);
+    // those primitives' box alone where bounds() is empty, and the cube from -1 to 1 where there
+    // are none. What the mesher meshes by default (with a margin) and what the ground grid lies
+    // under.
+    Aabb finiteBounds() const;
     const std::vector<FlatNode>& nodes() const { return nodes_; }
 
     // With skipping on, union and difference operands whose bounds cannot change the result are

@@ -54,12 +54,18 @@ struct LlmConfig {
     // A longer HTTP answer is cut off with a Remote error. generateScene() stops at four times
     // GenerateOptions::limits.maxFileBytes if that is less (4 MiB for its default limits).
     size_t maxResponseBytes = 16u << 20;
+    // The proxy of every request, as libcurl takes it ("http://proxy.example:3128"); empty: none.
+    // Unset: libcurl's environment variables (http_proxy, https_proxy, all_proxy, no_proxy),
+    // which libcurl reads at each request.
+    std::optional<std::string> proxy;
 };
 
-// Settings from the environment: OPENAI_BASE_URL and OPENAI_API_KEY, overridden by
+// Settings from environment variables: OPENAI_BASE_URL and OPENAI_API_KEY, overridden by
 // SDFCSG_LLM_BASE_URL, SDFCSG_LLM_API_KEY and SDFCSG_LLM_MODEL; SDFCSG_LLM_API ("openai" or
-// "ollama") forces the API. The base URL defaults to https://api.openai.com/v1.
-LlmConfig llmConfigFromEnvironment();
+// "ollama") forces the API. The base URL defaults to https://api.openai.com/v1. `lookup` gives a
+// variable's value, or null where it is unset; left empty, the process's environment is read
+// (std::getenv), when this is called: the tools call it once, as they start.
+LlmConfig llmConfigFromEnvironment(const std::function<const char*(const char* name)>& lookup = {});
 
 // Where generateScene() sends its requests: the URL, the API and the model, defaults applied.
 // Holds no key, so it can be shown. Errors: Usage (no model, a base URL that is not http(s)).

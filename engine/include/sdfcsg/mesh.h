@@ -147,6 +147,18 @@ struct SimplifyOptions {
     std::function<bool(float)> progress;
 };
 
+// Where simplifyMesh holds a triangle (a, b, c) to the field, as barycentric weights (the point
+// is w.x * a + w.y * b + w.z * c): its centre, the middles of its sides and the points halfway
+// from the centre to each corner. Unlike its corners, these see a triangle that cuts across a
+// sharp edge or corner of the solid. `sdfcsg bench --mesh --error` samples the same points.
+inline const glm::vec3 kTriangleSamples[7] = {glm::vec3(1.0f / 3),
+                                              glm::vec3(0.5f, 0.5f, 0.0f),
+                                              glm::vec3(0.0f, 0.5f, 0.5f),
+                                              glm::vec3(0.5f, 0.0f, 0.5f),
+                                              glm::vec3(2, 0.5f, 0.5f) / 3.0f,
+                                              glm::vec3(0.5f, 2, 0.5f) / 3.0f,
+                                              glm::vec3(0.5f, 0.5f, 2) / 3.0f};
+
 // The simplified mesh, closed and manifold with the same Euler characteristic wherever the input
 // was, ordered as optimizeMeshOrder orders it. `evaluator` is the scene that `mesh` was extracted
 // from (for scenes of kTapeMinNodes nodes or more its prunedDistance is used). Each

@@ -1,64 +1,42 @@
 // sdfcsg: the one table of node kinds.
 //
-// The parser, the validator, the JSON Schema, the documentation, the CPU evaluator and the GLSL
-// emitter are all driven by this table, so adding a primitive is its entry here (engine/src/
-// nodes.cpp) and its formula in shaders/sdf.glsl, which both the CPU and the GPU compile
+// The parser, the validator, the JSON Schema, the documentation, the language-model prompt, the
+// viewer, the CPU evaluator and the GLSL emitter are all driven by this table, so adding a
+// primitive is its line in sdfcsg/kinds.h, its entry in the table (engine/src/scene/nodes.cpp)
+// and its formula in shaders/sdf.glsl, which both the CPU and the GPU compile
 // (docs/vocabulary.md).
 #pragma once
+
+#include "sdfcsg/kinds.h"
 
 #include <glm/vec3.hpp>
 
 #include <array>
 #include <cstdint>
 #include <span>
+#include <string>
 #include <string_view>
 
 namespace sdfcsg {
 
+// Every kind of node, numbered in the order of sdfcsg/kinds.h.
 enum class NodeKind : uint8_t {
-    Sphere,
-    Box,
-    RoundBox,
-    Plane,
-    TriangularPrism,
-    Torus,
-    Cylinder,
-    Cone,
-    Capsule,
-    Ellipsoid,
-    HexPrism,
-    Octahedron,
-    Pyramid,
-    RoundedCylinder,
-    RoundCone,
-    Link,
-    CappedTorus,
-    // 2D profiles: shapes in the xy plane, for extrude and revolve,
-    Circle,
-    Rectangle,
-    RegularPolygon,
-    Polygon,
-    Text,
-    // Operations (nodes with children) from here on: the Boolean ones,
-    Union,
-    Intersection,
-    Difference,
-    // those that change their one child's value,
-    Shell,
-    Offset,
-    // and those that change the space their one child is evaluated in (domain operations).
-    Repeat,
-    PolarRepeat,
-    Mirror,
-    Elongate,
-    Twist,
-    Bend,
-    Taper,
-    Extrude,
-    Revolve,
+#define SDFCSG_KIND_ENUM(name) name,
+    SDFCSG_NODE_KINDS(SDFCSG_KIND_ENUM)
+#undef SDFCSG_KIND_ENUM
 };
-inline constexpr int kNodeKindCount = 36;
-inline constexpr NodeKind kFirstOperation = NodeKind::Union;
+
+#define SDFCSG_KIND_COUNT(name) +1
+inline constexpr int kNodeKindCount = 0 SDFCSG_NODE_KINDS(SDFCSG_KIND_COUNT);
+// The first kind of each group after the primitives (kinds.h keeps the groups in this order).
+inline constexpr NodeKind kFirstProfile = NodeKind(0 SDFCSG_PRIMITIVE_KINDS(SDFCSG_KIND_COUNT));
+inline constexpr NodeKind kFirstOperation =
+    NodeKind(int(kFirstProfile) SDFCSG_PROFILE_KINDS(SDFCSG_KIND_COUNT));
+inline constexpr NodeKind kFirstValueOperation =
+    NodeKind(int(kFirstOperation) SDFCSG_BOOLEAN_KINDS(SDFCSG_KIND_COUNT));
+inline constexpr NodeKind kFirstDomainOperation =
+    NodeKind(int(kFirstValueOperation) SDFCSG_VALUE_KINDS(SDFCSG_KIND_COUNT));
+#undef SDFCSG_KIND_COUNT
 
 // Every node stores its numeric parameters in this many float slots (see ParamInfo::slot).
 inline constexpr int kMaxParams = 8;
@@ -102,7 +80,7 @@ enum class Role : uint8_t { Primitive, Boolean, Value, Domain };
 // 2D profiles are primitives of the xy plane: as fields of space they are prisms along z, and
 // only extrude and revolve, which cut them at z = 0, may hold them.
 inline constexpr bool isProfile(NodeKind kind) {
-    return kind >= NodeKind::Circle && kind <= NodeKind::Text;
+    return kind >= kFirstProfile && kind < kFirstOperation;
 }
 // Polygon and text: their outlines' segments live beside the node (Node::outline).
 inline constexpr bool hasOutline(NodeKind kind) {
@@ -119,6 +97,9 @@ struct KindInfo {
     bool operation;        // has "children"
     std::span<const ParamInfo> params;
     std::string_view doc;
+    // The JSON members of a typical node of this kind, about a unit across (what an editor adds,
+    // the schema's and the prompt's example, the tests' instance): `"radius": 0.8`.
+    std::string_view example;
     // Primitives only. The formula in shaders/sdf.glsl and its arguments after the point.
     std::string_view function{};
     std::span<const KernelArg> args{};
@@ -149,6 +130,9 @@ struct CommonKey {
 };
 
 std::span<const KindInfo> nodeKinds();
+// A kind's example as a whole node: {"type": name, example members}, and for an operation
+// "children" with one operand (a sphere; a circle under extrude and revolve).
+std::string exampleNodeJson(const KindInfo& kind);
 const KindInfo& kindInfo(NodeKind kind);
 const KindInfo* findKind(std::string_view name); // nullptr when unknown
 // type, name, translate, rotate, scale, color and (operations only) children.

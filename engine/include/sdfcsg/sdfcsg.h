@@ -5,6 +5,7 @@
 #define SDFCSG_VERSION_MINOR 1
 #define SDFCSG_VERSION_PATCH 0
 
+#include "sdfcsg/camera.h"
 #include "sdfcsg/compile.h"
 #include "sdfcsg/context.h"
 #include "sdfcsg/error.h"

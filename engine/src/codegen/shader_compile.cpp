@@ -6,6 +6,7 @@
 #include "codegen/shader_compile.h"
 
 #include "codegen/embedded_shaders.h"
+#include "gpu/environment.h"
 
 #include "sdfcsg/compile.h"
 
@@ -18,7 +19,6 @@
 
 #include <atomic>
 #include <cstdio>
-#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -79,16 +79,6 @@ Cache& cache() {
 std::mutex& compilerMutex() {
     static std::mutex m;
     return m;
-}
-
-fs::path cacheDir() {
-    if (const char* dir = std::getenv("SDFCSG_CACHE_DIR"); dir && *dir)
-        return std::string_view(dir) == "off" ? fs::path() : fs::path(dir);
-    if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)
-        return fs::path(xdg) / "sdfcsg";
-    if (const char* home = std::getenv("HOME"); home && *home)
-        return fs::path(home) / ".cache" / "sdfcsg";
-    return {};
 }
 
 fs::path cacheFile(const fs::path& dir, uint64_t key) {
@@ -228,13 +218,16 @@ std::string_view shaderSource(std::string_view name) {
     return {};
 }
 
-Result<std::vector<uint32_t>> compileKernel(std::string_view kernel, std::string_view sceneGlsl) {
+Result<std::vector<uint32_t>> compileKernel(std::string_view kernel, std::string_view sceneGlsl,
+                                            const CompileOptions& options) {
     bool compiled;
-    return detail::compileKernel(kernel, sceneGlsl, compiled);
+    return detail::compileKernel(kernel, sceneGlsl, options, compiled);
 }
 
 Result<std::vector<uint32_t>> detail::compileKernel(std::string_view kernel,
-                                                    std::string_view sceneGlsl, bool& ranGlslang) {
+                                                    std::string_view sceneGlsl,
+                                                    const CompileOptions& options,
+                                                    bool& ranGlslang) {
     ranGlslang = false;
     std::string_view source = shaderSource(kernel);
     if (source.empty())
@@ -261,7 +254,7 @@ Result<std::vector<uint32_t>> detail::compileKernel(std::string_view kernel,
             return it->second;
         }
     }
-    const fs::path dir = cacheDir();
+    const fs::path dir = options.cacheDir ? *options.cacheDir : environment().shaderCacheDir;
     std::vector<uint32_t> spirv;
     if (!dir.empty() && readDisk(cacheFile(dir, key), key, spirv)) {
         std::lock_guard lock(c.mutex);
@@ -300,10 +293,11 @@ void warmUpCompiler() {
     });
 }
 
+} // namespace detail
+
 void clearShaderMemoryCache() {
     std::lock_guard lock(cache().mutex);
     cache().memory.clear();
 }
 
-} // namespace detail
 } // namespace sdfcsg

@@ -1,6 +1,7 @@
 // Internals of compileKernel (sdfcsg/compile.h) that tests and the benchmark look at.
 #pragma once
 
+#include "sdfcsg/compile.h"
 #include "sdfcsg/error.h"
 
 #include <cstdint>
@@ -21,14 +22,11 @@ ShaderCacheStats shaderCacheStats();
 // cache, so the kernel is new to this machine and the driver has most likely not cached its
 // machine code either.
 Result<std::vector<uint32_t>> compileKernel(std::string_view kernel, std::string_view sceneGlsl,
-                                            bool& ranGlslang);
+                                            const CompileOptions& options, bool& ranGlslang);
 
 // Sets glslang up for compute shaders, once per process: its first parse builds the tables of
 // built-in symbols (about 0.1 s on lavapipe's machines). Context::create starts it on a thread
 // of its own, so that it overlaps the device's setup; compiles wait for it.
 void warmUpCompiler();
-
-// Forgets the in-memory cache (the disk cache stays), so the next compile reads the disk.
-void clearShaderMemoryCache();
 
 } // namespace sdfcsg::detail

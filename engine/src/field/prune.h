@@ -3,7 +3,8 @@
 //
 // The tree becomes a tape: its nodes in post order, one instruction per primitive and one per
 // fold of an operation (operands fold left to right, as eval.cpp and the generated code do), run
-// by a small stack machine (this file's PrunedField::evaluate and shaders/tape.glsl). A cube
+// by a small stack machine (shaders/tape_run.glsl, which prune.cpp compiles as C++ for
+// PrunedField::distance and sample, and shaders/tape.glsl runs on the GPU). A cube
 // around the solid is refined as an octree; each cell runs its parent's tape once at its centre
 // c, and since every node's value is 1-Lipschitz, a node whose value is v at c lies within
 // [v - r, v + r] in the cell (r: the cell's half-diagonal). A fold whose operands are that far
@@ -31,13 +32,13 @@ namespace sdfcsg::detail {
 // operation pops b, then a, and pushes op(a, b) with its blend radius and profile.
 inline constexpr uint32_t kTapeNodeBits = SDFCSG_TAPE_NODE_BITS;
 inline constexpr uint32_t kTapeKindShift = SDFCSG_TAPE_KIND_SHIFT;
-static_assert(uint32_t(NodeKind::Union) == SDFCSG_TAPE_FIRST_OPERATION);
 // A domain operation's child is the tape between the operation's own instruction (which sets
 // the point the child is evaluated at) and this one (which takes the child's value, and runs the
 // child again at the operation's next candidate point, if any: sdf.glsl, domainPoint). Pruning
 // keeps the two and all between them whole. A value operation (shell, offset) is one
 // instruction after its child's.
 inline constexpr uint32_t kTapeDomainEnd = SDFCSG_TAPE_DOMAIN_END;
+static_assert(kNodeKindCount <= int(kTapeDomainEnd), "an instruction's kind has 6 bits");
 inline constexpr uint32_t kTapeNodeMask = (1u << kTapeNodeBits) - 1u;
 // A leaf cell entry (x, y): near a surface, the cell's tape [x, x + y) in PrunedField::tape;
 // far from every surface, x holds the root value at the centre of the cell of level
@@ -54,13 +55,14 @@ struct PruneOptions {
 };
 
 struct PrunedField {
-    glm::vec3 origin{0.0f};  // the grid's minimum corner
-    float cell = 1.0f;       // leaf cell side
-    uint32_t levels = 0;     // a top cell holds 2^levels leaf cells per axis
-    glm::uvec3 dims{0};      // leaf cells per axis
-    bool bounded = false;    // outside the grid, the field is at least its distance to it
-    uint32_t fullLength = 0; // tape[0, fullLength) is the whole tree
-    uint32_t stackDepth = 0; // the most values any tape holds at once
+    glm::vec3 origin{0.0f};   // the grid's minimum corner
+    float cell = 1.0f;        // leaf cell side
+    uint32_t levels = 0;      // a top cell holds 2^levels leaf cells per axis
+    glm::uvec3 dims{0};       // leaf cells per axis
+    bool bounded = false;     // outside the grid, the field is at least its distance to it
+    uint32_t fullLength = 0;  // tape[0, fullLength) is the whole tree
+    uint32_t stackDepth = 0;  // the most values any tape holds at once
+    uint32_t domainDepth = 0; // the most domain operations open at once in any tape
     std::vector<uint32_t> tape;
     std::vector<glm::uvec2> cells; // x + dims.x * (y + dims.y * z)
 

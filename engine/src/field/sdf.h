@@ -34,15 +34,16 @@ using uint = uint32_t;
 #undef SDF_DATA_PARAM
 #undef SDF_DATA_ARG
 
-static_assert(kKindShell == uint(NodeKind::Shell) && kKindOffset == uint(NodeKind::Offset) &&
-              kKindRepeat == uint(NodeKind::Repeat) &&
-              kKindPolarRepeat == uint(NodeKind::PolarRepeat) &&
-              kKindMirror == uint(NodeKind::Mirror) && kKindElongate == uint(NodeKind::Elongate) &&
-              kKindTwist == uint(NodeKind::Twist) && kKindBend == uint(NodeKind::Bend) &&
-              kKindTaper == uint(NodeKind::Taper) && kKindExtrude == uint(NodeKind::Extrude) &&
-              kKindRevolve == uint(NodeKind::Revolve));
-static_assert(uint(NodeKind::Polygon) == 20u && uint(NodeKind::Text) == 21u &&
-              uint(NodeKind::Circle) == 17u);
+// kinds.glsl, which sdf.glsl includes, is written by the build from the same list as NodeKind.
+#define SDFCSG_KIND_CHECK(name)                                                                    \
+    static_assert(kKind##name == uint(NodeKind::name), "kinds.glsl is out of date");
+SDFCSG_NODE_KINDS(SDFCSG_KIND_CHECK)
+#undef SDFCSG_KIND_CHECK
+static_assert(kKindFirstOperation == uint(kFirstOperation) && kKindCount == uint(kNodeKindCount));
+// sdPrimitive's `kinds` holds a bit for each kind of primitive and profile.
+static_assert(uint(kFirstOperation) <= 32u,
+              "more than 32 primitive and profile kinds: widen the kinds mask of sdPrimitive "
+              "(shaders/sdf.glsl) and of SDFCSG_TAPE_KINDS (engine/src/codegen/codegen.cpp)");
 
 using sdfcsg::Params;
 

@@ -3,11 +3,11 @@
 #include "gpu/vk.h"
 
 #include "codegen/shader_compile.h"
+#include "gpu/environment.h"
 
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
-#include <cstdlib>
 #include <string_view>
 #include <vector>
 
@@ -58,8 +58,7 @@ bool extensionAvailable(const char* layer, const char* name) {
 // missing layer is an error then; debug builds merely use it when present.
 int wantedValidation(int requested) {
     if (requested >= 0) return requested;
-    if (const char* env = std::getenv("SDFCSG_VALIDATION"); env && *env)
-        return std::string_view(env) == "0" ? 0 : 1;
+    if (detail::environment().validation >= 0) return detail::environment().validation;
 #ifndef NDEBUG
     return -1;
 #else
@@ -125,17 +124,6 @@ bool compilesAtDispatch(const Context::Impl& impl) {
     props.pNext = &driver;
     vkGetPhysicalDeviceProperties2(impl.physicalDevice, &props);
     return driver.driverID == VK_DRIVER_ID_MESA_LLVMPIPE;
-}
-
-// Mesa's disk cache of machine code, which the compile helper hands its work over with, is on
-// unless one of these says otherwise (as Mesa parses them).
-bool mesaCacheDisabled() {
-    for (const char* name : {"MESA_SHADER_CACHE_DISABLE", "MESA_GLSL_CACHE_DISABLE"}) {
-        const char* value = std::getenv(name);
-        const std::string v = lower(value ? value : "");
-        if (v == "1" || v == "y" || v == "yes" || v == "t" || v == "true") return true;
-    }
-    return false;
 }
 
 } // namespace
@@ -242,9 +230,8 @@ Status detail::setUpContext(Context::Impl& impl, const ContextOptions& options,
         return vulkanError("no Vulkan device found (install mesa-vulkan-drivers for the CPU "
                            "driver lavapipe)");
 
-    std::string wanted = options.device;
-    if (wanted.empty())
-        if (const char* env = std::getenv("SDFCSG_DEVICE")) wanted = env;
+    const std::string wanted =
+        options.device.empty() ? detail::environment().device : options.device;
 
     std::string list;
     int chosen = -1, chosenFamily = -1;
@@ -324,9 +311,15 @@ Status detail::setUpContext(Context::Impl& impl, const ContextOptions& options,
 
 Result<std::unique_ptr<Context>> Context::create(const ContextOptions& options) {
     auto impl = std::make_unique<Impl>();
+    // Read before the context's threads start (gpu/environment.h).
+    impl->compile.cacheDir =
+        options.shaderCacheDir ? *options.shaderCacheDir : detail::environment().shaderCacheDir;
+    const bool mesaCacheDisabled = detail::mesaDiskCacheDisabled();
     impl->compilerWarmUp = std::thread(detail::warmUpCompiler);
     if (auto ok = detail::setUpContext(*impl, options, *impl); !ok) return ok.error();
-    if (options.compileHelper && compilesAtDispatch(*impl) && !mesaCacheDisabled()) {
+    // Mesa's disk cache of machine code, which the compile helper hands its work over with, is on
+    // unless the environment turns it off.
+    if (options.compileHelper && compilesAtDispatch(*impl) && !mesaCacheDisabled) {
         impl->helperOptions = options;
         impl->helperOptions.device = std::to_string(impl->deviceIndex);
         impl->helperOptions.validation = impl->validation ? 1 : 0;

@@ -6,6 +6,7 @@
 // every build type.
 #pragma once
 
+#include "sdfcsg/compile.h"
 #include "sdfcsg/context.h"
 #include "sdfcsg/error.h"
 
@@ -55,6 +56,9 @@ struct Context::Impl {
     std::atomic<uint32_t> validationMessages{0};
     std::thread compilerWarmUp; // detail::warmUpCompiler(), while the device is set up
     uint32_t deviceIndex = 0;   // in vkEnumeratePhysicalDevices' order
+    // How the renderers and meshers of this context compile: ContextOptions::shaderCacheDir, or
+    // the environment's, resolved when the context is made.
+    CompileOptions compile;
 
     // llvmpipe only: a second instance and device on the same driver, whose queue compiles a
     // kernel to machine code while this one's compiles another (see precompileElsewhere()).
@@ -74,6 +78,14 @@ struct Context::Impl {
 };
 
 namespace detail {
+
+// The internals of a context, for the library and its tests; the public header names Impl only.
+struct ContextAccess {
+    static Context::Impl& impl(Context& context) { return *context.impl_; }
+};
+inline Context::Impl& contextImpl(Context& context) {
+    return ContextAccess::impl(context);
+}
 
 // The instance (its validation messages counted in `report`), the chosen device, its queue,
 // command pool and fence: Context::create, and the compile helper.

@@ -52,11 +52,6 @@ struct RequestState {
     bool temperature = true;          // reasoning models refuse any but the default
 };
 
-std::string env(const char* name) {
-    const char* v = std::getenv(name);
-    return v ? v : "";
-}
-
 std::string seconds(double s) {
     char text[32];
     std::snprintf(text, sizeof text, "%g", std::round(s * 10.0) / 10.0);
@@ -457,6 +452,7 @@ class Conversation {
         post.apiKey = options_.llm.apiKey;
         post.timeoutSeconds = options_.llm.timeoutSeconds;
         post.connectTimeoutSeconds = options_.llm.connectTimeoutSeconds;
+        post.proxy = options_.llm.proxy;
         post.maxResponseBytes = responseLimit(options_);
         post.tick = [&](double elapsed) { progress(status, elapsed, true); };
         post.cancelled = options_.cancelled;
@@ -507,7 +503,11 @@ std::vector<Message> firstMessages(std::string_view request, const GenerateOptio
 
 } // namespace
 
-LlmConfig llmConfigFromEnvironment() {
+LlmConfig llmConfigFromEnvironment(const std::function<const char*(const char* name)>& lookup) {
+    auto env = [&](const char* name) -> std::string {
+        const char* v = lookup ? lookup(name) : std::getenv(name);
+        return v ? v : "";
+    };
     LlmConfig config;
     config.baseUrl = env("SDFCSG_LLM_BASE_URL");
     if (config.baseUrl.empty()) config.baseUrl = env("OPENAI_BASE_URL");

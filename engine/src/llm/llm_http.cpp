@@ -116,6 +116,8 @@ Result<HttpResponse> httpPost(const HttpPost& post) {
     curl_easy_setopt(c, CURLOPT_XFERINFOFUNCTION, onProgress);
     curl_easy_setopt(c, CURLOPT_XFERINFODATA, &transfer);
     curl_easy_setopt(c, CURLOPT_NOPROGRESS, 0L);
+    // An empty string turns the proxy variables off as well.
+    if (post.proxy) curl_easy_setopt(c, CURLOPT_PROXY, post.proxy->c_str());
 
     const CURLcode code = curl_easy_perform(c);
     if (transfer.cancelled) return Error::message(ErrorKind::Cancelled, post.url, "cancelled");

@@ -1,11 +1,12 @@
 // A blocking HTTP POST through libcurl, for the language model client (llm_generate.cpp).
-// Proxies come from the standard variables (http_proxy, https_proxy, no_proxy), as libcurl
-// reads them by default.
+// Proxies come from HttpPost::proxy, or else from the standard variables (http_proxy,
+// https_proxy, no_proxy), as libcurl reads them by default.
 #pragma once
 
 #include "sdfcsg/error.h"
 
 #include <functional>
+#include <optional>
 #include <string>
 
 namespace sdfcsg::detail {
@@ -17,6 +18,7 @@ struct HttpPost {
     double timeoutSeconds = 300;
     double connectTimeoutSeconds = 15;
     size_t maxResponseBytes = 16u << 20; // a longer answer is cut off with an error
+    std::optional<std::string> proxy;    // LlmConfig::proxy
     // Called about four times a second while the answer is awaited, with the seconds elapsed.
     std::function<void(double)> tick;
     // Asked as often as libcurl reports progress (about once a second while nothing arrives);

@@ -415,7 +415,7 @@ Mesher::~Mesher() = default;
 Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& scene,
                                                Evaluation evaluation) {
     if (scene.nodes.empty()) return usage("the scene has no nodes");
-    auto impl = std::make_unique<Impl>(context.impl());
+    auto impl = std::make_unique<Impl>(detail::contextImpl(context));
     Impl& m = *impl;
     m.evaluator = std::make_unique<Evaluator>(scene);
     // Pruned on the host while the kernels build, as in Renderer::create.
@@ -478,7 +478,7 @@ Status Mesher::Impl::buildPasses(const std::string& sceneGlsl) {
     double helperMs = 0.0; // the helper's compile of the dual pass
     std::thread other([&] {
         bool fresh = false; // glslang made the SPIR-V: the driver has most likely not compiled it
-        auto spirv = detail::compileKernel("mesh_triangles.comp", "", fresh);
+        auto spirv = detail::compileKernel("mesh_triangles.comp", "", m.ctx.compile, fresh);
         if (!spirv) {
             passesError = spirv.error();
             return;
@@ -492,7 +492,7 @@ Status Mesher::Impl::buildPasses(const std::string& sceneGlsl) {
         dualPass = pipeline(passes, dual);
     });
     bool fresh = false;
-    auto spirv = detail::compileKernel("mesh_field.comp", sceneGlsl, fresh);
+    auto spirv = detail::compileKernel("mesh_field.comp", sceneGlsl, m.ctx.compile, fresh);
     if (spirv) {
         field = detail::createShaderModule(ctx, *spirv);
         cull = pipeline(field, spec(SDFCSG_MESH_PASS_CULL, SDFCSG_MESH_GROUP_X));

@@ -1,8 +1,9 @@
-// Ray generation and ray clipping shared by the renderer (which uploads these values) and the CPU
-// tests (which trace the same rays). shaders/raymarch.glsl and march.comp implement the same
-// formulas; keep the two in step.
+// Ray clipping shared by the renderer (which uploads these values), marchRay() (camera.cpp) and
+// the CPU tests (which trace the same rays). shaders/raymarch.glsl and march.comp implement the
+// same formulas; keep the two in step.
 #pragma once
 
+#include "sdfcsg/camera.h"
 #include "sdfcsg/eval.h"
 #include "sdfcsg/scene.h"
 #include "shared.h"
@@ -19,46 +20,13 @@
 
 namespace sdfcsg::detail {
 
-// Smallest hit epsilon, in scene units; farther away it grows with the pixel footprint.
-inline constexpr float kMinHitEpsilon = 1.0e-4f;
-
-struct RayCamera {
-    glm::vec3 eye;
-    glm::vec3 right, up, forward; // orthonormal, right-handed: forward = -z of the view
-    float tanHalfFov;             // vertical
-    float aspect;                 // width / height
-    float footprint;              // width of one pixel at unit distance (2 tan(fov/2) / height)
-};
-
-inline RayCamera makeRayCamera(const Camera& camera, uint32_t width, uint32_t height) {
-    RayCamera rc;
-    rc.eye = camera.eye;
-    rc.forward = glm::normalize(camera.target - camera.eye);
-    glm::vec3 up = camera.up;
-    if (glm::length(glm::cross(rc.forward, up)) < 1e-6f) // looking straight along up
-        up = std::abs(rc.forward.z) < 0.9f ? glm::vec3(0, 0, 1) : glm::vec3(1, 0, 0);
-    rc.right = glm::normalize(glm::cross(rc.forward, up));
-    rc.up = glm::cross(rc.right, rc.forward);
-    rc.tanHalfFov = std::tan(glm::radians(camera.fov) * 0.5f);
-    rc.aspect = float(width) / float(height);
-    rc.footprint = 2.0f * rc.tanHalfFov / float(height);
-    return rc;
-}
-
-// Direction through the image point (x, y) in pixels from the top-left corner; the centre of
-// pixel (i, j) is (i + 0.5, j + 0.5).
-inline glm::vec3 rayDirection(const RayCamera& rc, float x, float y, uint32_t width,
-                              uint32_t height) {
-    float u = (2.0f * x / float(width) - 1.0f) * rc.tanHalfFov * rc.aspect;
-    float v = (1.0f - 2.0f * y / float(height)) * rc.tanHalfFov;
-    return glm::normalize(rc.forward + u * rc.right + v * rc.up);
-}
-
-// About half a pixel's footprint at distance t: finer is invisible and costs steps. (With aa
-// samples per pixel the renderer uses the sample's footprint, a pixel's / aa.)
-inline float hitEpsilon(const RayCamera& rc, float t) {
-    return std::max(kMinHitEpsilon, 0.5f * t * rc.footprint);
-}
+// The camera's formulas are public (sdfcsg/camera.h, defined in camera.cpp); the renderer and
+// the tests name them here as before.
+using sdfcsg::hitEpsilon;
+using sdfcsg::kMinHitEpsilon;
+using sdfcsg::makeRayCamera;
+using sdfcsg::RayCamera;
+using sdfcsg::rayDirection;
 
 // A region that holds surfaces: a box, or the half-space dot(p, normal) < offset of a plane.
 struct SurfacePart {
@@ -127,9 +95,7 @@ inline Aabb finitePrimitiveBounds(const Evaluator& evaluator) {
     return box;
 }
 
-// The box the solid lies in, as tight as the bounds know it: the root's bounds on every side
-// where they are finite (a difference lies within its first operand, whatever it subtracts), the
-// finite primitives' elsewhere (a ground plane makes the root's bounds infinite).
+// Evaluator::finiteBounds() (sdfcsg/eval.h), here for the renderer and the mesher.
 inline Aabb finiteSceneBounds(const Evaluator& evaluator) {
     const Aabb root = evaluator.bounds();
     const Aabb parts = finitePrimitiveBounds(evaluator);

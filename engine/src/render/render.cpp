@@ -162,7 +162,7 @@ Result<std::shared_ptr<SharedPasses>> sharedPasses(Context::Impl& ctx) {
     std::vector<uint32_t>* fresh[] = {&shared->freshClip, &shared->freshLight, nullptr};
     for (int i = 0; i < 3; ++i) {
         bool ranGlslang = false;
-        auto spirv = detail::compileKernel(kernels[i], "", ranGlslang);
+        auto spirv = detail::compileKernel(kernels[i], "", ctx.compile, ranGlslang);
         if (!spirv) return spirv.error();
         *modules[i] = detail::createShaderModule(ctx, *spirv);
         if (ranGlslang && fresh[i]) *fresh[i] = std::move(*spirv);
@@ -261,8 +261,8 @@ struct Renderer::Impl {
         std::thread other([&, fresh = freshSharedSpirv()] {
             march = buildMarch(glsl, skipping, fresh, helperMs);
         });
-        BuiltKernel shade =
-            buildKernel(compileKernel("shade.comp", glsl), SDFCSG_RAYMARCH_PASS_SHADE, skipping);
+        BuiltKernel shade = buildKernel(compileKernel("shade.comp", glsl, ctx.compile),
+                                        SDFCSG_RAYMARCH_PASS_SHADE, skipping);
         if (!shade.error) {
             warmUp(shade.pipeline);
             pipeline(SDFCSG_RAYMARCH_PASS_LIGHT, false); // made once per context
@@ -329,7 +329,7 @@ struct Renderer::Impl {
                            const std::array<std::vector<uint32_t>, 2>& fresh, double& helperMs) {
         detail::makeCompileHelper(ctx); // the last build used it up
         bool compiled = false;
-        auto spirv = detail::compileKernel("march.comp", glsl, compiled);
+        auto spirv = detail::compileKernel("march.comp", glsl, ctx.compile, compiled);
         const auto marchSpec = specConstants(SDFCSG_RAYMARCH_PASS_MARCH, skipping);
         const auto clipSpec = specConstants(SDFCSG_RAYMARCH_PASS_CLIP, false);
         const auto endsSpec = specConstants(SDFCSG_RAYMARCH_PASS_ENDS, false);
@@ -391,7 +391,7 @@ struct Renderer::Impl {
         const char* names[] = {"march.comp", "shade.comp"};
         for (int i = 0; i < 2; ++i) {
             if (*made[i]) continue;
-            auto spirv = compileKernel(names[i], glsl);
+            auto spirv = compileKernel(names[i], glsl, ctx.compile);
             if (!spirv) return spirv.error();
             *made[i] = detail::createShaderModule(ctx, *spirv);
         }
@@ -839,7 +839,7 @@ VkPipeline SharedPasses::created(uint32_t pass) {
 Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene& scene,
                                                    const RendererOptions& options) {
     if (scene.nodes.empty()) return usage("the scene has no nodes");
-    auto impl = std::make_unique<Impl>(context.impl());
+    auto impl = std::make_unique<Impl>(detail::contextImpl(context));
     Impl& r = *impl;
     r.options = options;
     r.scene = scene;

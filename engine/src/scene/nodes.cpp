@@ -492,16 +492,17 @@ constexpr KernelArg kCapsuleArgs[] = {{0, 3}, {4, 3}, {3, 1}};
 constexpr KernelArg kRoundConeArgs[] = {{0, 1}, {1, 1}, {2, 1}, {3, 1}, {4, 1}};
 
 constexpr KindInfo kKinds[] = {
-    {NodeKind::Sphere, "sphere", false, kSphere, "Sphere centred at the origin.", "sdSphere", kA0,
-     [](const Params& v) -> Params { return {v[0]}; },
+    {NodeKind::Sphere, "sphere", false, kSphere, "Sphere centred at the origin.",
+     R"("radius": 0.8)", "sdSphere", kA0, [](const Params& v) -> Params { return {v[0]}; },
      [](const Params& k, vec3& lo, vec3& hi) { return symmetric(vec3(k[0]), lo, hi); }},
-    {NodeKind::Box, "box", false, kBox, "Axis-aligned box centred at the origin.", "sdBox", kA3,
-     halve3,
+    {NodeKind::Box, "box", false, kBox, "Axis-aligned box centred at the origin.",
+     R"("size": [1.2, 0.7, 1.6])", "sdBox", kA3, halve3,
      [](const Params& k, vec3& lo, vec3& hi) {
          return symmetric({k[0], k[1], k[2]}, lo, hi);
      }},
     {NodeKind::RoundBox, "round_box", false, kRoundBox,
-     "Box with rounded edges, centred at the origin.", "sdRoundBox", kA3A1,
+     "Box with rounded edges, centred at the origin.", R"("size": [1.2, 0.9, 1.4], "radius": 0.2)",
+     "sdRoundBox", kA3A1,
      [](const Params& v) -> Params {
          vec3 b = 0.5f * vec3(v[0], v[1], v[2]);
          return {b.x, b.y, b.z, std::min(v[3], std::min(b.x, std::min(b.y, b.z)))};
@@ -510,7 +511,7 @@ constexpr KindInfo kKinds[] = {
          return symmetric({k[0], k[1], k[2]}, lo, hi);
      }},
     {NodeKind::Plane, "plane", false, kPlane, "Half-space bounded by a plane (infinite).",
-     "sdPlane", kA3A1,
+     R"("normal": [0.2, 1, 0.3], "offset": 0.25)", "sdPlane", kA3A1,
      [](const Params& v) -> Params {
          vec3 n(v[0], v[1], v[2]);
          float len = std::sqrt(n.x * n.x + n.y * n.y + n.z * n.z);
@@ -522,7 +523,7 @@ constexpr KindInfo kKinds[] = {
      "Isosceles triangle in the xy plane (apex up, +y) extruded along z, its bounding box centred "
      "at "
      "the origin. A gable roof is one of these.",
-     "sdTriangularPrism", kA0A1A2,
+     R"("width": 1.4, "height": 1.1, "length": 1.8)", "sdTriangularPrism", kA0A1A2,
      [](const Params& v) -> Params {
          return {0.5f * v[0], v[1], 0.5f * v[2]};
      },
@@ -530,7 +531,7 @@ constexpr KindInfo kKinds[] = {
          return symmetric({k[0], 0.5f * k[1], k[2]}, lo, hi);
      }},
     {NodeKind::Torus, "torus", false, kTorus, "Ring around the y axis, centred at the origin.",
-     "sdTorus", kA0A1,
+     R"("major_radius": 0.9, "minor_radius": 0.25)", "sdTorus", kA0A1,
      [](const Params& v) -> Params {
          return {v[0], v[1]};
      },
@@ -538,7 +539,8 @@ constexpr KindInfo kKinds[] = {
          return symmetric({k[0] + k[1], k[1], k[0] + k[1]}, lo, hi);
      }},
     {NodeKind::Cylinder, "cylinder", false, kCylinder,
-     "Capped cylinder along y, centred at the origin.", "sdCylinder", kA0A1,
+     "Capped cylinder along y, centred at the origin.", R"("radius": 0.6, "height": 1.5)",
+     "sdCylinder", kA0A1,
      [](const Params& v) -> Params {
          return {v[0], 0.5f * v[1]};
      },
@@ -546,8 +548,8 @@ constexpr KindInfo kKinds[] = {
          return symmetric({k[0], k[1], k[0]}, lo, hi);
      }},
     {NodeKind::Cone, "cone", false, kCone,
-     "Capped cone along y, base at the bottom, centred at the origin (half way up).", "sdCone",
-     kA0A1A2,
+     "Capped cone along y, base at the bottom, centred at the origin (half way up).",
+     R"("radius": 0.7, "height": 1.3, "top_radius": 0.2)", "sdCone", kA0A1A2,
      [](const Params& v) -> Params {
          return {v[0], 0.5f * v[1], v[2]};
      },
@@ -556,7 +558,7 @@ constexpr KindInfo kKinds[] = {
          return symmetric({r, k[1], r}, lo, hi);
      }},
     {NodeKind::Capsule, "capsule", false, kCapsule, "Segment from a to b swept by a sphere.",
-     "sdCapsule", kCapsuleArgs,
+     R"("a": [-0.5, -0.3, 0.1], "b": [0.6, 0.4, -0.2], "radius": 0.3)", "sdCapsule", kCapsuleArgs,
      [](const Params& v) -> Params { return {v[0], v[1], v[2], v[6], v[3], v[4], v[5]}; },
      [](const Params& k, vec3& lo, vec3& hi) {
          vec3 a(k[0], k[1], k[2]), b(k[4], k[5], k[6]);
@@ -567,7 +569,7 @@ constexpr KindInfo kKinds[] = {
     {NodeKind::Ellipsoid, "ellipsoid", false, kEllipsoid,
      "Ellipsoid centred at the origin. Its field is a bound, not the exact distance: never above "
      "it, and at least the distance times the smallest over the largest radius.",
-     "sdEllipsoid", kA3A1,
+     R"("radii": [0.9, 0.5, 0.7])", "sdEllipsoid", kA3A1,
      [](const Params& v) -> Params {
          return {1.0f / v[0], 1.0f / v[1], 1.0f / v[2], std::min(v[0], std::min(v[1], v[2]))};
      },
@@ -576,7 +578,7 @@ constexpr KindInfo kKinds[] = {
      }},
     {NodeKind::HexPrism, "hex_prism", false, kHexPrism,
      "Regular hexagonal prism along y, centred at the origin (a nut, a bolt head, a pencil).",
-     "sdHexPrism", kA0A1,
+     R"("radius": 0.7, "height": 1.2)", "sdHexPrism", kA0A1,
      [](const Params& v) -> Params {
          return {v[0] * 0.8660254f, 0.5f * v[1]};
      },
@@ -584,12 +586,12 @@ constexpr KindInfo kKinds[] = {
          return symmetric({k[0] / 0.8660254f, k[1], k[0]}, lo, hi);
      }},
     {NodeKind::Octahedron, "octahedron", false, kOctahedron,
-     "Regular octahedron with its vertices on the axes, centred at the origin.", "sdOctahedron",
-     kA0, [](const Params& v) -> Params { return {v[0]}; },
+     "Regular octahedron with its vertices on the axes, centred at the origin.", R"("radius": 0.9)",
+     "sdOctahedron", kA0, [](const Params& v) -> Params { return {v[0]}; },
      [](const Params& k, vec3& lo, vec3& hi) { return symmetric(vec3(k[0]), lo, hi); }},
     {NodeKind::Pyramid, "pyramid", false, kPyramid,
      "Square pyramid, base at the bottom, apex up (+y), its bounding box centred at the origin.",
-     "sdPyramid", kA0A1A2,
+     R"("width": 1.2, "height": 1.1)", "sdPyramid", kA0A1A2,
      [](const Params& v) -> Params {
          return {v[0], v[1] / v[0], 0.5f * v[1]};
      },
@@ -597,7 +599,8 @@ constexpr KindInfo kKinds[] = {
          return symmetric({0.5f * k[0], k[2], 0.5f * k[0]}, lo, hi);
      }},
     {NodeKind::RoundedCylinder, "rounded_cylinder", false, kRoundedCylinder,
-     "Cylinder along y with rounded rims, centred at the origin.", "sdRoundedCylinder", kA0A1A2,
+     "Cylinder along y with rounded rims, centred at the origin.",
+     R"("radius": 0.6, "height": 1.4, "rounding": 0.15)", "sdRoundedCylinder", kA0A1A2,
      [](const Params& v) -> Params {
          float rr = std::min(v[2], std::min(v[0], 0.5f * v[1]));
          return {v[0] - rr, 0.5f * v[1] - rr, rr};
@@ -609,7 +612,7 @@ constexpr KindInfo kKinds[] = {
     {NodeKind::RoundCone, "round_cone", false, kRoundCone,
      "Two spheres on the y axis and the cone that joins them (their convex hull), the spheres' "
      "centres at -height/2 and +height/2.",
-     "sdRoundCone", kRoundConeArgs,
+     R"("radius": 0.5, "top_radius": 0.2, "height": 1.1)", "sdRoundCone", kRoundConeArgs,
      [](const Params& v) -> Params {
          // Where one sphere holds the other the smaller one shrinks to just inside the larger,
          // which keeps the formula's slope defined and the solid the larger sphere.
@@ -627,7 +630,8 @@ constexpr KindInfo kKinds[] = {
          return true;
      }},
     {NodeKind::Link, "link", false, kLink,
-     "Chain link standing in the xy plane, long along y, centred at the origin.", "sdLink", kA0A1A2,
+     "Chain link standing in the xy plane, long along y, centred at the origin.",
+     R"("length": 0.6, "major_radius": 0.4, "minor_radius": 0.12)", "sdLink", kA0A1A2,
      [](const Params& v) -> Params {
          return {0.5f * v[0], v[1], v[2]};
      },
@@ -635,8 +639,8 @@ constexpr KindInfo kKinds[] = {
          return symmetric({k[1] + k[2], k[0] + k[1] + k[2], k[2]}, lo, hi);
      }},
     {NodeKind::CappedTorus, "capped_torus", false, kCappedTorus,
-     "Arc of a ring around the y axis (a horseshoe, a handle), centred on +z.", "sdCappedTorus",
-     kA0A1A2A3,
+     "Arc of a ring around the y axis (a horseshoe, a handle), centred on +z.",
+     R"("major_radius": 0.8, "minor_radius": 0.2, "angle": 250)", "sdCappedTorus", kA0A1A2A3,
      [](const Params& v) -> Params {
          const double half = 0.5 * double(v[2]) * 3.14159265358979323846 / 180.0;
          return {v[0], v[1], float(std::sin(half)), float(std::cos(half))};
@@ -646,38 +650,40 @@ constexpr KindInfo kKinds[] = {
          return symmetric({r, k[1], r}, lo, hi);
      }},
     {NodeKind::Circle, "circle", false, kCircle,
-     "2D profile: a circle in the xy plane, centred at the origin.", "sdCircle", kA0,
-     [](const Params& v) -> Params { return {v[0]}; },
+     "2D profile: a circle in the xy plane, centred at the origin.", R"("radius": 0.5)", "sdCircle",
+     kA0, [](const Params& v) -> Params { return {v[0]}; },
      [](const Params& k, vec3& lo, vec3& hi) { return profile(k[0], k[0], lo, hi); }},
     {NodeKind::Rectangle, "rectangle", false, kRectangle,
      "2D profile: a rectangle in the xy plane, optionally with rounded corners, centred at the "
      "origin.",
-     "sdRectangle", kA0A1A2,
+     R"("width": 0.9, "height": 0.6, "rounding": 0.1)", "sdRectangle", kA0A1A2,
      [](const Params& v) -> Params {
          return {0.5f * v[0], 0.5f * v[1], std::min(v[2], 0.5f * std::min(v[0], v[1]))};
      },
      [](const Params& k, vec3& lo, vec3& hi) { return profile(k[0], k[1], lo, hi); }},
     {NodeKind::RegularPolygon, "regular_polygon", false, kRegularPolygon,
      "2D profile: a regular polygon in the xy plane, centred at the origin, an edge on top.",
-     "sdRegularPolygon", kA0A1A2A3,
+     R"("radius": 0.6, "sides": 5)", "sdRegularPolygon", kA0A1A2A3,
      [](const Params& v) -> Params {
          const double half = 3.14159265358979323846 / std::max(double(v[1]), 3.0);
          return {v[0], float(half), float(std::cos(half)), float(std::sin(half))};
      },
      [](const Params& k, vec3& lo, vec3& hi) { return profile(k[0], k[0], lo, hi); }},
     {NodeKind::Polygon, "polygon", false, kPolygon,
-     "2D profile: a polygon in the xy plane from its corners, exact distance.", "sdOutline",
+     "2D profile: a polygon in the xy plane from its corners, exact distance.",
+     R"("points": [[-0.5, -0.4], [0.6, -0.4], [0.1, 0.0], [0.3, 0.5], [-0.4, 0.3]])", "sdOutline",
      kOutlineArgs, nullptr, outlineBounds},
     {NodeKind::Text, "text", false, kText,
      "2D profile: a line of text in the xy plane, set in a TrueType or OpenType font through "
      "FreeType and centred on the origin (the middle of its outlines' extents); exact distance "
      "to the glyphs' outlines.",
-     "sdOutline", kOutlineArgs, nullptr, outlineBounds},
+     R"("text": "Bo sdfg", "size": 0.5)", "sdOutline", kOutlineArgs, nullptr, outlineBounds},
     {NodeKind::Union,
      "union",
      true,
      kOperation,
      "All children together.",
+     R"("smooth": 0.2)",
      {},
      {},
      nullptr,
@@ -688,6 +694,7 @@ constexpr KindInfo kKinds[] = {
      true,
      kOperation,
      "What all children have in common.",
+     R"("smooth": 0.1, "blend": "round")",
      {},
      {},
      nullptr,
@@ -698,6 +705,7 @@ constexpr KindInfo kKinds[] = {
      true,
      kOperation,
      "The first child minus all the others.",
+     R"("smooth": 0.05, "blend": "chamfer")",
      {},
      {},
      nullptr,
@@ -709,6 +717,7 @@ constexpr KindInfo kKinds[] = {
      kShell,
      "Its child hollowed to a skin of the given thickness, centred on the child's surface (an "
      "onion). Cut it open with a difference to see inside.",
+     R"("thickness": 0.1)",
      {},
      {},
      nullptr,
@@ -723,6 +732,7 @@ constexpr KindInfo kKinds[] = {
      true,
      kOffset,
      "Its child grown by a distance (rounding its edges), or shrunk by a negative one.",
+     R"("distance": 0.15)",
      {},
      {},
      nullptr,
@@ -738,6 +748,7 @@ constexpr KindInfo kKinds[] = {
      kRepeat,
      "A grid of copies of its child, centred on the origin: count copies along each axis, "
      "spacing apart. Costs about one copy to evaluate, however many there are.",
+     R"("count": [3, 2, 4], "spacing": [1.1, 0.9, 0.8])",
      {},
      {},
      nullptr,
@@ -754,6 +765,7 @@ constexpr KindInfo kKinds[] = {
      kPolarRepeat,
      "Copies of its child around the y axis, evenly spaced: the child moved radius along +x, "
      "then turned about y by each multiple of 360 / count degrees. Costs about one copy.",
+     R"("count": 7, "radius": 1.2)",
      {},
      {},
      nullptr,
@@ -770,6 +782,7 @@ constexpr KindInfo kKinds[] = {
      kMirror,
      "Its child's part on the positive side of each chosen axis plane, and that part's mirror "
      "image (a symmetric shape from one half).",
+     R"("axes": "xz", "smooth": 0.1)",
      {},
      {},
      nullptr,
@@ -792,6 +805,7 @@ constexpr KindInfo kKinds[] = {
      kElongate,
      "Its child cut through its centre planes and stretched apart by the given lengths: a sphere "
      "becomes a capsule or a rounded box, a torus a stadium-shaped ring.",
+     R"("length": [0.6, 0.2, 0.4])",
      {},
      {},
      nullptr,
@@ -809,6 +823,7 @@ constexpr KindInfo kKinds[] = {
      kTwist,
      "Its child twisted about the y axis, turning by the given angle per unit of height. The "
      "field is divided by the twist's Lipschitz bound, so it stays safe to trace.",
+     R"("angle": 60)",
      {},
      {},
      nullptr,
@@ -827,6 +842,7 @@ constexpr KindInfo kKinds[] = {
      "Its child bent in the xy plane about the z axis, turning by the given angle per unit "
      "along x: a bar along x becomes an arc. The field is divided by the bend's Lipschitz "
      "bound.",
+     R"("angle": 30)",
      {},
      {},
      nullptr,
@@ -845,6 +861,7 @@ constexpr KindInfo kKinds[] = {
      "Its child scaled in x and z by a factor that changes linearly with height: 1 at y = "
      "-height/2, top_scale at y = +height/2, constant beyond. The field is divided by the "
      "taper's Lipschitz bound.",
+     R"("height": 1.2, "top_scale": 0.4)",
      {},
      {},
      nullptr,
@@ -875,6 +892,7 @@ constexpr KindInfo kKinds[] = {
      kExtrude,
      "The cross-section of its child in the plane z = 0 (a 2D profile: circle, rectangle, "
      "polygon, text...) swept along z to the given thickness. Exact where the child's field is.",
+     R"("height": 0.4, "rounding": 0.05)",
      {},
      {},
      nullptr,
@@ -892,6 +910,7 @@ constexpr KindInfo kKinds[] = {
      kRevolve,
      "The cross-section of its child in the plane z = 0, its part at x >= -offset, turned about "
      "the y axis (a lathe): a vase, a chess piece, a ring.",
+     R"("offset": 0.3)",
      {},
      {},
      nullptr,
@@ -904,6 +923,23 @@ constexpr KindInfo kKinds[] = {
      }},
 };
 static_assert(sizeof(kKinds) / sizeof(kKinds[0]) == kNodeKindCount);
+
+// kindInfo() indexes the table by kind, and the groups of sdfcsg/kinds.h are roles.
+constexpr bool tableFollowsTheKinds() {
+    for (int i = 0; i < kNodeKindCount; ++i) {
+        const KindInfo& k = kKinds[i];
+        const bool operation = k.kind >= kFirstOperation;
+        const Role role = k.kind < kFirstOperation         ? Role::Primitive
+                          : k.kind < kFirstValueOperation  ? Role::Boolean
+                          : k.kind < kFirstDomainOperation ? Role::Value
+                                                           : Role::Domain;
+        if (k.kind != NodeKind(i) || k.operation != operation || k.role != role) return false;
+    }
+    return true;
+}
+static_assert(tableFollowsTheKinds(),
+              "kKinds lists the kinds in NodeKind's order (sdfcsg/kinds.h), each with its group's "
+              "role");
 
 constexpr CommonKey kCommonKeys[] = {
     {"type", R"({"type":"string"})", "Node kind: a primitive or an operation name."},
@@ -943,6 +979,17 @@ const KindInfo* findKind(std::string_view name) {
 
 std::span<const CommonKey> commonNodeKeys() {
     return kCommonKeys;
+}
+
+std::string exampleNodeJson(const KindInfo& kind) {
+    std::string json = "{\"type\": \"" + std::string(kind.name) + "\"";
+    if (!kind.example.empty()) json += ", " + std::string(kind.example);
+    if (kind.operation) {
+        const bool cuts = kind.kind == NodeKind::Extrude || kind.kind == NodeKind::Revolve;
+        json += cuts ? R"(, "children": [{"type": "circle", "radius": 0.5}])"
+                     : R"(, "children": [{"type": "sphere", "radius": 0.5}])";
+    }
+    return json + "}";
 }
 
 } // namespace sdfcsg

@@ -68,7 +68,7 @@ std::string sceneFormatReference() {
                       describeValue(p) + "; " + fallback(p) + "): " + std::string(p.doc);
         }
         out += "| `" + std::string(kind.name) + "` | " + fields + " | " + std::string(kind.doc) +
-               " |\n";
+               "<br>Example: `" + exampleNodeJson(kind) + "` |\n";
     }
     return out;
 }

@@ -239,6 +239,18 @@ void kind(JsonWriter& w, const KindInfo& k) {
     w.endArray();
     w.key("additionalProperties");
     w.boolean(false);
+    w.key("examples");
+    w.beginArray();
+    const std::string example = exampleNodeJson(k);
+    simdjson::dom::parser parser;
+    simdjson::dom::element e;
+    if (parser.parse(example).get(e)) {
+        std::fprintf(stderr, "%s:%d: bad example in the node table: %s\n", __FILE__, __LINE__,
+                     example.c_str());
+        std::abort(); // the table is ours: a bad example is a bug
+    }
+    copyValue(w, e);
+    w.endArray();
     w.endObject();
 }
 

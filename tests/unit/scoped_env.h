@@ -1,12 +1,13 @@
-// Sets or clears an environment variable for a scope, then restores it: for the benchmark and
-// the tests, which steer the caches and the driver through the environment.
+// Sets or clears an environment variable for a scope, then restores it: for the tests of what
+// reads the environment at each use, Mesa's disk cache (which Mesa reads whenever a device is made)
+// and libcurl's proxies. The library's own settings go through options (gpu/environment.h).
 #pragma once
 
 #include <cstdlib>
 #include <optional>
 #include <string>
 
-namespace sdfcsg::detail {
+namespace sdfcsg::test {
 
 class ScopedEnv {
   public:
@@ -33,4 +34,4 @@ class ScopedEnv {
     std::optional<std::string> old_;
 };
 
-} // namespace sdfcsg::detail
+} // namespace sdfcsg::test
