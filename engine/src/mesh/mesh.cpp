@@ -478,7 +478,7 @@ Status Mesher::Impl::buildPasses(const std::string& sceneGlsl) {
     double helperMs = 0.0; // the helper's compile of the dual pass
     std::thread other([&] {
         bool fresh = false; // glslang made the SPIR-V: the driver has most likely not compiled it
-        auto spirv = detail::compileKernel("mesh_triangles.comp", "", m.ctx.compile, fresh);
+        auto spirv = detail::compileKernel("mesh_triangles.comp", "", ctx.compile, fresh);
         if (!spirv) {
             passesError = spirv.error();
             return;
@@ -492,7 +492,7 @@ Status Mesher::Impl::buildPasses(const std::string& sceneGlsl) {
         dualPass = pipeline(passes, dual);
     });
     bool fresh = false;
-    auto spirv = detail::compileKernel("mesh_field.comp", sceneGlsl, m.ctx.compile, fresh);
+    auto spirv = detail::compileKernel("mesh_field.comp", sceneGlsl, ctx.compile, fresh);
     if (spirv) {
         field = detail::createShaderModule(ctx, *spirv);
         cull = pipeline(field, spec(SDFCSG_MESH_PASS_CULL, SDFCSG_MESH_GROUP_X));
