@@ -11,7 +11,19 @@
 set -eu
 viewer=$1 cli=$2 diff=$3 src=$4 work=$5 test_case=$6
 scene=$src/assets/scenes/snowman.json
-run() { "$viewer" "$@"; }
+# A crash prints the stacks of the viewer's threads from its core file (where gdb is installed and
+# the kernel writes cores to the working folder), so that a rare one can be told apart.
+run() {
+    rc=0
+    "$viewer" "$@" || rc=$?
+    if [ $rc -ge 128 ]; then
+        for core in core core.*; do
+            [ -f "$core" ] && command -v gdb >/dev/null 2>&1 &&
+                gdb -q -batch -ex 'thread apply all bt 25' "$viewer" "$core" 2>&1 | grep -v '^\[New LWP'
+        done
+    fi
+    return $rc
+}
 fail() { echo "FAIL: $*"; exit 1; }
 
 # The window shows what `sdfcsg render` computes for the same camera and size.
@@ -349,6 +361,7 @@ if ! command -v Xvfb >/dev/null 2>&1; then
     exit 77
 fi
 rm -rf "${work:?}/$test_case" && mkdir -p "$work/$test_case" && cd "$work/$test_case"
+ulimit -c unlimited 2>/dev/null || true
 export XDG_CONFIG_HOME="$work/$test_case/config" # the recent-files list stays in here
 # One X server for the case, on a display number that the server picks and writes to -displayfd
 # (xvfb-run -a looks for a free number before starting the server, so two cases starting at once
