@@ -432,12 +432,12 @@ std::vector<uint32_t> fullTape(const std::vector<FlatNode>& nodes, uint32_t& sta
     return tape;
 }
 
-PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) {
-    const std::vector<FlatNode>& nodes = evaluator.nodes();
-    PrunedField field;
-    field.tape = fullTape(nodes, field.stackDepth);
-    field.fullLength = uint32_t(field.tape.size());
-    std::vector<uint32_t> spans(nodes.size(), 0), begins;
+namespace {
+
+// The length of every domain operation's stretch of the full tape, from its instruction to its
+// end, by node; sets field.domainDepth, the deepest nesting of those stretches.
+std::vector<uint32_t> domainSpans(PrunedField& field, size_t nodeCount) {
+    std::vector<uint32_t> spans(nodeCount, 0), begins;
     for (uint32_t i = 0; i < field.fullLength; ++i) {
         const uint32_t ins = field.tape[i];
         if (isDomainEnd(ins)) {
@@ -448,6 +448,17 @@ PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) 
             field.domainDepth = std::max(field.domainDepth, uint32_t(begins.size()));
         }
     }
+    return spans;
+}
+
+} // namespace
+
+PrunedField pruneField(const Evaluator& evaluator, const PruneOptions& options) {
+    const std::vector<FlatNode>& nodes = evaluator.nodes();
+    PrunedField field;
+    field.tape = fullTape(nodes, field.stackDepth);
+    field.fullLength = uint32_t(field.tape.size());
+    const std::vector<uint32_t> spans = domainSpans(field, nodes.size());
     if (nodes.empty() || options.levels < 1 || !fieldGrid(evaluator, options, field)) {
         field.levels = 0;
         field.bounded = false;
