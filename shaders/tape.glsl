@@ -47,16 +47,16 @@ const uint kTapeUnion = kKindUnion, kTapeIntersection = kKindIntersection;
 // One blend for the three operations, which the compiler would otherwise all evaluate and
 // select from: intersection(a, b) is -union(-a, -b) and difference(a, b) intersection(a, -b),
 // bit for bit as sdf.glsl computes them (negation rounds symmetrically). Kinds that the scene
-// lacks fold away.
+// lacks fold away (a scene whose only boolean is union has none of the others' bits).
 float tapeOp(uint kind, float a, float b, float k, uint blend) {
-    if ((SDFCSG_TAPE_OPERATIONS & 6) == 0) kind = kTapeUnion;
+    if ((SDFCSG_TAPE_OPERATIONS & SDFCSG_BOOLEAN_OPERATION_BITS) <= 1u) kind = kTapeUnion;
     float s = kind == kTapeUnion ? 1.0 : -1.0;
     float c = kind == kTapeIntersection || kind == kTapeUnion ? b : -b;
     return s * opUnion(s * a, s * c, k, blend);
 }
 
 vec4 tapeOp(uint kind, vec4 a, vec4 b, float k, uint blend) {
-    if ((SDFCSG_TAPE_OPERATIONS & 6) == 0) kind = kTapeUnion;
+    if ((SDFCSG_TAPE_OPERATIONS & SDFCSG_BOOLEAN_OPERATION_BITS) <= 1u) kind = kTapeUnion;
     float s = kind == kTapeUnion ? 1.0 : -1.0;
     float c = kind == kTapeIntersection || kind == kTapeUnion ? b.w : -b.w;
     vec4 u = opUnion(vec4(a.rgb, s * a.w), vec4(b.rgb, s * c), k, blend);

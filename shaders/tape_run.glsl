@@ -54,12 +54,12 @@ TAPE_VALUE TAPE_RUN(uint begin, uint end, vec3 p) {
             }
         }
 #if SDFCSG_TAPE_STACK > 0
-        else if (kind < kTapeUnion + 3u) {
+        else if (kind < kKindFirstValueOperation) {
             acc = tapeOp(kind, stack[top--], acc, nodeSmooth(i), nodeBlend(i));
         }
 #endif
-#if (SDFCSG_TAPE_OPERATIONS & 24) != 0
-        else if (kind < kTapeUnion + 5u) {
+#if (SDFCSG_TAPE_OPERATIONS & SDFCSG_VALUE_OPERATION_BITS) != 0
+        else if (kind < kKindFirstDomainOperation) {
             acc = TAPE_WITH(acc, valueOp(kind, TAPE_DIST(acc), TAPE_A(i)));
         }
 #endif

@@ -39,6 +39,17 @@ int main(int argc, char** argv) {
     SDFCSG_DOMAIN_KINDS(SDFCSG_KIND_LINE)
 #undef SDFCSG_KIND_LINE
     out << "const uint kKindCount = " << n << "u;\n";
+    // The tape machine's operation bits (SDFCSG_TAPE_OPERATIONS, shaders/tape.glsl): bit k for
+    // kind kKindFirstOperation + k, as preprocessor numbers for its #if.
+    unsigned bit = 0, booleans = 0, values = 0;
+#define SDFCSG_KIND_BIT(name) booleans |= 1u << bit++;
+    SDFCSG_BOOLEAN_KINDS(SDFCSG_KIND_BIT)
+#undef SDFCSG_KIND_BIT
+#define SDFCSG_KIND_BIT(name) values |= 1u << bit++;
+    SDFCSG_VALUE_KINDS(SDFCSG_KIND_BIT)
+#undef SDFCSG_KIND_BIT
+    out << "#define SDFCSG_BOOLEAN_OPERATION_BITS " << booleans
+        << "\n#define SDFCSG_VALUE_OPERATION_BITS " << values << "\n";
 
     const std::string text = out.str();
     std::ifstream old(argv[1], std::ios::binary);

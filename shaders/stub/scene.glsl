@@ -45,7 +45,7 @@ vec4 sceneSample(vec3 p) {
 // The scene code of large scenes includes the tape machine instead (codegen.cpp).
 #define SDFCSG_TAPE_STACK 4
 #define SDFCSG_TAPE_KINDS 0xffffffffu
-#define SDFCSG_TAPE_OPERATIONS 31
+#define SDFCSG_TAPE_OPERATIONS (SDFCSG_BOOLEAN_OPERATION_BITS | SDFCSG_VALUE_OPERATION_BITS)
 #define SDFCSG_TAPE_BALLS 1
 #define SDFCSG_TAPE_DOMAINS 2
 #include "tape.glsl"

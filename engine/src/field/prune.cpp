@@ -135,7 +135,7 @@ template <class V> class Machine {
     // Every branch compiled in: the stack, every operation, domain operations. The arrays are
     // the machine's own, sized in run().
 #define SDFCSG_TAPE_STACK 1
-#define SDFCSG_TAPE_OPERATIONS 31
+#define SDFCSG_TAPE_OPERATIONS (SDFCSG_BOOLEAN_OPERATION_BITS | SDFCSG_VALUE_OPERATION_BITS)
 #define SDFCSG_TAPE_DOMAINS 1
 #define TAPE_A(i) kernelA(nodes_[i])
 #define TAPE_B(i) kernelB(nodes_[i])
