@@ -1,5 +1,7 @@
 #include "cli.h"
 
+#include <sdfcsg/io.h>
+
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -22,6 +24,17 @@ volatile std::sig_atomic_t gInterrupted = 0;
 sem_t gSignalled;                   // posted by the signal handler (sem_post is signal-safe)
 std::mutex gFinishing;              // held while outputs are written whole, or reports left
 std::atomic<bool> gReported{false}; // the reason of the stop has been printed
+// Under gFinishing: the outputs in place, and one being streamed (into a FIFO, standard
+// output), for the message of an interruption.
+std::string gWritten, gStreaming;
+
+// Under gFinishing.
+std::string interruptedMessage() {
+    std::string message = "sdfcsg: interrupted; ";
+    message += gWritten.empty() ? "nothing was written" : "wrote " + gWritten + " in full";
+    if (!gStreaming.empty()) message += "; " + gStreaming + " holds part of its output";
+    return message;
+}
 
 extern "C" void onInterrupt(int) {
     if (gInterrupted) ::_exit(kInterrupted);
@@ -33,10 +46,10 @@ void watchdog() {
     while (::sem_wait(&gSignalled) != 0) {
     }
     std::this_thread::sleep_for(kGrace);
-    std::lock_guard lock(gFinishing); // an output being written is written whole
+    std::lock_guard lock(gFinishing); // an output being put in place is put there
     if (!gReported.exchange(true)) {
-        static const char kMessage[] = "sdfcsg: interrupted; nothing was written\n";
-        (void)!::write(STDERR_FILENO, kMessage, sizeof kMessage - 1);
+        const std::string message = interruptedMessage() + "\n";
+        (void)!::write(STDERR_FILENO, message.data(), message.size());
     }
     ::_exit(kInterrupted);
 }
@@ -65,8 +78,10 @@ int exitCode(const Error& e) {
 }
 
 int fail(const Error& e) {
-    if (e.kind == ErrorKind::Cancelled && interrupted())
-        return stopInterrupted("sdfcsg: interrupted; nothing was written");
+    if (e.kind == ErrorKind::Cancelled && interrupted()) {
+        std::lock_guard lock(gFinishing);
+        return stopInterrupted(interruptedMessage());
+    }
     std::fprintf(stderr, "%s\n", e.str().c_str());
     return exitCode(e);
 }
@@ -98,6 +113,30 @@ void catchInterrupts() {
 
 bool interrupted() {
     return gInterrupted != 0;
+}
+
+Status writeOutput(const std::filesystem::path& path, std::string_view bytes) {
+    const Error cancelled = Error::message(ErrorKind::Cancelled, path.string(), "cancelled");
+    if (interrupted()) return cancelled;
+    auto file = OutputFile::open(path);
+    if (!file) return file.error();
+    if (file->streamed()) {
+        std::lock_guard lock(gFinishing);
+        gStreaming = path == "-" ? "standard output" : path.string();
+    }
+    // In pieces, so that an interruption stops the write within a piece's time, and the
+    // temporary file goes with the OutputFile.
+    constexpr size_t kPiece = size_t(4) << 20;
+    for (size_t at = 0; at < bytes.size(); at += kPiece) {
+        if (interrupted()) return cancelled;
+        if (auto written = file->write(bytes.substr(at, kPiece)); !written) return written;
+    }
+    std::lock_guard lock(gFinishing);
+    if (interrupted()) return cancelled;
+    if (auto committed = file->commit(); !committed) return committed;
+    gWritten += (gWritten.empty() ? "" : ", ") + (path == "-" ? "standard output" : path.string());
+    gStreaming.clear();
+    return Ok{};
 }
 
 Finishing::Finishing() {

@@ -3,6 +3,7 @@
 
 #include <sdfcsg/error.h>
 
+#include <filesystem>
 #include <string>
 #include <string_view>
 
@@ -53,11 +54,8 @@ template <class Write> Status writeWhole(Write&& write) {
     return write();
 }
 
-// The same, unless the command was interrupted.
-template <class Write> Status writeOutput(Write&& write) {
-    Finishing finishing;
-    if (interrupted()) return Error::message(ErrorKind::Cancelled, "<output>", "cancelled");
-    return write();
-}
+// Writes `bytes` to `path` (sdfcsg::OutputFile), unless the command is interrupted first: then
+// nothing is written (a Cancelled error). Once in place, an interruption's message names it.
+Status writeOutput(const std::filesystem::path& path, std::string_view bytes);
 
 } // namespace sdfcsg::app

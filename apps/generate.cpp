@@ -273,17 +273,13 @@ int generateAndWrite(std::string_view command, std::string_view request, Generat
             return fail(generated.error());
         }
     }
-    if (auto written = writeOutput([&] { return writeFileAtomic(out, generated->json); }); !written)
-        return fail(written.error());
+    if (auto written = writeOutput(out, generated->json); !written) return fail(written.error());
     printSummary(out, *generated, stats);
     if (const std::string png = args.get("--render"); !png.empty()) {
         Renders renders;
         auto image = renders.render(generated->scene, 800, 600);
-        Status written =
-            image ? writeOutput([&] { return writePng(*image, png); }) : Status(image.error());
-        if (!written && written.error().kind == ErrorKind::Cancelled && interrupted())
-            return stopInterrupted("sdfcsg: interrupted; " + out + " was written, " + png +
-                                   " was not");
+        auto bytes = image ? encodePng(*image, png) : Result<std::string>(image.error());
+        Status written = bytes ? writeOutput(png, *bytes) : Status(bytes.error());
         if (!written) return fail(written.error());
     }
     return kOk;

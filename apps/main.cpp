@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <string_view>
@@ -74,6 +75,14 @@ struct Args {
         return fallback;
     }
 };
+
+// A path's extension in lower case (".png"), or "" without one.
+std::string lowerExtension(const std::string& path) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    for (char& c : ext)
+        c = char(std::tolower(static_cast<unsigned char>(c)));
+    return ext;
+}
 
 bool parseUint(const std::string& s, uint32_t lo, uint32_t hi, uint32_t& out) {
     char* end = nullptr;
@@ -137,7 +146,9 @@ const char* kRenderHelp = R"(Usage: sdfcsg render SCENE -o OUT.png [options]
 Ray-marches SCENE with a Vulkan compute pass and writes a PNG (atomically).
 
 Options:
-  -o, --output FILE     output PNG (required)
+  -o, --output FILE     output PNG (required); - for standard output. A symbolic link is
+                        followed; a FIFO or a device is written into; any other file that is
+                        not a regular one is refused
   --width W, --height H image size in pixels (default 800 x 600, at most 16384 each)
   --mode M              shaded (default), normals, depth or steps (iteration heat map)
   --eye X,Y,Z           camera position (default: the scene's camera, else framed)
@@ -208,6 +219,9 @@ int cmdRender(int argc, char** argv) {
     if (args.positional.size() != 1) return usageError("render", "expected one SCENE file");
     std::string out = args.get("-o", args.get("--output"));
     if (out.empty()) return usageError("render", "missing -o OUT.png");
+    if (const std::string ext = lowerExtension(out); !ext.empty() && ext != ".png")
+        return usageError("render", "render writes PNG images; the output must end in .png, got '" +
+                                        out + "'");
 
     sdfcsg::RenderOptions options;
     if (args.has("--width") && !parseUint(args.get("--width"), 1, 16384, options.width))
@@ -233,6 +247,7 @@ int cmdRender(int argc, char** argv) {
     options.grid = args.has("--grid");
     if (args.has("--skip")) options.boundsSkipping = true;
     if (args.has("--no-skip")) options.boundsSkipping = false;
+    if (auto writable = sdfcsg::checkOutput(out); !writable) return fail(writable.error());
 
     auto scene = load(args.positional[0]);
     if (!scene) return fail(scene.error());
@@ -271,8 +286,9 @@ int cmdRender(int argc, char** argv) {
         return (*renderer)->render(options);
     }();
     if (!image) return fail(image.error());
-    if (auto written = writeOutput([&] { return sdfcsg::writePng(*image, out); }); !written)
-        return fail(written.error());
+    auto png = sdfcsg::encodePng(*image, out);
+    if (!png) return fail(png.error());
+    if (auto written = writeOutput(out, *png); !written) return fail(written.error());
     return kOk;
 }
 
@@ -296,7 +312,10 @@ did, no farther than that. With both, the simplification stops at whichever limi
 reaches first.
 
 Options:
-  -o, --output FILE      output mesh (required): .ply, .obj, .stl, .glb or .3mf
+  -o, --output FILE      output mesh (required): .ply, .obj, .stl, .glb or .3mf; - for
+                         standard output. A symbolic link is followed; a FIFO or a device
+                         is written into; any other file that is not a regular one is refused
+  --format F             ply, obj, stl, glb or 3mf, instead of OUT's extension
   --unit U               3MF only: what one scene unit is, mm (default), cm, m or inch
   --method M             dc (dual contouring, the default) or mc (marching cubes)
   --resolution N         cells along the longest axis of the bounds (default 128)
@@ -379,7 +398,8 @@ int cmdMesh(int argc, char** argv) {
     };
     Args args("mesh", argc, argv,
               {"-o", "--output", "--resolution", "--voxel-size", "--bounds", "--device",
-               "--evaluation", "--unit", "--method", "--simplify", "--target-triangles"},
+               "--evaluation", "--unit", "--method", "--simplify", "--target-triangles",
+               "--format"},
               {"--stats", "--validation", "--help", "-h"});
     if (args.has("--help") || args.has("-h")) return std::fputs(kMeshHelp, stdout), kOk;
     if (!args.error.empty()) return usageError("mesh", args.error);
@@ -387,8 +407,13 @@ int cmdMesh(int argc, char** argv) {
     std::string out = args.get("-o", args.get("--output"));
     if (out.empty()) return usageError("mesh", "missing -o OUT.(ply|obj|stl|glb|3mf)");
     auto format = sdfcsg::meshFormatFromPath(out);
+    if (args.has("--format")) {
+        format = sdfcsg::meshFormatFromPath("mesh." + args.get("--format"));
+        if (!format) return usageError("mesh", "--format expects ply, obj, stl, glb or 3mf");
+    }
     if (!format)
-        return usageError("mesh", "the output must end in .ply, .obj, .stl, .glb or .3mf, got '" +
+        return usageError("mesh", "the output must end in .ply, .obj, .stl, .glb or .3mf (or give "
+                                  "--format), got '" +
                                       out + "'");
     sdfcsg::LengthUnit unit = sdfcsg::LengthUnit::Millimeter;
     if (args.has("--unit")) {
@@ -446,6 +471,7 @@ int cmdMesh(int argc, char** argv) {
                               "--target-triangles expects a positive integer, got '" + value + "'");
         simplify.targetTriangles = size_t(n);
     }
+    if (auto writable = sdfcsg::checkOutput(out); !writable) return fail(writable.error());
 
     auto scene = load(args.positional[0]);
     if (!scene) return fail(scene.error());
@@ -487,9 +513,9 @@ int cmdMesh(int argc, char** argv) {
         stats.totalSeconds += seconds;
     }
     t0 = Clock::now();
-    if (auto written = writeOutput([&] { return sdfcsg::writeMesh(*mesh, out, *format, unit); });
-        !written)
-        return fail(written.error());
+    auto bytes = sdfcsg::encodeMeshFile(*mesh, out, *format, unit);
+    if (!bytes) return fail(bytes.error());
+    if (auto written = writeOutput(out, *bytes); !written) return fail(written.error());
     const double writeSeconds = secondsSince(t0);
 
     if (args.has("--stats")) printMeshStats(stats, compileSeconds, writeSeconds);

@@ -96,7 +96,7 @@ case_mesh() {
     check "mesh voxel size" 0 "$bin" mesh "$mesh_a" -o voxel.ply --voxel-size 0.1
     check "mesh usage" 2 "$bin" mesh "$mesh_a"
     check "mesh bad extension" 2 "$bin" mesh "$mesh_a" -o part.txt
-    expect_text "mesh bad extension message" err.txt "sdfcsg mesh: the output must end in .ply, .obj, .stl, .glb or .3mf, got 'part.txt'"
+    expect_text "mesh bad extension message" err.txt "sdfcsg mesh: the output must end in .ply, .obj, .stl, .glb or .3mf (or give --format), got 'part.txt'"
     # 3MF, read back by Python's own ZIP and XML readers against the PLY of the same mesh.
     check "mesh 3mf" 0 "$bin" mesh "$mesh_a" -o part.3mf --resolution 24 --bounds $box --unit cm
     if command -v python3 >/dev/null 2>&1; then
@@ -255,6 +255,87 @@ case_interrupt() {
         --resolution 2048
     interrupt "render interrupted" TERM big.png "$bin" render "$src/assets/scenes/house.json" \
         -o big.png --width 4096 --height 4096 --aa 2
+}
+
+# Where -o leads: a symbolic link writes its target (the link stays), a FIFO, a character device
+# and - are written into, a folder is refused; a missing or unwritable folder is refused before
+# any work (here, before the scene is even read).
+case_outputs() {
+    small="--width 32 --height 24"
+    echo text >target.txt && ln -s target.txt link.png
+    check "render through a link" 0 "$bin" render "$mesh_a" -o link.png $small
+    [ -L link.png ] && [ "$(head -c 4 target.txt | od -An -c | tr -d ' ')" = "211PNG" ] ||
+        { echo "FAIL the link was replaced, or its target not written"; ls -l; failures=$((failures + 1)); }
+    ln -s missing/deeper.png dangling.png
+    check "render through a dangling link" 3 "$bin" render "$mesh_a" -o dangling.png $small
+    expect_text "dangling link message" err.txt "dangling.png: the folder missing does not exist"
+    "$bin" render "$mesh_a" -o - $small >stdout.png 2>err.txt
+    [ "$(head -c 4 stdout.png | od -An -c | tr -d ' ')" = "211PNG" ] && [ ! -e ./- ] ||
+        { echo "FAIL render -o - wrote no PNG to standard output"; failures=$((failures + 1)); }
+    "$bin" mesh "$mesh_a" -o - --format stl --resolution 16 >stdout.stl 2>err.txt
+    [ "$(wc -c <stdout.stl)" -gt 84 ] || { echo "FAIL mesh -o - --format stl"; failures=$((failures + 1)); }
+    mkfifo pipe.png
+    head -c 4 pipe.png >fifo-start.txt &
+    reader=$!
+    check "render into a FIFO" 0 "$bin" render "$mesh_a" -o pipe.png $small
+    wait $reader
+    [ -p pipe.png ] && [ "$(od -An -c fifo-start.txt | tr -d ' ')" = "211PNG" ] ||
+        { echo "FAIL the FIFO was replaced or not written"; failures=$((failures + 1)); }
+    if mknod null c 1 3 2>/dev/null; then # a private /dev/null, where the user may make one
+        check "render into a device" 0 "$bin" render "$mesh_a" -o null $small
+        [ -c null ] || { echo "FAIL the device was replaced"; failures=$((failures + 1)); }
+    fi
+    mkdir folder.png
+    check "render onto a folder" 3 "$bin" render "$mesh_a" -o folder.png $small
+    expect_text "folder message" err.txt "folder.png: is a folder, not a file to write"
+    check "mesh into a missing folder" 3 "$bin" mesh no-such-scene.json -o no/such/dir.ply
+    expect_text "missing folder message, before the scene" err.txt "no/such/dir.ply: the folder no/such does not exist"
+    check "render a JPEG name" 2 "$bin" render "$mesh_a" -o x.jpg
+    expect_text "JPEG name message" err.txt "sdfcsg render: render writes PNG images; the output must end in .png, got 'x.jpg'"
+    ls | grep -q '\.tmp-' && { echo "FAIL a temporary file was left behind"; failures=$((failures + 1)); }
+    # A temporary that a killed process left beside the target goes with the next write to it.
+    sh -c 'exit 0' &
+    dead=$!
+    wait $dead
+    touch "part.ply.tmp-$dead-0"
+    check "mesh over a stale temporary" 0 "$bin" mesh "$mesh_a" -o part.ply --resolution 12
+    [ ! -e "part.ply.tmp-$dead-0" ] || { echo "FAIL the stale temporary is still there"; failures=$((failures + 1)); }
+}
+
+# Ctrl-C at moments around the end of a large mesh's write: wherever it lands, the exit is 130
+# within a second and the message is true (no file and "nothing was written", or the whole file
+# and "wrote big.ply in full"); a run that finished first exits 0 with the whole file.
+case_interrupt_write() {
+    scene="$src/assets/scenes/house.json"
+    start=$(date +%s%N)
+    check "mesh to compare with" 0 "$bin" mesh "$scene" -o whole.ply --resolution 400
+    total=$((($(date +%s%N) - start) / 1000000))
+    for before in 600 350 200 100 40; do
+        rm -f big.ply
+        env --default-signal=INT "$bin" mesh "$scene" -o big.ply --resolution 400 >out.txt 2>err.txt &
+        pid=$!
+        wait_ms=$((total > before ? total - before : 0))
+        sleep "$((wait_ms / 1000)).$(printf %03d $((wait_ms % 1000)))"
+        sent=$(date +%s%N)
+        kill -INT "$pid" 2>/dev/null
+        wait "$pid"
+        rc=$?
+        ms=$((($(date +%s%N) - sent) / 1000000))
+        echo "interrupted $before ms before the end: exit $rc after $ms ms: $(cat err.txt)"
+        if [ "$rc" -eq 0 ] && cmp -s big.ply whole.ply; then
+            passed=$((passed + 1))
+        elif [ "$rc" -ne 130 ] || [ "$ms" -gt 1000 ]; then
+            echo "FAIL interrupt $before ms before the end: exit $rc after $ms ms"; cat err.txt
+            failures=$((failures + 1))
+        elif [ -e big.ply ]; then
+            cmp -s big.ply whole.ply && grep -qxF "sdfcsg: interrupted; wrote big.ply in full" err.txt &&
+                passed=$((passed + 1)) ||
+                { echo "FAIL interrupt $before ms before the end: a file, and"; cat err.txt; failures=$((failures + 1)); }
+        else
+            grep -qxF "sdfcsg: interrupted; nothing was written" err.txt && passed=$((passed + 1)) ||
+                { echo "FAIL interrupt $before ms before the end: no file, and"; cat err.txt; failures=$((failures + 1)); }
+        fi
+    done
 }
 
 # Inlined, the 1,000 spheres of molecule_1k take far longer than two seconds to compile.

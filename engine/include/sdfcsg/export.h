@@ -36,6 +36,10 @@ std::optional<LengthUnit> lengthUnitFromName(std::string_view name);
 std::string encodeMesh(const Mesh& mesh, MeshFormat format,
                        LengthUnit unit = LengthUnit::Millimeter);
 
+// The file that writeMesh() writes to `path`: the encoded bytes, or its error (naming `path`).
+Result<std::string> encodeMeshFile(const Mesh& mesh, const std::filesystem::path& path,
+                                   MeshFormat format, LengthUnit unit = LengthUnit::Millimeter);
+
 // Encodes and writes atomically (see io.h).
 Status writeMesh(const Mesh& mesh, const std::filesystem::path& path, MeshFormat format,
                  LengthUnit unit = LengthUnit::Millimeter);

@@ -11,6 +11,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -111,7 +112,10 @@ class Renderer {
     std::unique_ptr<Impl> impl_;
 };
 
-// Writes a PNG atomically: to a temporary file beside `path`, then renamed over it.
+// The PNG file of an image; errors name `path`.
+Result<std::string> encodePng(const Image& image, const std::filesystem::path& path);
+
+// Writes a PNG as writeFileAtomic() does (sdfcsg/io.h).
 Status writePng(const Image& image, const std::filesystem::path& path);
 
 } // namespace sdfcsg

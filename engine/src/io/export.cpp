@@ -453,17 +453,24 @@ std::string encodeMesh(const Mesh& mesh, MeshFormat format, LengthUnit unit) {
     return {};
 }
 
-Status writeMesh(const Mesh& mesh, const std::filesystem::path& path, MeshFormat format,
-                 LengthUnit unit) {
+Result<std::string> encodeMeshFile(const Mesh& mesh, const std::filesystem::path& path,
+                                   MeshFormat format, LengthUnit unit) {
     if (auto problem = meshProblem(mesh))
         return Error::message(ErrorKind::Usage, path.string(),
                               "cannot write an inconsistent mesh: " + *problem);
-    const std::string bytes = encodeMesh(mesh, format, unit);
+    std::string bytes = encodeMesh(mesh, format, unit);
     if (bytes.empty())
         return Error::message(ErrorKind::Limit, path.string(),
                               "the mesh is too large for a 3MF file (its ZIP container holds "
                               "4 GiB); write .ply, or mesh at a lower resolution");
-    return writeFileAtomic(path, bytes);
+    return bytes;
+}
+
+Status writeMesh(const Mesh& mesh, const std::filesystem::path& path, MeshFormat format,
+                 LengthUnit unit) {
+    auto bytes = encodeMeshFile(mesh, path, format, unit);
+    if (!bytes) return bytes.error();
+    return writeFileAtomic(path, *bytes);
 }
 
 } // namespace sdfcsg

@@ -26,7 +26,7 @@ void append(void* context, void* data, int size) {
 
 } // namespace
 
-Status writePng(const Image& image, const std::filesystem::path& path) {
+Result<std::string> encodePng(const Image& image, const std::filesystem::path& path) {
     if (image.width == 0 || image.height == 0 ||
         image.rgba.size() != size_t(image.width) * image.height * 4)
         return Error::message(ErrorKind::Usage, path.string(),
@@ -36,7 +36,13 @@ Status writePng(const Image& image, const std::filesystem::path& path) {
                                     image.rgba.data(), int(image.width * 4));
     if (!ok || png.empty())
         return Error::message(ErrorKind::Io, path.string(), "PNG encoding failed");
-    return writeFileAtomic(path, png);
+    return png;
+}
+
+Status writePng(const Image& image, const std::filesystem::path& path) {
+    auto png = encodePng(image, path);
+    if (!png) return png.error();
+    return writeFileAtomic(path, *png);
 }
 
 } // namespace sdfcsg
