@@ -1082,5 +1082,24 @@ TEST_F(ContextTest, ValidationIsOnInTests) {
     EXPECT_TRUE(context().validationEnabled());
 }
 
+// Depth spans the solid: a revolved or extruded profile's depth range is its solid's, not its
+// 2D outline's (which left chess_pawn two grey levels).
+TEST_F(Render, DepthOfProfileSolidsHasManyLevels) {
+    for (const char* name : {"chess_pawn.json", "name_plate.json"}) {
+        Scene scene = loadOrDie(scenePath(name));
+        auto renderer = Renderer::create(context(), scene);
+        ASSERT_TRUE(renderer) << renderer.error().str();
+        RenderOptions options;
+        options.width = 160, options.height = 120;
+        options.mode = RenderMode::Depth;
+        auto image = (*renderer)->render(options);
+        ASSERT_TRUE(image) << image.error().str();
+        std::set<uint8_t> levels;
+        for (size_t i = 0; i < image->rgba.size(); i += 4)
+            levels.insert(image->rgba[i]);
+        EXPECT_GT(levels.size(), 20u) << name;
+    }
+}
+
 } // namespace
 } // namespace sdfcsg::test

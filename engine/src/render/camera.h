@@ -87,7 +87,12 @@ struct ClipVolume {
 inline Aabb finitePrimitiveBounds(const Evaluator& evaluator) {
     Aabb box;
     for (const FlatNode& node : evaluator.nodes()) {
-        if (kindInfo(node.kind).operation || !node.bounds.finite() || node.bounds.empty()) continue;
+        // A 2D profile's own box is a prism of the xy plane: the solid is the box of the extrude
+        // or revolve that holds it.
+        const bool solid = kindInfo(node.kind).operation
+                               ? node.kind == NodeKind::Extrude || node.kind == NodeKind::Revolve
+                               : !isProfile(node.kind);
+        if (!solid || !node.bounds.finite() || node.bounds.empty()) continue;
         box.min = glm::min(box.min, node.bounds.min);
         box.max = glm::max(box.max, node.bounds.max);
     }
