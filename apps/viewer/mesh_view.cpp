@@ -34,26 +34,6 @@ struct MeshVertex {
 };
 static_assert(sizeof(MeshVertex) == 36, "the vertex input reads tightly packed floats");
 
-void destroyTarget(Presenter& p, Target& t) {
-    if (t.view) vkDestroyImageView(p.device, t.view, nullptr);
-    if (t.image) vkDestroyImage(p.device, t.image, nullptr);
-    if (t.memory) vkFreeMemory(p.device, t.memory, nullptr);
-    t = {};
-}
-
-Target createTarget(Presenter& p, VkExtent2D extent, VkFormat format, VkImageUsageFlags usage,
-                    VkImageAspectFlags aspect) {
-    Target t;
-    createImage(p, extent, format, usage, t.image, t.memory);
-    VkImageViewCreateInfo view = {VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
-    view.image = t.image;
-    view.viewType = VK_IMAGE_VIEW_TYPE_2D;
-    view.format = format;
-    view.subresourceRange = {aspect, 0, 1, 0, 1};
-    VK_CHECK(vkCreateImageView(p.device, &view, nullptr, &t.view));
-    return t;
-}
-
 // The first depth-only format the device can render to (D16 always can); float depth first,
 // since the mesh view's depth is reversed and precise only in floating point.
 VkFormat chooseDepthFormat(VkPhysicalDevice physical) {
@@ -65,34 +45,13 @@ VkFormat chooseDepthFormat(VkPhysicalDevice physical) {
     return VK_FORMAT_D16_UNORM;
 }
 
-VkShaderModule createShader(VkDevice device, const uint32_t* code, size_t bytes) {
-    VkShaderModuleCreateInfo info = {VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-    info.codeSize = bytes;
-    info.pCode = code;
-    VkShaderModule module;
-    VK_CHECK(vkCreateShaderModule(device, &info, nullptr, &module));
-    return module;
-}
-
 // Runs one command buffer's worth of work now and waits for it (uploads between frames).
 template <typename Record> void submitNow(Presenter& p, Record record) {
     VK_CHECK(vkResetCommandBuffer(p.cmd, 0));
-    VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-    begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    VK_CHECK(vkBeginCommandBuffer(p.cmd, &begin));
+    vk::beginCommands(p.cmd);
     record(p.cmd);
-    VK_CHECK(vkEndCommandBuffer(p.cmd));
-    VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
-    submit.commandBufferCount = 1;
-    submit.pCommandBuffers = &p.cmd;
-    VK_CHECK(vkQueueSubmit(p.queue, 1, &submit, p.fence));
-    VK_CHECK(vkWaitForFences(p.device, 1, &p.fence, VK_TRUE, UINT64_MAX));
-    VK_CHECK(vkResetFences(p.device, 1, &p.fence));
+    vk::submitAndWait(p.device, p.queue, p.cmd, p.fence);
 }
-
-} // namespace
-
-namespace {
 
 // Colour cleared to the background and left ready for the blit; depth cleared, never kept.
 void createMeshPass(Presenter& p) {
@@ -270,10 +229,10 @@ void createMeshPipeline(Presenter& p) {
     VK_CHECK(vkCreatePipelineLayout(p.device, &layoutInfo, nullptr, &p.meshLayout));
     createMeshPass(p);
 
-    VkShaderModule vert = createShader(p.device, kMeshVert, sizeof kMeshVert);
-    VkShaderModule frag = createShader(p.device, kMeshFrag, sizeof kMeshFrag);
-    VkShaderModule gridVert = createShader(p.device, kGridVert, sizeof kGridVert);
-    VkShaderModule gridFrag = createShader(p.device, kGridFrag, sizeof kGridFrag);
+    VkShaderModule vert = vk::createShaderModule(p.device, kMeshVert);
+    VkShaderModule frag = vk::createShaderModule(p.device, kMeshFrag);
+    VkShaderModule gridVert = vk::createShaderModule(p.device, kGridVert);
+    VkShaderModule gridFrag = vk::createShaderModule(p.device, kGridFrag);
     PipelineState state(p, vert, frag);
     // Culling back faces halves the triangles a CPU device sets up; only a closed mesh may,
     // since where bounds cut the surface open its inside shows.
@@ -293,8 +252,8 @@ void createMeshPipeline(Presenter& p) {
 void destroyMeshTarget(Presenter& p) {
     if (p.meshFramebuffer) vkDestroyFramebuffer(p.device, p.meshFramebuffer, nullptr);
     p.meshFramebuffer = VK_NULL_HANDLE;
-    destroyTarget(p, p.meshColor);
-    destroyTarget(p, p.meshDepth);
+    vk::destroyImage(p.device, p.meshColor);
+    vk::destroyImage(p.device, p.meshDepth);
     p.meshExtent = {};
     p.meshDrawn = false;
 }
@@ -305,12 +264,12 @@ void ensureMeshTarget(Presenter& p) {
         return;
     destroyMeshTarget(p);
     p.meshColor =
-        createTarget(p, p.extent, VK_FORMAT_R8G8B8A8_UNORM,
-                     VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-                     VK_IMAGE_ASPECT_COLOR_BIT);
+        vk::createImage(p.device, p.memoryProperties, p.extent, VK_FORMAT_R8G8B8A8_UNORM,
+                        VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                        VK_IMAGE_ASPECT_COLOR_BIT);
     p.meshDepth =
-        createTarget(p, p.extent, p.depthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
-                     VK_IMAGE_ASPECT_DEPTH_BIT);
+        vk::createImage(p.device, p.memoryProperties, p.extent, p.depthFormat,
+                        VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT);
     VkImageView views[] = {p.meshColor.view, p.meshDepth.view};
     VkFramebufferCreateInfo fb = {VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
     fb.renderPass = p.meshPass;
@@ -324,8 +283,7 @@ void ensureMeshTarget(Presenter& p) {
 }
 
 void destroyMesh(Presenter& p, DeviceMesh& m) {
-    if (m.buffer) vkDestroyBuffer(p.device, m.buffer, nullptr);
-    if (m.memory) vkFreeMemory(p.device, m.memory, nullptr);
+    vk::destroyBuffer(p.device, m.buffer);
     m = DeviceMesh{};
 }
 
@@ -344,39 +302,20 @@ bool uploadMesh(Presenter& p, DeviceMesh& m, const Mesh& mesh, std::string& erro
     const VkDeviceSize total = vertexBytes + indexBytes + cornerBytes; // multiples of 4
     // Through a staging buffer into device-local memory: the mesh is read every frame, and on a
     // discrete GPU host-visible memory would be read across the bus each time.
-    auto allocate = [&](VkBufferUsageFlags usage, VkMemoryPropertyFlags flags, VkBuffer& buffer,
-                        VkDeviceMemory& memory) {
-        VkBufferCreateInfo info = {VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
-        info.size = total;
-        info.usage = usage;
-        VK_CHECK(vkCreateBuffer(p.device, &info, nullptr, &buffer));
-        VkMemoryRequirements req;
-        vkGetBufferMemoryRequirements(p.device, buffer, &req);
-        VkMemoryAllocateInfo alloc = {VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-        alloc.allocationSize = req.size;
-        alloc.memoryTypeIndex = memoryType(p, req.memoryTypeBits, flags);
+    vk::Buffer staging;
+    auto allocate = [&](VkBufferUsageFlags usage, vk::MemoryUse use, vk::Buffer& buffer) {
         // A fine mesh can exhaust the memory: the user's choice of resolution, not a bug.
-        VkResult result = vkAllocateMemory(p.device, &alloc, nullptr, &memory);
-        if (result == VK_ERROR_OUT_OF_DEVICE_MEMORY || result == VK_ERROR_OUT_OF_HOST_MEMORY) {
-            error = "not enough memory to draw the mesh (" + std::to_string(total >> 20) + " MiB)";
-            return false;
-        }
-        VK_CHECK(result);
-        VK_CHECK(vkBindBufferMemory(p.device, buffer, memory, 0));
-        return true;
+        if (vk::createBuffer(p.device, p.memoryProperties, total, usage, use, buffer) == VK_SUCCESS)
+            return true;
+        error = "not enough memory to draw the mesh (" + std::to_string(total >> 20) + " MiB)";
+        return false;
     };
-    VkBuffer staging = VK_NULL_HANDLE;
-    VkDeviceMemory stagingMemory = VK_NULL_HANDLE;
-    bool ok = allocate(VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                       VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
-                       staging, stagingMemory) &&
+    bool ok = allocate(VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Staging, staging) &&
               allocate(VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_INDEX_BUFFER_BIT |
                            VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                       VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, m.buffer, m.memory);
+                       vk::MemoryUse::Device, m.buffer);
     if (ok) {
-        void* mapped = nullptr;
-        VK_CHECK(vkMapMemory(p.device, stagingMemory, 0, VK_WHOLE_SIZE, 0, &mapped));
-        auto* bytes = static_cast<unsigned char*>(mapped);
+        auto* bytes = static_cast<unsigned char*>(staging.data);
         // Written from the mesh, never read back: mapped memory may be uncached.
         const bool coloured = mesh.colors.size() == mesh.positions.size();
         auto vertex = [&](size_t i) { // a mesh without colours is light grey
@@ -390,23 +329,17 @@ bool uploadMesh(Presenter& p, DeviceMesh& m, const Mesh& mesh, std::string& erro
         auto* corners = reinterpret_cast<MeshVertex*>(bytes + vertexBytes + indexBytes);
         for (size_t i = 0; i < mesh.indices.size(); ++i)
             corners[i] = vertex(mesh.indices[i]);
-        vkUnmapMemory(p.device, stagingMemory);
+        vk::flushBuffer(p.device, staging);
         submitNow(p, [&](VkCommandBuffer cmd) {
             VkBufferCopy region = {0, 0, total};
-            vkCmdCopyBuffer(cmd, staging, m.buffer, 1, &region);
-            VkBufferMemoryBarrier b = {VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
-            b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-            b.dstAccessMask = VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT | VK_ACCESS_INDEX_READ_BIT;
-            b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-            b.buffer = m.buffer;
-            b.size = VK_WHOLE_SIZE;
-            vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                                 VK_PIPELINE_STAGE_VERTEX_INPUT_BIT, 0, 0, nullptr, 1, &b, 0,
-                                 nullptr);
+            vkCmdCopyBuffer(cmd, staging.buffer, m.buffer.buffer, 1, &region);
+            vk::recordBufferBarrier(cmd, m.buffer.buffer, VK_ACCESS_TRANSFER_WRITE_BIT,
+                                    VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT | VK_ACCESS_INDEX_READ_BIT,
+                                    VK_PIPELINE_STAGE_TRANSFER_BIT,
+                                    VK_PIPELINE_STAGE_VERTEX_INPUT_BIT);
         });
     }
-    if (staging) vkDestroyBuffer(p.device, staging, nullptr);
-    if (stagingMemory) vkFreeMemory(p.device, stagingMemory, nullptr);
+    vk::destroyBuffer(p.device, staging);
     if (!ok) {
         destroyMesh(p, m);
         return false;
@@ -502,12 +435,12 @@ void drawMesh(Presenter& p, const MeshView& view, const float background[3]) {
     vkCmdBindPipeline(p.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p.meshPipelines[view.closed]);
     const DeviceMesh& m = shownMesh(p, view);
     if (view.wireframe) {
-        vkCmdBindVertexBuffers(p.cmd, 0, 1, &m.buffer, &m.cornerOffset);
+        vkCmdBindVertexBuffers(p.cmd, 0, 1, &m.buffer.buffer, &m.cornerOffset);
         vkCmdDraw(p.cmd, m.indexCount, 1, 0, 0);
     } else {
         const VkDeviceSize start = 0;
-        vkCmdBindVertexBuffers(p.cmd, 0, 1, &m.buffer, &start);
-        vkCmdBindIndexBuffer(p.cmd, m.buffer, m.indexOffset, VK_INDEX_TYPE_UINT32);
+        vkCmdBindVertexBuffers(p.cmd, 0, 1, &m.buffer.buffer, &start);
+        vkCmdBindIndexBuffer(p.cmd, m.buffer.buffer, m.indexOffset, VK_INDEX_TYPE_UINT32);
         vkCmdDrawIndexed(p.cmd, m.indexCount, 1, 0, 0, 0);
     }
     if (view.grid) { // two lines of two vertices each per step along each axis

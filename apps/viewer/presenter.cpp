@@ -7,125 +7,32 @@
 #include <imgui_impl_vulkan.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cstddef>
-#include <cstdio>
-#include <cstdlib>
 #include <cstring>
-#include <string_view>
 #include <vector>
 
 namespace sdfcsg::viewer {
 
-void check(VkResult result, const char* call, const char* file, int line) {
-    if (result == VK_SUCCESS) return;
-    std::fprintf(stderr, "%s:%d: %s failed: VkResult %d\n", file, line, call, int(result));
-    std::abort();
-}
-
 namespace {
 
 void imguiCheck(VkResult result) {
-    check(result, "ImGui Vulkan backend", __FILE__, __LINE__);
+    if (result != VK_SUCCESS) vk::fail("ImGui Vulkan backend", result, __FILE__, __LINE__);
 }
 
-VKAPI_ATTR VkBool32 VKAPI_CALL debugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
-                                             VkDebugUtilsMessageTypeFlagsEXT,
-                                             const VkDebugUtilsMessengerCallbackDataEXT* data,
-                                             void* user) {
-    static_cast<Presenter*>(user)->validationMessages.fetch_add(1);
-    const char* level =
-        (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) ? "error" : "warning";
-    std::fprintf(stderr, "vulkan validation (window) %s: %s\n", level,
-                 data && data->pMessage ? data->pMessage : "(no message)");
-    return VK_FALSE;
-}
-
-bool validationLayerInstalled() {
-    uint32_t count = 0;
-    vkEnumerateInstanceLayerProperties(&count, nullptr);
-    std::vector<VkLayerProperties> layers(count);
-    vkEnumerateInstanceLayerProperties(&count, layers.data());
-    for (const VkLayerProperties& l : layers)
-        if (std::string_view(l.layerName) == "VK_LAYER_KHRONOS_validation") return true;
-    return false;
-}
-
-} // namespace
-
-uint32_t memoryType(const Presenter& p, uint32_t bits, VkMemoryPropertyFlags flags) {
-    for (uint32_t i = 0; i < p.memoryProperties.memoryTypeCount; ++i)
-        if ((bits & (1u << i)) &&
-            (p.memoryProperties.memoryTypes[i].propertyFlags & flags) == flags)
-            return i;
-    std::fprintf(stderr, "presenter: no suitable memory type\n");
-    std::abort();
-}
-
-void createImage(Presenter& p, VkExtent2D extent, VkFormat format, VkImageUsageFlags usage,
-                 VkImage& image, VkDeviceMemory& memory) {
-    VkImageCreateInfo info = {VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
-    info.imageType = VK_IMAGE_TYPE_2D;
-    info.format = format;
-    info.extent = {extent.width, extent.height, 1};
-    info.mipLevels = 1;
-    info.arrayLayers = 1;
-    info.samples = VK_SAMPLE_COUNT_1_BIT;
-    info.tiling = VK_IMAGE_TILING_OPTIMAL;
-    info.usage = usage;
-    info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    VK_CHECK(vkCreateImage(p.device, &info, nullptr, &image));
-    VkMemoryRequirements req;
-    vkGetImageMemoryRequirements(p.device, image, &req);
-    VkMemoryAllocateInfo alloc = {VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-    alloc.allocationSize = req.size;
-    alloc.memoryTypeIndex = memoryType(p, req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-    VK_CHECK(vkAllocateMemory(p.device, &alloc, nullptr, &memory));
-    VK_CHECK(vkBindImageMemory(p.device, image, memory, 0));
-}
-
-namespace {
-
-void destroyBuffer(Presenter& p, Buffer& b) {
-    if (b.buffer) vkDestroyBuffer(p.device, b.buffer, nullptr);
-    if (b.memory) vkFreeMemory(p.device, b.memory, nullptr);
-    b = {};
-}
-
-// Host-visible, coherent, persistently mapped.
-void ensureBuffer(Presenter& p, Buffer& b, VkDeviceSize size, VkBufferUsageFlags usage) {
+// Host visible and mapped, replaced by a larger one when it is too small.
+void ensureBuffer(Presenter& p, vk::Buffer& b, VkDeviceSize size, VkBufferUsageFlags usage) {
     if (b.size >= size) return;
-    destroyBuffer(p, b);
-    VkBufferCreateInfo info = {VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
-    info.size = size;
-    info.usage = usage;
-    VK_CHECK(vkCreateBuffer(p.device, &info, nullptr, &b.buffer));
-    VkMemoryRequirements req;
-    vkGetBufferMemoryRequirements(p.device, b.buffer, &req);
-    VkMemoryAllocateInfo alloc = {VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-    alloc.allocationSize = req.size;
-    alloc.memoryTypeIndex =
-        memoryType(p, req.memoryTypeBits,
-                   VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
-    VK_CHECK(vkAllocateMemory(p.device, &alloc, nullptr, &b.memory));
-    VK_CHECK(vkBindBufferMemory(p.device, b.buffer, b.memory, 0));
-    VK_CHECK(vkMapMemory(p.device, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped));
-    b.size = size;
-}
-
-void destroySceneImage(Presenter& p) {
-    if (p.sceneImage) vkDestroyImage(p.device, p.sceneImage, nullptr);
-    if (p.sceneMemory) vkFreeMemory(p.device, p.sceneMemory, nullptr);
-    p.sceneImage = VK_NULL_HANDLE;
-    p.sceneMemory = VK_NULL_HANDLE;
+    vk::destroyBuffer(p.device, b);
+    VK_CHECK(
+        vk::createBuffer(p.device, p.memoryProperties, size, usage, vk::MemoryUse::Staging, b));
 }
 
 void createSceneImage(Presenter& p, uint32_t width, uint32_t height) {
-    destroySceneImage(p);
+    vk::destroyImage(p.device, p.sceneImage);
     // The bytes as the engine wrote them, no conversion.
-    createImage(p, {width, height}, VK_FORMAT_R8G8B8A8_UNORM,
-                VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, p.sceneImage,
-                p.sceneMemory);
+    p.sceneImage =
+        vk::createImage(p.device, p.memoryProperties, {width, height}, VK_FORMAT_R8G8B8A8_UNORM,
+                        VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
     p.sceneWidth = width;
     p.sceneHeight = height;
 }
@@ -210,20 +117,6 @@ bool createSwapchain(Presenter& p) {
     return true;
 }
 
-void barrier(VkCommandBuffer cmd, VkImage image, VkImageLayout from, VkImageLayout to,
-             VkAccessFlags srcAccess, VkAccessFlags dstAccess, VkPipelineStageFlags srcStage,
-             VkPipelineStageFlags dstStage) {
-    VkImageMemoryBarrier b = {VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
-    b.srcAccessMask = srcAccess;
-    b.dstAccessMask = dstAccess;
-    b.oldLayout = from;
-    b.newLayout = to;
-    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.image = image;
-    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 0, nullptr, 0, nullptr, 1, &b);
-}
-
 // createPresenter's steps after the instance and the window's surface (defined below it).
 bool pickDevice(Presenter& p, std::string& error);
 void createDevice(Presenter& p);
@@ -243,39 +136,12 @@ PresenterPtr createPresenter(GLFWwindow* window, bool validationWanted, std::str
         error = "GLFW found no Vulkan window-system support";
         return nullptr;
     }
-    VkApplicationInfo app = {VK_STRUCTURE_TYPE_APPLICATION_INFO};
-    app.pApplicationName = "sdfcsg-viewer";
-    app.apiVersion = VK_API_VERSION_1_1;
-    std::vector<const char*> instanceExtensions(extensions, extensions + extensionCount);
-    const bool validation = validationWanted && validationLayerInstalled();
-    const char* layer = "VK_LAYER_KHRONOS_validation";
-    VkDebugUtilsMessengerCreateInfoEXT messengerInfo = {
-        VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-    messengerInfo.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
-                                    VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-    messengerInfo.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
-                                VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
-                                VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
-    messengerInfo.pfnUserCallback = debugCallback;
-    messengerInfo.pUserData = p.get();
-    VkInstanceCreateInfo instanceInfo = {VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
-    instanceInfo.pApplicationInfo = &app;
-    if (validation) {
-        instanceExtensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
-        instanceInfo.enabledLayerCount = 1;
-        instanceInfo.ppEnabledLayerNames = &layer;
-        instanceInfo.pNext = &messengerInfo;
-    }
-    instanceInfo.enabledExtensionCount = uint32_t(instanceExtensions.size());
-    instanceInfo.ppEnabledExtensionNames = instanceExtensions.data();
-    if (vkCreateInstance(&instanceInfo, nullptr, &p->instance) != VK_SUCCESS) {
+    const bool validation = validationWanted && vk::validationAvailable();
+    if (vk::createInstance("sdfcsg-viewer", VK_API_VERSION_1_1, {extensions, extensionCount},
+                           validation ? &p->validationMessages : nullptr, p->instance,
+                           p->messenger) != VK_SUCCESS) {
         error = "could not create a Vulkan instance with window-system extensions";
         return nullptr;
-    }
-    if (validation) {
-        auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
-            vkGetInstanceProcAddr(p->instance, "vkCreateDebugUtilsMessengerEXT"));
-        VK_CHECK(create(p->instance, &messengerInfo, nullptr, &p->messenger));
     }
     if (glfwCreateWindowSurface(p->instance, window, nullptr, &p->surface) != VK_SUCCESS) {
         error = "could not create a Vulkan surface for the window";
@@ -445,16 +311,9 @@ void initImGui(Presenter& p) {
     init.CheckVkResultFn = imguiCheck;
     ImGui_ImplVulkan_Init(&init, p.renderPass);
 
-    VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-    begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    VK_CHECK(vkBeginCommandBuffer(p.cmd, &begin));
+    vk::beginCommands(p.cmd);
     ImGui_ImplVulkan_CreateFontsTexture(p.cmd);
-    VK_CHECK(vkEndCommandBuffer(p.cmd));
-    VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
-    submit.commandBufferCount = 1;
-    submit.pCommandBuffers = &p.cmd;
-    VK_CHECK(vkQueueSubmit(p.queue, 1, &submit, VK_NULL_HANDLE));
-    VK_CHECK(vkDeviceWaitIdle(p.device));
+    vk::submitAndWait(p.device, p.queue, p.cmd, p.fence);
     ImGui_ImplVulkan_DestroyFontUploadObjects();
 }
 
@@ -465,9 +324,9 @@ void destroyPresenter(Presenter* p) {
     if (p->device) {
         vkDeviceWaitIdle(p->device);
         if (p->renderPass) ImGui_ImplVulkan_Shutdown();
-        destroyBuffer(*p, p->staging);
-        destroyBuffer(*p, p->readback);
-        destroySceneImage(*p);
+        vk::destroyBuffer(p->device, p->staging);
+        vk::destroyBuffer(p->device, p->readback);
+        vk::destroyImage(p->device, p->sceneImage);
         for (DeviceMesh& m : p->meshes)
             destroyMesh(*p, m);
         destroyMeshTarget(*p);
@@ -488,12 +347,7 @@ void destroyPresenter(Presenter* p) {
         vkDestroyDevice(p->device, nullptr);
     }
     if (p->surface) vkDestroySurfaceKHR(p->instance, p->surface, nullptr);
-    if (p->messenger) {
-        auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
-            vkGetInstanceProcAddr(p->instance, "vkDestroyDebugUtilsMessengerEXT"));
-        destroy(p->instance, p->messenger, nullptr);
-    }
-    if (p->instance) vkDestroyInstance(p->instance, nullptr);
+    vk::destroyInstance(p->instance, p->messenger);
     delete p;
 }
 
@@ -501,7 +355,7 @@ void setImage(Presenter& p, const Image& image) {
     if (image.width == 0 || image.height == 0) return;
     ensureBuffer(p, p.staging, image.rgba.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
     // The previous frame has finished (drawFrame waits), so the buffer is free to overwrite.
-    std::memcpy(p.staging.mapped, image.rgba.data(), image.rgba.size());
+    vk::uploadBuffer(p.device, p.staging, image.rgba.data(), image.rgba.size());
     if (image.width != p.sceneWidth || image.height != p.sceneHeight)
         createSceneImage(p, image.width, image.height);
     p.sceneDirty = true;
@@ -512,27 +366,27 @@ namespace {
 
 // The engine's new image, from the staging buffer into the scene image.
 void recordSceneUpload(Presenter& p) {
-    barrier(p.cmd, p.sceneImage, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
-            VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
-            VK_PIPELINE_STAGE_TRANSFER_BIT);
+    vk::recordImageBarrier(p.cmd, p.sceneImage.image, VK_IMAGE_LAYOUT_UNDEFINED,
+                           VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0, VK_ACCESS_TRANSFER_WRITE_BIT,
+                           VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
     VkBufferImageCopy region = {};
     region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
     region.imageExtent = {p.sceneWidth, p.sceneHeight, 1};
-    vkCmdCopyBufferToImage(p.cmd, p.staging.buffer, p.sceneImage,
+    vkCmdCopyBufferToImage(p.cmd, p.staging.buffer, p.sceneImage.image,
                            VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-    barrier(p.cmd, p.sceneImage, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-            VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
-            VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-            VK_PIPELINE_STAGE_TRANSFER_BIT);
+    vk::recordImageBarrier(p.cmd, p.sceneImage.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                           VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
+                           VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                           VK_PIPELINE_STAGE_TRANSFER_BIT);
     p.sceneDirty = false;
 }
 
 // The window's image cleared to the background, and the scene image or the mesh view blitted
 // over it.
 void recordBackground(Presenter& p, VkImage target, const float background[3], bool drawsMesh) {
-    barrier(p.cmd, target, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
-            VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-            VK_PIPELINE_STAGE_TRANSFER_BIT);
+    vk::recordImageBarrier(p.cmd, target, VK_IMAGE_LAYOUT_UNDEFINED,
+                           VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0, VK_ACCESS_TRANSFER_WRITE_BIT,
+                           VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
     VkClearColorValue clear = {{background[0], background[1], background[2], 1.0f}};
     VkImageSubresourceRange range = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
     vkCmdClearColorImage(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &clear, 1, &range);
@@ -540,13 +394,13 @@ void recordBackground(Presenter& p, VkImage target, const float background[3], b
         // The engine renders at the window's aspect ratio, at full or reduced size; stretching
         // fills the window either way. Same size (always so for the mesh): a plain copy of
         // every pixel.
-        const VkImage source = drawsMesh ? p.meshColor.image : p.sceneImage;
+        const VkImage source = drawsMesh ? p.meshColor.image : p.sceneImage.image;
         const uint32_t width = drawsMesh ? p.meshExtent.width : p.sceneWidth;
         const uint32_t height = drawsMesh ? p.meshExtent.height : p.sceneHeight;
-        barrier(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
-                VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                VK_PIPELINE_STAGE_TRANSFER_BIT);
+        vk::recordImageBarrier(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                               VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
+                               VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                               VK_PIPELINE_STAGE_TRANSFER_BIT);
         VkImageBlit blit = {};
         blit.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
         blit.srcOffsets[1] = {int32_t(width), int32_t(height), 1};
@@ -561,10 +415,11 @@ void recordBackground(Presenter& p, VkImage target, const float background[3], b
 
 // ImGui over the image, in the window's render pass, which leaves it ready to present.
 void recordUi(Presenter& p, VkImage target, uint32_t index, ImDrawData* ui) {
-    barrier(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-            VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
-            VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
-            VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT);
+    vk::recordImageBarrier(
+        p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+        VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
+        VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
+        VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT);
     VkRenderPassBeginInfo pass = {VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
     pass.renderPass = p.renderPass;
     pass.framebuffer = p.framebuffers[index];
@@ -578,25 +433,21 @@ void recordUi(Presenter& p, VkImage target, uint32_t index, ImDrawData* ui) {
 void recordCapture(Presenter& p, VkImage target) {
     ensureBuffer(p, p.readback, VkDeviceSize(p.extent.width) * p.extent.height * 4,
                  VK_BUFFER_USAGE_TRANSFER_DST_BIT);
-    barrier(p.cmd, target, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-            VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT,
-            VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
+    vk::recordImageBarrier(
+        p.cmd, target, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+        VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT,
+        VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
     VkBufferImageCopy region = {};
     region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
     region.imageExtent = {p.extent.width, p.extent.height, 1};
     vkCmdCopyImageToBuffer(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, p.readback.buffer,
                            1, &region);
-    barrier(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
-            VK_ACCESS_TRANSFER_READ_BIT, 0, VK_PIPELINE_STAGE_TRANSFER_BIT,
-            VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT);
-    VkBufferMemoryBarrier host = {VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
-    host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-    host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-    host.srcQueueFamilyIndex = host.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    host.buffer = p.readback.buffer;
-    host.size = VK_WHOLE_SIZE;
-    vkCmdPipelineBarrier(p.cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 0,
-                         nullptr, 1, &host, 0, nullptr);
+    vk::recordImageBarrier(p.cmd, target, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                           VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_ACCESS_TRANSFER_READ_BIT, 0,
+                           VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT);
+    vk::recordBufferBarrier(p.cmd, p.readback.buffer, VK_ACCESS_TRANSFER_WRITE_BIT,
+                            VK_ACCESS_HOST_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                            VK_PIPELINE_STAGE_HOST_BIT);
 }
 
 // Submits the frame and presents it, then waits for it: one frame in flight, as the image takes
@@ -644,7 +495,8 @@ void readCapture(const Presenter& p, Image& capture) {
     capture.width = p.extent.width;
     capture.height = p.extent.height;
     capture.rgba.resize(size_t(p.extent.width) * p.extent.height * 4);
-    std::memcpy(capture.rgba.data(), p.readback.mapped, capture.rgba.size());
+    vk::invalidateBuffer(p.device, p.readback);
+    std::memcpy(capture.rgba.data(), p.readback.data, capture.rgba.size());
     bool bgra =
         p.format.format == VK_FORMAT_B8G8R8A8_UNORM || p.format.format == VK_FORMAT_B8G8R8A8_SRGB;
     for (size_t i = 0; i < capture.rgba.size(); i += 4) {
@@ -669,9 +521,7 @@ bool drawFrame(Presenter& p, ImDrawData* ui, const float background[3], const Me
     VkImage target = p.images[index];
 
     VK_CHECK(vkResetCommandBuffer(p.cmd, 0));
-    VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-    begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    VK_CHECK(vkBeginCommandBuffer(p.cmd, &begin));
+    vk::beginCommands(p.cmd);
     const bool drawsMesh = mesh && p.meshes[0].indexCount > 0;
     bool meshDrawn = false; // this frame
     if (drawsMesh) {
@@ -699,7 +549,7 @@ bool drawFrame(Presenter& p, ImDrawData* ui, const float background[3], const Me
 }
 
 uint32_t presenterValidationMessages(const Presenter& p) {
-    return p.validationMessages.load();
+    return p.validationMessages.count.load();
 }
 
 std::string presenterDeviceName(const Presenter& p) {

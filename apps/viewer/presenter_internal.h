@@ -5,40 +5,20 @@
 
 #include "presenter.h"
 
-#include <vulkan/vulkan.h>
+#include "vulkan_helpers.h" // the engine's helpers on plain handles, and VK_CHECK
 
-#include <atomic>
 #include <cstdint>
 #include <string>
 #include <vector>
 
 namespace sdfcsg::viewer {
 
-// As in the engine: a failing Vulkan call here is a bug or a lost device, not a user error.
-void check(VkResult result, const char* call, const char* file, int line);
-#define VK_CHECK(call) check((call), #call, __FILE__, __LINE__)
-
-struct Buffer {
-    VkBuffer buffer = VK_NULL_HANDLE;
-    VkDeviceMemory memory = VK_NULL_HANDLE;
-    void* mapped = nullptr;
-    VkDeviceSize size = 0;
-};
-
-// An image the mesh is drawn into, with its memory and view.
-struct Target {
-    VkImage image = VK_NULL_HANDLE;
-    VkDeviceMemory memory = VK_NULL_HANDLE;
-    VkImageView view = VK_NULL_HANDLE;
-};
-
 // In one device-local buffer: the vertices (MeshVertex), the triangles' indices, and for the
 // wireframe the triangles' corners (three MeshVertex per triangle). The corners triple the memory
 // (about 140 bytes a triangle in all), but lavapipe draws them faster than the welded vertices'
 // edges as lines (62 against 300 ms at 717k triangles).
 struct DeviceMesh {
-    VkBuffer buffer = VK_NULL_HANDLE;
-    VkDeviceMemory memory = VK_NULL_HANDLE;
+    vk::Buffer buffer;
     VkDeviceSize indexOffset = 0, cornerOffset = 0;
     uint32_t indexCount = 0; // 0: no mesh
 };
@@ -47,7 +27,7 @@ struct Presenter {
     GLFWwindow* window = nullptr;
     VkInstance instance = VK_NULL_HANDLE;
     VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
-    std::atomic<uint32_t> validationMessages{0};
+    vk::MessageCounter validationMessages{"(window) "};
     VkPhysicalDevice physical = VK_NULL_HANDLE;
     VkPhysicalDeviceMemoryProperties memoryProperties{};
     std::string deviceName;
@@ -72,20 +52,19 @@ struct Presenter {
     bool rebuild = true;
 
     // The engine's image: host staging buffer, device image it is copied into.
-    Buffer staging;
-    VkImage sceneImage = VK_NULL_HANDLE;
-    VkDeviceMemory sceneMemory = VK_NULL_HANDLE;
+    vk::Buffer staging;
+    vk::Image sceneImage;
     uint32_t sceneWidth = 0, sceneHeight = 0;
     bool sceneDirty = false;
     bool hasScene = false;
-    Buffer readback;
+    vk::Buffer readback;
 
     // The mesh view is drawn into an image of the window's size, then blitted as the engine's
     // image is: a frame whose camera, mesh and size are those of the last draw only blits it,
     // so panels stay quick over a mesh that takes long to draw (a CPU device).
     VkFormat depthFormat = VK_FORMAT_UNDEFINED;
     VkRenderPass meshPass = VK_NULL_HANDLE;
-    Target meshColor, meshDepth;
+    vk::Image meshColor, meshDepth; // with their views
     VkExtent2D meshExtent{};
     VkFramebuffer meshFramebuffer = VK_NULL_HANDLE;
     VkPhysicalDeviceLimits limits{};
@@ -99,14 +78,6 @@ struct Presenter {
     uint64_t timestampMask = 0;
     double meshMs = -1.0;
 };
-
-// ---- presenter.cpp ---------------------------------------------------------------------------
-
-// The first of the memory types in `bits` that has all of `flags`; aborts when none has.
-uint32_t memoryType(const Presenter& p, uint32_t bits, VkMemoryPropertyFlags flags);
-// A 2D image in device-local memory, in the undefined layout.
-void createImage(Presenter& p, VkExtent2D extent, VkFormat format, VkImageUsageFlags usage,
-                 VkImage& image, VkDeviceMemory& memory);
 
 // ---- mesh_view.cpp ---------------------------------------------------------------------------
 

@@ -1,7 +1,8 @@
 // sdfcsg: errors the user can cause come back as values.
 //
 // A Diagnostic names the file, the JSON path of the offending value and what was expected.
-// Vulkan failures that can only be bugs abort with file:line instead (see engine/src/gpu/vk.h).
+// Vulkan failures that can only be bugs abort with file:line instead (VK_CHECK in
+// engine/vulkan/vulkan_helpers.h).
 #pragma once
 
 #include <string>

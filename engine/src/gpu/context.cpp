@@ -7,51 +7,15 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cstdio>
 #include <string_view>
 #include <vector>
 
 namespace sdfcsg {
 namespace {
 
-constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
-
 Error vulkanError(std::string text, VkResult result = VK_SUCCESS) {
-    if (result != VK_SUCCESS) text += std::string(" (") + detail::vkResultName(result) + ")";
+    if (result != VK_SUCCESS) text += std::string(" (") + vk::resultName(result) + ")";
     return Error::message(ErrorKind::Vulkan, "<vulkan>", std::move(text));
-}
-
-VKAPI_ATTR VkBool32 VKAPI_CALL debugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
-                                             VkDebugUtilsMessageTypeFlagsEXT,
-                                             const VkDebugUtilsMessengerCallbackDataEXT* data,
-                                             void* user) {
-    auto* impl = static_cast<Context::Impl*>(user);
-    impl->validationMessages.fetch_add(1, std::memory_order_relaxed);
-    const char* level =
-        (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) ? "error" : "warning";
-    std::fprintf(stderr, "vulkan validation %s: %s\n", level,
-                 data && data->pMessage ? data->pMessage : "(no message)");
-    return VK_FALSE;
-}
-
-bool layerAvailable(const char* name) {
-    uint32_t count = 0;
-    VK_CHECK(vkEnumerateInstanceLayerProperties(&count, nullptr));
-    std::vector<VkLayerProperties> layers(count);
-    VK_CHECK(vkEnumerateInstanceLayerProperties(&count, layers.data()));
-    return std::any_of(layers.begin(), layers.end(), [&](const VkLayerProperties& l) {
-        return std::string_view(l.layerName) == name;
-    });
-}
-
-bool extensionAvailable(const char* layer, const char* name) {
-    uint32_t count = 0;
-    VK_CHECK(vkEnumerateInstanceExtensionProperties(layer, &count, nullptr));
-    std::vector<VkExtensionProperties> list(count);
-    VK_CHECK(vkEnumerateInstanceExtensionProperties(layer, &count, list.data()));
-    return std::any_of(list.begin(), list.end(), [&](const VkExtensionProperties& e) {
-        return std::string_view(e.extensionName) == name;
-    });
 }
 
 // 1: required, 0: off, -1: on if installed. SDFCSG_VALIDATION=1 asks for it explicitly, so a
@@ -138,12 +102,7 @@ Context::Impl::~Impl() {
         if (commandPool) vkDestroyCommandPool(device, commandPool, nullptr);
         vkDestroyDevice(device, nullptr);
     }
-    if (messenger) {
-        auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
-            vkGetInstanceProcAddr(instance, "vkDestroyDebugUtilsMessengerEXT"));
-        if (destroy) destroy(instance, messenger, nullptr);
-    }
-    if (instance) vkDestroyInstance(instance, nullptr);
+    vk::destroyInstance(instance, messenger);
 }
 
 Context::Context(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -159,7 +118,7 @@ bool Context::validationEnabled() const {
     return impl_->validation;
 }
 uint32_t Context::validationMessageCount() const {
-    return impl_->validationMessages.load(std::memory_order_relaxed);
+    return impl_->validationMessages.count.load(std::memory_order_relaxed);
 }
 
 Status detail::setUpContext(Context::Impl& impl, const ContextOptions& options,
@@ -174,52 +133,20 @@ Status detail::setUpContext(Context::Impl& impl, const ContextOptions& options,
     // Validation: 1 = required, -1 = if available, 0 = off.
     int validation = wantedValidation(options.validation);
     if (validation != 0) {
-        bool available = layerAvailable(kValidationLayer) &&
-                         extensionAvailable(nullptr, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+        bool available = vk::validationAvailable();
         if (!available && validation == 1)
             return vulkanError(
-                std::string(kValidationLayer) +
+                std::string(vk::kValidationLayer) +
                 " was requested but is not installed (Debian: vulkan-validationlayers)");
         impl.validation = available;
     }
 
-    VkApplicationInfo app = {VK_STRUCTURE_TYPE_APPLICATION_INFO};
-    app.pApplicationName = "sdfcsg";
-    app.pEngineName = "sdfcsg";
-    app.apiVersion = std::min<uint32_t>(loaderVersion, VK_API_VERSION_1_3);
-
-    const char* layers[] = {kValidationLayer};
-    const char* extensions[] = {VK_EXT_DEBUG_UTILS_EXTENSION_NAME};
-
-    VkDebugUtilsMessengerCreateInfoEXT messengerInfo = {
-        VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-    messengerInfo.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
-                                    VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-    messengerInfo.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
-                                VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
-                                VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
-    messengerInfo.pfnUserCallback = debugCallback;
-    messengerInfo.pUserData = &report;
-
-    VkInstanceCreateInfo info = {VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
-    info.pApplicationInfo = &app;
-    if (impl.validation) {
-        info.enabledLayerCount = 1;
-        info.ppEnabledLayerNames = layers;
-        info.enabledExtensionCount = 1;
-        info.ppEnabledExtensionNames = extensions;
-        info.pNext = &messengerInfo; // also reports problems in vkCreate/DestroyInstance
-    }
-    VkResult result = vkCreateInstance(&info, nullptr, &impl.instance);
+    VkResult result = vk::createInstance(
+        "sdfcsg", std::min<uint32_t>(loaderVersion, VK_API_VERSION_1_3), {},
+        impl.validation ? &report.validationMessages : nullptr, impl.instance, impl.messenger);
     if (result == VK_ERROR_INCOMPATIBLE_DRIVER)
         return vulkanError("no Vulkan driver is installed (Debian: mesa-vulkan-drivers)", result);
     if (result != VK_SUCCESS) return vulkanError("cannot create a Vulkan instance", result);
-
-    if (impl.validation) {
-        auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
-            vkGetInstanceProcAddr(impl.instance, "vkCreateDebugUtilsMessengerEXT"));
-        VK_CHECK(create(impl.instance, &messengerInfo, nullptr, &impl.messenger));
-    }
 
     // Device selection.
     uint32_t count = 0;

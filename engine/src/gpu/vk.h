@@ -1,5 +1,6 @@
-// Private Vulkan plumbing: the context's internals and small helpers for buffers, compute
-// pipelines, descriptors and one-shot submissions. Plain structs and free functions.
+// Private Vulkan plumbing: the context's internals, and helpers for buffers, compute pipelines,
+// descriptors and one-shot submissions on a context. Plain structs and free functions, over the
+// helpers on plain handles that the viewer shares (engine/vulkan/vulkan_helpers.h).
 //
 // Errors the user can cause (no device, out of memory for a requested size) come back as
 // Results; every other VkResult that is not VK_SUCCESS is a bug and aborts via VK_CHECK, in
@@ -9,6 +10,8 @@
 #include "sdfcsg/compile.h"
 #include "sdfcsg/context.h"
 #include "sdfcsg/error.h"
+
+#include "vulkan_helpers.h"
 
 #include <vulkan/vulkan.h>
 
@@ -20,20 +23,6 @@
 #include <span>
 #include <string>
 #include <thread>
-
-namespace sdfcsg::detail {
-
-[[noreturn]] void vkFail(const char* call, VkResult result, const char* file, int line);
-const char* vkResultName(VkResult result);
-
-} // namespace sdfcsg::detail
-
-#define VK_CHECK(call)                                                                             \
-    do {                                                                                           \
-        VkResult vkCheckResult_ = (call);                                                          \
-        if (vkCheckResult_ != VK_SUCCESS)                                                          \
-            ::sdfcsg::detail::vkFail(#call, vkCheckResult_, __FILE__, __LINE__);                   \
-    } while (0)
 
 namespace sdfcsg {
 
@@ -53,9 +42,9 @@ struct Context::Impl {
     // the queue are shared by every Renderer and Mesher of the context, whatever their thread.
     std::mutex submitMutex;
     bool validation = false;
-    std::atomic<uint32_t> validationMessages{0};
-    std::thread compilerWarmUp; // detail::warmUpCompiler(), while the device is set up
-    uint32_t deviceIndex = 0;   // in vkEnumeratePhysicalDevices' order
+    vk::MessageCounter validationMessages; // this context's and its compile helper's
+    std::thread compilerWarmUp;            // detail::warmUpCompiler(), while the device is set up
+    uint32_t deviceIndex = 0;              // in vkEnumeratePhysicalDevices' order
     // How the renderers and meshers of this context compile: ContextOptions::shaderCacheDir, or
     // the environment's, resolved when the context is made.
     CompileOptions compile;
@@ -91,31 +80,24 @@ inline Context::Impl& contextImpl(Context& context) {
 // command pool and fence: Context::create, and the compile helper.
 Status setUpContext(Context::Impl& impl, const ContextOptions& options, Context::Impl& report);
 
-enum class MemoryUse {
-    Upload,   // written by the host every frame, read by shaders (uniforms, node data)
-    Readback, // written by shaders, read by the host; device-local where that is also mappable
-    Staging,  // transfer target for Readback buffers that turned out not to be mappable; also
-              // storage the shaders write and the host reads in place (host visible, cached)
-    Device,   // used by shaders alone; device-local where there is such memory
-};
-
-struct Buffer {
-    VkBuffer buffer = VK_NULL_HANDLE;
-    VkDeviceMemory memory = VK_NULL_HANDLE;
-    VkDeviceSize size = 0;
-    void* data = nullptr;  // persistently mapped, or null when the memory is not host visible
-    bool coherent = false; // no flush/invalidate needed
-};
+using vk::Buffer;
+using vk::MemoryUse;
 
 // Out of device or host memory is an ErrorKind::Limit error naming the size; anything else
 // aborts. Sizes of 0 are rounded up to 4 bytes.
 Result<Buffer> createBuffer(Context::Impl& ctx, VkDeviceSize size, VkBufferUsageFlags usage,
                             MemoryUse use);
-void destroyBuffer(Context::Impl& ctx, Buffer& buffer);
+inline void destroyBuffer(Context::Impl& ctx, Buffer& buffer) {
+    vk::destroyBuffer(ctx.device, buffer);
+}
 // Copies to a mapped buffer and flushes it when not coherent.
-void uploadBuffer(Context::Impl& ctx, const Buffer& buffer, const void* data, size_t size);
+inline void uploadBuffer(Context::Impl& ctx, const Buffer& buffer, const void* data, size_t size) {
+    vk::uploadBuffer(ctx.device, buffer, data, size);
+}
 // Makes device writes visible to the host (after the fence): invalidates when not coherent.
-void invalidateBuffer(Context::Impl& ctx, const Buffer& buffer);
+inline void invalidateBuffer(Context::Impl& ctx, const Buffer& buffer) {
+    vk::invalidateBuffer(ctx.device, buffer);
+}
 
 struct SpecConstant {
     uint32_t id;
@@ -127,7 +109,9 @@ struct Binding {
     VkDescriptorType type;
 };
 
-VkShaderModule createShaderModule(Context::Impl& ctx, std::span<const uint32_t> spirv);
+inline VkShaderModule createShaderModule(Context::Impl& ctx, std::span<const uint32_t> spirv) {
+    return vk::createShaderModule(ctx.device, spirv);
+}
 // Every binding is visible to the compute stage.
 VkDescriptorSetLayout createDescriptorSetLayout(Context::Impl& ctx,
                                                 std::span<const Binding> bindings);
