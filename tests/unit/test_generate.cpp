@@ -6,6 +6,7 @@
 
 #include "fake_llm_server.h"
 #include "scene/json_writer.h"
+#include "scene/parse_util.h"
 #include "scoped_env.h"
 
 #include <gtest/gtest.h>
@@ -704,6 +705,42 @@ TEST_F(Generate, KeyInTheBaseUrlIsRedacted) {
               "https://me:url-secret-1234@example.org/v1/chat/completions?key=query-secret-5678");
     EXPECT_EQ(request->shownUrl,
               "https://[redacted]@example.org/v1/chat/completions?key=[redacted]");
+}
+
+// A model that names files as fonts learns nothing about them: whether a path exists, is a
+// folder, a device or a secret, the problem that goes back in the conversation reads the same.
+// A family name loads.
+TEST_F(Generate, FontPathsInAnAnswerTellNothingAboutTheFileSystem) {
+    const std::string home = std::getenv("HOME") ? std::getenv("HOME") : "/root";
+    const std::vector<std::string> probes = {
+        "/etc/passwd", "/etc/shadow",      home + "/.ssh/id_rsa",    "/etc",
+        "/dev/zero",   "/nonexistent.ttf", "../../../../etc/passwd", "No Such Family"};
+    auto answer = [](const std::string& font) {
+        return openAi(R"({"version": 1, "root": {"type": "extrude", "height": 0.2, "children":
+            [{"type": "text", "text": "Hi", "font": )" +
+                      jsonQuote(font) + "}]}}");
+    };
+    std::vector<Scripted> script;
+    for (const std::string& font : probes)
+        script.push_back(answer(font));
+    script.push_back(answer("DejaVu Sans"));
+    server.script(script);
+    auto o = options();
+    o.maxRepairs = int(probes.size());
+    auto g = generateScene("a sign", o);
+    ASSERT_TRUE(g) << g.error().str();
+    EXPECT_FALSE(g->scene.files.trusted);
+    ASSERT_EQ(server.received().size(), probes.size() + 1);
+    for (size_t i = 0; i < probes.size(); ++i) {
+        const std::string repair(lastMessage(body(i + 1)));
+        EXPECT_EQ(repair, "Your scene does not load. The validator reported:\n"
+                          "- root.children[0].font: unknown font " +
+                              detail::quote(probes[i]) +
+                              ": name an installed font family, such as \"DejaVu Sans\", or "
+                              "leave it out\n"
+                              "Answer with the whole corrected scene as one JSON object, and "
+                              "nothing else.");
+    }
 }
 
 TEST_F(Generate, OllamaNativeApi) {

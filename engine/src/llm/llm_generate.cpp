@@ -628,6 +628,11 @@ Result<Generated> generate(std::string_view request, const GenerateOptions& opti
     const std::string url = endpoint->shownUrl, model = endpoint->model;
     Conversation conversation(std::move(*endpoint), options, stats);
     std::vector<Message> messages = firstMessages(request, options);
+    // The answers' problems go back to the model: they may tell nothing about this machine's
+    // files (sdfcsg/scene.h, SceneFiles).
+    ParseOptions untrusted;
+    untrusted.limits = options.limits;
+    untrusted.files.trusted = false;
     const int rounds = std::max(0, options.maxRepairs);
 
     for (int round = 0;; ++round) {
@@ -658,7 +663,7 @@ Result<Generated> generate(std::string_view request, const GenerateOptions& opti
             json.empty()
                 ? Result<Scene>(Error::message(ErrorKind::Validation, std::string(kAnswerFile),
                                                "the model returned no text"))
-                : parseScene(json, kAnswerFile, options.limits);
+                : parseScene(json, kAnswerFile, untrusted);
         if (scene) {
             stats.valid = true;
             stats.firstTryValid = round == 0;
