@@ -7,8 +7,10 @@
 // problems goes back into the conversation with a request for a corrected scene, for a number of
 // rounds. A scene that does not load is never returned.
 //
-// Model output is untrusted: it is parsed under Limits (size, node count, nesting), and a scene
-// names no files, so an answer cannot make the program read or write anything. The API key is
+// Model output is untrusted: it is parsed under Limits (size, node count, nesting) as an
+// untrusted scene (SceneFiles, sdfcsg/scene.h): it may name font families but no file, and its
+// problems say nothing about the file system, so an answer cannot make the program write
+// anything, nor learn what the machine holds. The API key is
 // sent in the Authorization header only; it is never printed, logged or recorded, and where a
 // server echoes it or a model repeats it, messages, recordings and scenes say "[redacted]". A
 // credential typed into the base URL (user information, query values) is redacted the same way.
