@@ -243,7 +243,7 @@ int generateAndWrite(std::string_view command, std::string_view request, Generat
     if (args.has("--dry-run")) {
         auto r = firstLlmRequest(request, options);
         if (!r) return fail(r.error());
-        std::printf("POST %s\n%s\n\n%s\n", r->url.c_str(),
+        std::printf("POST %s\n%s\n\n%s\n", r->shownUrl.c_str(),
                     options.llm.apiKey.empty() ? "(no API key)" : "Authorization: Bearer [hidden]",
                     r->body.c_str());
         return kOk;

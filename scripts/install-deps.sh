@@ -7,7 +7,7 @@ PACKAGES="build-essential cmake ninja-build pkg-config git
   libglm-dev libsimdjson-dev libstb-dev libgtest-dev
   libcurl4-openssl-dev libcpp-httplib-dev
   libglfw3-dev libimgui-dev xvfb xauth gdb
-  libfreetype-dev fonts-dejavu-core zlib1g-dev libmeshoptimizer-dev
+  libfreetype-dev libfontconfig-dev fonts-dejavu-core zlib1g-dev libmeshoptimizer-dev
   clang-14 libclang-rt-14-dev clang-format"
 missing=""
 for p in $PACKAGES; do

@@ -155,7 +155,11 @@ std::optional<uint32_t> sameNode(const Scene& before, uint32_t node, const Scene
 }
 
 Result<Scene> revalidate(const Scene& scene) {
-    auto parsed = parseScene(toJson(scene), scene.file);
+    // Under the rule the scene was loaded by: a generated scene's fonts stay untrusted, and a
+    // file's relative names still resolve beside it.
+    ParseOptions options;
+    options.files = scene.files;
+    auto parsed = parseScene(toJson(scene), scene.file, options);
     if (parsed) parsed->file = scene.file;
     return parsed;
 }

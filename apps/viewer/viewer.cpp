@@ -110,7 +110,7 @@ void describeEndpoint(Viewer& v) {
     v.llm = llmConfigFromEnvironment();
     auto endpoint = llmEndpoint(v.llm);
     v.endpointOk = bool(endpoint);
-    v.endpoint = endpoint ? endpoint->model + " at " + endpoint->url +
+    v.endpoint = endpoint ? endpoint->model + " at " + endpoint->shownUrl +
                                 (v.llm.apiKey.empty() ? " (no API key)" : "")
                           : endpoint.error().str();
 }

@@ -198,6 +198,14 @@ case_generate() {
     check "generate usage" 2 "$bin" generate -o x.json
     check "generate record and replay" 2 "$bin" generate "x" -o x.json --record a --replay b
     check "generate bad base URL" 2 "$bin" generate "x" -o x.json --base-url localhost:9 --model m
+    check "generate without a key" 2 env -u SDFCSG_LLM_API_KEY -u OPENAI_API_KEY -u SDFCSG_LLM_BASE_URL \
+        -u OPENAI_BASE_URL https_proxy=http://127.0.0.1:9 "$bin" generate "x" -o x.json
+    expect_text "generate without a key message" err.txt "<llm>: no API key for api.openai.com: set SDFCSG_LLM_API_KEY or OPENAI_API_KEY, or point SDFCSG_LLM_BASE_URL (or --base-url) at a server that needs no key"
+    check "generate with a key in the base URL" 5 "$bin" generate "x" -o x.json --model m --timeout 5 \
+        --base-url "http://me:url-secret-1234@127.0.0.1:9/v1?key=query-secret-5678"
+    grep -q "secret" out.txt err.txt && { echo "FAIL a key in the base URL was printed"; cat err.txt; failures=$((failures + 1)); }
+    grep -q '^http://\[redacted\]@127.0.0.1:9/v1/chat/completions?key=\[redacted\]: ' err.txt ||
+        { echo "FAIL the redacted base URL"; cat err.txt; failures=$((failures + 1)); }
     check "generate unreachable" 5 "$bin" generate "x" -o x.json $llm --timeout 5
     [ ! -e x.json ] || { echo "FAIL a failed generate left an output"; failures=$((failures + 1)); }
     check "generate replay" 0 "$bin" generate "A snowman" -o snow.json $llm --replay "$recording" --render snow.png

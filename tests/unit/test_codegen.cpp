@@ -19,8 +19,10 @@
 #include <map>
 #include <optional>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace sdfcsg {
@@ -351,6 +353,111 @@ TEST(Codegen, SpirvIsCachedInMemoryAndOnDisk) {
     EXPECT_FALSE(fs::exists(dir));
 }
 
+// A tiny cap: each write trims the folder to it, the least recently used entries first, and
+// reading an entry makes it the most recently used.
+TEST(Codegen, DiskCacheStaysUnderItsCapLeastRecentlyUsedFirst) {
+    const fs::path dir = fs::path(SDFCSG_TEST_OUTPUT_DIR) / "codegen-cache-cap";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    std::ofstream(dir / "notes.txt") << "not the cache's";
+    const std::string stamp =
+        std::to_string(std::chrono::steady_clock::now().time_since_epoch().count());
+    // Four scenes no other test compiles, each a file of the same size (within a few bytes).
+    std::vector<std::string> glsl;
+    for (int i = 0; i < 4; ++i)
+        glsl.push_back(generateSceneGlsl(randomScene(7, 3)) + "// " + stamp + " " +
+                       std::to_string(i) + "\n");
+    CompileOptions uncapped{dir};
+    std::vector<fs::path> files;
+    const auto now = fs::file_time_type::clock::now();
+    for (int i = 0; i < 3; ++i) {
+        std::set<fs::path> before;
+        for (const auto& entry : fs::directory_iterator(dir))
+            before.insert(entry.path());
+        ASSERT_TRUE(compileKernel("probe.comp", glsl[i], uncapped));
+        for (const auto& entry : fs::directory_iterator(dir))
+            if (!before.count(entry.path())) files.push_back(entry.path());
+        ASSERT_EQ(files.size(), size_t(i) + 1);
+        // Entry 0 the oldest, then 1, then 2.
+        fs::last_write_time(files[i], now - std::chrono::minutes(30 - 10 * i));
+    }
+    const uint64_t entryBytes = fs::file_size(files[0]);
+
+    // Reading entry 0 back from disk makes it the most recently used.
+    clearShaderMemoryCache();
+    const auto diskHits = detail::shaderCacheStats().diskHits;
+    ASSERT_TRUE(compileKernel("probe.comp", glsl[0], uncapped));
+    ASSERT_EQ(detail::shaderCacheStats().diskHits, diskHits + 1);
+    EXPECT_GT(fs::last_write_time(files[0]), now - std::chrono::minutes(1));
+
+    // Room for two entries: writing a fourth removes 1 and 2, the least recently used.
+    CompileOptions capped{dir, 2 * entryBytes + entryBytes / 2};
+    const auto evictions = detail::shaderCacheStats().evictions;
+    ASSERT_TRUE(compileKernel("probe.comp", glsl[3], capped));
+    EXPECT_EQ(detail::shaderCacheStats().evictions, evictions + 2);
+    EXPECT_TRUE(fs::exists(files[0]));
+    EXPECT_FALSE(fs::exists(files[1]));
+    EXPECT_FALSE(fs::exists(files[2]));
+    EXPECT_TRUE(fs::exists(dir / "notes.txt"));
+    uint64_t total = 0;
+    size_t entries = 0;
+    for (const auto& entry : fs::directory_iterator(dir))
+        if (entry.path().extension() == ".spv") total += entry.file_size(), ++entries;
+    EXPECT_EQ(entries, 2u);
+    EXPECT_LE(total, *capped.cacheMaxBytes);
+
+    // A cap below one entry keeps the entry just written, and nothing else.
+    CompileOptions tiny{dir, 1};
+    clearShaderMemoryCache();
+    ASSERT_TRUE(compileKernel("probe.comp", glsl[1], tiny));
+    entries = 0;
+    for (const auto& entry : fs::directory_iterator(dir))
+        entries += entry.path().extension() == ".spv";
+    EXPECT_EQ(entries, 1u);
+    clearShaderMemoryCache();
+    const auto hits = detail::shaderCacheStats().diskHits;
+    ASSERT_TRUE(compileKernel("probe.comp", glsl[1], tiny));
+    EXPECT_EQ(detail::shaderCacheStats().diskHits, hits + 1);
+}
+
+// Processes share the folder: a reader keeps an entry that another trims away, files that
+// vanish while a trim lists them are skipped, and a dead writer's old temporaries go.
+TEST(Codegen, TrimmingToleratesVanishingFilesAndOpenReaders) {
+    const fs::path dir = fs::path(SDFCSG_TEST_OUTPUT_DIR) / "codegen-cache-trim";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    auto name = [](int i) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%016x.spv", i);
+        return std::string(text);
+    };
+    const std::string bytes(1000, 'x');
+    for (int i = 0; i < 400; ++i)
+        std::ofstream(dir / name(i)) << bytes;
+    std::ifstream reader(dir / name(0), std::ios::binary);
+    ASSERT_TRUE(reader);
+    std::thread remover([&] {
+        for (int i = 399; i > 0; --i) {
+            std::error_code ec;
+            fs::remove(dir / name(i), ec);
+        }
+    });
+    for (int round = 0; round < 20; ++round)
+        detail::trimShaderCache(dir, 0);
+    remover.join();
+    EXPECT_TRUE(fs::is_empty(dir));
+    std::string read((std::istreambuf_iterator<char>(reader)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(read, bytes) << "an open entry stays readable after it is trimmed away";
+
+    const fs::path fresh = dir / (name(1) + ".tmp123.0"), stale = dir / (name(2) + ".tmp456.0");
+    std::ofstream(fresh) << bytes;
+    std::ofstream(stale) << bytes;
+    fs::last_write_time(stale, fs::file_time_type::clock::now() - std::chrono::hours(2));
+    detail::trimShaderCache(dir, 0);
+    EXPECT_TRUE(fs::exists(fresh)) << "a temporary being written stays";
+    EXPECT_FALSE(fs::exists(stale));
+}
+
 // The variables of sdfcsg/context.h, as the library reads them once (gpu/environment.h).
 TEST(Codegen, SettingsFromTheEnvironment) {
     std::map<std::string, std::string> environment;
@@ -387,6 +494,16 @@ TEST(Codegen, SettingsFromTheEnvironment) {
     e = read();
     EXPECT_EQ(e.shaderCacheDir, fs::path("/cache/sdfcsg"));
     EXPECT_EQ(e.validation, -1);
+
+    EXPECT_EQ(e.shaderCacheMaxBytes, uint64_t(64) << 20);
+    environment["SDFCSG_CACHE_SIZE"] = "16";
+    EXPECT_EQ(read().shaderCacheMaxBytes, uint64_t(16) << 20);
+    environment["SDFCSG_CACHE_SIZE"] = "0.5";
+    EXPECT_EQ(read().shaderCacheMaxBytes, uint64_t(1) << 19);
+    for (const char* ignored : {"0", "-3", "lots", "12MB", ""}) {
+        environment["SDFCSG_CACHE_SIZE"] = ignored;
+        EXPECT_EQ(read().shaderCacheMaxBytes, uint64_t(64) << 20) << ignored;
+    }
 }
 
 } // namespace

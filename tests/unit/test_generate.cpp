@@ -6,6 +6,7 @@
 
 #include "fake_llm_server.h"
 #include "scene/json_writer.h"
+#include "scene/parse_util.h"
 #include "scoped_env.h"
 
 #include <gtest/gtest.h>
@@ -16,6 +17,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <deque>
 #include <filesystem>
 #include <fstream>
@@ -658,6 +660,89 @@ TEST_F(Generate, ConnectionRefused) {
         << g.error().str();
 }
 
+// A key typed into the base URL, as user information and as a query value, reaches the server
+// but no message or recording: not in the URL that messages name, nor where the server quotes it.
+TEST_F(Generate, KeyInTheBaseUrlIsRedacted) {
+    const std::string port = server.url("").substr(std::string("http://127.0.0.1:").size());
+    GenerateOptions o = options();
+    o.llm.baseUrl = "http://me:url-secret-1234@127.0.0.1:" + port + "/v1/?key=query-secret-5678";
+    std::vector<HttpExchange> recording;
+    o.record = &recording;
+    server.script({openAiError(404, "no route for /v1/chat/completions?key=query-secret-5678 "
+                                    "(user me:url-secret-1234)")});
+    auto g = generateScene("a sphere", o);
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().str(), "http://[redacted]@127.0.0.1:" + port +
+                                   "/v1/chat/completions?key=[redacted]: HTTP 404: no route for "
+                                   "/v1/chat/completions?key=[redacted] (user me:[redacted]) "
+                                   "(check the base URL and the model name)");
+    ASSERT_EQ(server.received().size(), 1u);
+    EXPECT_EQ(server.received()[0].path, "/v1/chat/completions");
+    ASSERT_EQ(recording.size(), 1u);
+    EXPECT_EQ(recording[0].url,
+              "http://[redacted]@127.0.0.1:" + port + "/v1/chat/completions?key=[redacted]");
+    EXPECT_EQ(recordingToJson(recording).find("secret"), std::string::npos);
+
+    o.record = nullptr;
+    o.llm.baseUrl = "http://me:url-secret-1234@127.0.0.1:1/v1?key=query-secret-5678";
+    g = generateScene("a sphere", o);
+    ASSERT_FALSE(g);
+    EXPECT_TRUE(g.error().str().starts_with(
+        "http://[redacted]@127.0.0.1:1/v1/chat/completions?key=[redacted]: request failed: "))
+        << g.error().str();
+    EXPECT_EQ(g.error().str().find("secret"), std::string::npos) << g.error().str();
+
+    o.llm.baseUrl = "localhost:1/v1?api_key=query-secret-5678";
+    auto bad = firstLlmRequest("x", o);
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error().diagnostics[0].message,
+              "the base URL must start with http:// or "
+              "https://, got \"localhost:1/v1?api_key=[redacted]\"");
+    o.llm.baseUrl = "https://me:url-secret-1234@example.org/v1?key=query-secret-5678#part";
+    auto request = firstLlmRequest("x", o);
+    ASSERT_TRUE(request) << request.error().str();
+    EXPECT_EQ(request->url,
+              "https://me:url-secret-1234@example.org/v1/chat/completions?key=query-secret-5678");
+    EXPECT_EQ(request->shownUrl,
+              "https://[redacted]@example.org/v1/chat/completions?key=[redacted]");
+}
+
+// A model that names files as fonts learns nothing about them: whether a path exists, is a
+// folder, a device or a secret, the problem that goes back in the conversation reads the same.
+// A family name loads.
+TEST_F(Generate, FontPathsInAnAnswerTellNothingAboutTheFileSystem) {
+    const std::string home = std::getenv("HOME") ? std::getenv("HOME") : "/root";
+    const std::vector<std::string> probes = {
+        "/etc/passwd", "/etc/shadow",      home + "/.ssh/id_rsa",    "/etc",
+        "/dev/zero",   "/nonexistent.ttf", "../../../../etc/passwd", "No Such Family"};
+    auto answer = [](const std::string& font) {
+        return openAi(R"({"version": 1, "root": {"type": "extrude", "height": 0.2, "children":
+            [{"type": "text", "text": "Hi", "font": )" +
+                      jsonQuote(font) + "}]}}");
+    };
+    std::vector<Scripted> script;
+    for (const std::string& font : probes)
+        script.push_back(answer(font));
+    script.push_back(answer("DejaVu Sans"));
+    server.script(script);
+    auto o = options();
+    o.maxRepairs = int(probes.size());
+    auto g = generateScene("a sign", o);
+    ASSERT_TRUE(g) << g.error().str();
+    EXPECT_FALSE(g->scene.files.trusted);
+    ASSERT_EQ(server.received().size(), probes.size() + 1);
+    for (size_t i = 0; i < probes.size(); ++i) {
+        const std::string repair(lastMessage(body(i + 1)));
+        EXPECT_EQ(repair, "Your scene does not load. The validator reported:\n"
+                          "- root.children[0].font: unknown font " +
+                              detail::quote(probes[i]) +
+                              ": name an installed font family, such as \"DejaVu Sans\", or "
+                              "leave it out\n"
+                              "Answer with the whole corrected scene as one JSON object, and "
+                              "nothing else.");
+    }
+}
+
 TEST_F(Generate, OllamaNativeApi) {
     server.script({{200, R"({"model": "test-model", "created_at": "2025-01-01T00:00:00Z",
         "message": {"role": "assistant", "content": )" +
@@ -849,6 +934,22 @@ TEST(GenerateConfig, Usage) {
     auto openai = firstLlmRequest("x", o);
     ASSERT_TRUE(openai);
     EXPECT_NE(openai->body.find(R"("model":"gpt-4o-mini")"), std::string::npos);
+}
+
+// With no key and no base URL, the request would go to api.openai.com without a key and come
+// back a 401 (or fail on the network): generation says at once what to set, and sends nothing.
+// A dry run still shows the request.
+TEST(GenerateConfig, NoKeyForOpenAiSaysWhatToSet) {
+    GenerateOptions o;
+    o.llm = llmConfigFromEnvironment([](const char*) -> const char* { return nullptr; });
+    o.llm.proxy = "http://127.0.0.1:1"; // were a request sent, it would fail here, not say this
+    auto g = generateScene("a sphere", o);
+    ASSERT_FALSE(g);
+    EXPECT_EQ(g.error().kind, ErrorKind::Usage);
+    EXPECT_EQ(g.error().str(), "<llm>: no API key for api.openai.com: set SDFCSG_LLM_API_KEY or "
+                               "OPENAI_API_KEY, or point SDFCSG_LLM_BASE_URL (or --base-url) at a "
+                               "server that needs no key");
+    EXPECT_TRUE(firstLlmRequest("a sphere", o));
 }
 
 TEST(GenerateConfig, EndpointWithTheDefaultsApplied) {

@@ -2,7 +2,9 @@
 // extruded circle is a cylinder, a revolved circle a torus), polygons and text against brute
 // force over their outlines, and the font's outlines against their own geometry.
 #include "scene/font.h"
+#include "scene/json_writer.h"
 #include "scene/outline.h"
+#include "scene/parse_util.h"
 
 #include "scene_build_util.h"
 
@@ -13,6 +15,8 @@
 #include <glm/geometric.hpp>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 namespace sdfcsg {
@@ -201,6 +205,126 @@ TEST(Profiles, BadProfilesGiveExactMessages) {
 }
 
 // Outlines are bounded per scene, not only per node.
+std::string textScene(const std::string& font) {
+    return R"({"version": 1, "root": {"type": "extrude", "height": 0.2, "children": [
+        {"type": "text", "text": "Ab", "font": )" +
+           detail::jsonQuote(font) + "}]}}";
+}
+
+// The working directory for as long as it lives.
+struct InFolder {
+    std::filesystem::path before = std::filesystem::current_path();
+    explicit InFolder(const std::filesystem::path& folder) {
+        std::filesystem::current_path(folder);
+    }
+    ~InFolder() { std::filesystem::current_path(before); }
+};
+
+// A scene and the font beside it move together: the font's relative name resolves in the
+// scene file's folder, whatever the working directory.
+TEST(Profiles, FontBesideTheSceneLoadsFromAnotherWorkingDirectory) {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::path(SDFCSG_TEST_OUTPUT_DIR) / "font-beside" / "scenes";
+    fs::remove_all(dir.parent_path());
+    fs::create_directories(dir / "fonts");
+    fs::copy_file(detail::defaultFontFile(), dir / "fonts" / "Beside.ttf");
+    std::ofstream(dir / "scene.json") << textScene("fonts/Beside.ttf");
+    std::ofstream(dir / "missing.json") << textScene("fonts/Missing.ttf");
+    {
+        InFolder elsewhere("/");
+        auto scene = loadScene(dir / "scene.json");
+        ASSERT_TRUE(scene) << scene.error().str();
+        EXPECT_EQ(scene->files.folder, dir);
+        EXPECT_TRUE(scene->files.trusted);
+        EXPECT_EQ(scene->nodes[1].strings[1], "fonts/Beside.ttf");
+        auto missing = loadScene(dir / "missing.json");
+        ASSERT_FALSE(missing);
+        EXPECT_EQ(missing.error().str(),
+                  (dir / "missing.json").string() + ": root.children[0].font: cannot load font \"" +
+                      (dir / "fonts" / "Missing.ttf").string() + "\": no such file");
+    }
+    {
+        InFolder parent(dir.parent_path());
+        auto scene = loadScene("scenes/scene.json");
+        ASSERT_TRUE(scene) << scene.error().str();
+        // The same font as the default, so the same outline.
+        auto reference = parseScene(textScene(""));
+        ASSERT_TRUE(reference);
+        EXPECT_EQ(*scene->nodes[1].outline, *reference->nodes[1].outline);
+        // An edited copy parses under the same rule.
+        ParseOptions options;
+        options.files = scene->files;
+        EXPECT_TRUE(parseScene(toJson(*scene), scene->file, options));
+    }
+}
+
+// Fonts by family, through fontconfig: matched ignoring case and blanks, and never parsed as a
+// fontconfig pattern.
+TEST(Profiles, FontsByFamily) {
+    auto sans = parseScene(textScene("DejaVu Sans"));
+    ASSERT_TRUE(sans) << sans.error().str();
+    auto reference = parseScene(textScene(""));
+    ASSERT_TRUE(reference);
+    EXPECT_EQ(*sans->nodes[1].outline, *reference->nodes[1].outline);
+    auto lower = parseScene(textScene("dejavu sans"));
+    ASSERT_TRUE(lower) << lower.error().str();
+    EXPECT_EQ(*lower->nodes[1].outline, *reference->nodes[1].outline);
+    auto serif = parseScene(textScene("DejaVu Serif"));
+    ASSERT_TRUE(serif) << serif.error().str();
+    EXPECT_NE(*serif->nodes[1].outline, *reference->nodes[1].outline);
+
+    for (const char* family : {"No Such Family", "DejaVu Sans:style=Bold"}) {
+        auto unknown = parseScene(textScene(family), "test.json");
+        ASSERT_FALSE(unknown);
+        EXPECT_EQ(unknown.error().str(),
+                  std::string("test.json: root.children[0].font: cannot load font \"") + family +
+                      "\": no installed font family has that name (fc-list : family lists them)");
+    }
+}
+
+// An untrusted scene (a model's answer) may name files inside its folder only, and whatever is
+// wrong with a font it names, the message is the same and tells nothing of the file system.
+TEST(Profiles, UntrustedScenesNameNoFilesOutsideTheirFolder) {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::path(SDFCSG_TEST_OUTPUT_DIR) / "font-untrusted";
+    fs::remove_all(dir);
+    fs::create_directories(dir / "fonts");
+    fs::copy_file(detail::defaultFontFile(), dir / "fonts" / "Inside.ttf");
+    fs::create_symlink("/etc/passwd", dir / "fonts" / "out.ttf");
+    fs::create_symlink(fs::absolute(dir / "fonts" / "Inside.ttf"), dir / "fonts" / "in.ttf");
+    ParseOptions options;
+    options.files = {dir, false};
+    for (const char* font : {"fonts/Inside.ttf", "fonts/in.ttf", "DejaVu Serif"}) {
+        auto scene = parseScene(textScene(font), "answer", options);
+        EXPECT_TRUE(scene) << font << ": " << scene.error().str();
+        if (scene) {
+            EXPECT_FALSE(scene->files.trusted);
+        }
+    }
+    const std::string inside = (dir / "fonts" / "Inside.ttf").string();
+    for (const std::string& font :
+         std::vector<std::string>{"/etc/passwd", "/etc", "/dev/zero", "/nonexistent.ttf", inside,
+                                  "../font-untrusted/fonts/Inside.ttf", "fonts/out.ttf",
+                                  "fonts/missing.ttf", "fonts", "No Such Family"}) {
+        auto scene = parseScene(textScene(font), "answer", options);
+        ASSERT_FALSE(scene) << font;
+        EXPECT_EQ(scene.error().str(),
+                  "answer: root.children[0].font: unknown font " + detail::quote(font) +
+                      ": name an installed font family, such as \"DejaVu Sans\", or leave it out");
+    }
+    // Without a folder, families only.
+    options.files.folder.clear();
+    EXPECT_FALSE(parseScene(textScene("fonts/Inside.ttf"), "answer", options));
+    EXPECT_TRUE(parseScene(textScene("DejaVu Sans"), "answer", options));
+    // A glyph the font lacks is named by the font's name in the scene, not its file.
+    auto glyph = parseScene(R"({"version": 1, "root": {"type": "extrude", "height": 0.2,
+        "children": [{"type": "text", "text": "\ue000", "font": "DejaVu Sans"}]}})",
+                            "answer", options);
+    ASSERT_FALSE(glyph);
+    EXPECT_EQ(glyph.error().str(), "answer: root.children[0].text: the font \"DejaVu Sans\" has "
+                                   "no glyph for (U+E000)");
+}
+
 TEST(Profiles, OutlinesOfAllNodesAreBounded) {
     std::string kids;
     for (int i = 0; i < 200; ++i)

@@ -58,6 +58,11 @@ struct CompileOptions {
     // Unset: the environment's, SDFCSG_CACHE_DIR ("off": none), else $XDG_CACHE_HOME/sdfcsg, else
     // ~/.cache/sdfcsg, as the library read it once (sdfcsg/context.h).
     std::optional<std::filesystem::path> cacheDir;
+    // The disk cache's size cap in bytes. After each entry it writes, compileKernel removes the
+    // least recently used entries (by modification time, which reading an entry renews) until
+    // the folder fits; the entry just written always stays. Processes that share the folder may
+    // read, write and trim it at once. Unset: SDFCSG_CACHE_SIZE (MiB), else 64 MiB.
+    std::optional<uint64_t> cacheMaxBytes;
 };
 
 // Compiles an embedded kernel with `scene.glsl` resolving to `sceneGlsl`. SPIR-V is cached by a

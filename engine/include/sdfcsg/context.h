@@ -12,6 +12,8 @@
 //   SDFCSG_DEVICE       a device index or part of its name (ContextOptions::device)
 //   SDFCSG_CACHE_DIR    the SPIR-V disk cache ("off": none), else $XDG_CACHE_HOME/sdfcsg, else
 //                       $HOME/.cache/sdfcsg (ContextOptions::shaderCacheDir, CompileOptions)
+//   SDFCSG_CACHE_SIZE   that cache's cap in MiB, default 64; past it the least recently used
+//                       entries are removed (CompileOptions::cacheMaxBytes)
 // Mesa's own MESA_SHADER_CACHE_DISABLE and MESA_GLSL_CACHE_DISABLE, which Mesa reads whenever a
 // device is made, are read by every Context::create (see ContextOptions::compileHelper). The
 // language model's settings come from the environment only through llmConfigFromEnvironment()

@@ -7,10 +7,13 @@
 // problems goes back into the conversation with a request for a corrected scene, for a number of
 // rounds. A scene that does not load is never returned.
 //
-// Model output is untrusted: it is parsed under Limits (size, node count, nesting), and a scene
-// names no files, so an answer cannot make the program read or write anything. The API key is
+// Model output is untrusted: it is parsed under Limits (size, node count, nesting) as an
+// untrusted scene (SceneFiles, sdfcsg/scene.h): it may name font families but no file, and its
+// problems say nothing about the file system, so an answer cannot make the program write
+// anything, nor learn what the machine holds. The API key is
 // sent in the Authorization header only; it is never printed, logged or recorded, and where a
-// server echoes it or a model repeats it, messages, recordings and scenes say "[redacted]".
+// server echoes it or a model repeats it, messages, recordings and scenes say "[redacted]". A
+// credential typed into the base URL (user information, query values) is redacted the same way.
 #pragma once
 
 #include "sdfcsg/error.h"
@@ -68,9 +71,13 @@ struct LlmConfig {
 LlmConfig llmConfigFromEnvironment(const std::function<const char*(const char* name)>& lookup = {});
 
 // Where generateScene() sends its requests: the URL, the API and the model, defaults applied.
-// Holds no key, so it can be shown. Errors: Usage (no model, a base URL that is not http(s)).
+// A query in the base URL ("?key=...") ends every URL made from it. `url` holds whatever
+// credential was typed into the base URL ("https://user:KEY@host/", "?key=KEY"); `shownUrl` is
+// the same URL with those parts "[redacted]", for people, and the one that messages name.
+// Errors: Usage (no model, a base URL that is not http(s)).
 struct LlmEndpoint {
     std::string url;
+    std::string shownUrl;
     LlmApi api = LlmApi::OpenAI;
     std::string model;
 };
@@ -135,10 +142,11 @@ struct Generated {
 
 // Asks the model for a scene matching `request` (or, with options.currentScene, for that scene
 // changed as `request` says). Blocks until done: callers with a window run it on a thread (the
-// viewer's GenerateWorker). Errors: Usage (no model, bad URL), Remote (HTTP and network
-// failures, refusals, answers cut off at the token limit), Validation (no answer loaded within
-// options.maxRepairs rounds; the diagnostics are the last answer's problems), Cancelled
-// (options.cancelled said so). `stats`, when given, is filled in either case.
+// viewer's GenerateWorker). Errors: Usage (no model, bad URL, no API key for api.openai.com
+// outside a replay), Remote (HTTP and network failures, refusals, answers cut off at the token
+// limit), Validation (no answer loaded within options.maxRepairs rounds; the diagnostics are the
+// last answer's problems), Cancelled (options.cancelled said so). `stats`, when given, is filled in
+// either case.
 Result<Generated> generateScene(std::string_view request, const GenerateOptions& options,
                                 GenerateStats* stats = nullptr);
 
@@ -163,9 +171,11 @@ std::string sceneRepairPrompt(const Error& problems);
 // (minimum, minItems, pattern, defaults, ...) are left to the validator. Compact JSON.
 std::string sceneLlmSchema();
 
-// The first request generateScene() would send, for --dry-run: the URL and the body.
+// The first request generateScene() would send, for --dry-run: the URL (and as LlmEndpoint
+// shows it) and the body.
 struct LlmRequest {
     std::string url;
+    std::string shownUrl;
     std::string body;
 };
 Result<LlmRequest> firstLlmRequest(std::string_view request, const GenerateOptions& options);

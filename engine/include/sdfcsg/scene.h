@@ -59,8 +59,26 @@ struct Light {
     float intensity = 1.0f;
 };
 
+// Where the files that a scene names may come from: today a text node's "font", tomorrow any node
+// that reads a file. One rule for all of them, applied by the loader:
+//  - A relative name resolves in `folder`; loadScene() sets the scene file's folder, so a scene
+//    and the files beside it move together. An empty folder is the working directory for a
+//    trusted scene, and no folder at all for an untrusted one.
+//  - A trusted scene (one the user loads) may name any file, absolute paths and ".." included,
+//    and a problem with the file says what it is ("no such file", "not a regular file", ...).
+//  - An untrusted scene (a language model's answer: generateScene() parses every answer so) may
+//    name only files inside `folder` (no absolute path, no "..", none where the folder is empty),
+//    and every problem with a file it names reads the same, "unknown font" for a font: its
+//    messages, which go back to the model, tell nothing about the file system.
+// Fonts named by family ("DejaVu Sans") come from fontconfig under either rule.
+struct SceneFiles {
+    std::filesystem::path folder;
+    bool trusted = true;
+};
+
 struct Scene {
     std::string file;             // where it came from, for messages
+    SceneFiles files;             // the rule it was loaded under, for parsing an edited copy
     std::vector<Node> nodes;      // nodes[0] is the root; a parent always precedes its children
     std::optional<Camera> camera; // unset: framed automatically from the scene's bounds
     std::vector<Light> lights;    // empty: the default two-light rig (defaultLights())
@@ -76,13 +94,21 @@ struct Limits {
     uint32_t maxDepth = 64; // operations nested inside operations
 };
 
+struct ParseOptions {
+    Limits limits;
+    SceneFiles files; // default: trusted, relative names in the working directory
+};
+
 // Parses and validates a scene in either the current format or the legacy SDFBooleanEngine
 // format (detected by its top-level "nodes" array). `file` is used in messages only.
 // Every problem found is reported (up to a few dozen), each with its JSON path.
+Result<Scene> parseScene(std::string_view json, std::string_view file, const ParseOptions& options);
+// The same, trusted, with relative file names in the working directory.
 Result<Scene> parseScene(std::string_view json, std::string_view file = "<input>",
                          const Limits& limits = {});
 
-// Reads and parses a file; I/O errors and oversize files are reported like any other.
+// Reads and parses a file, trusted, with relative file names in the file's folder; I/O errors
+// and oversize files are reported like any other.
 Result<Scene> loadScene(const std::filesystem::path& path, const Limits& limits = {});
 
 // Serialises to the current format (2-space indent, stable key order). parseScene(toJson(s))

@@ -2,7 +2,9 @@
 // every source that can reach the compiler (the kernel, the embedded library, the generated
 // scene) plus a salt naming this code and glslang's version. The cache lives in memory and on
 // disk; disk entries carry their key, length and a checksum, so a truncated or foreign file is
-// ignored and overwritten, never trusted.
+// ignored and overwritten, never trusted. The disk cache is kept under a size cap, least recently
+// used entries going first: a read renews an entry's modification time, and each write trims the
+// folder (trimShaderCache).
 #include "codegen/shader_compile.h"
 
 #include "codegen/embedded_shaders.h"
@@ -17,7 +19,9 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -106,11 +110,16 @@ bool readDisk(const fs::path& file, uint64_t key, std::vector<uint32_t>& out) {
     if (in.peek() != std::ifstream::traits_type::eof()) return false; // trailing garbage
     if (words[0] != kSpirvMagic || checksum(words) != header.checksum) return false;
     out = std::move(words);
+    // Recently used: the last to be trimmed. Best effort (the folder may be read-only), and
+    // harmless where another process removed the entry meanwhile.
+    std::error_code ec;
+    fs::last_write_time(file, fs::file_time_type::clock::now(), ec);
     return true;
 }
 
 // Best effort: a cache that cannot be written only costs the next run a compile.
-void writeDisk(const fs::path& dir, uint64_t key, const std::vector<uint32_t>& words) {
+void writeDisk(const fs::path& dir, uint64_t key, const std::vector<uint32_t>& words,
+               uint64_t maxBytes) {
     std::error_code ec;
     fs::create_directories(dir, ec);
     if (ec) return;
@@ -134,7 +143,11 @@ void writeDisk(const fs::path& dir, uint64_t key, const std::vector<uint32_t>& w
         }
     }
     fs::rename(temp, target, ec);
-    if (ec) fs::remove(temp, ec);
+    if (ec) {
+        fs::remove(temp, ec);
+        return;
+    }
+    detail::trimShaderCache(dir, maxBytes, target);
 }
 
 // Resolves "scene.glsl" to the generated scene and every other name to an embedded file.
@@ -270,11 +283,58 @@ Result<std::vector<uint32_t>> detail::compileKernel(std::string_view kernel,
         ++c.stats.compiles;
         if (compiled) remember(c, key, *compiled);
     }
-    if (compiled && !dir.empty()) writeDisk(dir, key, *compiled);
+    if (compiled && !dir.empty())
+        writeDisk(dir, key, *compiled,
+                  options.cacheMaxBytes ? *options.cacheMaxBytes
+                                        : environment().shaderCacheMaxBytes);
     return compiled;
 }
 
 namespace detail {
+
+void trimShaderCache(const fs::path& dir, uint64_t maxBytes, const fs::path& keep) {
+    struct Entry {
+        fs::file_time_type used;
+        uint64_t bytes;
+        fs::path path;
+    };
+    std::vector<Entry> entries;
+    uint64_t total = 0;
+    const auto now = fs::file_time_type::clock::now();
+    std::error_code ec;
+    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+        const fs::path& path = it->path();
+        const std::string name = path.filename().string();
+        // Entries are "<16 hex digits>.spv"; their temporaries add ".tmp<pid>.<n>". Anything
+        // else in the folder is not the cache's to remove.
+        const bool entry = name.size() == 20 && name.ends_with(".spv");
+        const bool temporary = name.size() > 24 && name.find(".spv.tmp") == 16;
+        if (!entry && !temporary) continue;
+        std::error_code fileEc;
+        const uint64_t bytes = it->file_size(fileEc);
+        const fs::file_time_type used = it->last_write_time(fileEc);
+        if (fileEc) continue; // gone meanwhile: another process trimmed it, or renamed it in
+        // A temporary an hour old belongs to a process that died while writing it.
+        if (temporary) {
+            if (now - used > std::chrono::hours(1)) fs::remove(path, fileEc);
+            continue;
+        }
+        total += bytes;
+        if (path != keep) entries.push_back({used, bytes, path});
+    }
+    if (total <= maxBytes) return;
+    std::sort(entries.begin(), entries.end(),
+              [](const Entry& a, const Entry& b) { return a.used < b.used; });
+    for (const Entry& e : entries) {
+        if (total <= maxBytes) break;
+        // Another process may have removed it first; either way it no longer counts. A process
+        // reading it keeps its open file (POSIX), and one about to open it recompiles.
+        fs::remove(e.path, ec);
+        total -= e.bytes;
+        std::lock_guard lock(cache().mutex);
+        ++cache().stats.evictions;
+    }
+}
 
 ShaderCacheStats shaderCacheStats() {
     std::lock_guard lock(cache().mutex);

@@ -1,8 +1,10 @@
 // The one place where the library reads the environment (environment.h says when).
 #include "gpu/environment.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cstdlib>
+#include <string>
 #include <string_view>
 
 namespace sdfcsg::detail {
@@ -22,6 +24,13 @@ Environment readEnvironment(const std::function<const char*(const char* name)>& 
         e.shaderCacheDir = std::filesystem::path(xdg) / "sdfcsg";
     else if (const std::string_view home = variable("HOME"); !home.empty())
         e.shaderCacheDir = std::filesystem::path(home) / ".cache" / "sdfcsg";
+    if (const std::string size(variable("SDFCSG_CACHE_SIZE")); !size.empty()) {
+        char* end = nullptr;
+        const double mib = std::strtod(size.c_str(), &end);
+        // Up to an exbibyte, which no disk holds: beyond it, the bytes would not fit 64 bits.
+        if (end != size.c_str() && *end == '\0' && mib > 0.0 && mib <= double(1ull << 40))
+            e.shaderCacheMaxBytes = std::max<uint64_t>(1, uint64_t(mib * double(1 << 20)));
+    }
     return e;
 }
 

@@ -9,11 +9,14 @@
 // on their caller's thread; the only other reads are of Mesa's variables, below.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <string>
 
 namespace sdfcsg::detail {
+
+inline constexpr uint64_t kDefaultShaderCacheBytes = uint64_t(64) << 20;
 
 struct Environment {
     // SDFCSG_VALIDATION: 0 for "0", 1 for any other value, -1 where unset or empty.
@@ -23,6 +26,9 @@ struct Environment {
     // The SPIR-V disk cache: SDFCSG_CACHE_DIR (empty for "off"), else $XDG_CACHE_HOME/sdfcsg,
     // else $HOME/.cache/sdfcsg; empty (no disk cache) where none of them is set.
     std::filesystem::path shaderCacheDir;
+    // Its size cap: SDFCSG_CACHE_SIZE in MiB (a number above 0; anything else is ignored), else
+    // 64 MiB. Past it, the least recently used entries go (shader_compile.cpp).
+    uint64_t shaderCacheMaxBytes = kDefaultShaderCacheBytes;
 };
 
 // The environment as it was at the first call.

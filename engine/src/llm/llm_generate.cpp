@@ -91,14 +91,101 @@ int urlPort(std::string_view url) {
     return std::atoi(std::string(rest.substr(colon + 1)).c_str());
 }
 
+// Servers quote what they received; an API key must not reach a terminal or a log that way.
+std::string redactKey(std::string text, const std::string& key) {
+    if (key.size() >= 4)
+        for (size_t at; (at = text.find(key)) != std::string::npos;)
+            text.replace(at, key.size(), "[redacted]");
+    // OpenAI quotes a masked key ("sk-proj-****...AbCd") in its 401 message.
+    for (size_t at = 0; (at = text.find("sk-", at)) != std::string::npos;) {
+        if (at > 0 && !std::isspace(static_cast<unsigned char>(text[at - 1]))) {
+            at += 3;
+            continue;
+        }
+        // Key characters only, so that a key quoted in JSON leaves the quotes and braces intact.
+        size_t end = at;
+        while (end < text.size() && (std::isalnum(static_cast<unsigned char>(text[end])) ||
+                                     text[end] == '-' || text[end] == '_' || text[end] == '*'))
+            ++end;
+        text.replace(at, end - at, "[redacted]");
+        at += 10;
+    }
+    return text;
+}
+
+// A part of a base URL that may hold a credential, as it appears there, and what shows instead.
+struct UrlSecret {
+    std::string text, shown;
+};
+
+// A key typed into the base URL: its user information ("https://user:KEY@host") and its query's
+// values ("?key=KEY"), each in its context ("user:KEY@", "key=KEY") and, where a server may quote
+// it alone, bare (from 4 characters: shorter ones would blank out unrelated text). Compound
+// forms first, so that they are replaced whole.
+std::vector<UrlSecret> urlSecrets(std::string_view url) {
+    std::vector<UrlSecret> compound, bare;
+    auto addBare = [&](std::string_view part) {
+        if (part.size() >= 4) bare.push_back({std::string(part), "[redacted]"});
+    };
+    const size_t scheme = url.find("://");
+    const size_t start = scheme == std::string_view::npos ? 0 : scheme + 3;
+    const size_t end = std::min(url.find_first_of("/?#", start), url.size());
+    if (const size_t at = url.substr(start, end - start).rfind('@'); at != std::string_view::npos) {
+        const std::string_view info = url.substr(start, at);
+        compound.push_back({std::string(info) + "@", "[redacted]@"});
+        const size_t colon = info.find(':');
+        addBare(info.substr(0, colon));
+        if (colon != std::string_view::npos) addBare(info.substr(colon + 1));
+    }
+    if (const size_t q = url.find('?', end); q != std::string_view::npos) {
+        std::string_view query = url.substr(q + 1);
+        query = query.substr(0, query.find('#'));
+        while (!query.empty()) {
+            const std::string_view piece = query.substr(0, query.find('&'));
+            query.remove_prefix(std::min(query.size(), piece.size() + 1));
+            const size_t eq = piece.find('=');
+            if (eq == std::string_view::npos) {
+                addBare(piece);
+            } else if (eq + 1 < piece.size()) {
+                compound.push_back(
+                    {std::string(piece), std::string(piece.substr(0, eq)) + "=[redacted]"});
+                addBare(piece.substr(eq + 1));
+            }
+        }
+    }
+    compound.insert(compound.end(), bare.begin(), bare.end());
+    return compound;
+}
+
+// The API key and any credential in the base URL, wherever a message, a recording or a scene
+// would carry them.
+std::string redact(std::string text, const LlmConfig& config) {
+    text = redactKey(std::move(text), config.apiKey);
+    for (const UrlSecret& s : urlSecrets(config.baseUrl))
+        for (size_t at = 0; (at = text.find(s.text, at)) != std::string::npos; at += s.shown.size())
+            text.replace(at, s.text.size(), s.shown);
+    return text;
+}
+
+bool isOpenAi(std::string_view url) {
+    return url.find("://api.openai.com") != std::string_view::npos;
+}
+
 Result<LlmEndpoint> resolve(const LlmConfig& config) {
     std::string base = config.baseUrl.empty() ? "https://api.openai.com/v1" : config.baseUrl;
+    // A query (?key=...) stays at the end of every URL made from the base; a fragment is never
+    // sent.
+    std::string query;
+    if (const size_t q = base.find_first_of("?#"); q != std::string::npos) {
+        if (base[q] == '?') query = base.substr(q, base.find('#', q) - q);
+        base.resize(q);
+    }
     while (base.ends_with('/'))
         base.pop_back();
     if (!base.starts_with("http://") && !base.starts_with("https://"))
         return Error::message(ErrorKind::Usage, "<llm>",
                               "the base URL must start with http:// or https://, got " +
-                                  detail::quote(base));
+                                  detail::quote(redact(base + query, config)));
     LlmEndpoint e;
     e.api = config.api != LlmApi::Auto ? config.api
             : urlPort(base) == 11434   ? LlmApi::Ollama
@@ -107,13 +194,14 @@ Result<LlmEndpoint> resolve(const LlmConfig& config) {
         // Ollama's OpenAI-compatible /v1 silently cuts prompts at 2048 tokens: use /api/chat.
         for (std::string_view suffix : {"/v1", "/api"})
             if (base.ends_with(suffix)) base.resize(base.size() - suffix.size());
-        e.url = base + "/api/chat";
+        e.url = base + "/api/chat" + query;
     } else {
-        e.url = base + "/chat/completions";
+        e.url = base + "/chat/completions" + query;
     }
+    e.shownUrl = redact(e.url, config);
     e.model = config.model;
     if (e.model.empty()) {
-        if (base.find("://api.openai.com") == std::string::npos)
+        if (!isOpenAi(base))
             return Error::message(ErrorKind::Usage, "<llm>",
                                   "no model given: set SDFCSG_LLM_MODEL or pass --model");
         e.model = "gpt-4o-mini";
@@ -191,31 +279,9 @@ ServerError serverError(std::string_view body) {
     return out;
 }
 
-// Servers quote what they received; an API key must not reach a terminal or a log that way.
-std::string redact(std::string text, const std::string& key) {
-    if (key.size() >= 4)
-        for (size_t at; (at = text.find(key)) != std::string::npos;)
-            text.replace(at, key.size(), "[redacted]");
-    // OpenAI quotes a masked key ("sk-proj-****...AbCd") in its 401 message.
-    for (size_t at = 0; (at = text.find("sk-", at)) != std::string::npos;) {
-        if (at > 0 && !std::isspace(static_cast<unsigned char>(text[at - 1]))) {
-            at += 3;
-            continue;
-        }
-        // Key characters only, so that a key quoted in JSON leaves the quotes and braces intact.
-        size_t end = at;
-        while (end < text.size() && (std::isalnum(static_cast<unsigned char>(text[end])) ||
-                                     text[end] == '-' || text[end] == '_' || text[end] == '*'))
-            ++end;
-        text.replace(at, end - at, "[redacted]");
-        at += 10;
-    }
-    return text;
-}
-
 // The strings of a loaded scene. The answer's text was redacted before it was parsed, but a key
 // written with JSON escapes ("\u0073k-...") reads back as the key itself.
-void redactStrings(Scene& scene, const std::string& key) {
+void redactStrings(Scene& scene, const LlmConfig& key) {
     scene.name = redact(std::move(scene.name), key);
     scene.description = redact(std::move(scene.description), key);
     for (Node& node : scene.nodes)
@@ -240,12 +306,12 @@ struct Answer {
     uint64_t promptTokens = 0, completionTokens = 0;
 };
 
-Result<Answer> readAnswer(const LlmEndpoint& e, std::string_view body, const std::string& key) {
+Result<Answer> readAnswer(const LlmEndpoint& e, std::string_view body, const LlmConfig& key) {
     dom::parser parser;
     dom::element top;
     auto unexpected = [&](const std::string& what) {
-        return remote(e.url, "unexpected answer (" + what +
-                                 "): " + printable(redact(std::string(head(body, 200)), key)));
+        return remote(e.shownUrl, "unexpected answer (" + what +
+                                      "): " + printable(redact(std::string(head(body, 200)), key)));
     };
     if (parser.parse(body.data(), body.size()).get(top) || !top.is_object())
         return unexpected("not a JSON object");
@@ -366,7 +432,7 @@ class Conversation {
         const LlmConfig& config = options_.llm;
         int retries = 0;
         for (;;) {
-            if (cancelled()) return cancelledAt(e_.url);
+            if (cancelled()) return cancelledAt(e_.shownUrl);
             stats_.mode = state_.mode;
             const std::string body = requestBody(e_, config, messages, state_);
             const std::string status = what + " (" + std::string(outputModeName(state_.mode)) + ")";
@@ -375,15 +441,15 @@ class Conversation {
             auto response = exchange(body, status);
             if (!response) return response.error();
             const long code = response->status;
-            if (code >= 200 && code < 300) return readAnswer(e_, response->body, config.apiKey);
+            if (code >= 200 && code < 300) return readAnswer(e_, response->body, config);
 
             const ServerError error = serverError(response->body);
-            const std::string reason = "HTTP " + std::to_string(code) + ": " +
-                                       printable(redact(error.message, config.apiKey));
+            const std::string reason =
+                "HTTP " + std::to_string(code) + ": " + printable(redact(error.message, config));
             if ((code == 429 && error.code != "insufficient_quota") || code >= 500) {
                 if (retries >= config.maxRetries)
-                    return remote(e_.url, reason + " (gave up after " +
-                                              counted(size_t(retries) + 1, "attempt") + ")");
+                    return remote(e_.shownUrl, reason + " (gave up after " +
+                                                   counted(size_t(retries) + 1, "attempt") + ")");
                 double delay = config.retryBaseSeconds * std::pow(2.0, retries);
                 if (auto after = retryAfterSeconds(response->retryAfter)) delay = *after;
                 delay = std::min(delay, config.maxRetryDelaySeconds);
@@ -397,10 +463,11 @@ class Conversation {
             }
             if ((code == 400 || code == 422) && adapt(error)) continue;
             if (code == 401 || code == 403)
-                return remote(e_.url, reason + " (check SDFCSG_LLM_API_KEY or OPENAI_API_KEY)");
+                return remote(e_.shownUrl,
+                              reason + " (check SDFCSG_LLM_API_KEY or OPENAI_API_KEY)");
             if (code == 404)
-                return remote(e_.url, reason + " (check the base URL and the model name)");
-            return remote(e_.url, reason);
+                return remote(e_.shownUrl, reason + " (check the base URL and the model name)");
+            return remote(e_.shownUrl, reason);
         }
     }
 
@@ -439,15 +506,16 @@ class Conversation {
     Result<detail::HttpResponse> exchange(const std::string& body, const std::string& status) {
         if (options_.replay) {
             if (replayed_ >= options_.replay->size())
-                return remote(e_.url, "the recording holds " +
-                                          counted(options_.replay->size(), "exchange") +
-                                          ", and a further request was made");
+                return remote(e_.shownUrl, "the recording holds " +
+                                               counted(options_.replay->size(), "exchange") +
+                                               ", and a further request was made");
             const HttpExchange& x = (*options_.replay)[replayed_++];
             if (options_.record) keep(x);
             return detail::HttpResponse{x.status, x.response, x.retryAfter};
         }
         detail::HttpPost post;
         post.url = e_.url;
+        post.shownUrl = e_.shownUrl;
         post.body = body;
         post.apiKey = options_.llm.apiKey;
         post.timeoutSeconds = options_.llm.timeoutSeconds;
@@ -465,7 +533,7 @@ class Conversation {
     // A recording is a file that gets shared: a key that the server echoed (in a 400 that
     // quotes the request's headers, say) or that the model repeated does not go into it.
     void keep(HttpExchange x) {
-        const std::string& key = options_.llm.apiKey;
+        const LlmConfig& key = options_.llm;
         x.url = redact(std::move(x.url), key);
         x.request = redact(std::move(x.request), key);
         x.retryAfter = redact(std::move(x.retryAfter), key);
@@ -530,7 +598,7 @@ Result<LlmRequest> firstLlmRequest(std::string_view request, const GenerateOptio
     if (!endpoint) return endpoint.error();
     RequestState state;
     state.mode = options.firstMode;
-    return LlmRequest{endpoint->url,
+    return LlmRequest{endpoint->url, endpoint->shownUrl,
                       requestBody(*endpoint, options.llm, firstMessages(request, options), state)};
 }
 
@@ -550,9 +618,21 @@ Result<Generated> generate(std::string_view request, const GenerateOptions& opti
 
     auto endpoint = resolve(options.llm);
     if (!endpoint) return endpoint.error();
-    const std::string url = endpoint->url, model = endpoint->model;
+    // OpenAI answers a request without a key with a 401 after a round trip; say at once what to
+    // set.
+    if (options.llm.apiKey.empty() && isOpenAi(endpoint->url) && options.replay == nullptr)
+        return Error::message(ErrorKind::Usage, "<llm>",
+                              "no API key for api.openai.com: set SDFCSG_LLM_API_KEY or "
+                              "OPENAI_API_KEY, or point SDFCSG_LLM_BASE_URL (or --base-url) at "
+                              "a server that needs no key");
+    const std::string url = endpoint->shownUrl, model = endpoint->model;
     Conversation conversation(std::move(*endpoint), options, stats);
     std::vector<Message> messages = firstMessages(request, options);
+    // The answers' problems go back to the model: they may tell nothing about this machine's
+    // files (sdfcsg/scene.h, SceneFiles).
+    ParseOptions untrusted;
+    untrusted.limits = options.limits;
+    untrusted.files.trusted = false;
     const int rounds = std::max(0, options.maxRepairs);
 
     for (int round = 0;; ++round) {
@@ -576,18 +656,18 @@ Result<Generated> generate(std::string_view request, const GenerateOptions& opti
 
         // A model may repeat the key (a prompt injection may ask it to): it goes neither into
         // the scene nor back into the conversation.
-        answer->content = redact(std::move(answer->content), options.llm.apiKey);
+        answer->content = redact(std::move(answer->content), options.llm);
         const std::string json = withoutNulls(extractJson(answer->content), options.limits);
         // Null content (or none, or not a string) would read as an empty scene file.
         auto scene =
             json.empty()
                 ? Result<Scene>(Error::message(ErrorKind::Validation, std::string(kAnswerFile),
                                                "the model returned no text"))
-                : parseScene(json, kAnswerFile, options.limits);
+                : parseScene(json, kAnswerFile, untrusted);
         if (scene) {
             stats.valid = true;
             stats.firstTryValid = round == 0;
-            redactStrings(*scene, options.llm.apiKey);
+            redactStrings(*scene, options.llm);
             Generated out;
             out.warnings = sceneSanityWarnings(*scene);
             out.json = toJson(*scene);
@@ -624,7 +704,7 @@ Result<Generated> generate(std::string_view request, const GenerateOptions& opti
 Result<Generated> generateScene(std::string_view request, const GenerateOptions& options,
                                 GenerateStats* stats) {
     auto result = generate(request, options, stats);
-    const std::string& key = options.llm.apiKey;
+    const LlmConfig& key = options.llm;
     auto clean = [&](std::vector<Diagnostic>& diagnostics) {
         for (Diagnostic& d : diagnostics) {
             d.path = printable(redact(std::move(d.path), key));

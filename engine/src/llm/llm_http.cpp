@@ -80,7 +80,7 @@ Result<HttpResponse> httpPost(const HttpPost& post) {
     static std::once_flag init;
     std::call_once(init, [] { curl_global_init(CURL_GLOBAL_DEFAULT); });
     auto fail = [&](std::string message) {
-        return Error::message(ErrorKind::Remote, post.url, std::move(message));
+        return Error::message(ErrorKind::Remote, post.shownUrl, std::move(message));
     };
 
     std::unique_ptr<CURL, CurlDeleter> curl(curl_easy_init());
@@ -120,7 +120,7 @@ Result<HttpResponse> httpPost(const HttpPost& post) {
     if (post.proxy) curl_easy_setopt(c, CURLOPT_PROXY, post.proxy->c_str());
 
     const CURLcode code = curl_easy_perform(c);
-    if (transfer.cancelled) return Error::message(ErrorKind::Cancelled, post.url, "cancelled");
+    if (transfer.cancelled) return Error::message(ErrorKind::Cancelled, post.shownUrl, "cancelled");
     if (transfer.tooLarge)
         return fail("the answer exceeds the limit of " + std::to_string(post.maxResponseBytes) +
                     " bytes");

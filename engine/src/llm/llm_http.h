@@ -13,8 +13,9 @@ namespace sdfcsg::detail {
 
 struct HttpPost {
     std::string url;
-    std::string body;   // JSON
-    std::string apiKey; // sent as "Authorization: Bearer KEY" when not empty, nowhere else
+    std::string shownUrl; // the URL in messages: url with any credential in it redacted
+    std::string body;     // JSON
+    std::string apiKey;   // sent as "Authorization: Bearer KEY" when not empty, nowhere else
     double timeoutSeconds = 300;
     double connectTimeoutSeconds = 15;
     size_t maxResponseBytes = 16u << 20; // a longer answer is cut off with an error
@@ -33,7 +34,7 @@ struct HttpResponse {
 };
 
 // Any HTTP status is a response; only transport failures (no connection, timeout, oversize
-// answer) are errors, of kind Remote, naming the URL, and a cancel (kind Cancelled).
+// answer) are errors, of kind Remote, naming shownUrl, and a cancel (kind Cancelled).
 Result<HttpResponse> httpPost(const HttpPost& post);
 
 } // namespace sdfcsg::detail

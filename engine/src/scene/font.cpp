@@ -3,6 +3,10 @@
 // hand-written reader would get right.
 #include "scene/font.h"
 
+#include "scene/files.h"
+
+#include <fontconfig/fontconfig.h>
+
 #include <ft2build.h>
 #include FT_FREETYPE_H
 #include FT_OUTLINE_H
@@ -11,15 +15,20 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <mutex>
+#include <optional>
 #include <string>
 
 namespace sdfcsg::detail {
 
 namespace {
+
+constexpr uintmax_t kMaxFontBytes = uintmax_t(64) << 20;
 
 Error problem(std::string text) {
     return Error::message(ErrorKind::Validation, {}, std::move(text));
@@ -88,23 +97,80 @@ Result<std::vector<long>> codePoints(std::string_view utf8) {
 
 // Only regular files of a font's size reach FreeType: a pipe or a device would block or never
 // end.
-Result<Font> openFont(const std::string& file) {
+Result<Font> openFont(const std::string& file, long faceIndex) {
     const auto fail = [&](const char* why) {
         return problem("cannot load font \"" + file + "\": " + why);
     };
     std::error_code ec;
     if (!std::filesystem::is_regular_file(file, ec))
         return fail(std::filesystem::exists(file, ec) ? "not a regular file" : "no such file");
-    if (std::filesystem::file_size(file, ec) > 64u << 20) return fail("larger than 64 MiB");
+    if (std::filesystem::file_size(file, ec) > kMaxFontBytes) return fail("larger than 64 MiB");
     FT_Library library = nullptr;
     if (FT_Init_FreeType(&library) != 0) return problem("cannot start FreeType");
     Font font{decltype(Font::library)(library), nullptr};
     FT_Face face = nullptr;
-    if (FT_New_Face(library, file.c_str(), 0, &face) != 0)
+    if (FT_New_Face(library, file.c_str(), faceIndex, &face) != 0)
         return fail("not a font FreeType can read");
     font.face.reset(face);
     if (!FT_IS_SCALABLE(face) || face->units_per_EM == 0) return fail("it has no outlines");
     return font;
+}
+
+// A name with a slash or a font file's extension is a file; anything else a family.
+bool namesAFile(std::string_view name) {
+    if (name.find_first_of("/\\") != std::string_view::npos) return true;
+    std::string lower(name.substr(name.size() - std::min<size_t>(name.size(), 6)));
+    for (char& c : lower)
+        c = char(std::tolower(static_cast<unsigned char>(c)));
+    for (std::string_view extension :
+         {".ttf", ".otf", ".ttc", ".otc", ".pfa", ".pfb", ".woff", ".woff2"})
+        if (lower.ends_with(extension)) return true;
+    return false;
+}
+
+// A family name as fontconfig compares them: blanks dropped, ASCII letters in lower case.
+std::string folded(std::string_view name) {
+    std::string out;
+    for (char c : name)
+        if (c != ' ') out += char(std::tolower(static_cast<unsigned char>(c)));
+    return out;
+}
+
+struct PatternDone {
+    void operator()(FcPattern* p) const { FcPatternDestroy(p); }
+};
+using Pattern = std::unique_ptr<FcPattern, PatternDone>;
+
+// The installed font whose family is `family` (ignoring case and blanks), its regular face as
+// fontconfig picks it; empty where none is. fontconfig's best match for an unknown family is
+// some other font, so the match's families are checked.
+std::optional<FontFace> fontOfFamily(const std::string& family) {
+    // fontconfig's configuration is process-wide; calls take turns.
+    static std::mutex mutex;
+    std::lock_guard lock(mutex);
+    if (!FcInit()) return std::nullopt;
+    Pattern pattern(FcPatternCreate());
+    if (!pattern) return std::nullopt;
+    // Added as a value, not parsed as a fontconfig name: "x:file=/etc/passwd" is a family.
+    const auto* name = reinterpret_cast<const FcChar8*>(family.c_str());
+    FcPatternAddString(pattern.get(), FC_FAMILY, name);
+    FcConfigSubstitute(nullptr, pattern.get(), FcMatchPattern);
+    FcDefaultSubstitute(pattern.get());
+    FcResult result = FcResultNoMatch;
+    Pattern match(FcFontMatch(nullptr, pattern.get(), &result));
+    if (!match) return std::nullopt;
+    bool named = false;
+    FcChar8* value = nullptr;
+    for (int i = 0;
+         !named && FcPatternGetString(match.get(), FC_FAMILY, i, &value) == FcResultMatch; ++i)
+        named = folded(reinterpret_cast<const char*>(value)) == folded(family);
+    if (!named || FcPatternGetString(match.get(), FC_FILE, 0, &value) != FcResultMatch)
+        return std::nullopt;
+    FontFace face{reinterpret_cast<const char*>(value), 0};
+    int index = 0;
+    if (FcPatternGetInteger(match.get(), FC_INDEX, 0, &index) == FcResultMatch)
+        face.index = index & 0xffff; // the high bits pick a variable font's named instance
+    return face;
 }
 
 std::string missingGlyph(const std::string& file, long code) {
@@ -192,6 +258,27 @@ void growExtents(const GlyphSegment& g, glm::vec2& lo, glm::vec2& hi) {
 
 } // namespace
 
+Result<FontFace> findFont(std::string_view name, const SceneFiles& files) {
+    if (name.empty()) return FontFace{std::string(defaultFontFile()), 0};
+    const auto fail = [&](const std::string& shown, const std::string& why) {
+        return problem("cannot load font \"" + shown + "\": " + why);
+    };
+    if (namesAFile(name)) {
+        auto file = sceneFile(name, files, kMaxFontBytes);
+        if (!file) {
+            const std::filesystem::path named(name);
+            const bool joined = !named.is_absolute() && !files.folder.empty();
+            return fail(joined ? (files.folder / named).string() : std::string(name),
+                        file.error().diagnostics[0].message);
+        }
+        return FontFace{file->string(), 0};
+    }
+    const std::string family(name);
+    if (family.find('\0') == std::string::npos)
+        if (auto face = fontOfFamily(family)) return *face;
+    return fail(family, "no installed font family has that name (fc-list : family lists them)");
+}
+
 std::string_view defaultFontFile() {
     return "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
 }
@@ -227,11 +314,12 @@ void cubicToQuadratics(glm::vec2 p0f, glm::vec2 p1f, glm::vec2 p2f, glm::vec2 p3
     }
 }
 
-Result<TextOutline> textOutline(std::string_view utf8, std::string_view fontFile, float size) {
+Result<TextOutline> textOutline(std::string_view utf8, std::string_view fontFile, float size,
+                                long faceIndex) {
     auto codes = codePoints(utf8);
     if (!codes) return codes.error();
     const std::string file(fontFile);
-    auto font = openFont(file);
+    auto font = openFont(file, faceIndex);
     if (!font) return font.error();
     const FT_Face face = font->face.get();
 

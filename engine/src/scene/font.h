@@ -2,10 +2,12 @@
 #pragma once
 
 #include "sdfcsg/error.h"
+#include "sdfcsg/scene.h"
 
 #include <glm/vec2.hpp>
 
 #include <cstddef>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -32,6 +34,19 @@ inline constexpr float kCubicTolerance = 1e-3f;
 // DejaVu Sans from Debian's fonts-dejavu-core.
 std::string_view defaultFontFile();
 
+// A font file and the face in it that a text is set in (a collection holds several).
+struct FontFace {
+    std::string file;
+    long index = 0;
+};
+
+// The font that a text node's "font" names, under the scene's rule (scene/files.h): empty, the
+// default font; a name with a slash or a font file's extension (.ttf, .otf, ...), a file
+// (sceneFile()); anything else, an installed family through fontconfig ("DejaVu Sans", matched
+// ignoring case and blanks). Errors: "cannot load font \"NAME\": <why>", with the file it
+// resolved to for a trusted scene; the caller says less for an untrusted one.
+Result<FontFace> findFont(std::string_view name, const SceneFiles& files);
+
 // The outlines of `utf8` set on one line in `fontFile`, the font's em square `size` units tall,
 // with its kerning (the legacy 'kern' table; GPOS is not read). Contours come as the font winds
 // them: TrueType's outer contours clockwise, holes counter-clockwise; inside is non-zero winding.
@@ -40,7 +55,9 @@ std::string_view defaultFontFile();
 // place: "cannot load font \"PATH\": <why>", "the font \"PATH\" has no glyph for 'X' (U+0058)",
 // "text is one line: it may not hold a line break", bad UTF-8, more than kMaxTextCharacters
 // characters or kMaxTextSegments segments.
-Result<TextOutline> textOutline(std::string_view utf8, std::string_view fontFile, float size);
+// `faceIndex` picks the face of a collection.
+Result<TextOutline> textOutline(std::string_view utf8, std::string_view fontFile, float size,
+                                long faceIndex = 0);
 
 // The cubic Bezier p0, p1, p2, p3 as quadratics appended to `out`, chained from p0 to p3, within
 // `tolerance` of it (units of the points; plus float rounding): n equal parameter pieces, n the

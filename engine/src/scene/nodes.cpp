@@ -240,9 +240,11 @@ constexpr ParamInfo kText[] = {
      1,
      false,
      {},
-     "file",
-     "A TrueType or OpenType font file; empty or absent: DejaVu Sans (Debian's "
-     "fonts-dejavu-core)."},
+     "font",
+     "An installed font family (\"DejaVu Sans\", \"DejaVu Serif\"; `fc-list : family` lists "
+     "them), or a TrueType or OpenType file (a name with a slash or a font extension) relative to "
+     "the scene file's folder; empty or absent: DejaVu Sans (Debian's fonts-dejavu-core). "
+     "Generated scenes name families only."},
 };
 constexpr ParamInfo kExtrude[] = {
     {"height",

@@ -1,5 +1,7 @@
 #include "scene/outline.h"
+
 #include "field/sdf.h"
+#include "scene/files.h"
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
@@ -381,7 +383,8 @@ std::string polygonProblem(std::span<const glm::vec2> points) {
     return {};
 }
 
-Result<std::shared_ptr<const std::vector<glm::vec4>>> buildOutline(const Node& node) {
+Result<std::shared_ptr<const std::vector<glm::vec4>>> buildOutline(const Node& node,
+                                                                   const SceneFiles& files) {
     std::vector<GlyphSegment> segments;
     glm::vec2 shift(0.0f);
     if (node.kind == NodeKind::Polygon) {
@@ -389,10 +392,27 @@ Result<std::shared_ptr<const std::vector<glm::vec4>>> buildOutline(const Node& n
         for (size_t i = 0; i < p.size(); ++i)
             segments.push_back({p[i], p[(i + 1) % p.size()], p[i], false});
     } else {
-        const std::string& font = node.strings[1];
-        auto text =
-            textOutline(node.strings[0], font.empty() ? defaultFontFile() : font, node.params[0]);
-        if (!text) return text.error();
+        const std::string& name = node.strings[1];
+        // An untrusted scene's messages name the font as the scene does, and nothing else.
+        auto fontProblem = [&](const Error& e) {
+            const std::string said =
+                files.trusted ? e.diagnostics[0].message
+                              : untrustedFileProblem("font", name,
+                                                     ": name an installed font family, such as "
+                                                     "\"DejaVu Sans\", or leave it out");
+            return Error(ErrorKind::Validation, Diagnostic{{}, "font", said});
+        };
+        auto font = findFont(name, files);
+        if (!font) return fontProblem(font.error());
+        auto text = textOutline(node.strings[0], font->file, node.params[0], font->index);
+        if (!text) {
+            std::string message = text.error().diagnostics[0].message;
+            if (message.starts_with("cannot load font")) return fontProblem(text.error());
+            if (!files.trusted && !name.empty())
+                for (size_t at; (at = message.find(font->file)) != std::string::npos;)
+                    message.replace(at, font->file.size(), name);
+            return Error::message(ErrorKind::Validation, {}, message);
+        }
         segments = std::move(text->segments);
         shift = -0.5f * (text->min + text->max);
     }

@@ -41,9 +41,13 @@ std::vector<glm::vec4> packOutline(std::span<const GlyphSegment> segments, glm::
 // Why the polygon is not simple (two edges that cross or touch, a repeated point), or "".
 std::string polygonProblem(std::span<const glm::vec2> points);
 
-// The node's outline: a polygon's edges, or a text's glyphs centred on the origin. Errors are
-// the font's (font.h), for the caller to place at the node.
-Result<std::shared_ptr<const std::vector<glm::vec4>>> buildOutline(const Node& node);
+// The node's outline: a polygon's edges, or a text's glyphs centred on the origin, its font found
+// under `files` (findFont()). Errors are the font's (font.h), for the caller to place at the
+// node: at its "font" where the diagnostic's path is "font", else at its "text". An untrusted
+// scene's font problems say "unknown font" and nothing of the file system, and its glyph
+// problems name the font as the scene does.
+Result<std::shared_ptr<const std::vector<glm::vec4>>> buildOutline(const Node& node,
+                                                                   const SceneFiles& files);
 
 // A revolve's polygon profile that lies at x >= axis and meets the axis x = axis along one run of
 // edges: the outline of the polygon joined with its mirror image across the axis, those edges

@@ -108,7 +108,8 @@ glm::vec3 normalised(glm::vec3 v) {
 
 class SceneReader {
   public:
-    SceneReader(const Limits& limits, Problems& problems) : limits_(limits), problems_(problems) {}
+    SceneReader(const ParseOptions& options, Problems& problems)
+        : limits_(options.limits), files_(options.files), problems_(problems) {}
 
     Scene read(element top);
 
@@ -124,6 +125,7 @@ class SceneReader {
                    Node& node, bool& ok);
 
     const Limits& limits_;
+    const SceneFiles& files_;
     Problems& problems_;
     size_t outlineWords_ = 0; // polygon and text outlines so far, in vec4s
 };
@@ -443,10 +445,9 @@ std::optional<dom::array> SceneReader::readNode(element value, std::string path,
     }
     // Past the limit, the outline that passed it has said so: no more are built.
     if (hasOutline(kind->kind) && paramsOk && outlineWords_ <= kMaxOutlineWords) {
-        auto outline = buildOutline(node);
+        auto outline = buildOutline(node, files_);
         if (!outline) {
-            const bool fontProblem =
-                outline.error().diagnostics[0].message.starts_with("cannot load font");
+            const bool fontProblem = outline.error().diagnostics[0].path == "font";
             problems_.add(member(p, fontProblem && !node.strings[1].empty() ? "font" : "text"),
                           outline.error().diagnostics[0].message);
         } else if ((*outline)->empty()) {
@@ -593,6 +594,14 @@ void checkCombinedTransforms(const Scene& scene, Problems& problems) {
 } // namespace
 
 Result<Scene> parseScene(std::string_view json, std::string_view file, const Limits& limits) {
+    ParseOptions options;
+    options.limits = limits;
+    return parseScene(json, file, options);
+}
+
+Result<Scene> parseScene(std::string_view json, std::string_view file,
+                         const ParseOptions& options) {
+    const Limits& limits = options.limits;
     const std::string fileName = file.empty() ? "<input>" : std::string(file);
     if (json.size() > limits.maxFileBytes) return tooLarge(fileName, json.size(), limits);
     if (json.starts_with("\xEF\xBB\xBF")) json.remove_prefix(3); // editors' byte order mark
@@ -607,11 +616,12 @@ Result<Scene> parseScene(std::string_view json, std::string_view file, const Lim
 
     Problems problems(fileName);
     Scene scene = isLegacyScene(top) ? convertLegacy(asObject(top), limits, problems)
-                                     : SceneReader(limits, problems).read(top);
+                                     : SceneReader(options, problems).read(top);
     if (problems.empty()) closeRevolvedProfiles(scene);
     if (problems.empty()) checkCombinedTransforms(scene, problems);
     if (!problems.empty()) return problems.error();
     scene.file = fileName;
+    scene.files = options.files;
     return scene;
 }
 
@@ -627,7 +637,10 @@ Result<Scene> loadScene(const std::filesystem::path& path, const Limits& limits)
     in.read(text.data(), static_cast<std::streamsize>(size));
     if (!in && !in.eof()) return Error::message(ErrorKind::Io, file, "cannot read file");
     text.resize(static_cast<size_t>(in.gcount()));
-    return parseScene(text, file, limits);
+    ParseOptions options;
+    options.limits = limits;
+    options.files.folder = path.parent_path();
+    return parseScene(text, file, options);
 }
 
 std::vector<Light> defaultLights() {
