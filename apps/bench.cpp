@@ -2,6 +2,7 @@
 // JSON to a ready pipeline, for every scene in a folder; with --mesh, median mesh extraction
 // times per stage at several resolutions instead.
 #include "bench.h"
+#include "cli.h"
 
 #include <sdfcsg/sdfcsg.h>
 
@@ -470,7 +471,7 @@ int runMeshBench(int argc, char** argv) {
         if (auto ok = measureMeshScene(**context, path, args, stageNames, rows); !ok) {
             const Error& e = ok.error();
             std::fprintf(stderr, "%s: %s\n", path.string().c_str(), e.str().c_str());
-            status = e.kind == ErrorKind::Io ? 3 : e.kind == ErrorKind::Limit ? 1 : 4;
+            status = exitCode(e);
             break;
         }
     printMeshRows(rows, stageNames, args);
@@ -693,7 +694,7 @@ int runBench(int argc, char** argv) {
 
         auto fail = [&](const Error& e) {
             std::fprintf(stderr, "%s: %s\n", file.c_str(), e.str().c_str());
-            status = 4;
+            status = exitCode(e);
         };
         // Alternated: cold, one device, new process, first.
         constexpr int kColdColumns = 4;

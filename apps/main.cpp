@@ -126,7 +126,7 @@ Usage: sdfcsg COMMAND [ARGS...]
 
 Commands:
   render    ray-march a scene to a PNG image
-  mesh      extract a triangle mesh (PLY, OBJ, STL or glTF binary)
+  mesh      extract a triangle mesh (PLY, OBJ, STL, glTF binary or 3MF)
   validate  check scene files and list every problem found
   glsl      print the GLSL a scene compiles to
   convert   convert a scene (e.g. the legacy format) to the current format
@@ -161,8 +161,9 @@ Options:
   --grid                a ground grid under the solid (lines a power of ten apart)
   --skip, --no-skip     force bounds skipping on or off (default: on for GPUs, off for
                         CPU devices, where it only adds work; the image is the same)
-  --evaluation E        auto (default), inlined (every node a line of the kernel) or
-                        tapes (per-region pruned tapes; the default above 160 nodes)
+  --evaluation E        auto (default), inlined (every node a line of the kernel; at most
+                        512 nodes) or tapes (per-region pruned tapes; the default from 160
+                        nodes)
   --device NAME         Vulkan device: index or part of its name (also SDFCSG_DEVICE)
   --validation          enable the Vulkan validation layer
 )";
@@ -228,8 +229,9 @@ int cmdRender(int argc, char** argv) {
         return usageError("render", "--width expects an integer in 1..16384");
     if (args.has("--height") && !parseUint(args.get("--height"), 1, 16384, options.height))
         return usageError("render", "--height expects an integer in 1..16384");
-    if (args.has("--aa") && !parseUint(args.get("--aa"), 1, 8, options.aa))
-        return usageError("render", "--aa expects an integer in 1..8");
+    if (args.has("--aa") && !parseUint(args.get("--aa"), 1, sdfcsg::kMaxAntialiasing, options.aa))
+        return usageError("render", "--aa expects an integer in 1.." +
+                                        std::to_string(sdfcsg::kMaxAntialiasing));
     if (args.has("--mode")) {
         auto mode = sdfcsg::parseRenderMode(args.get("--mode"));
         if (!mode)
@@ -269,14 +271,16 @@ int cmdRender(int argc, char** argv) {
         options.camera = camera;
     }
 
+    sdfcsg::RendererOptions rendererOptions;
+    if (!parseEvaluation(args, "render", rendererOptions.evaluation)) return kUsage;
+    if (auto fits = sdfcsg::checkEvaluation(*scene, rendererOptions.evaluation); !fits)
+        return fail(fits.error());
     sdfcsg::ContextOptions contextOptions;
     contextOptions.device = args.get("--device");
     if (args.has("--validation")) contextOptions.validation = 1;
     auto context = sdfcsg::Context::create(contextOptions);
     if (!context) return fail(context.error());
     catchInterrupts();
-    sdfcsg::RendererOptions rendererOptions;
-    if (!parseEvaluation(args, "render", rendererOptions.evaluation)) return kUsage;
     auto renderer = sdfcsg::Renderer::create(**context, *scene, rendererOptions);
     if (!renderer) return fail(renderer.error());
     auto image = [&] {
@@ -473,8 +477,11 @@ int cmdMesh(int argc, char** argv) {
     }
     if (auto writable = sdfcsg::checkOutput(out); !writable) return fail(writable.error());
 
+    sdfcsg::Evaluation evaluation = sdfcsg::Evaluation::Auto;
+    if (!parseEvaluation(args, "mesh", evaluation)) return kUsage;
     auto scene = load(args.positional[0]);
     if (!scene) return fail(scene.error());
+    if (auto fits = sdfcsg::checkEvaluation(*scene, evaluation); !fits) return fail(fits.error());
     sdfcsg::ContextOptions contextOptions;
     contextOptions.device = args.get("--device");
     if (args.has("--validation")) contextOptions.validation = 1;
@@ -482,8 +489,6 @@ int cmdMesh(int argc, char** argv) {
     if (!context) return fail(context.error());
     catchInterrupts();
     auto t0 = Clock::now();
-    sdfcsg::Evaluation evaluation = sdfcsg::Evaluation::Auto;
-    if (!parseEvaluation(args, "mesh", evaluation)) return kUsage;
     auto mesher = sdfcsg::Mesher::create(**context, *scene, evaluation);
     if (!mesher) return fail(mesher.error());
     const double compileSeconds = secondsSince(t0);

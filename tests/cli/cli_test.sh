@@ -142,6 +142,10 @@ case_mesh_simplify() {
     grep -q '^scene .* triangles  *before .* simplify .* max err' out.txt ||
         { echo "FAIL bench --mesh --simplify columns:"; cat out.txt; failures=$((failures + 1)); }
     check "bench bad simplify" 2 "$bin" bench --mesh --simplify 0
+    # An invalid scene exits as render and mesh do (1), not as a Vulkan failure.
+    mkdir -p badbench && printf '{"version": 1, "root": {"type": "sphere", "radius": -1}}' >badbench/bad.json
+    check "bench invalid scene" 1 "$bin" bench --scenes badbench --frames 1
+    check "bench mesh invalid scene" 1 "$bin" bench --mesh --scenes badbench --resolutions 8 --runs 1
 }
 
 case_mesh_errors() {
@@ -346,12 +350,32 @@ case_interrupt_write() {
     done
 }
 
-# Inlined, the 1,000 spheres of molecule_1k take far longer than two seconds to compile.
+spheres() { # spheres N FILE: a scene of N spheres of distinct sizes and places in one union
+    awk -v n="$1" 'BEGIN {
+        printf "{\"version\": 1, \"root\": {\"type\": \"union\", \"children\": ["
+        for (i = 0; i < n; i++)
+            printf "%s{\"type\": \"sphere\", \"radius\": %.5f, \"translate\": [%.5f, %.5f, %.5f]}",
+                (i ? ", " : ""), 0.02 + 0.00001 * i, sin(i), cos(0.7 * i), sin(1.3 * i)
+        print "]}}" }' >"$2"
+}
+
+# Inlined, 511 distinct spheres (512 nodes, the limit) take far longer than two seconds to
+# compile; one more node is refused at once, naming the limit and the modes that take it.
 case_interrupt_kernel_build() {
+    spheres 511 limit.json
     interrupt "kernel build interrupted" TERM big.ply env SDFCSG_CACHE_DIR=off \
-        MESA_SHADER_CACHE_DISABLE=true "$bin" mesh "$src/assets/bench/molecule_1k.json" -o big.ply \
-        --evaluation inlined
+        MESA_SHADER_CACHE_DISABLE=true "$bin" mesh limit.json -o big.ply --evaluation inlined
     expect_text "kernel build interrupted message" err.txt "sdfcsg: interrupted; nothing was written"
+    spheres 512 past.json
+    for command in "render -o past.png" "mesh -o past.ply"; do
+        start=$(date +%s%N)
+        check "inlined past the limit: $command" 1 env SDFCSG_CACHE_DIR=off "$bin" $command \
+            past.json --evaluation inlined
+        ms=$((($(date +%s%N) - start) / 1000000))
+        [ "$ms" -le 1000 ] ||
+            { echo "FAIL inlined past the limit: $command took $ms ms"; failures=$((failures + 1)); }
+        expect_text "inlined past the limit message" err.txt "past.json: root: inlined evaluation takes at most 512 nodes and this scene has 513; evaluate it from tapes (--evaluation tapes or auto)"
+    done
 }
 
 # Ctrl-C while a language model is awaited (skipped without python3): a stand-in answers the

@@ -261,14 +261,26 @@ TEST(Codegen, LiteralSharpOperationsTakeTheShortForm) {
         << buffer;
 }
 
-// Past 1024 nodes inlining would make glslang quadratic; such scenes read the buffer.
-TEST(Codegen, HugeScenesAreNotInlined) {
-    EXPECT_NE(generateSceneGlsl(smoothChain(1100)).find("tape.glsl"), std::string::npos);
+// Inlined evaluation inlines every value it is asked to, and takes at most kInlinedMaxNodes
+// nodes: a larger scene is refused, naming the limit and the modes that take it.
+TEST(Codegen, InlinedEvaluationIsBounded) {
     CodegenOptions inl;
     inl.inlineParams = true;
     inl.evaluation = Evaluation::Inlined; // by default, such scenes run pruned tapes
-    EXPECT_EQ(generateSceneGlsl(smoothChain(1000), inl).find("nodes["), std::string::npos);
-    EXPECT_NE(generateSceneGlsl(smoothChain(1100), inl).find("nodes["), std::string::npos);
+    const Scene atLimit = smoothChain(int(kInlinedMaxNodes) - 1); // the union and its spheres
+    ASSERT_EQ(atLimit.nodes.size(), kInlinedMaxNodes);
+    EXPECT_EQ(generateSceneGlsl(atLimit, inl).find("nodes["), std::string::npos);
+    EXPECT_TRUE(checkEvaluation(atLimit, Evaluation::Inlined));
+    Scene past = smoothChain(int(kInlinedMaxNodes));
+    past.file = "big.json";
+    auto refused = checkEvaluation(past, Evaluation::Inlined);
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error().kind, ErrorKind::Limit);
+    EXPECT_EQ(refused.error().str(),
+              "big.json: root: inlined evaluation takes at most 512 nodes and this scene has 513; "
+              "evaluate it from tapes (--evaluation tapes or auto)");
+    EXPECT_TRUE(checkEvaluation(past, Evaluation::Auto));
+    EXPECT_TRUE(checkEvaluation(past, Evaluation::Tapes));
 }
 
 TEST(Codegen, CompileErrorsComeBackWithTheLog) {

@@ -934,9 +934,9 @@ TEST_F(Render, RejectsBadOptions) {
     EXPECT_EQ(refused(options), "<render>: the image must be at least 1 x 1 pixels");
     options.width = 8;
     options.aa = 0;
-    EXPECT_EQ(refused(options), "<render>: aa must be in 1..16");
-    options.aa = 17;
-    EXPECT_EQ(refused(options), "<render>: aa must be in 1..16");
+    EXPECT_EQ(refused(options), "<render>: aa must be in 1..8");
+    options.aa = 9;
+    EXPECT_EQ(refused(options), "<render>: aa must be in 1..8");
     options.aa = 1;
     options.width = options.height = 1u << 16; // 4 G pixels
     auto huge = (*renderer)->render(options);

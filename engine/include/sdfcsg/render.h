@@ -33,11 +33,14 @@ struct GroundGrid {
 };
 GroundGrid groundGrid(const Evaluator& evaluator);
 
+// The most samples per pixel along each axis (RenderOptions::aa).
+inline constexpr uint32_t kMaxAntialiasing = 8;
+
 struct RenderOptions {
     uint32_t width = 800, height = 600;
     RenderMode mode = RenderMode::Shaded;
     std::optional<Camera> camera; // unset: the scene's camera, else framed from its bounds
-    uint32_t aa = 1;              // N x N samples per pixel
+    uint32_t aa = 1;              // N x N samples per pixel, 1..kMaxAntialiasing
     bool shadows = true;
     bool ambientOcclusion = true;
     // Skip operands whose bounds cannot change the result (the image is the same either way).

@@ -415,6 +415,7 @@ Mesher::~Mesher() = default;
 Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& scene,
                                                Evaluation evaluation) {
     if (scene.nodes.empty()) return usage("the scene has no nodes");
+    if (auto fits = checkEvaluation(scene, evaluation); !fits) return fits.error();
     auto impl = std::make_unique<Impl>(detail::contextImpl(context));
     Impl& m = *impl;
     m.evaluator = std::make_unique<Evaluator>(scene);

@@ -193,7 +193,8 @@ bool sameStructure(const Scene& a, const Scene& b) {
 static std::optional<Error> checkRenderOptions(const RenderOptions& options, uint32_t nodeCount) {
     if (options.width == 0 || options.height == 0)
         return usage("the image must be at least 1 x 1 pixels");
-    if (options.aa == 0 || options.aa > 16) return usage("aa must be in 1..16");
+    if (options.aa == 0 || options.aa > kMaxAntialiasing)
+        return usage("aa must be in 1.." + std::to_string(kMaxAntialiasing));
     if (options.boxes == BoxOverlay::Selected &&
         (options.selectedNode < 0 || uint32_t(options.selectedNode) >= nodeCount))
         return usage("selectedNode " + std::to_string(options.selectedNode) +
@@ -839,6 +840,7 @@ VkPipeline SharedPasses::created(uint32_t pass) {
 Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Scene& scene,
                                                    const RendererOptions& options) {
     if (scene.nodes.empty()) return usage("the scene has no nodes");
+    if (auto fits = checkEvaluation(scene, options.evaluation); !fits) return fits.error();
     auto impl = std::make_unique<Impl>(detail::contextImpl(context));
     Impl& r = *impl;
     r.options = options;

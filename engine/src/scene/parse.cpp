@@ -151,7 +151,7 @@ Scene SceneReader::read(element top) {
                                      std::to_string(kSceneVersion));
     }
     if (v[1])
-        if (auto s = readString(*v[1], "name", 200, problems_)) scene.name = *s;
+        if (auto s = readString(*v[1], "name", kMaxNameCharacters, problems_)) scene.name = *s;
     if (v[2])
         if (auto s = readString(*v[2], "description", 0, problems_)) scene.description = *s;
     if (v[3]) readCamera(*v[3], scene);
@@ -305,8 +305,7 @@ void SceneReader::readParam(const ParamInfo& p, std::optional<element> value,
     }
     const std::string keyPath = member(path, p.name);
     if (p.type == ValueType::Text) {
-        // Bytes: the font's reader counts the characters (a UTF-8 one takes up to 4).
-        auto s = readString(*value, keyPath, 4 * kMaxTextCharacters, problems_);
+        auto s = readString(*value, keyPath, kMaxTextCharacters, problems_);
         if (s) node.strings[p.slot] = *s;
         ok = ok && s.has_value();
     } else if (p.type == ValueType::Points) {
@@ -417,7 +416,8 @@ std::optional<dom::array> SceneReader::readNode(element value, std::string path,
     for (const ParamInfo& param : kind->params)
         readParam(param, valueOf(param.name), p, node, paramsOk);
     if (auto e = valueOf("name"))
-        if (auto s = readString(*e, member(p, "name"), 200, problems_)) node.name = *s;
+        if (auto s = readString(*e, member(p, "name"), kMaxNameCharacters, problems_))
+            node.name = *s;
     if (auto e = valueOf("translate"))
         if (auto t = readVec3(*e, member(p, "translate"), Check::Any, problems_))
             node.transform.translate = *t;

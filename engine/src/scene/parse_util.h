@@ -31,6 +31,8 @@ inline simdjson::dom::object asObject(element e) {
 
 // Enough to fix a file in a few rounds without flooding a terminal.
 inline constexpr size_t kMaxProblems = 50;
+// The longest scene or node name.
+inline constexpr size_t kMaxNameCharacters = 200;
 
 class Problems {
   public:
