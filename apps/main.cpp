@@ -293,6 +293,8 @@ int cmdRender(int argc, char** argv) {
     auto png = sdfcsg::encodePng(*image, out);
     if (!png) return fail(png.error());
     if (auto written = writeOutput(out, *png); !written) return fail(written.error());
+    if (auto why = (*renderer)->nothingShown())
+        std::fprintf(stderr, "warning: %s shows nothing: %s\n", out.c_str(), why->c_str());
     return kOk;
 }
 
@@ -524,10 +526,14 @@ int cmdMesh(int argc, char** argv) {
     const double writeSeconds = secondsSince(t0);
 
     if (args.has("--stats")) printMeshStats(stats, compileSeconds, writeSeconds);
-    if (mesh->triangleCount() == 0)
-        std::fprintf(stderr, "note: no surface lies inside the bounds; %s holds an empty mesh\n",
-                     out.c_str());
-    else if (stats.surfaceCut && !args.has("--stats"))
+    if (mesh->triangleCount() == 0) {
+        options.progress = [](float) { return !interrupted(); };
+        const auto why = (*mesher)->whyEmpty(options);
+        if (interrupted())
+            return fail(sdfcsg::Error::message(sdfcsg::ErrorKind::Cancelled, {}, {}));
+        std::fprintf(stderr, "warning: %s holds an empty mesh: %s\n", out.c_str(),
+                     why ? why->c_str() : "no surface lies inside the bounds");
+    } else if (stats.surfaceCut && !args.has("--stats"))
         std::fprintf(stderr, "note: the bounds cut the surface, so the mesh is open there\n");
     return kOk;
 }

@@ -350,6 +350,42 @@ case_interrupt_write() {
     done
 }
 
+# Valid scenes that show nothing say why, on standard error, and still exit 0.
+case_degenerate() {
+    one() { # one FILE ROOT: a scene of the node ROOT
+        printf '{"version": 1, "root": %s}' "$2" >"$1"
+    }
+    one huge.json '{"type": "sphere", "radius": 3e38}'
+    one scaled.json '{"type": "sphere", "radius": 1, "scale": 1e20}'
+    one tiny.json '{"type": "sphere", "radius": 1e-30}'
+    one shrunk.json '{"type": "sphere", "radius": 1, "scale": 1e-20}'
+    one empty.json '{"type": "difference", "children": [{"type": "sphere", "radius": 1}, {"type": "sphere", "radius": 2}]}'
+    one ball.json '{"type": "sphere", "radius": 1}'
+    shows() { # shows FILE REASON [RENDER OPTIONS...]: render warns that FILE shows nothing
+        file=$1 reason=$2
+        shift 2
+        check "render $file" 0 "$bin" render "$file" -o "$file.png" --width 64 --height 48 "$@"
+        expect_text "render $file warning" err.txt "warning: $file.png shows nothing: $reason"
+    }
+    shows huge.json "the solid is too large for single precision: its bounds reach 3e+38"
+    shows scaled.json "the solid is too large for single precision: its bounds reach 1e+20"
+    shows tiny.json "the solid is smaller than a pixel: at most 3.46e-06 units across, seen from 0.00287 units away"
+    shows shrunk.json "the solid is smaller than a pixel: at most 3.46e-06 units across, seen from 0.00287 units away"
+    shows empty.json "the solid is empty: no point of its bounds lies inside it"
+    shows ball.json "the solid lies outside the view" --eye 0,0,5 --target 0,0,10
+    check "render ball" 0 "$bin" render ball.json -o ball.png --width 64 --height 48
+    [ ! -s err.txt ] || { echo "FAIL render ball: a warning"; cat err.txt; failures=$((failures + 1)); }
+
+    check "mesh empty" 0 "$bin" mesh empty.json -o empty.ply
+    expect_text "mesh empty warning" err.txt "warning: empty.ply holds an empty mesh: the solid is empty: no point of its bounds lies inside it"
+    check "mesh resolution 1" 0 "$bin" mesh ball.json -o coarse.ply --resolution 1
+    expect_text "mesh resolution 1 warning" err.txt "warning: coarse.ply holds an empty mesh: the grid is too coarse to find the surface; --resolution 2 is the smallest that does"
+    check "mesh resolution 2" 0 "$bin" mesh ball.json -o fine.ply --resolution 2
+    [ ! -s err.txt ] || { echo "FAIL mesh resolution 2: a warning"; cat err.txt; failures=$((failures + 1)); }
+    check "mesh huge" 1 "$bin" mesh huge.json -o huge.ply
+    expect_text "mesh huge message" err.txt "<mesh>: the solid is too large for single precision: its bounds reach 3e+38"
+}
+
 spheres() { # spheres N FILE: a scene of N spheres of distinct sizes and places in one union
     awk -v n="$1" 'BEGIN {
         printf "{\"version\": 1, \"root\": {\"type\": \"union\", \"children\": ["

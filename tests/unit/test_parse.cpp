@@ -154,6 +154,17 @@ std::vector<BadInput> badInputs() {
          "lights, background and root"},
         {"name too long", withSphere(R"("version": 1, "name": ")" + std::string(201, 'x') + "\""),
          "scene.json: name: expected a string of at most 200 characters, got 201 characters"},
+        {"text too long", // 257 characters of two bytes each: counted as characters
+         R"({"version": 1, "root": {"type": "extrude", "height": 0.1, "children": [{"type": "text", "text": ")" +
+             [] {
+                 std::string s;
+                 for (int i = 0; i < 257; ++i)
+                     s += "\xc3\xa9";
+                 return s;
+             }() +
+             "\"}]}}",
+         "scene.json: root.children[0].text: expected a string of at most 256 characters, got 257 "
+         "characters"},
         {"camera without target, fov 180",
          withSphere(R"("version": 1, "camera": {"eye": [0, 0, 5], "fov": 180})"),
          "scene.json: camera: missing required key \"target\" (an array of 3 numbers)\n"

@@ -100,6 +100,12 @@ class Evaluator {
     std::shared_ptr<Pruned> pruned_;
 };
 
+// Whether the solid is certainly empty: its bounds are empty, or finite and split into boxes
+// whose centres each lie outside, farther from the surface than the box's half-diagonal (every
+// field is 1-Lipschitz). False where some point is inside, or a few thousand values do not
+// settle it.
+bool provablyEmpty(const Evaluator& evaluator);
+
 // A camera looking at the finite part of the scene's bounds from the front and slightly above.
 Camera frameCamera(const Evaluator& evaluator, float aspect, float fov = 45.0f);
 

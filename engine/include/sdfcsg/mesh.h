@@ -115,6 +115,11 @@ class Mesher {
     // Fails with ErrorKind::Usage for bad options (empty or non-finite bounds, resolution 0)
     // and ErrorKind::Limit when the grid needs more memory than options.memoryBudget.
     Result<Mesh> extract(const MeshOptions& options, MeshStats* stats = nullptr);
+    // Why extract(options) found no surface, as a clause for a note: the solid is empty, or the
+    // grid too coarse, with the smallest resolution that finds the surface (by extracting
+    // coarse grids again, each cancelled as options.progress says). Nothing where the reason
+    // is not known (options.bounds may just miss the solid) or an extraction failed.
+    std::optional<std::string> whyEmpty(const MeshOptions& options);
 
     struct Impl;
 

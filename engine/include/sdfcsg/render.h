@@ -107,6 +107,9 @@ class Renderer {
     Result<Image> render(const RenderOptions& options);
     // Per-pixel hit depth and step count of the last render().
     const std::vector<PixelInfo>& lastPixelInfo() const;
+    // Why the last render() shows no surface, as a clause for a warning ("the solid is empty:
+    // ..."); nothing where some pixel shows it.
+    std::optional<std::string> nothingShown() const;
 
     struct Impl;
 

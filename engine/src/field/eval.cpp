@@ -448,6 +448,26 @@ float Evaluator::prunedDistance(glm::vec3 p) const {
     return pruned_->field.distance(nodes_, p);
 }
 
+bool provablyEmpty(const Evaluator& evaluator) {
+    const Aabb& bounds = evaluator.bounds();
+    if (bounds.empty()) return true;
+    if (!bounds.finite()) return false;
+    std::vector<Aabb> boxes{bounds}; // coarse to fine: boxes[next] is the next to look at
+    for (size_t next = 0; next < boxes.size(); ++next) {
+        const Aabb box = boxes[next];
+        const glm::vec3 centre = 0.5f * (box.min + box.max), half = 0.5f * (box.max - box.min);
+        const float d = evaluator.distance(centre);
+        if (!(d >= 0.0f) || next == 4096) return false;
+        if (d > glm::length(half)) continue;
+        for (int i = 0; i < 8; ++i) {
+            const glm::vec3 corner(i & 1 ? centre.x : box.min.x, i & 2 ? centre.y : box.min.y,
+                                   i & 4 ? centre.z : box.min.z);
+            boxes.push_back(Aabb{corner, corner + half});
+        }
+    }
+    return true;
+}
+
 Camera frameCamera(const Evaluator& evaluator, float aspect, float fov) {
     Camera camera;
     camera.fov = fov;

@@ -112,25 +112,6 @@ std::string absurdBounds(const Extent& box) {
     return {};
 }
 
-// True when no grid sample over the bounds comes close enough to the surface to hide a solid:
-// the field is a lower bound of the distance, so a value above half a cell's diagonal at every
-// cell centre leaves no room for one.
-bool provablyEmpty(const Evaluator& evaluator) {
-    const Aabb& box = evaluator.bounds();
-    if (box.empty()) return true;
-    if (!box.finite()) return false;
-    constexpr int kCells = 16;
-    const glm::vec3 cell = (box.max - box.min) / float(kCells);
-    const float reach = 0.5f * glm::length(cell);
-    for (int z = 0; z < kCells; ++z)
-        for (int y = 0; y < kCells; ++y)
-            for (int x = 0; x < kCells; ++x) {
-                glm::vec3 p = box.min + (glm::vec3(x, y, z) + 0.5f) * cell;
-                if (evaluator.distance(p) <= reach) return false;
-            }
-    return true;
-}
-
 } // namespace
 
 std::vector<Diagnostic> sceneSanityWarnings(const Scene& scene) {

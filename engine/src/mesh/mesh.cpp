@@ -194,9 +194,18 @@ Result<Grid> planGrid(const Evaluator& evaluator, const MeshOptions& options) {
         box.min -= glm::vec3(float(margin) * h);
         box.max += glm::vec3(float(margin) * h);
     }
+    glm::vec3 extent = box.max - box.min;
+    if (!std::isfinite(extent.x + extent.y + extent.z + h)) {
+        const Aabb solid = detail::finiteSceneBounds(evaluator);
+        const glm::vec3 reach = glm::max(glm::abs(solid.min), glm::abs(solid.max));
+        char text[120];
+        std::snprintf(text, sizeof text,
+                      "the solid is too large for single precision: its bounds reach %.3g",
+                      double(std::max({reach.x, reach.y, reach.z})));
+        return Error::message(ErrorKind::Limit, "<mesh>", text);
+    }
     Grid g;
     g.h = h;
-    glm::vec3 extent = box.max - box.min;
     for (int a = 0; a < 3; ++a) {
         double n = std::ceil(double(extent[a]) / double(h) - 1e-3);
         if (!(n < double(1u << 24)))
@@ -514,6 +523,42 @@ Status Mesher::Impl::buildPasses(const std::string& sceneGlsl) {
     // Loading the helper's machine code takes a tenth of its compile or less.
     if (helperMs > 0.0 && dualMs.count() > 0.25 * helperMs) detail::compileHelperMissed(ctx);
     return Ok{};
+}
+
+std::optional<std::string> Mesher::whyEmpty(const MeshOptions& options) {
+    if (provablyEmpty(*impl_->evaluator))
+        return "the solid is empty: no point of its bounds lies inside it";
+    if (options.bounds) return std::nullopt;
+    // The smallest resolution that finds the surface: doubling from the one asked for, then
+    // halving the gap. Coarse grids extract in a fraction of the first one's time.
+    MeshOptions finer = options;
+    finer.voxelSize.reset();
+    auto finds = [&](uint32_t resolution) -> std::optional<bool> {
+        finer.resolution = resolution;
+        auto mesh = extract(finer);
+        if (!mesh) return std::nullopt;
+        return mesh->triangleCount() > 0;
+    };
+    constexpr uint32_t kFinest = 1024;
+    uint32_t coarse = options.voxelSize ? 0 : options.resolution, fine = coarse;
+    for (bool found = false; !found; coarse = fine) {
+        if (fine >= kFinest)
+            return "no grid of up to " + std::to_string(fine) +
+                   " cells along the longest axis finds the surface";
+        fine = std::min(std::max(2 * fine, 2u), kFinest);
+        auto hit = finds(fine);
+        if (!hit) return std::nullopt;
+        found = *hit;
+        if (found) break;
+    }
+    while (fine - coarse > 1) {
+        const uint32_t middle = coarse + (fine - coarse) / 2;
+        auto found = finds(middle);
+        if (!found) return std::nullopt;
+        (*found ? fine : coarse) = middle;
+    }
+    return "the grid is too coarse to find the surface; --resolution " + std::to_string(fine) +
+           " is the smallest that does";
 }
 
 Result<Mesh> Mesher::extract(const MeshOptions& options, MeshStats* stats) {

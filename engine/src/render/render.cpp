@@ -232,6 +232,8 @@ struct Renderer::Impl {
     uint32_t tileCapacity = 0;     // workgroups the tile list holds
     bool samplesArePixels = false; // what the SAMPLES binding points at
     std::vector<PixelInfo> lastInfo;
+    Camera lastCamera;       // of the last render()
+    uint32_t lastHeight = 0; // in pixels
 
     explicit Impl(Context::Impl& c) : ctx(c), sceneBuffers(c) {}
     // No work of this renderer is pending between calls (submitAndWait() waits for it), and the
@@ -931,6 +933,7 @@ Result<Image> Renderer::render(const RenderOptions& options) {
     const Camera camera = options.camera   ? *options.camera
                           : r.scene.camera ? *r.scene.camera
                                            : frameCamera(*r.evaluator, aspect);
+    r.lastCamera = camera, r.lastHeight = options.height;
     auto passes = r.framePasses(options);
     if (!passes) return passes.error();
     const detail::RayCamera rc = detail::makeRayCamera(camera, options.width, options.height);
@@ -948,6 +951,41 @@ Result<Image> Renderer::render(const RenderOptions& options) {
 
 const std::vector<PixelInfo>& Renderer::lastPixelInfo() const {
     return impl_->lastInfo;
+}
+
+std::optional<std::string> Renderer::nothingShown() const {
+    const Impl& r = *impl_;
+    if (r.lastInfo.empty() ||
+        std::any_of(r.lastInfo.begin(), r.lastInfo.end(), [](PixelInfo i) { return i.depth >= 0; }))
+        return std::nullopt;
+    const Evaluator& evaluator = *r.evaluator;
+    const Camera& camera = r.lastCamera;
+    const Aabb box = evaluator.finiteBounds();
+    auto largest = [](glm::vec3 v) {
+        return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+    };
+    const float reach = std::max(largest(box.min), largest(box.max));
+    char text[160];
+    // Past this, squared distances overflow single precision.
+    constexpr float kLargest = 1e18f;
+    if (!(reach < kLargest) || !(largest(camera.eye) < kLargest)) {
+        std::snprintf(text, sizeof text,
+                      "the solid is too large for single precision: its bounds reach %.3g", reach);
+        return text;
+    }
+    if (provablyEmpty(evaluator))
+        return "the solid is empty: no point of its bounds lies inside it";
+    const float size = glm::length(box.max - box.min);
+    const float away = glm::length(0.5f * (box.min + box.max) - camera.eye);
+    const float pixel = 2.0f * away * std::tan(0.5f * glm::radians(camera.fov)) / r.lastHeight;
+    if (size < pixel || size < 2.0f * kMinHitEpsilon) {
+        std::snprintf(text, sizeof text,
+                      "the solid is smaller than a pixel: at most %.3g units across, seen from "
+                      "%.3g units away",
+                      size, away);
+        return text;
+    }
+    return "the solid lies outside the view";
 }
 
 } // namespace sdfcsg
