@@ -213,6 +213,14 @@ bool writeShot(Viewer& v, Image& capture, bool drawsMesh) {
         v.exitCode = 3;
         return false;
     }
+    const std::string shot = v.pendingShot.string();
+    if (!v.scene) {
+        std::fprintf(stderr, "note: %s shows no scene: none is open\n", shot.c_str());
+    } else if (!drawsMesh && v.evaluator) {
+        const Camera camera = v.last.options.camera.value_or(toCamera(v.camera));
+        if (auto why = whyNothingShows(*v.evaluator, camera, v.last.options.height, v.last.pixels))
+            std::fprintf(stderr, "note: %s shows nothing: %s\n", shot.c_str(), why->c_str());
+    }
     // With the mesh's device time, so scripts can time the mesh view.
     if (drawsMesh && v.meshDrawMs >= 0.0)
         std::printf("wrote %s (%u x %u), mesh drawn in %.1f ms\n", v.pendingShot.string().c_str(),

@@ -43,6 +43,9 @@ double now() {
 void resetCamera(Viewer& v) {
     if (!v.evaluator) return;
     Camera c = v.scene->camera ? *v.scene->camera : frameCamera(*v.evaluator, aspectOf(v));
+    // A solid beyond single precision frames no camera: the default one shows why nothing shows.
+    auto finite = [](glm::vec3 p) { return std::isfinite(p.x + p.y + p.z); };
+    if (!finite(c.eye) || !finite(c.target)) c = Camera{};
     v.camera = orbitFromCamera(c);
 }
 
@@ -323,7 +326,8 @@ void updateImage(Viewer& v) {
 }
 
 bool settled(Viewer& v) {
-    return v.scene && v.haveShown && v.shown == wantedKey(v, true) && v.renderer->idle() &&
+    if (!v.scene) return !v.doc.loaded() && !v.generating; // nothing to draw, none coming
+    return v.haveShown && v.shown == wantedKey(v, true) && v.renderer->idle() &&
            !(v.last.live && v.renderer->refinementPending(v.sceneVersion));
 }
 

@@ -373,6 +373,7 @@ case_degenerate() {
     shows shrunk.json "the solid is smaller than a pixel: at most 3.46e-06 units across, seen from 0.00287 units away"
     shows empty.json "the solid is empty: no point of its bounds lies inside it"
     shows ball.json "the solid lies outside the view" --eye 0,0,5 --target 0,0,10
+    shows ball.json "the camera is inside the solid" --eye 0,0,0.5 --target 0,0,0
     check "render ball" 0 "$bin" render ball.json -o ball.png --width 64 --height 48
     [ ! -s err.txt ] || { echo "FAIL render ball: a warning"; cat err.txt; failures=$((failures + 1)); }
 

@@ -243,6 +243,24 @@ case_quit() {
         --size 320x240 --no-ui || fail "the viewer did not exit promptly after an edit"
 }
 
+# A screenshot with nothing to show is written within seconds, with the reason.
+case_screenshot_empty() {
+    timeout 10 "$viewer" --screenshot none.png --size 320x240 --no-ui 2>none.err ||
+        fail "no screenshot within 10 s without a scene"
+    [ -s none.png ] || fail "no screenshot without a scene"
+    grep -qxF "note: none.png shows no scene: none is open" none.err || fail "$(cat none.err)"
+    printf '{"version": 1, "root": {"type": "sphere", "radius": 3e38}}' >huge.json
+    timeout 10 "$viewer" huge.json --screenshot huge.png --size 320x240 --no-ui 2>huge.err ||
+        fail "no screenshot within 10 s of a solid beyond single precision"
+    grep -qxF "note: huge.png shows nothing: the solid is too large for single precision: its bounds reach 3e+38" huge.err ||
+        fail "$(cat huge.err)"
+    printf '{"version": 1, "root": {"type": "difference", "children": [{"type": "sphere", "radius": 1}, {"type": "sphere", "radius": 2}]}}' >empty.json
+    timeout 10 "$viewer" empty.json --screenshot empty.png --size 320x240 --no-ui 2>empty.err ||
+        fail "no screenshot within 10 s of an empty solid"
+    grep -qxF "note: empty.png shows nothing: the solid is empty: no point of its bounds lies inside it" empty.err ||
+        fail "$(cat empty.err)"
+}
+
 # A script with a mistake is refused before any window opens.
 case_bad_script() {
     cp "$src/assets/scenes/snowman.json" edit.json

@@ -69,6 +69,13 @@ struct PixelInfo {
     uint32_t steps;
 };
 
+// Why an image whose pixels (Renderer::lastPixelInfo) `camera` saw on a grid `height` pixels high
+// shows no surface, as a clause for a warning: the solid too large for single precision (whatever
+// the pixels), the camera inside it, the solid empty, smaller than a pixel, or out of view.
+// Nothing where some pixel shows the solid.
+std::optional<std::string> whyNothingShows(const Evaluator& evaluator, const Camera& camera,
+                                           uint32_t height, const std::vector<PixelInfo>& pixels);
+
 // Same node kinds and children, node for node: what updateValues() needs to keep the kernel.
 bool sameStructure(const Scene& a, const Scene& b);
 
@@ -107,8 +114,7 @@ class Renderer {
     Result<Image> render(const RenderOptions& options);
     // Per-pixel hit depth and step count of the last render().
     const std::vector<PixelInfo>& lastPixelInfo() const;
-    // Why the last render() shows no surface, as a clause for a warning ("the solid is empty:
-    // ..."); nothing where some pixel shows it.
+    // whyNothingShows() for the last render().
     std::optional<std::string> nothingShown() const;
 
     struct Impl;

@@ -955,11 +955,11 @@ const std::vector<PixelInfo>& Renderer::lastPixelInfo() const {
 
 std::optional<std::string> Renderer::nothingShown() const {
     const Impl& r = *impl_;
-    if (r.lastInfo.empty() ||
-        std::any_of(r.lastInfo.begin(), r.lastInfo.end(), [](PixelInfo i) { return i.depth >= 0; }))
-        return std::nullopt;
-    const Evaluator& evaluator = *r.evaluator;
-    const Camera& camera = r.lastCamera;
+    return whyNothingShows(*r.evaluator, r.lastCamera, r.lastHeight, r.lastInfo);
+}
+
+std::optional<std::string> whyNothingShows(const Evaluator& evaluator, const Camera& camera,
+                                           uint32_t height, const std::vector<PixelInfo>& pixels) {
     const Aabb box = evaluator.finiteBounds();
     auto largest = [](glm::vec3 v) {
         return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
@@ -973,11 +973,15 @@ std::optional<std::string> Renderer::nothingShown() const {
                       "the solid is too large for single precision: its bounds reach %.3g", reach);
         return text;
     }
+    auto all = [&](auto&& holds) { return std::all_of(pixels.begin(), pixels.end(), holds); };
+    if (pixels.empty()) return std::nullopt;
+    if (all([](PixelInfo i) { return i.depth == 0.0f; })) return "the camera is inside the solid";
+    if (!all([](PixelInfo i) { return i.depth < 0.0f; })) return std::nullopt;
     if (provablyEmpty(evaluator))
         return "the solid is empty: no point of its bounds lies inside it";
     const float size = glm::length(box.max - box.min);
     const float away = glm::length(0.5f * (box.min + box.max) - camera.eye);
-    const float pixel = 2.0f * away * std::tan(0.5f * glm::radians(camera.fov)) / r.lastHeight;
+    const float pixel = 2.0f * away * std::tan(0.5f * glm::radians(camera.fov)) / float(height);
     if (size < pixel || size < 2.0f * kMinHitEpsilon) {
         std::snprintf(text, sizeof text,
                       "the solid is smaller than a pixel: at most %.3g units across, seen from "
