@@ -322,7 +322,7 @@ Options:
                          standard output. A symbolic link is followed; a FIFO or a device
                          is written into; any other file that is not a regular one is refused
   --format F             ply, obj, stl, glb or 3mf, instead of OUT's extension
-  --unit U               3MF only: what one scene unit is, mm (default), cm, m or inch
+  --unit U               3MF only: what one scene unit is, mm, cm (default), m or inch
   --method M             dc (dual contouring, the default) or mc (marching cubes)
   --resolution N         cells along the longest axis of the bounds (default 128)
   --voxel-size H         cell edge length in scene units, instead of --resolution
@@ -421,7 +421,7 @@ int cmdMesh(int argc, char** argv) {
         return usageError("mesh", "the output must end in .ply, .obj, .stl, .glb or .3mf (or give "
                                   "--format), got '" +
                                       out + "'");
-    sdfcsg::LengthUnit unit = sdfcsg::LengthUnit::Millimeter;
+    sdfcsg::LengthUnit unit = sdfcsg::kDefaultLengthUnit;
     if (args.has("--unit")) {
         auto named = sdfcsg::lengthUnitFromName(args.get("--unit"));
         if (!named) return usageError("mesh", "--unit expects mm, cm, m or inch");

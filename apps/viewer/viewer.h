@@ -105,7 +105,7 @@ struct Viewer {
     int meshResolution = 128;
     int meshMethod = 0;        // 0 dual contouring, 1 marching cubes (MeshMethod's order)
     float meshSimplify = 0.0f; // cells from the surface that simplification may move it; 0: off
-    int exportUnit = 0;        // 3MF: LengthUnit's order
+    int exportUnit = int(kDefaultLengthUnit); // 3MF: LengthUnit's order
     bool customBounds = false;
     float boundsMin[3] = {-1, -1, -1}, boundsMax[3] = {1, 1, 1};
     std::string meshMessage;

@@ -98,11 +98,15 @@ case_mesh() {
     check "mesh bad extension" 2 "$bin" mesh "$mesh_a" -o part.txt
     expect_text "mesh bad extension message" err.txt "sdfcsg mesh: the output must end in .ply, .obj, .stl, .glb or .3mf (or give --format), got 'part.txt'"
     # 3MF, read back by Python's own ZIP and XML readers against the PLY of the same mesh.
-    check "mesh 3mf" 0 "$bin" mesh "$mesh_a" -o part.3mf --resolution 24 --bounds $box --unit cm
+    # One scene unit is a centimetre unless --unit says otherwise.
+    check "mesh 3mf" 0 "$bin" mesh "$mesh_a" -o part.3mf --resolution 24 --bounds $box
+    check "mesh 3mf in mm" 0 "$bin" mesh "$mesh_a" -o part-mm.3mf --resolution 24 --bounds $box --unit mm
     if command -v python3 >/dev/null 2>&1; then
         python3 "$src/tests/cli/read_3mf.py" part.3mf part.ply centimeter >out.txt 2>&1 &&
             grep -q "^3mf: $vertices vertices, $triangles triangles, 2 colours" out.txt ||
             { echo "FAIL part.3mf:"; cat out.txt; failures=$((failures + 1)); }
+        python3 "$src/tests/cli/read_3mf.py" part-mm.3mf part.ply millimeter >out.txt 2>&1 ||
+            { echo "FAIL part-mm.3mf:"; cat out.txt; failures=$((failures + 1)); }
     else
         echo "skipped reading part.3mf back: python3 not found"
     fi

@@ -24,6 +24,9 @@ enum class MeshFormat {
 
 // The length that one scene unit stands for, where the format says (3MF).
 enum class LengthUnit { Millimeter, Centimeter, Meter, Inch };
+// Scenes are modelled a few units across (the bundled ones 1.3 to 10): one unit a centimetre
+// prints them 1.3 to 10 cm wide, where millimetres, 3MF's own default, made a 1 mm pawn.
+inline constexpr LengthUnit kDefaultLengthUnit = LengthUnit::Centimeter;
 
 // The format named by a path's extension (case-insensitive), or nullopt.
 std::optional<MeshFormat> meshFormatFromPath(const std::filesystem::path& path);
@@ -33,15 +36,14 @@ std::string_view meshFormatName(MeshFormat format); // "ply", "obj", "stl", "glb
 std::optional<LengthUnit> lengthUnitFromName(std::string_view name);
 
 // The file's bytes; empty for a 3MF past what its ZIP container holds (4 GiB).
-std::string encodeMesh(const Mesh& mesh, MeshFormat format,
-                       LengthUnit unit = LengthUnit::Millimeter);
+std::string encodeMesh(const Mesh& mesh, MeshFormat format, LengthUnit unit = kDefaultLengthUnit);
 
 // The file that writeMesh() writes to `path`: the encoded bytes, or its error (naming `path`).
 Result<std::string> encodeMeshFile(const Mesh& mesh, const std::filesystem::path& path,
-                                   MeshFormat format, LengthUnit unit = LengthUnit::Millimeter);
+                                   MeshFormat format, LengthUnit unit = kDefaultLengthUnit);
 
 // Encodes and writes atomically (see io.h).
 Status writeMesh(const Mesh& mesh, const std::filesystem::path& path, MeshFormat format,
-                 LengthUnit unit = LengthUnit::Millimeter);
+                 LengthUnit unit = kDefaultLengthUnit);
 
 } // namespace sdfcsg
