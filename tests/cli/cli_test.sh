@@ -384,7 +384,7 @@ case_degenerate() {
     check "mesh empty" 0 "$bin" mesh empty.json -o empty.ply
     expect_text "mesh empty warning" err.txt "warning: empty.ply holds an empty mesh: the solid is empty: no point of its bounds lies inside it"
     check "mesh resolution 1" 0 "$bin" mesh ball.json -o coarse.ply --resolution 1
-    expect_text "mesh resolution 1 warning" err.txt "warning: coarse.ply holds an empty mesh: the grid is too coarse to find the surface; --resolution 2 is the smallest that does"
+    expect_text "mesh resolution 1 warning" err.txt "warning: coarse.ply holds an empty mesh: the grid is too coarse to find the surface; resolution 2 is the smallest that does"
     check "mesh resolution 2" 0 "$bin" mesh ball.json -o fine.ply --resolution 2
     [ ! -s err.txt ] || { echo "FAIL mesh resolution 2: a warning"; cat err.txt; failures=$((failures + 1)); }
     check "mesh huge" 1 "$bin" mesh huge.json -o huge.ply

@@ -540,16 +540,17 @@ std::optional<std::string> Mesher::whyEmpty(const MeshOptions& options) {
         return mesh->triangleCount() > 0;
     };
     constexpr uint32_t kFinest = 1024;
-    uint32_t coarse = options.voxelSize ? 0 : options.resolution, fine = coarse;
-    for (bool found = false; !found; coarse = fine) {
+    uint32_t coarse = options.voxelSize ? 0 : options.resolution; // finds nothing
+    uint32_t fine = coarse;
+    for (;;) {
         if (fine >= kFinest)
             return "no grid of up to " + std::to_string(fine) +
                    " cells along the longest axis finds the surface";
         fine = std::min(std::max(2 * fine, 2u), kFinest);
         auto hit = finds(fine);
         if (!hit) return std::nullopt;
-        found = *hit;
-        if (found) break;
+        if (*hit) break;
+        coarse = fine;
     }
     while (fine - coarse > 1) {
         const uint32_t middle = coarse + (fine - coarse) / 2;
@@ -557,7 +558,7 @@ std::optional<std::string> Mesher::whyEmpty(const MeshOptions& options) {
         if (!found) return std::nullopt;
         (*found ? fine : coarse) = middle;
     }
-    return "the grid is too coarse to find the surface; --resolution " + std::to_string(fine) +
+    return "the grid is too coarse to find the surface; resolution " + std::to_string(fine) +
            " is the smallest that does";
 }
 
