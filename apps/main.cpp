@@ -334,6 +334,10 @@ Options:
                          outlines allow)
   --stats                print the grid, brick and mesh sizes, the time per stage and the
                          peak memory (and the triangles before and after simplifying)
+  --report               check the written mesh and print the report: closed, manifold,
+                         oriented, self-intersections, shells, genus, volume, area, bounds
+                         (on standard error where the mesh goes to standard output)
+  --report-json FILE     write the same report as JSON to FILE
   --evaluation E         auto (default), inlined or tapes, as for render
   --device NAME          Vulkan device: index or part of its name (also SDFCSG_DEVICE)
   --validation           enable the Vulkan validation layer
@@ -404,9 +408,9 @@ int cmdMesh(int argc, char** argv) {
     };
     Args args("mesh", argc, argv,
               {"-o", "--output", "--resolution", "--voxel-size", "--bounds", "--device",
-               "--evaluation", "--unit", "--method", "--simplify", "--target-triangles",
-               "--format"},
-              {"--stats", "--validation", "--help", "-h"});
+               "--evaluation", "--unit", "--method", "--simplify", "--target-triangles", "--format",
+               "--report-json"},
+              {"--stats", "--report", "--validation", "--help", "-h"});
     if (args.has("--help") || args.has("-h")) return std::fputs(kMeshHelp, stdout), kOk;
     if (!args.error.empty()) return usageError("mesh", args.error);
     if (args.positional.size() != 1) return usageError("mesh", "expected one SCENE file");
@@ -478,6 +482,10 @@ int cmdMesh(int argc, char** argv) {
         simplify.targetTriangles = size_t(n);
     }
     if (auto writable = sdfcsg::checkOutput(out); !writable) return fail(writable.error());
+    const std::string reportFile = args.get("--report-json");
+    if (args.has("--report-json"))
+        if (auto writable = sdfcsg::checkOutput(reportFile); !writable)
+            return fail(writable.error());
 
     sdfcsg::Evaluation evaluation = sdfcsg::Evaluation::Auto;
     if (!parseEvaluation(args, "mesh", evaluation)) return kUsage;
@@ -526,6 +534,14 @@ int cmdMesh(int argc, char** argv) {
     const double writeSeconds = secondsSince(t0);
 
     if (args.has("--stats")) printMeshStats(stats, compileSeconds, writeSeconds);
+    if (args.has("--report") || args.has("--report-json")) {
+        const sdfcsg::MeshReport report = sdfcsg::reportMesh(*mesh);
+        if (args.has("--report"))
+            std::fputs(sdfcsg::reportText(report).c_str(), out == "-" ? stderr : stdout);
+        if (args.has("--report-json"))
+            if (auto written = writeOutput(reportFile, sdfcsg::reportJson(report)); !written)
+                return fail(written.error());
+    }
     if (mesh->triangleCount() == 0) {
         options.progress = [](float) { return !interrupted(); };
         const auto why = (*mesher)->whyEmpty(options);

@@ -354,6 +354,24 @@ case_interrupt_write() {
     done
 }
 
+# --report checks the written mesh; --report-json writes the same as JSON (atomically).
+case_mesh_report() {
+    printf '{"version": 1, "root": {"type": "torus", "major_radius": 1, "minor_radius": 0.3}}' >torus.json
+    check "mesh report" 0 "$bin" mesh torus.json -o torus.ply --resolution 32 --report \
+        --report-json torus-report.json
+    for line in "closed:             yes (0 boundary edges)" "watertight:         yes" \
+        "shells:             1" "genus:              1"; do
+        expect_text "mesh report line" out.txt "$line"
+    done
+    grep -q '"watertight": true, "shells": 1, "euler": 0, "genus": 1,' torus-report.json ||
+        { echo "FAIL mesh --report-json:"; cat torus-report.json; failures=$((failures + 1)); }
+    # With the mesh on standard output, the report goes to standard error.
+    check "mesh report to stderr" 0 "$bin" mesh torus.json -o - --format ply --resolution 16 --report
+    expect_text "mesh report on stderr" err.txt "genus:              1"
+    check "mesh report into a missing folder" 3 "$bin" mesh torus.json -o torus.ply \
+        --report-json missing/report.json
+}
+
 # Valid scenes that show nothing say why, on standard error, and still exit 0.
 case_degenerate() {
     one() { # one FILE ROOT: a scene of the node ROOT

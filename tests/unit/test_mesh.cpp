@@ -68,6 +68,15 @@ TEST_F(MeshTest, SphereHasTheAnalyticVolumeAndArea) {
     EXPECT_EQ(m.referencedVertices, m.vertices);
     EXPECT_NEAR(m.volume, 4.0 / 3.0 * kPi, 0.01 * 4.0 / 3.0 * kPi);
     EXPECT_NEAR(m.area, 4.0 * kPi, 0.01 * 4.0 * kPi);
+    // The report (sdfcsg mesh --report) says the same of it.
+    const MeshReport report = reportMesh(mesh);
+    EXPECT_TRUE(report.watertight()) << reportText(report);
+    EXPECT_EQ(report.shells, 1u);
+    EXPECT_EQ(report.genus(), 0);
+    EXPECT_NEAR(report.volume, 4.0 / 3.0 * kPi, 0.01 * 4.0 / 3.0 * kPi);
+    EXPECT_NEAR(report.area, 4.0 * kPi, 0.01 * 4.0 * kPi);
+    EXPECT_NEAR(report.bounds.max.x, 1.0f, 1e-3f);
+    EXPECT_NEAR(report.bounds.min.y, -1.0f, 1e-3f);
 
     const Evaluator evaluator(scene);
     EXPECT_LE(maxSurfaceDistance(mesh, evaluator), 0.1f * stats.voxelSize);
@@ -94,6 +103,10 @@ TEST_F(MeshTest, TorusHasEulerCharacteristicZero) {
     EXPECT_EQ(m.euler, 0);
     const double volume = 2 * kPi * kPi * 0.7 * 0.25 * 0.25;
     EXPECT_NEAR(m.volume, volume, 0.02 * volume);
+    const MeshReport report = reportMesh(mesh);
+    EXPECT_TRUE(report.watertight()) << reportText(report);
+    EXPECT_EQ(report.genus(), 1);
+    EXPECT_NEAR(report.volume, volume, 0.02 * volume);
     const Evaluator evaluator(scene);
     EXPECT_LE(maxSurfaceDistance(mesh, evaluator), 0.1f * stats.voxelSize);
     expectEmbedded(mesh, evaluator, stats.voxelSize);

@@ -14,6 +14,7 @@
 #include "sdfcsg/generate.h"
 #include "sdfcsg/io.h"
 #include "sdfcsg/mesh.h"
+#include "sdfcsg/mesh_report.h"
 #include "sdfcsg/nodes.h"
 #include "sdfcsg/render.h"
 #include "sdfcsg/scene.h"

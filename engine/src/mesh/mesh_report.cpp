@@ -1,0 +1,136 @@
+// The mesh report: edges by sorting half-edges, shells by union-find over the triangles'
+// vertices, self-intersections by mesh/self_intersections.cpp.
+#include "sdfcsg/mesh_report.h"
+
+#include "mesh/self_intersections.h"
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <numeric>
+#include <vector>
+
+namespace sdfcsg {
+namespace {
+
+// Union-find over vertex numbers, with path halving.
+struct Pieces {
+    std::vector<uint32_t> parent;
+    explicit Pieces(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
+    uint32_t root(uint32_t v) {
+        while (parent[v] != v)
+            v = parent[v] = parent[parent[v]];
+        return v;
+    }
+    void join(uint32_t a, uint32_t b) { parent[root(a)] = root(b); }
+};
+
+} // namespace
+
+MeshReport reportMesh(const Mesh& mesh) {
+    MeshReport r;
+    r.vertices = mesh.vertexCount();
+    r.triangles = mesh.triangleCount();
+    std::vector<bool> used(r.vertices, false);
+    Pieces pieces(r.vertices);
+    // Per side of a triangle: (lower vertex << 32 | higher vertex) << 1 | (1 when it runs from
+    // the lower to the higher). Sorted, the uses of each edge lie together.
+    std::vector<uint64_t> sides;
+    sides.reserve(mesh.indices.size());
+    size_t unusable = 0; // triangles with indices out of range or repeated
+    for (size_t t = 0; t < r.triangles; ++t) {
+        const uint32_t* v = &mesh.indices[3 * t];
+        if (v[0] >= r.vertices || v[1] >= r.vertices || v[2] >= r.vertices || v[0] == v[1] ||
+            v[1] == v[2] || v[2] == v[0]) {
+            ++r.degenerateTriangles, ++unusable;
+            continue;
+        }
+        const glm::dvec3 a(mesh.positions[v[0]]), b(mesh.positions[v[1]]), c(mesh.positions[v[2]]);
+        const double area = 0.5 * glm::length(glm::cross(b - a, c - a));
+        if (!(area > 0.0)) ++r.degenerateTriangles;
+        r.area += area;
+        r.volume += glm::dot(a, glm::cross(b, c)) / 6.0;
+        for (int i = 0; i < 3; ++i) {
+            const uint32_t from = v[i], to = v[(i + 1) % 3];
+            used[from] = true;
+            pieces.join(from, to);
+            r.bounds.min = glm::min(r.bounds.min, mesh.positions[from]);
+            r.bounds.max = glm::max(r.bounds.max, mesh.positions[from]);
+            const uint64_t lo = std::min(from, to), hi = std::max(from, to);
+            sides.push_back((lo << 32 | hi) << 1 | (from < to ? 1u : 0u));
+        }
+    }
+    std::sort(sides.begin(), sides.end());
+    for (size_t i = 0; i < sides.size();) {
+        size_t end = i, forward = 0;
+        for (; end < sides.size() && sides[end] >> 1 == sides[i] >> 1; ++end)
+            forward += sides[end] & 1u;
+        const size_t uses = end - i;
+        ++r.edges;
+        r.boundaryEdges += uses == 1;
+        r.nonManifoldEdges += uses > 2;
+        r.misorientedEdges += uses == 2 && forward != 1;
+        i = end;
+    }
+    size_t usedVertices = 0;
+    for (uint32_t v = 0; v < r.vertices; ++v) {
+        if (!used[v]) continue;
+        ++usedVertices;
+        r.shells += pieces.root(v) == v;
+    }
+    r.euler = int64_t(usedVertices) - int64_t(r.edges) + int64_t(r.triangles - unusable);
+    r.selfIntersections = detail::findSelfIntersections(mesh).total();
+    return r;
+}
+
+std::string reportText(const MeshReport& r) {
+    auto yes = [](bool b) { return b ? "yes" : "no"; };
+    char text[1024];
+    std::snprintf(
+        text, sizeof text,
+        "triangles:          %zu (%zu degenerate)\n"
+        "vertices:           %zu\n"
+        "closed:             %s (%zu boundary edges)\n"
+        "manifold:           %s (%zu edges shared by more than two triangles)\n"
+        "oriented:           %s (%zu edges used twice in one direction, volume %s)\n"
+        "self-intersections: %zu pairs of triangles\n"
+        "watertight:         %s\n"
+        "shells:             %zu\n"
+        "genus:              %s\n"
+        "volume:             %.6g\n"
+        "area:               %.6g\n"
+        "bounds:             [%.6g, %.6g, %.6g] .. [%.6g, %.6g, %.6g]\n",
+        r.triangles, r.degenerateTriangles, r.vertices, yes(r.closed()), r.boundaryEdges,
+        yes(r.manifold()), r.nonManifoldEdges, yes(r.oriented()), r.misorientedEdges,
+        r.volume > 0.0 ? "positive" : "not positive", r.selfIntersections, yes(r.watertight()),
+        r.shells, r.genus() >= 0 ? std::to_string(r.genus()).c_str() : "unknown (not watertight)",
+        r.volume, r.area, double(r.bounds.min.x), double(r.bounds.min.y), double(r.bounds.min.z),
+        double(r.bounds.max.x), double(r.bounds.max.y), double(r.bounds.max.z));
+    return text;
+}
+
+std::string reportJson(const MeshReport& r) {
+    auto flag = [](bool b) { return b ? "true" : "false"; };
+    char text[1024];
+    std::snprintf(
+        text, sizeof text,
+        "{\"triangles\": %zu, \"vertices\": %zu, \"degenerate_triangles\": %zu, "
+        "\"edges\": %zu, \"boundary_edges\": %zu, \"non_manifold_edges\": %zu, "
+        "\"misoriented_edges\": %zu, \"self_intersections\": %zu, \"closed\": %s, "
+        "\"manifold\": %s, \"oriented\": %s, \"watertight\": %s, \"shells\": %zu, "
+        "\"euler\": %lld, \"genus\": %lld, \"volume\": %.9g, \"area\": %.9g, \"bounds\": ",
+        r.triangles, r.vertices, r.degenerateTriangles, r.edges, r.boundaryEdges,
+        r.nonManifoldEdges, r.misorientedEdges, r.selfIntersections, flag(r.closed()),
+        flag(r.manifold()), flag(r.oriented()), flag(r.watertight()), r.shells,
+        static_cast<long long>(r.euler), static_cast<long long>(r.genus()), r.volume, r.area);
+    std::string json = text;
+    if (r.bounds.empty()) return json + "null}\n";
+    std::snprintf(text, sizeof text,
+                  "{\"min\": [%.9g, %.9g, %.9g], \"max\": [%.9g, %.9g, %.9g]}}\n",
+                  double(r.bounds.min.x), double(r.bounds.min.y), double(r.bounds.min.z),
+                  double(r.bounds.max.x), double(r.bounds.max.y), double(r.bounds.max.z));
+    return json + text;
+}
+
+} // namespace sdfcsg

@@ -1,0 +1,229 @@
+#include "mesh/self_intersections.h"
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+#include <glm/vector_relational.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace sdfcsg::detail {
+namespace {
+
+using glm::dvec3;
+
+double pointSegmentDistance(dvec3 p, dvec3 a, dvec3 b) {
+    const dvec3 ab = b - a;
+    const double length2 = glm::dot(ab, ab);
+    const double t = length2 > 0.0 ? std::clamp(glm::dot(p - a, ab) / length2, 0.0, 1.0) : 0.0;
+    return glm::length(p - (a + t * ab));
+}
+
+// Ericson, Real-Time Collision Detection (2005), 5.1.9: the closest points of two segments.
+double segmentSegmentDistance(dvec3 p1, dvec3 q1, dvec3 p2, dvec3 q2) {
+    const dvec3 d1 = q1 - p1, d2 = q2 - p2, r = p1 - p2;
+    const double a = glm::dot(d1, d1), e = glm::dot(d2, d2), f = glm::dot(d2, r);
+    if (a <= 0.0 && e <= 0.0) return glm::length(r);
+    double s = 0.0, t = 0.0;
+    if (a <= 0.0) {
+        t = std::clamp(f / e, 0.0, 1.0);
+    } else {
+        const double c = glm::dot(d1, r);
+        if (e <= 0.0) {
+            s = std::clamp(-c / a, 0.0, 1.0);
+        } else {
+            const double b = glm::dot(d1, d2), denominator = a * e - b * b;
+            s = denominator > 0.0 ? std::clamp((b * f - c * e) / denominator, 0.0, 1.0) : 0.0;
+            t = (b * s + f) / e;
+            if (t < 0.0) {
+                t = 0.0;
+                s = std::clamp(-c / a, 0.0, 1.0);
+            } else if (t > 1.0) {
+                t = 1.0;
+                s = std::clamp((b - c) / a, 0.0, 1.0);
+            }
+        }
+    }
+    return glm::length(p1 + d1 * s - (p2 + d2 * t));
+}
+
+// A triangle in double precision. One whose height over its longest side is at most the
+// tolerance of the test (a needle or a point) gets no plane: within that tolerance it is the
+// union of its sides, and a plane through it would only be rounding noise.
+struct Triangle {
+    std::array<dvec3, 3> v;
+    dvec3 normal{0.0}; // unit, or zero without a plane
+    dvec3 lo{0.0}, hi{0.0};
+
+    Triangle(glm::vec3 a, glm::vec3 b, glm::vec3 c, double tolerance)
+        : v{dvec3(a), dvec3(b), dvec3(c)} {
+        const dvec3 n = glm::cross(v[1] - v[0], v[2] - v[0]);
+        const double longest = std::max(
+            {glm::length(v[1] - v[0]), glm::length(v[2] - v[1]), glm::length(v[0] - v[2])});
+        if (glm::length(n) > tolerance * longest) normal = glm::normalize(n);
+        lo = glm::min(v[0], glm::min(v[1], v[2]));
+        hi = glm::max(v[0], glm::max(v[1], v[2]));
+    }
+    bool hasPlane() const { return normal != dvec3(0.0); }
+    // Whether x, taken as lying in the plane, is within the triangle (the prism over it).
+    bool overTriangle(dvec3 x) const {
+        for (int i = 0; i < 3; ++i)
+            if (glm::dot(glm::cross(v[(i + 1) % 3] - v[i], x - v[i]), normal) < 0.0) return false;
+        return true;
+    }
+    double distance(dvec3 p) const {
+        if (hasPlane() && overTriangle(p)) return std::abs(glm::dot(p - v[0], normal));
+        double d = pointSegmentDistance(p, v[0], v[1]);
+        d = std::min(d, pointSegmentDistance(p, v[1], v[2]));
+        return std::min(d, pointSegmentDistance(p, v[2], v[0]));
+    }
+};
+
+// Whether segment pq comes within `tolerance` of the triangle: it crosses the triangle's plane
+// over the triangle, or else the nearest points are an end of the segment and the triangle or
+// the segment and a side.
+bool segmentMeetsTriangle(dvec3 p, dvec3 q, const Triangle& t, double tolerance) {
+    if (t.hasPlane()) {
+        const double sp = glm::dot(p - t.v[0], t.normal), sq = glm::dot(q - t.v[0], t.normal);
+        if ((sp > tolerance && sq > tolerance) || (sp < -tolerance && sq < -tolerance))
+            return false;
+        if ((sp < 0.0) != (sq < 0.0) && t.overTriangle(p + (q - p) * (sp / (sp - sq)))) return true;
+    }
+    if (t.distance(p) <= tolerance || t.distance(q) <= tolerance) return true;
+    for (int i = 0; i < 3; ++i)
+        if (segmentSegmentDistance(p, q, t.v[i], t.v[(i + 1) % 3]) <= tolerance) return true;
+    return false;
+}
+
+// Two triangles come within `tolerance` of each other exactly when a side of one comes within it
+// of the other: where they cross, the ends of the crossing lie on sides; where they are apart,
+// the nearest points can be chosen with one of them on a side.
+bool trianglesMeet(const Triangle& a, const Triangle& b, double tolerance) {
+    for (int i = 0; i < 3; ++i)
+        if (segmentMeetsTriangle(a.v[i], a.v[(i + 1) % 3], b, tolerance) ||
+            segmentMeetsTriangle(b.v[i], b.v[(i + 1) % 3], a, tolerance))
+            return true;
+    return false;
+}
+
+} // namespace
+
+SelfIntersections findSelfIntersections(const Mesh& mesh, double tolerance, double foldAngle,
+                                        std::vector<std::pair<uint32_t, uint32_t>>* pairs) {
+    using glm::dvec3;
+    SelfIntersections r;
+    const size_t n = mesh.triangleCount();
+    if (n == 0) return r;
+    dvec3 lo(1e300), hi(-1e300);
+    for (const glm::vec3& p : mesh.positions) {
+        lo = glm::min(lo, dvec3(p));
+        hi = glm::max(hi, dvec3(p));
+    }
+    if (tolerance < 0.0) tolerance = 1e-6 * glm::length(hi - lo);
+    std::vector<Triangle> triangles;
+    std::vector<uint32_t> valid; // triangles with three distinct vertices in range
+    triangles.reserve(n);
+    double extent = 0.0;
+    for (size_t t = 0; t < n; ++t) {
+        const uint32_t* v = &mesh.indices[3 * t];
+        const bool ok = v[0] < mesh.vertexCount() && v[1] < mesh.vertexCount() &&
+                        v[2] < mesh.vertexCount() && v[0] != v[1] && v[1] != v[2] && v[2] != v[0];
+        triangles.emplace_back(mesh.positions[ok ? v[0] : 0], mesh.positions[ok ? v[1] : 0],
+                               mesh.positions[ok ? v[2] : 0], tolerance);
+        if (!ok) continue;
+        valid.push_back(uint32_t(t));
+        const dvec3 size = triangles.back().hi - triangles.back().lo;
+        extent += std::max(size.x, std::max(size.y, size.z));
+    }
+    if (valid.empty()) return r;
+
+    // A uniform grid of cells about twice the mean triangle's size; each triangle is listed in
+    // every cell its bounds (grown by the tolerance) reach, and each pair is tested only in the
+    // cell that holds the low corner of the overlap of their grown bounds.
+    const double cell = std::max(2.0 * extent / double(valid.size()), 1e-30);
+    auto cellOf = [&](dvec3 p) { return glm::ivec3(glm::floor((p - lo) / cell)); };
+    auto key = [](glm::ivec3 c) {
+        return (uint64_t(uint32_t(c.x) & 0x1fffff) << 42) |
+               (uint64_t(uint32_t(c.y) & 0x1fffff) << 21) | uint64_t(uint32_t(c.z) & 0x1fffff);
+    };
+    std::vector<std::pair<uint64_t, uint32_t>> listed;
+    for (uint32_t t : valid) {
+        const glm::ivec3 c0 = cellOf(triangles[t].lo - tolerance);
+        const glm::ivec3 c1 = cellOf(triangles[t].hi + tolerance);
+        for (int z = c0.z; z <= c1.z; ++z)
+            for (int y = c0.y; y <= c1.y; ++y)
+                for (int x = c0.x; x <= c1.x; ++x)
+                    listed.push_back({key({x, y, z}), t});
+    }
+    std::sort(listed.begin(), listed.end());
+
+    auto describe = [&](uint32_t t) {
+        std::ostringstream s;
+        s.precision(7);
+        s << "triangle " << t;
+        for (int i = 0; i < 3; ++i) {
+            const glm::vec3 p = mesh.positions[mesh.indices[3 * t + i]];
+            s << (i ? ", " : " (") << mesh.indices[3 * t + i] << " at " << p.x << " " << p.y << " "
+              << p.z;
+        }
+        return s.str() + ")";
+    };
+    auto found = [&](size_t& count, uint32_t a, uint32_t b, const char* what) {
+        ++count;
+        if (pairs) pairs->push_back({a, b});
+        if (r.first.empty()) r.first = describe(a) + " and " + describe(b) + " " + what;
+    };
+    for (size_t i = 0; i < listed.size();) {
+        size_t end = i;
+        while (end < listed.size() && listed[end].first == listed[i].first)
+            ++end;
+        for (size_t j = i; j < end; ++j)
+            for (size_t k = j + 1; k < end; ++k) {
+                const uint32_t ta = listed[j].second, tb = listed[k].second;
+                const Triangle &a = triangles[ta], &b = triangles[tb];
+                const dvec3 overlapLo = glm::max(a.lo, b.lo) - tolerance;
+                const dvec3 overlapHi = glm::min(a.hi, b.hi) + tolerance;
+                if (glm::any(glm::greaterThan(overlapLo, overlapHi)) ||
+                    key(cellOf(overlapLo)) != listed[i].first)
+                    continue;
+                const uint32_t* va = &mesh.indices[3 * size_t(ta)];
+                const uint32_t* vb = &mesh.indices[3 * size_t(tb)];
+                int shared = 0, inA = -1, inB = -1; // a shared vertex's place in a and in b
+                int onlyA = 3, onlyB = 3;           // the sum of the unshared places
+                for (int x = 0; x < 3; ++x)
+                    for (int y = 0; y < 3; ++y)
+                        if (va[x] == vb[y]) {
+                            ++shared;
+                            inA = x, inB = y;
+                            onlyA -= x, onlyB -= y;
+                        }
+                if (shared == 0) {
+                    if (trianglesMeet(a, b, tolerance)) found(r.crossing, ta, tb, "cross");
+                } else if (shared == 1) {
+                    const dvec3 &a1 = a.v[(inA + 1) % 3], &a2 = a.v[(inA + 2) % 3];
+                    const dvec3 &b1 = b.v[(inB + 1) % 3], &b2 = b.v[(inB + 2) % 3];
+                    if (segmentMeetsTriangle(a1, a2, b, tolerance) ||
+                        segmentMeetsTriangle(b1, b2, a, tolerance))
+                        found(r.overlapping, ta, tb, "overlap beyond their common vertex");
+                } else if (shared == 2) {
+                    if (!a.hasPlane() || !b.hasPlane()) continue;
+                    // onlyA and onlyB now name each triangle's vertex off the common side.
+                    const dvec3 u = a.v[(onlyA + 1) % 3], side = a.v[(onlyA + 2) % 3] - u;
+                    auto across = [&](dvec3 p) { // from the side's line to p, at right angles
+                        const dvec3 d = p - u;
+                        return glm::normalize(d -
+                                              side * (glm::dot(d, side) / glm::dot(side, side)));
+                    };
+                    if (glm::dot(across(a.v[onlyA]), across(b.v[onlyB])) > std::cos(foldAngle))
+                        found(r.folded, ta, tb, "fold onto their common side");
+                } else {
+                    found(r.duplicates, ta, tb, "have the same vertices");
+                }
+            }
+        i = end;
+    }
+    return r;
+}
+
+} // namespace sdfcsg::detail
