@@ -338,6 +338,10 @@ Options:
                          oriented, self-intersections, shells, genus, volume, area, bounds
                          (on standard error where the mesh goes to standard output)
   --report-json FILE     write the same report as JSON to FILE
+  --min-wall W           with --report or --report-json, also measure the walls from the
+                         field and report the area thinner than W (scene units; default
+                         0.8 mm in the unit of --unit, so 0.08 with one unit a centimetre),
+                         and the overhangs past 45 degrees with the scene's +y up
   --evaluation E         auto (default), inlined or tapes, as for render
   --device NAME          Vulkan device: index or part of its name (also SDFCSG_DEVICE)
   --validation           enable the Vulkan validation layer
@@ -409,7 +413,7 @@ int cmdMesh(int argc, char** argv) {
     Args args("mesh", argc, argv,
               {"-o", "--output", "--resolution", "--voxel-size", "--bounds", "--device",
                "--evaluation", "--unit", "--method", "--simplify", "--target-triangles", "--format",
-               "--report-json"},
+               "--report-json", "--min-wall"},
               {"--stats", "--report", "--validation", "--help", "-h"});
     if (args.has("--help") || args.has("-h")) return std::fputs(kMeshHelp, stdout), kOk;
     if (!args.error.empty()) return usageError("mesh", args.error);
@@ -483,6 +487,13 @@ int cmdMesh(int argc, char** argv) {
     }
     if (auto writable = sdfcsg::checkOutput(out); !writable) return fail(writable.error());
     const std::string reportFile = args.get("--report-json");
+    auto minWall = float(0.8 / sdfcsg::millimetres(unit));
+    if (args.has("--min-wall")) {
+        const std::string value = args.get("--min-wall");
+        if (!parseFloat(value, minWall) || !(minWall > 0.0f) || !std::isfinite(minWall))
+            return usageError("mesh",
+                              "--min-wall expects a length greater than 0, got '" + value + "'");
+    }
     if (args.has("--report-json"))
         if (auto writable = sdfcsg::checkOutput(reportFile); !writable)
             return fail(writable.error());
@@ -535,7 +546,8 @@ int cmdMesh(int argc, char** argv) {
 
     if (args.has("--stats")) printMeshStats(stats, compileSeconds, writeSeconds);
     if (args.has("--report") || args.has("--report-json")) {
-        const sdfcsg::MeshReport report = sdfcsg::reportMesh(*mesh);
+        const sdfcsg::MeshReport report =
+            sdfcsg::reportMesh(*mesh, sdfcsg::Evaluator(*scene), minWall);
         if (args.has("--report"))
             std::fputs(sdfcsg::reportText(report).c_str(), out == "-" ? stderr : stdout);
         if (args.has("--report-json"))

@@ -359,15 +359,27 @@ case_mesh_report() {
     printf '{"version": 1, "root": {"type": "torus", "major_radius": 1, "minor_radius": 0.3}}' >torus.json
     check "mesh report" 0 "$bin" mesh torus.json -o torus.ply --resolution 32 --report \
         --report-json torus-report.json
+    # The tube is 0.6 across; with one unit a centimetre, walls under 0.08 are thin.
     for line in "closed:             yes (0 boundary edges)" "watertight:         yes" \
-        "shells:             1" "genus:              1"; do
+        "shells:             1" "genus:              1" \
+        "thin walls:         area 0 (0.0% of the surface) thinner than 0.08"; do
         expect_text "mesh report line" out.txt "$line"
     done
+    grep -q '^thinnest wall:      0\.59[0-9]* at ' out.txt ||
+        { echo "FAIL mesh --report thinnest wall:"; cat out.txt; failures=$((failures + 1)); }
     grep -q '"watertight": true, "shells": 1, "euler": 0, "genus": 1,' torus-report.json ||
         { echo "FAIL mesh --report-json:"; cat torus-report.json; failures=$((failures + 1)); }
     # With the mesh on standard output, the report goes to standard error.
     check "mesh report to stderr" 0 "$bin" mesh torus.json -o - --format ply --resolution 16 --report
     expect_text "mesh report on stderr" err.txt "genus:              1"
+    check "mesh report min wall" 0 "$bin" mesh torus.json -o torus.ply --resolution 32 --report \
+        --min-wall 0.7
+    grep -q '^thin walls:         area [0-9.]* (100\.0% of the surface) thinner than 0\.7$' out.txt ||
+        { echo "FAIL mesh --report --min-wall 0.7:"; cat out.txt; failures=$((failures + 1)); }
+    for v in 0 -1 x nan; do
+        check "mesh bad min wall $v" 2 "$bin" mesh torus.json -o torus.ply --report --min-wall "$v"
+        expect_text "mesh bad min wall message" err.txt "sdfcsg mesh: --min-wall expects a length greater than 0, got '$v'"
+    done
     check "mesh report into a missing folder" 3 "$bin" mesh torus.json -o torus.ply \
         --report-json missing/report.json
 }

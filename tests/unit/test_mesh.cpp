@@ -89,6 +89,40 @@ TEST_F(MeshTest, SphereHasTheAnalyticVolumeAndArea) {
             << "vertex " << i << ": the normal of a unit sphere at p is p";
 }
 
+// Printability against analytic solids: a unit ball's wall is its diameter and the area facing
+// down past 45 degrees is a cap of 2 pi (1 - cos 45); a hollow box's walls are 0.1 thick.
+TEST_F(MeshTest, PrintabilityOfAnalyticSolids) {
+    const Scene ball = sceneFrom(kSphere);
+    MeshOptions options;
+    options.resolution = 64;
+    MeshReport report = reportMesh(extract(ball, options), Evaluator(ball), 0.5f);
+    ASSERT_TRUE(report.printability);
+    const Printability* p = &*report.printability;
+    EXPECT_GT(p->samples, 1000u);
+    EXPECT_NEAR(p->thinnestWall, 2.0f, 0.02f);
+    EXPECT_EQ(p->thinArea, 0.0);
+    const double cap = 2.0 * kPi * (1.0 - std::sqrt(0.5));
+    EXPECT_NEAR(p->overhangArea, cap, 0.03 * cap);
+
+    const Scene hollow = sceneFrom(R"({"version": 1, "root": {"type": "difference", "children": [
+        {"type": "box", "size": [1, 1, 1]}, {"type": "box", "size": [0.8, 0.8, 0.8]}]}})");
+    const Mesh mesh = extract(hollow, options);
+    report = reportMesh(mesh, Evaluator(hollow), 0.15f);
+    p = &*report.printability;
+    EXPECT_TRUE(report.watertight()) << reportText(report);
+    EXPECT_EQ(report.shells, 2u); // the outside and the cavity
+    EXPECT_NEAR(p->thinnestWall, 0.1f, 0.01f);
+    // Walls are measured along the normal: every face is 0.1 thick there but the outer faces'
+    // strips over the walls at right angles to them (6 x (1 - 0.8^2) = 2.16), where the normal
+    // runs along such a wall.
+    EXPECT_NEAR(report.area, 6.0 + 6.0 * 0.64, 0.01);
+    EXPECT_NEAR(p->thinArea, report.area - 2.16, 0.03 * (report.area - 2.16));
+    // Down-facing: the outer bottom lies on the plate; the cavity's ceiling (0.8 x 0.8) faces down.
+    EXPECT_NEAR(p->overhangArea, 0.64, 0.02);
+    report = reportMesh(mesh, Evaluator(hollow), 0.05f);
+    EXPECT_EQ(report.printability->thinArea, 0.0);
+}
+
 TEST_F(MeshTest, TorusHasEulerCharacteristicZero) {
     const Scene scene = sceneFrom(R"({"version": 1, "root": {"type": "torus",
         "major_radius": 0.7, "minor_radius": 0.25, "rotate": [30, 0, 20]}})");

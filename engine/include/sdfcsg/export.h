@@ -34,6 +34,8 @@ std::string_view meshFormatName(MeshFormat format); // "ply", "obj", "stl", "glb
 
 // A unit from its short name ("mm", "cm", "m", "inch"), or nullopt.
 std::optional<LengthUnit> lengthUnitFromName(std::string_view name);
+// How many millimetres one unit is.
+double millimetres(LengthUnit unit);
 
 // The file's bytes; empty for a 3MF past what its ZIP container holds (4 GiB).
 std::string encodeMesh(const Mesh& mesh, MeshFormat format, LengthUnit unit = kDefaultLengthUnit);

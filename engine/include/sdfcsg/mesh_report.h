@@ -5,11 +5,32 @@
 #include "sdfcsg/eval.h"
 #include "sdfcsg/mesh.h"
 
+#include <glm/vec3.hpp>
+
 #include <cstddef>
 #include <cstdint>
+#include <limits>
+#include <optional>
 #include <string>
 
 namespace sdfcsg {
+
+// How a mesh of a scene would print, from the scene's field: walls measured by marching into the
+// solid from points of the surface along the triangles' normals until the field changes sign,
+// and overhangs, with the scene's +y the build direction (as the 3MF and STL exports put it).
+// Along the normal, the end face of a wall measures the wall's length, not its thickness: thin
+// walls are found by their sides.
+struct Printability {
+    float minWall = 0.0f; // the least wall asked for, scene units
+    // The thinnest wall measured and where; infinite where no sample found one.
+    float thinnestWall = std::numeric_limits<float>::infinity();
+    glm::vec3 thinnestAt{0.0f};
+    size_t samples = 0;  // points of the surface where walls were measured
+    double thinArea = 0; // surface area whose wall is thinner than minWall (from the samples)
+    // Area of triangles facing down more than 45 degrees past the vertical (their normal within
+    // 45 degrees of -y), but those that lie on the build plate under the mesh.
+    double overhangArea = 0;
+};
 
 struct MeshReport {
     size_t vertices = 0, triangles = 0;
@@ -27,6 +48,7 @@ struct MeshReport {
     double volume = 0; // signed: positive when the triangles face outwards
     double area = 0;
     Aabb bounds; // of the vertices that triangles use
+    std::optional<Printability> printability;
 
     bool closed() const { return boundaryEdges == 0; }
     bool manifold() const { return nonManifoldEdges == 0 && degenerateTriangles == 0; }
@@ -42,6 +64,11 @@ struct MeshReport {
 };
 
 MeshReport reportMesh(const Mesh& mesh);
+// The same with the printability of the mesh of the scene that `evaluator` evaluates: walls
+// thinner than `minWall` (scene units), measured at up to `samples` triangles spread over the
+// mesh (bounded work on any mesh).
+MeshReport reportMesh(const Mesh& mesh, const Evaluator& evaluator, float minWall,
+                      size_t samples = 20000);
 
 // The report as lines of text ("closed: yes"), and as one JSON object.
 std::string reportText(const MeshReport& report);

@@ -421,6 +421,20 @@ std::optional<LengthUnit> lengthUnitFromName(std::string_view name) {
     return std::nullopt;
 }
 
+double millimetres(LengthUnit unit) {
+    switch (unit) {
+    case LengthUnit::Millimeter:
+        return 1.0;
+    case LengthUnit::Centimeter:
+        return 10.0;
+    case LengthUnit::Meter:
+        return 1000.0;
+    case LengthUnit::Inch:
+        return 25.4;
+    }
+    return 1.0;
+}
+
 std::string_view meshFormatName(MeshFormat format) {
     switch (format) {
     case MeshFormat::Ply:

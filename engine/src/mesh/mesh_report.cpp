@@ -3,12 +3,15 @@
 #include "sdfcsg/mesh_report.h"
 
 #include "mesh/self_intersections.h"
+#include "sdfcsg/compile.h"
 
 #include <glm/geometric.hpp>
 
 #include <algorithm>
 #include <cstdio>
+#include <functional>
 #include <numeric>
+#include <optional>
 #include <vector>
 
 namespace sdfcsg {
@@ -26,7 +29,70 @@ struct Pieces {
     void join(uint32_t a, uint32_t b) { parent[root(a)] = root(b); }
 };
 
+// The wall under point c of the surface, along -n (n the outward unit normal there): the distance
+// from c to where the field turns positive again, marching by the field's value (every field is
+// 1-Lipschitz, so a step never passes the far side by more than `least`). Nothing where the march
+// does not get inside (c on a sharp edge, n off) or leaves no inside within `reach`.
+std::optional<float> wallAt(const std::function<float(glm::vec3)>& field, glm::vec3 c, glm::vec3 n,
+                            float least, float reach) {
+    float t = std::max(field(c), 0.0f) + least;
+    if (!(field(c - n * t) < 0.0f)) return std::nullopt;
+    for (int step = 0; step < 256 && t < reach; ++step) {
+        const float d = field(c - n * t);
+        if (d >= 0.0f) return t;
+        t += std::max(-d, least);
+    }
+    return std::nullopt;
+}
+
+Printability printability(const Mesh& mesh, const Evaluator& evaluator, float minWall,
+                          size_t samples, const Aabb& bounds) {
+    Printability p;
+    p.minWall = minWall;
+    const size_t n = mesh.triangleCount();
+    if (n == 0 || bounds.empty()) return p;
+    const float size = glm::length(bounds.max - bounds.min);
+    const float least = 1e-4f * size, plate = bounds.min.y + 1e-4f * size;
+    // Large scenes answer from pruned tapes, as their kernels do.
+    const bool pruned = evaluator.nodes().size() >= kTapeMinNodes;
+    const std::function<float(glm::vec3)> field = [&](glm::vec3 x) {
+        return pruned ? evaluator.prunedDistance(x) : evaluator.distance(x);
+    };
+    const size_t stride = std::max<size_t>(1, (n + samples - 1) / std::max<size_t>(samples, 1));
+    double sampledArea = 0, thinSampled = 0, area = 0;
+    for (size_t t = 0; t < n; ++t) {
+        const uint32_t* v = &mesh.indices[3 * t];
+        if (v[0] >= mesh.vertexCount() || v[1] >= mesh.vertexCount() || v[2] >= mesh.vertexCount())
+            continue;
+        const glm::vec3 a = mesh.positions[v[0]], b = mesh.positions[v[1]],
+                        c = mesh.positions[v[2]];
+        const glm::vec3 cross = glm::cross(b - a, c - a);
+        const float twice = glm::length(cross);
+        if (!(twice > 0.0f)) continue;
+        const glm::vec3 normal = cross / twice;
+        area += 0.5 * twice;
+        const bool onPlate = a.y <= plate && b.y <= plate && c.y <= plate;
+        if (!onPlate && -normal.y > 0.70710678f) p.overhangArea += 0.5 * twice;
+        if (t % stride != 0) continue;
+        const glm::vec3 centre = (a + b + c) / 3.0f;
+        const auto wall = wallAt(field, centre, normal, least, size);
+        if (!wall) continue;
+        ++p.samples;
+        sampledArea += 0.5 * twice;
+        if (*wall < minWall) thinSampled += 0.5 * twice;
+        if (*wall < p.thinnestWall) p.thinnestWall = *wall, p.thinnestAt = centre;
+    }
+    if (sampledArea > 0) p.thinArea = area * thinSampled / sampledArea;
+    return p;
+}
+
 } // namespace
+
+MeshReport reportMesh(const Mesh& mesh, const Evaluator& evaluator, float minWall, size_t samples) {
+    MeshReport r = reportMesh(mesh);
+    r.printability = printability(mesh, evaluator, minWall, samples, r.bounds);
+    return r;
+}
 
 MeshReport reportMesh(const Mesh& mesh) {
     MeshReport r;
@@ -107,7 +173,25 @@ std::string reportText(const MeshReport& r) {
         r.shells, r.genus() >= 0 ? std::to_string(r.genus()).c_str() : "unknown (not watertight)",
         r.volume, r.area, double(r.bounds.min.x), double(r.bounds.min.y), double(r.bounds.min.z),
         double(r.bounds.max.x), double(r.bounds.max.y), double(r.bounds.max.z));
-    return text;
+    std::string out = text;
+    if (!r.printability) return out;
+    const Printability& p = *r.printability;
+    const double share = r.area > 0 ? 100.0 / r.area : 0.0;
+    if (p.samples == 0)
+        std::snprintf(text, sizeof text, "thinnest wall:      not measured\n");
+    else
+        std::snprintf(text, sizeof text,
+                      "thinnest wall:      %.4g at [%.4g, %.4g, %.4g] (%zu points measured)\n",
+                      double(p.thinnestWall), double(p.thinnestAt.x), double(p.thinnestAt.y),
+                      double(p.thinnestAt.z), p.samples);
+    out += text;
+    std::snprintf(text, sizeof text,
+                  "thin walls:         area %.4g (%.1f%% of the surface) thinner than %.4g\n"
+                  "overhangs:          area %.4g (%.1f%% of the surface) facing down past 45 "
+                  "degrees, off the plate\n",
+                  p.thinArea, p.thinArea * share, double(p.minWall), p.overhangArea,
+                  p.overhangArea * share);
+    return out + text;
 }
 
 std::string reportJson(const MeshReport& r) {
@@ -125,12 +209,26 @@ std::string reportJson(const MeshReport& r) {
         flag(r.manifold()), flag(r.oriented()), flag(r.watertight()), r.shells,
         static_cast<long long>(r.euler), static_cast<long long>(r.genus()), r.volume, r.area);
     std::string json = text;
-    if (r.bounds.empty()) return json + "null}\n";
-    std::snprintf(text, sizeof text,
-                  "{\"min\": [%.9g, %.9g, %.9g], \"max\": [%.9g, %.9g, %.9g]}}\n",
-                  double(r.bounds.min.x), double(r.bounds.min.y), double(r.bounds.min.z),
-                  double(r.bounds.max.x), double(r.bounds.max.y), double(r.bounds.max.z));
-    return json + text;
+    if (r.bounds.empty()) {
+        json += "null";
+    } else {
+        std::snprintf(text, sizeof text,
+                      "{\"min\": [%.9g, %.9g, %.9g], \"max\": [%.9g, %.9g, %.9g]}",
+                      double(r.bounds.min.x), double(r.bounds.min.y), double(r.bounds.min.z),
+                      double(r.bounds.max.x), double(r.bounds.max.y), double(r.bounds.max.z));
+        json += text;
+    }
+    if (r.printability) {
+        const Printability& p = *r.printability;
+        char wall[32] = "null";
+        if (p.samples > 0) std::snprintf(wall, sizeof wall, "%.9g", double(p.thinnestWall));
+        std::snprintf(text, sizeof text,
+                      ", \"min_wall\": %.9g, \"thinnest_wall\": %s, \"thin_area\": %.9g, "
+                      "\"overhang_area\": %.9g, \"wall_samples\": %zu",
+                      double(p.minWall), wall, p.thinArea, p.overhangArea, p.samples);
+        json += text;
+    }
+    return json + "}\n";
 }
 
 } // namespace sdfcsg
