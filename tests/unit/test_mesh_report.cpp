@@ -2,6 +2,8 @@
 // the GPU meshes of analytic solids are reported on in test_mesh.cpp.
 #include <sdfcsg/mesh_report.h>
 
+#include "mesh/mesh_dual.h"
+
 #include <gtest/gtest.h>
 
 #include <glm/vec3.hpp>
@@ -110,6 +112,32 @@ TEST(MeshReport, ShellsAndSelfIntersections) {
     EXPECT_GT(crossing.selfIntersections, 0u);
     EXPECT_FALSE(crossing.watertight());
     EXPECT_EQ(crossing.genus(), -1);
+}
+
+// Two tetrahedra that touch along an edge, sharing its two vertices: the edge joins four
+// triangles until splitTouchingSheets gives each solid its own copies of the two.
+TEST(MeshReport, SheetsTouchingAlongAnEdgeAreSplit) {
+    Mesh mesh = tetrahedron();
+    Mesh other = tetrahedron();
+    for (glm::vec3& p : other.positions)
+        p = glm::vec3(-p.x, -p.y, p.z); // turned half a turn about z: faces still outwards
+    Mesh both = joined(mesh, other);
+    for (uint32_t& i : both.indices) { // the second's corners 0 and 3 are the first's
+        if (i == 4) i = 0;
+        if (i == 7) i = 3;
+    }
+    MeshReport r = reportMesh(both);
+    EXPECT_EQ(r.nonManifoldEdges, 1u);
+    EXPECT_EQ(r.misorientedEdges, 0u);
+    EXPECT_EQ(detail::splitTouchingSheets(both), 1u);
+    r = reportMesh(both);
+    EXPECT_EQ(r.nonManifoldEdges, 0u);
+    EXPECT_EQ(r.misorientedEdges, 0u);
+    EXPECT_EQ(r.boundaryEdges, 0u);
+    EXPECT_EQ(r.shells, 2u);
+    EXPECT_EQ(r.euler, 4);
+    EXPECT_EQ(both.vertexCount(), 10u);               // 8 used, 2 unused, 2 copies
+    EXPECT_EQ(detail::splitTouchingSheets(both), 0u); // nothing left to split
 }
 
 TEST(MeshReport, AnEmptyMeshHasNoBounds) {

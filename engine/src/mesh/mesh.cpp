@@ -859,6 +859,9 @@ void Extraction::finish() {
             distance = [&](glm::vec3 p) { return evaluator.distance(p); };
         detail::foldQuads(mesh, smooth, distance, g.h);
         stage("quads", t0);
+        const auto t1 = Clock::now();
+        detail::splitTouchingSheets(mesh);
+        stage("sheets", t1);
     }
     stats.surfaceCut = status[0] != 0;
     stats.vertices = mesh.vertexCount();

@@ -29,4 +29,14 @@ namespace sdfcsg::detail {
 using Distance = std::function<float(glm::vec3)>;
 void foldQuads(Mesh& mesh, const std::vector<glm::vec3>& smooth, const Distance& distance, float h);
 
+// Where a cell's one vertex for a piece of surface serves two sheets that touch across an
+// ambiguous face (each of the face's four crossed edges in one piece on both sides), the edge
+// between the two cells' vertices joins four triangles. Each such edge is cut into one per sheet:
+// around it, a triangle running against the edge's direction and the next running along it (the
+// solid lies between them) form a sheet; then each vertex at the end of a cut edge is copied for
+// every further fan of triangles around it, so that every edge joins two triangles in opposite
+// directions. The copies keep the vertex's position: the sheets still touch there. Returns how
+// many edges were cut.
+size_t splitTouchingSheets(Mesh& mesh);
+
 } // namespace sdfcsg::detail
