@@ -243,6 +243,22 @@ void meshPanel(Viewer& v) {
                         (unsigned long long)v.meshStats.unsimplifiedTriangles,
                         v.meshStats.simplifiedError / v.meshStats.voxelSize);
         ImGui::Text("mesh frame %.1f ms, last drawn in %.1f ms", v.meshFrameMs, v.meshDrawMs);
+        const MeshReport& r = v.meshReport;
+        if (r.watertight())
+            ImGui::Text("watertight: %zu shell%s, genus %lld", r.shells, r.shells == 1 ? "" : "s",
+                        static_cast<long long>(r.genus()));
+        else
+            ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.3f, 1.0f),
+                               "not watertight: %zu boundary, %zu non-manifold, %zu misoriented "
+                               "edges, %zu self-intersections",
+                               r.boundaryEdges, r.nonManifoldEdges, r.misorientedEdges,
+                               r.selfIntersections);
+        ImGui::Text("volume %.4g, area %.4g", r.volume, r.area);
+        if (const auto& p = r.printability; p && p->samples > 0)
+            ImGui::Text("thinnest wall %.3g; %.1f%% of the surface thinner than %.3g; overhangs "
+                        "%.1f%%",
+                        double(p->thinnestWall), r.area > 0 ? 100.0 * p->thinArea / r.area : 0.0,
+                        double(p->minWall), r.area > 0 ? 100.0 * p->overhangArea / r.area : 0.0);
     }
     ImGui::InputText("file", v.exportPath, sizeof v.exportPath);
     if (meshFormatFromPath(v.exportPath) == MeshFormat::ThreeMf)

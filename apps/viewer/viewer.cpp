@@ -203,6 +203,7 @@ bool finishMesh(Viewer& v) {
         if (*done) {
             auto mesh = std::make_shared<const Mesh>(std::move((*done)->mesh));
             v.meshStats = v.mesher->stats();
+            v.meshReport = (*done)->report;
             std::string error;
             const Mesh* preview = (*done)->preview ? &*(*done)->preview : nullptr;
             if (setMesh(*v.presenter, *mesh, preview, error)) {

@@ -97,6 +97,7 @@ struct Viewer {
     // the device.
     std::shared_ptr<const Mesh> mesh;
     MeshStats meshStats;
+    MeshReport meshReport; // of the mesh shown
     // The last mesh frame's time (a blit when the view did not change) and the device time of the
     // last drawing of the mesh.
     double meshFrameMs = 0.0, meshDrawMs = -1.0;

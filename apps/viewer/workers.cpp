@@ -383,6 +383,8 @@ Result<ExtractedMesh> MeshWorker::extract(const Scene& scene, MeshOptions option
             if (!simplified) return simplified.error();
             extracted.mesh = std::move(*simplified);
         }
+        extracted.report =
+            reportMesh(extracted.mesh, evaluator, float(0.8 / millimetres(kDefaultLengthUnit)));
         if (extracted.mesh.triangleCount() <= previewThreshold_ || job_.cancelled())
             return extracted;
         SimplifyOptions preview;

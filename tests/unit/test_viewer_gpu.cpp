@@ -337,4 +337,9 @@ TEST_F(ViewerGpu, MeshWorkerSimplifiesAPreviewOfALargeMesh) {
     ExtractedMesh small = extract(kPreviewMeshTriangles, 96);
     EXPECT_GT(small.mesh.triangleCount(), 1000u);
     EXPECT_FALSE(small.preview);
+    // The report the mesh panel shows is the mesh's.
+    EXPECT_EQ(small.report.triangles, small.mesh.triangleCount());
+    EXPECT_EQ(small.report.euler, test::measureMesh(small.mesh).euler);
+    ASSERT_TRUE(small.report.printability);
+    EXPECT_GT(small.report.printability->samples, 0u);
 }
