@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <thread>
 
 namespace sdfcsg::detail {
 namespace {
@@ -84,6 +86,9 @@ struct Triangle {
 // over the triangle, or else the nearest points are an end of the segment and the triangle or
 // the segment and a side.
 bool segmentMeetsTriangle(dvec3 p, dvec3 q, const Triangle& t, double tolerance) {
+    if (glm::any(glm::greaterThan(glm::min(p, q), t.hi + tolerance)) ||
+        glm::any(glm::lessThan(glm::max(p, q), t.lo - tolerance)))
+        return false; // their boxes are apart
     if (t.hasPlane()) {
         const double sp = glm::dot(p - t.v[0], t.normal), sq = glm::dot(q - t.v[0], t.normal);
         if ((sp > tolerance && sq > tolerance) || (sp < -tolerance && sq < -tolerance))
@@ -169,60 +174,84 @@ SelfIntersections findSelfIntersections(const Mesh& mesh, double tolerance, doub
         }
         return s.str() + ")";
     };
-    auto found = [&](size_t& count, uint32_t a, uint32_t b, const char* what) {
-        ++count;
-        if (pairs) pairs->push_back({a, b});
-        if (r.first.empty()) r.first = describe(a) + " and " + describe(b) + " " + what;
-    };
-    for (size_t i = 0; i < listed.size();) {
-        size_t end = i;
-        while (end < listed.size() && listed[end].first == listed[i].first)
-            ++end;
-        for (size_t j = i; j < end; ++j)
-            for (size_t k = j + 1; k < end; ++k) {
-                const uint32_t ta = listed[j].second, tb = listed[k].second;
-                const Triangle &a = triangles[ta], &b = triangles[tb];
-                const dvec3 overlapLo = glm::max(a.lo, b.lo) - tolerance;
-                const dvec3 overlapHi = glm::min(a.hi, b.hi) + tolerance;
-                if (glm::any(glm::greaterThan(overlapLo, overlapHi)) ||
-                    key(cellOf(overlapLo)) != listed[i].first)
-                    continue;
-                const uint32_t* va = &mesh.indices[3 * size_t(ta)];
-                const uint32_t* vb = &mesh.indices[3 * size_t(tb)];
-                int shared = 0, inA = -1, inB = -1; // a shared vertex's place in a and in b
-                int onlyA = 3, onlyB = 3;           // the sum of the unshared places
-                for (int x = 0; x < 3; ++x)
-                    for (int y = 0; y < 3; ++y)
-                        if (va[x] == vb[y]) {
-                            ++shared;
-                            inA = x, inB = y;
-                            onlyA -= x, onlyB -= y;
-                        }
-                if (shared == 0) {
-                    if (trianglesMeet(a, b, tolerance)) found(r.crossing, ta, tb, "cross");
-                } else if (shared == 1) {
-                    const dvec3 &a1 = a.v[(inA + 1) % 3], &a2 = a.v[(inA + 2) % 3];
-                    const dvec3 &b1 = b.v[(inB + 1) % 3], &b2 = b.v[(inB + 2) % 3];
-                    if (segmentMeetsTriangle(a1, a2, b, tolerance) ||
-                        segmentMeetsTriangle(b1, b2, a, tolerance))
-                        found(r.overlapping, ta, tb, "overlap beyond their common vertex");
-                } else if (shared == 2) {
-                    if (!a.hasPlane() || !b.hasPlane()) continue;
-                    // onlyA and onlyB now name each triangle's vertex off the common side.
-                    const dvec3 u = a.v[(onlyA + 1) % 3], side = a.v[(onlyA + 2) % 3] - u;
-                    auto across = [&](dvec3 p) { // from the side's line to p, at right angles
-                        const dvec3 d = p - u;
-                        return glm::normalize(d -
-                                              side * (glm::dot(d, side) / glm::dot(side, side)));
-                    };
-                    if (glm::dot(across(a.v[onlyA]), across(b.v[onlyB])) > std::cos(foldAngle))
-                        found(r.folded, ta, tb, "fold onto their common side");
-                } else {
-                    found(r.duplicates, ta, tb, "have the same vertices");
+    // The cells of listed[begin, end) into `out` (and `outPairs`): two threads take a half each.
+    auto scan = [&](size_t begin, size_t end, SelfIntersections& out,
+                    std::vector<std::pair<uint32_t, uint32_t>>* outPairs) {
+        auto found = [&](size_t& count, uint32_t a, uint32_t b, const char* what) {
+            ++count;
+            if (outPairs) outPairs->push_back({a, b});
+            if (out.first.empty()) out.first = describe(a) + " and " + describe(b) + " " + what;
+        };
+        for (size_t i = begin; i < end;) {
+            size_t cellEnd = i;
+            while (cellEnd < end && listed[cellEnd].first == listed[i].first)
+                ++cellEnd;
+            for (size_t j = i; j < cellEnd; ++j)
+                for (size_t k = j + 1; k < cellEnd; ++k) {
+                    const uint32_t ta = listed[j].second, tb = listed[k].second;
+                    const Triangle &a = triangles[ta], &b = triangles[tb];
+                    const dvec3 overlapLo = glm::max(a.lo, b.lo) - tolerance;
+                    const dvec3 overlapHi = glm::min(a.hi, b.hi) + tolerance;
+                    if (glm::any(glm::greaterThan(overlapLo, overlapHi)) ||
+                        key(cellOf(overlapLo)) != listed[i].first)
+                        continue;
+                    const uint32_t* va = &mesh.indices[3 * size_t(ta)];
+                    const uint32_t* vb = &mesh.indices[3 * size_t(tb)];
+                    int shared = 0, inA = -1, inB = -1; // a shared vertex's place in a and in b
+                    int onlyA = 3, onlyB = 3;           // the sum of the unshared places
+                    for (int x = 0; x < 3; ++x)
+                        for (int y = 0; y < 3; ++y)
+                            if (va[x] == vb[y]) {
+                                ++shared;
+                                inA = x, inB = y;
+                                onlyA -= x, onlyB -= y;
+                            }
+                    if (shared == 0) {
+                        if (trianglesMeet(a, b, tolerance)) found(r.crossing, ta, tb, "cross");
+                    } else if (shared == 1) {
+                        const dvec3 &a1 = a.v[(inA + 1) % 3], &a2 = a.v[(inA + 2) % 3];
+                        const dvec3 &b1 = b.v[(inB + 1) % 3], &b2 = b.v[(inB + 2) % 3];
+                        if (segmentMeetsTriangle(a1, a2, b, tolerance) ||
+                            segmentMeetsTriangle(b1, b2, a, tolerance))
+                            found(r.overlapping, ta, tb, "overlap beyond their common vertex");
+                    } else if (shared == 2) {
+                        if (!a.hasPlane() || !b.hasPlane()) continue;
+                        // onlyA and onlyB now name each triangle's vertex off the common side.
+                        const dvec3 u = a.v[(onlyA + 1) % 3], side = a.v[(onlyA + 2) % 3] - u;
+                        auto across = [&](dvec3 p) { // from the side's line to p, at right angles
+                            const dvec3 d = p - u;
+                            return glm::normalize(
+                                d - side * (glm::dot(d, side) / glm::dot(side, side)));
+                        };
+                        if (glm::dot(across(a.v[onlyA]), across(b.v[onlyB])) > std::cos(foldAngle))
+                            found(r.folded, ta, tb, "fold onto their common side");
+                    } else {
+                        found(r.duplicates, ta, tb, "have the same vertices");
+                    }
                 }
-            }
-        i = end;
+            i = cellEnd;
+        }
+    };
+    // The halves meet at a change of cell, so that each cell is one thread's.
+    size_t middle = listed.size() / 2;
+    while (middle > 0 && middle < listed.size() && listed[middle].first == listed[middle - 1].first)
+        ++middle;
+    if (listed.size() < 100000 || std::thread::hardware_concurrency() < 2) {
+        scan(0, listed.size(), r, pairs);
+        return r;
     }
+    SelfIntersections second;
+    std::vector<std::pair<uint32_t, uint32_t>> secondPairs;
+    std::thread helper(scan, middle, listed.size(), std::ref(second),
+                       pairs ? &secondPairs : nullptr);
+    scan(0, middle, r, pairs);
+    helper.join();
+    r.crossing += second.crossing;
+    r.overlapping += second.overlapping;
+    r.folded += second.folded;
+    r.duplicates += second.duplicates;
+    if (r.first.empty()) r.first = second.first;
+    if (pairs) pairs->insert(pairs->end(), secondPairs.begin(), secondPairs.end());
     return r;
 }
 
