@@ -487,7 +487,7 @@ int cmdMesh(int argc, char** argv) {
     }
     if (auto writable = sdfcsg::checkOutput(out); !writable) return fail(writable.error());
     const std::string reportFile = args.get("--report-json");
-    auto minWall = float(0.8 / sdfcsg::millimetres(unit));
+    float minWall = sdfcsg::defaultMinWall(unit);
     if (args.has("--min-wall")) {
         const std::string value = args.get("--min-wall");
         if (!parseFloat(value, minWall) || !(minWall > 0.0f) || !std::isfinite(minWall))

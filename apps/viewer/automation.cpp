@@ -175,6 +175,15 @@ template <bool Viewer::*flag> Failure toggle(Viewer& v, const Step& s) {
     return std::nullopt;
 }
 
+Failure showThinWalls(Viewer& v, const Step& s) {
+    if (!v.mesh) return "thin-walls: no mesh extracted";
+    if (v.meshWalls.empty()) return "thin-walls: the mesh is too large to measure every wall";
+    v.thinWalls = s.arg == "on";
+    std::string error;
+    if (!uploadShownMesh(v, *v.mesh, error)) return "thin-walls: " + error;
+    return std::nullopt;
+}
+
 Failure setMode(Viewer& v, const Step& s) {
     v.mode = *parseRenderMode(s.arg);
     return std::nullopt;
@@ -270,6 +279,7 @@ const Action kActions[] = {
     {"mesh", meshCommand},
     {"view", setView},
     {"wireframe", toggle<&Viewer::wireframe>},
+    {"thin-walls", showThinWalls},
     {"generate", generateScene, Wait::None, false},
     {"edit-scene", generateScene, Wait::None, false},
 };

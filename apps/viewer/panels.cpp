@@ -254,6 +254,10 @@ void meshPanel(Viewer& v) {
                                r.boundaryEdges, r.nonManifoldEdges, r.misorientedEdges,
                                r.selfIntersections);
         ImGui::Text("volume %.4g, area %.4g", r.volume, r.area);
+        if (!v.meshWalls.empty() && ImGui::Checkbox("thin walls in red", &v.thinWalls)) {
+            std::string error;
+            if (!uploadShownMesh(v, *v.mesh, error)) v.meshMessage = error;
+        }
         if (const auto& p = r.printability; p && p->samples > 0)
             ImGui::Text("thinnest wall %.3g; %.1f%% of the surface thinner than %.3g; overhangs "
                         "%.1f%%",

@@ -119,6 +119,7 @@ const std::vector<Verb>& verbs() {
         {"mesh", 2, 4, false, {"extract", "export"}, {}, checkMesh},
         {"view", 1, 1, false, {"mesh", "march"}},
         {"wireframe", 1, 1, false, {"on", "off"}},
+        {"thin-walls", 1, 1, false, {"on", "off"}},
     };
     return table;
 }

@@ -40,6 +40,8 @@
 //   mesh export PATH         write the mesh (.ply, .obj, .stl, .glb) and wait for the file
 //   view mesh|march          the extracted mesh or the ray-marched image
 //   wireframe on|off         the mesh view's edges
+//   thin-walls on|off        the mesh's vertices over walls thinner than 0.8 mm (one scene unit
+//                            a centimetre) drawn red
 //
 // Numbers must be finite. The text of generate, edit-scene and expect-error is the rest of the
 // line, so it cannot hold a '#'. A generation, extraction or export that fails (no valid

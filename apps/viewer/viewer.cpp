@@ -40,6 +40,28 @@ double now() {
     return duration<double>(steady_clock::now().time_since_epoch()).count();
 }
 
+namespace {
+
+// `mesh` with the vertices whose wall is thinner than `minWall` red.
+Mesh thinWallsRed(const Mesh& mesh, const std::vector<float>& walls, float minWall) {
+    Mesh red = mesh;
+    for (size_t i = 0; i < red.colors.size() && i < walls.size(); ++i)
+        if (walls[i] < minWall) red.colors[i] = glm::vec3(0.9f, 0.1f, 0.05f);
+    return red;
+}
+
+} // namespace
+
+bool uploadShownMesh(Viewer& v, const Mesh& mesh, std::string& error) {
+    const Mesh* preview = v.meshPreview.get();
+    if (!v.thinWalls) return setMesh(*v.presenter, mesh, preview, error);
+    const float least = defaultMinWall();
+    const Mesh red = thinWallsRed(mesh, v.meshWalls, least);
+    std::optional<Mesh> redPreview;
+    if (preview) redPreview = thinWallsRed(*preview, v.previewWalls, least);
+    return setMesh(*v.presenter, red, redPreview ? &*redPreview : nullptr, error);
+}
+
 void resetCamera(Viewer& v) {
     if (!v.evaluator) return;
     Camera c = v.scene->camera ? *v.scene->camera : frameCamera(*v.evaluator, aspectOf(v));
@@ -203,10 +225,15 @@ bool finishMesh(Viewer& v) {
         if (*done) {
             auto mesh = std::make_shared<const Mesh>(std::move((*done)->mesh));
             v.meshStats = v.mesher->stats();
-            v.meshReport = (*done)->report;
+            v.meshReport = std::move((*done)->report);
+            v.meshWalls = std::move((*done)->walls);
+            v.previewWalls = std::move((*done)->previewWalls);
+            v.meshPreview.reset();
+            if ((*done)->preview)
+                v.meshPreview = std::make_shared<const Mesh>(std::move(*(*done)->preview));
+            v.thinWalls = v.thinWalls && !v.meshWalls.empty();
             std::string error;
-            const Mesh* preview = (*done)->preview ? &*(*done)->preview : nullptr;
-            if (setMesh(*v.presenter, *mesh, preview, error)) {
+            if (uploadShownMesh(v, *mesh, error)) {
                 v.mesh = std::move(mesh);
                 char text[160];
                 std::snprintf(text, sizeof text, "%zu vertices, %zu triangles, %.2f s%s",

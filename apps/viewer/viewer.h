@@ -97,7 +97,10 @@ struct Viewer {
     // the device.
     std::shared_ptr<const Mesh> mesh;
     MeshStats meshStats;
-    MeshReport meshReport; // of the mesh shown
+    MeshReport meshReport;                      // of the mesh shown
+    std::shared_ptr<const Mesh> meshPreview;    // drawn while the camera moves, if any
+    std::vector<float> meshWalls, previewWalls; // ExtractedMesh's
+    bool thinWalls = false;                     // thin regions drawn red
     // The last mesh frame's time (a blit when the view did not change) and the device time of the
     // last drawing of the mesh.
     double meshFrameMs = 0.0, meshDrawMs = -1.0;
@@ -160,6 +163,9 @@ double now();
 
 // Back to the scene's own camera, or one that frames it.
 void resetCamera(Viewer& v);
+// Gives the presenter `mesh` and the preview, their thin walls red where v.thinWalls is set;
+// false with `error` where they do not fit.
+bool uploadShownMesh(Viewer& v, const Mesh& mesh, std::string& error);
 // Frames the selected node, or the scene when none is selected (F).
 void frameSelection(Viewer& v);
 // Hands the document's scene to the workers when it changed.

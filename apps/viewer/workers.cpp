@@ -383,15 +383,19 @@ Result<ExtractedMesh> MeshWorker::extract(const Scene& scene, MeshOptions option
             if (!simplified) return simplified.error();
             extracted.mesh = std::move(*simplified);
         }
-        extracted.report =
-            reportMesh(extracted.mesh, evaluator, float(0.8 / millimetres(kDefaultLengthUnit)));
+        extracted.report = reportMesh(extracted.mesh, evaluator, defaultMinWall());
+        if (extracted.mesh.vertexCount() <= kWallColouredVertices && !job_.cancelled())
+            extracted.walls = wallThickness(extracted.mesh, evaluator);
         if (extracted.mesh.triangleCount() <= previewThreshold_ || job_.cancelled())
             return extracted;
         SimplifyOptions preview;
         preview.targetTriangles = previewThreshold_;
         preview.progress = going;
-        if (auto copy = simplifyMesh(extracted.mesh, evaluator, preview); copy)
+        if (auto copy = simplifyMesh(extracted.mesh, evaluator, preview); copy) {
             extracted.preview = std::move(*copy);
+            if (!extracted.walls.empty())
+                extracted.previewWalls = wallThickness(*extracted.preview, evaluator);
+        }
         return extracted;
     }();
     // Before the result is handed over, so that its taker reads these stats.

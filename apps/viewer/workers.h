@@ -244,7 +244,11 @@ struct ExtractedMesh {
     // Of the mesh, with its printability at the default least wall (0.8 mm, one scene unit a
     // centimetre); the self-intersection search takes about 2 s per million triangles.
     MeshReport report;
+    // The wall under each vertex of the mesh and of the preview (wallThickness), for meshes of
+    // up to kWallColouredVertices vertices; empty for larger ones.
+    std::vector<float> walls, previewWalls;
 };
+inline constexpr size_t kWallColouredVertices = 1000000;
 
 // Meshes with more triangles than this get a preview of at most this many: lavapipe redraws
 // about 15 million triangles a second (2.9 million in 200 ms), so a larger mesh takes over

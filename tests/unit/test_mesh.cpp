@@ -96,7 +96,12 @@ TEST_F(MeshTest, PrintabilityOfAnalyticSolids) {
     const Scene ball = sceneFrom(kSphere);
     MeshOptions options;
     options.resolution = 64;
-    MeshReport report = reportMesh(extract(ball, options), Evaluator(ball), 0.5f);
+    const Mesh ballMesh = extract(ball, options);
+    MeshReport report = reportMesh(ballMesh, Evaluator(ball), 0.5f);
+    const std::vector<float> walls = wallThickness(ballMesh, Evaluator(ball));
+    ASSERT_EQ(walls.size(), ballMesh.vertexCount());
+    for (float wall : walls)
+        ASSERT_NEAR(wall, 2.0f, 0.02f); // every vertex: through the centre
     ASSERT_TRUE(report.printability);
     const Printability* p = &*report.printability;
     EXPECT_GT(p->samples, 1000u);

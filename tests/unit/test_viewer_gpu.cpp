@@ -342,4 +342,6 @@ TEST_F(ViewerGpu, MeshWorkerSimplifiesAPreviewOfALargeMesh) {
     EXPECT_EQ(small.report.euler, test::measureMesh(small.mesh).euler);
     ASSERT_TRUE(small.report.printability);
     EXPECT_GT(small.report.printability->samples, 0u);
+    EXPECT_EQ(small.walls.size(), small.mesh.vertexCount());
+    EXPECT_EQ(large.previewWalls.size(), large.preview->vertexCount());
 }

@@ -295,6 +295,14 @@ SCRIPT
     "$diff" m0-march.png m2-wire.png mask 3 0.98 || fail "the wireframe's silhouette is not the scene's"
     "$diff" m1-mesh.png m2-wire.png differ 0.01 || fail "the wireframe shows no edges"
     "$diff" m1-mesh.png m4-grid.png differ 0.005 || fail "the mesh view shows no grid"
+    # A plate 0.04 thick under a ball: thinner than 0.8 mm at a centimetre a unit, so it turns red.
+    printf '{"version": 1, "root": {"type": "union", "children": [%s, %s]}}' \
+        '{"type": "box", "size": [2, 0.04, 2], "color": "#808080"}' \
+        '{"type": "sphere", "radius": 0.5, "translate": [0, 0.5, 0], "color": "#808080"}' >plate.json
+    printf 'mesh extract 96\nscreenshot t0.png\nthin-walls on\nscreenshot t1.png\nthin-walls off\nscreenshot t2.png\n' >thin.txt
+    run plate.json --script thin.txt --size 320x240 --no-ui || fail "scripted thin walls"
+    "$diff" t0.png t1.png differ 0.05 || fail "thin-walls on showed no thin walls"
+    "$diff" t0.png t2.png same 0 0 || fail "thin-walls off did not bring the colours back"
     "$diff" m3-march.png m0-march.png same 0 0 || fail "the ray-marched view did not come back"
     grep -q "^f " mesh.obj || fail "the exported mesh has no faces"
     printf 'view mesh\n' > no-mesh.txt

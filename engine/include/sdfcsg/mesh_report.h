@@ -3,6 +3,7 @@
 #pragma once
 
 #include "sdfcsg/eval.h"
+#include "sdfcsg/export.h"
 #include "sdfcsg/mesh.h"
 
 #include <glm/vec3.hpp>
@@ -12,6 +13,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace sdfcsg {
 
@@ -64,11 +66,19 @@ struct MeshReport {
 };
 
 MeshReport reportMesh(const Mesh& mesh);
+// 0.8 mm, the least wall that a common 0.4 mm nozzle prints, in scene units where one unit is
+// `unit`: the default minWall.
+float defaultMinWall(LengthUnit unit = kDefaultLengthUnit);
 // The same with the printability of the mesh of the scene that `evaluator` evaluates: walls
 // thinner than `minWall` (scene units), measured at up to `samples` triangles spread over the
 // mesh (bounded work on any mesh).
 MeshReport reportMesh(const Mesh& mesh, const Evaluator& evaluator, float minWall,
                       size_t samples = 20000);
+
+// The wall under each vertex of `mesh` (a mesh of the scene `evaluator` evaluates), measured as
+// Printability measures it but along the vertex's normal; infinite where the march does not
+// get inside. For colouring thin regions.
+std::vector<float> wallThickness(const Mesh& mesh, const Evaluator& evaluator);
 
 // The report as lines of text ("closed: yes"), and as one JSON object.
 std::string reportText(const MeshReport& report);

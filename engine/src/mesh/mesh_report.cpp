@@ -45,6 +45,14 @@ std::optional<float> wallAt(const std::function<float(glm::vec3)>& field, glm::v
     return std::nullopt;
 }
 
+// The scene's field; large scenes answer from pruned tapes, as their kernels do.
+std::function<float(glm::vec3)> fieldOf(const Evaluator& evaluator) {
+    const bool pruned = evaluator.nodes().size() >= kTapeMinNodes;
+    return [&evaluator, pruned](glm::vec3 x) {
+        return pruned ? evaluator.prunedDistance(x) : evaluator.distance(x);
+    };
+}
+
 Printability printability(const Mesh& mesh, const Evaluator& evaluator, float minWall,
                           size_t samples, const Aabb& bounds) {
     Printability p;
@@ -53,11 +61,7 @@ Printability printability(const Mesh& mesh, const Evaluator& evaluator, float mi
     if (n == 0 || bounds.empty()) return p;
     const float size = glm::length(bounds.max - bounds.min);
     const float least = 1e-4f * size, plate = bounds.min.y + 1e-4f * size;
-    // Large scenes answer from pruned tapes, as their kernels do.
-    const bool pruned = evaluator.nodes().size() >= kTapeMinNodes;
-    const std::function<float(glm::vec3)> field = [&](glm::vec3 x) {
-        return pruned ? evaluator.prunedDistance(x) : evaluator.distance(x);
-    };
+    const std::function<float(glm::vec3)> field = fieldOf(evaluator);
     const size_t stride = std::max<size_t>(1, (n + samples - 1) / std::max<size_t>(samples, 1));
     double sampledArea = 0, thinSampled = 0, area = 0;
     for (size_t t = 0; t < n; ++t) {
@@ -87,6 +91,24 @@ Printability printability(const Mesh& mesh, const Evaluator& evaluator, float mi
 }
 
 } // namespace
+
+float defaultMinWall(LengthUnit unit) {
+    return float(0.8 / millimetres(unit));
+}
+
+std::vector<float> wallThickness(const Mesh& mesh, const Evaluator& evaluator) {
+    std::vector<float> walls(mesh.vertexCount(), std::numeric_limits<float>::infinity());
+    Aabb box;
+    for (const glm::vec3& p : mesh.positions)
+        box.min = glm::min(box.min, p), box.max = glm::max(box.max, p);
+    if (box.empty()) return walls;
+    const float size = glm::length(box.max - box.min);
+    const std::function<float(glm::vec3)> field = fieldOf(evaluator);
+    for (size_t v = 0; v < walls.size(); ++v)
+        if (auto wall = wallAt(field, mesh.positions[v], mesh.normals[v], 1e-4f * size, size))
+            walls[v] = *wall;
+    return walls;
+}
 
 MeshReport reportMesh(const Mesh& mesh, const Evaluator& evaluator, float minWall, size_t samples) {
     MeshReport r = reportMesh(mesh);
