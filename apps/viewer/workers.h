@@ -248,7 +248,7 @@ struct ExtractedMesh {
     // up to kWallColouredVertices vertices; empty for larger ones.
     std::vector<float> walls, previewWalls;
 };
-inline constexpr size_t kWallColouredVertices = 1000000;
+inline constexpr size_t kWallColouredVertices = 300000;
 
 // Meshes with more triangles than this get a preview of at most this many: lavapipe redraws
 // about 15 million triangles a second (2.9 million in 200 ms), so a larger mesh takes over
