@@ -40,10 +40,11 @@ struct SelfIntersections {
 // beyond it only when they lie in one plane on the same side of it, folded onto each other: when
 // the angle between them at the side is under `foldAngle` radians. Triangles without a plane
 // (see Triangle in self_intersections.cpp) are judged by their sides alone, and pairs with a side
-// in common of which one has no plane not at all: the tests' checkTriangleFacing() and the mesh
-// report count them as degenerate. `tolerance` defaults to 1e-6 of the diagonal of the mesh's
-// bounds, above the rounding of float positions and far below any feature a mesher should make.
-// `pairs`, if given, receives every pair found (triangle numbers).
+// in common of which one has no plane not at all: the tests' checkTriangleFacing() counts them
+// as degenerate. `tolerance` defaults to 1e-6 of the diagonal of the mesh's bounds, above the
+// rounding of float positions and far below any feature a mesher should make. `pairs`, if
+// given, receives every pair found (triangle numbers), in the same order however many threads
+// search (two, on meshes of some 30,000 triangles or more).
 SelfIntersections
 findSelfIntersections(const Mesh& mesh, double tolerance = -1.0, double foldAngle = 1e-3,
                       std::vector<std::pair<uint32_t, uint32_t>>* pairs = nullptr);
