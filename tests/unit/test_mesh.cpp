@@ -10,6 +10,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <cstdio>
+#include <cstdlib>
 #include <numbers>
 #include <random>
 
@@ -183,9 +184,12 @@ Scene smallPrimitives(uint32_t seed, int count) {
 
 // Every such scene meshes closed, manifold and consistently oriented at resolutions odd and even,
 // including where two sheets touch across a cell's face (splitTouchingSheets): 40 scenes of about
-// 180 nodes (one tape kernel for all) at 5 resolutions.
+// 180 nodes (one tape kernel for all) at 5 resolutions; SDFCSG_MESH_SEEDS=N runs N scenes
+// (docs/robustness.md, "Mesh properties").
 TEST_F(MeshTest, ManySmallPrimitivesMeshClosedAndManifoldAtEveryResolution) {
-    for (uint32_t seed = 0; seed < 40; ++seed) {
+    const char* seeds = std::getenv("SDFCSG_MESH_SEEDS");
+    const uint32_t count = seeds ? uint32_t(std::strtoul(seeds, nullptr, 10)) : 40u;
+    for (uint32_t seed = 0; seed < count; ++seed) {
         const Scene scene = smallPrimitives(seed, 180);
         auto mesher = Mesher::create(context(), scene);
         ASSERT_TRUE(mesher) << mesher.error().str();
