@@ -130,8 +130,9 @@ TEST_F(MeshTest, PrintabilityOfAnalyticSolids) {
     EXPECT_EQ(report.printability->thinArea, 0.0);
 }
 
-// About `count` small primitives of random kinds, sizes, places and turns, in sharp unions and
-// smooth groups, with a few cut away: two sheets meet across cells' faces all over such scenes.
+// About `count` small primitives of random kinds, sizes, places and turns (sheets often thinner
+// than a cell among them), in sharp unions and smooth groups, with a few cut away: two sheets
+// meet across cells' faces all over such scenes.
 Scene smallPrimitives(uint32_t seed, int count) {
     std::mt19937 rng(seed);
     auto uni = [&](float a, float b) { return std::uniform_real_distribution<float>(a, b)(rng); };
@@ -139,7 +140,7 @@ Scene smallPrimitives(uint32_t seed, int count) {
     auto primitive = [&]() {
         const float s = uni(0.03f, 0.15f);
         Tree t;
-        switch (pick(6)) {
+        switch (pick(9)) {
         case 0:
             t = sphere(s);
             break;
@@ -154,6 +155,15 @@ Scene smallPrimitives(uint32_t seed, int count) {
             break;
         case 4:
             t = cone(s, 2 * s);
+            break;
+        case 5: // a sheet, often thinner than a cell
+            t = box(s * uni(1, 3), s * uni(0.02f, 0.1f), s * uni(1, 3));
+            break;
+        case 6:
+            t = roundBox(s, s * uni(0.5f, 2), s, 0.2f * s);
+            break;
+        case 7:
+            t = prism(s, s * uni(0.5f, 2), s);
             break;
         default:
             t = capsule({0, 0, 0}, {0, s * uni(1, 3), 0}, 0.3f * s);
