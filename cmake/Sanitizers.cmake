@@ -36,11 +36,13 @@ endif()
 
 # What the tests' environment adds under the sanitizers (appended to each test's ENVIRONMENT,
 # hence the leading ';'): the leak suppressions for lavapipe, whose driver is preloaded so that
-# the Vulkan loader's unloading it does not leave its leaks unnamed (tests/sanitizers/lsan.supp).
+# the Vulkan loader's unloading it does not leave its leaks unnamed (tests/sanitizers/lsan.supp);
+# and a factor for the command-line tests' deadlines (Ctrl-C within a second), since the leak
+# check at exit scans the whole heap, hundreds of megabytes after a large mesh.
 set(SDFCSG_SANITIZER_ENV "")
 if(SDFCSG_SANITIZERS)
     find_library(SDFCSG_LAVAPIPE_LIBRARY vulkan_lvp)
-    set(SDFCSG_SANITIZER_ENV ";LSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/tests/sanitizers/lsan.supp:print_suppressions=0;UBSAN_OPTIONS=print_stacktrace=1")
+    set(SDFCSG_SANITIZER_ENV ";LSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/tests/sanitizers/lsan.supp:print_suppressions=0;UBSAN_OPTIONS=print_stacktrace=1;SDFCSG_TEST_DEADLINE_SCALE=3")
     if(SDFCSG_LAVAPIPE_LIBRARY)
         # The preloaded driver precedes the sanitizer runtime in the library list.
         string(APPEND SDFCSG_SANITIZER_ENV

@@ -2,7 +2,8 @@
 # command line's Ctrl-C tests: every POST gets an OpenAI Chat Completions answer whose content is
 # the file ANSWER, read anew for each request so the test can change it. With ANSWERED, only the
 # first ANSWERED requests are answered and the next one is held for a minute, so that a client
-# can be interrupted while it waits. Writes the port it listens on to PORT_FILE.
+# can be interrupted while it waits; PORT_FILE.held appears when a request is held. Writes the
+# port it listens on to PORT_FILE.
 # Usage: fake_llm.py ANSWER PORT_FILE [ANSWERED]
 import http.server
 import json
@@ -21,6 +22,7 @@ class Handler(http.server.BaseHTTPRequestHandler):
         self.rfile.read(int(self.headers.get("Content-Length", 0)))
         requests += 1
         if answered is not None and requests > answered:
+            open(port_path + ".held", "w").close()
             time.sleep(60)
             return
         with open(answer_path, encoding="utf-8") as f:

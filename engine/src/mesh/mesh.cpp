@@ -835,8 +835,9 @@ Status Extraction::triangles(uint32_t batch) {
             smooth[o] = glm::vec3(v[9], v[10], v[11]);
         }
     }
-    std::memcpy(mesh.indices.data() + uint64_t(first) * 3,
-                m.mapped<uint32_t>(SDFCSG_BINDING_MESH_INDICES), batchTriangles * 12);
+    if (batchTriangles > 0) // an empty vector's data() may be null, which memcpy must not get
+        std::memcpy(mesh.indices.data() + uint64_t(first) * 3,
+                    m.mapped<uint32_t>(SDFCSG_BINDING_MESH_INDICES), batchTriangles * 12);
     stage("download", t0);
     notePeak(map.size() * 4 + mesh.positions.capacity() * 36 + smooth.capacity() * 12 +
              mesh.indices.capacity() * 4);
