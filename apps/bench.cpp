@@ -67,7 +67,7 @@ const char* kHelp =
     R"(Usage: sdfcsg bench [--scenes DIR] [--width W] [--height H] [--frames N] [--buffer]
                    [--evaluation E]
        sdfcsg bench --mesh [--scenes DIR] [--resolutions 128,256,512] [--runs N]
-                   [--method dc|mc] [--simplify E] [--error]
+                   [--method dc|mc] [--simplify E] [--error] [--report]
 
 For every scene (*.json) in DIR (default assets/scenes), prints the median milliseconds per
 frame in shaded mode with and without bounding-box skipping (after two warm-up frames; a frame
@@ -105,7 +105,9 @@ defines. --method picks dual contouring (default) or marching cubes. --simplify 
 simplifies every mesh with a largest error of E cells (as sdfcsg mesh --simplify does, its
 time in the total), and the triangle counts before and after are shown. --error adds the
 distance from the surface of points spread over every triangle (not only its vertices),
-by the CPU evaluator, in cells: the largest and the 99th percentile.
+by the CPU evaluator, in cells: the largest and the 99th percentile. --report adds the median
+seconds of the mesh report on each mesh (as sdfcsg mesh --report computes it, walls from the
+field included), beside the extraction and not in its total.
 )";
 
 using Clock = std::chrono::steady_clock;
@@ -292,7 +294,7 @@ struct MeshRow {
     uint64_t triangles = 0, unsimplified = 0;
     float maxError = NAN, p99Error = NAN; // cells
     std::vector<double> stages;           // median seconds, in the order of the stage names
-    double total = 0;
+    double total = 0, report = NAN;       // median seconds; report: beside the total
 };
 
 // The distance from the surface, in cells of edge h, of the points kTriangleSamples of
@@ -319,7 +321,7 @@ struct MeshArgs {
     std::vector<uint32_t> resolutions = {128, 256, 512};
     uint32_t runs = 3;
     MeshMethod method = MeshMethod::DualContouring;
-    bool measureError = false;
+    bool measureError = false, report = false;
     float simplifyCells = 0; // 0: no simplification
 };
 
@@ -332,6 +334,8 @@ std::optional<int> parseMeshArgs(int argc, char** argv, MeshArgs& args) {
             continue;
         else if (a == "--error")
             args.measureError = true;
+        else if (a == "--report")
+            args.report = true;
         else if (i + 1 < argc && a == "--method" && std::string_view(argv[i + 1]) == "dc")
             args.method = MeshMethod::DualContouring, ++i;
         else if (i + 1 < argc && a == "--method" && std::string_view(argv[i + 1]) == "mc")
@@ -362,7 +366,7 @@ std::optional<int> parseMeshArgs(int argc, char** argv, MeshArgs& args) {
 Status measureMeshRow(Mesher& mesher, const Evaluator& evaluator, const MeshOptions& options,
                       const MeshArgs& args, std::vector<std::string>& stageNames, MeshRow& row) {
     std::vector<std::vector<double>> stageTimes;
-    std::vector<double> totals;
+    std::vector<double> totals, reports;
     for (uint32_t run = 0; run < args.runs; ++run) {
         MeshStats stats;
         auto mesh = mesher.extract(options, &stats);
@@ -375,6 +379,11 @@ Status measureMeshRow(Mesher& mesher, const Evaluator& evaluator, const MeshOpti
         if (!mesh) return mesh.error();
         if (args.measureError && run == 0)
             std::tie(row.maxError, row.p99Error) = surfaceError(*mesh, evaluator, stats.voxelSize);
+        if (args.report) {
+            const auto start = Clock::now();
+            reportMesh(*mesh, evaluator, defaultMinWall());
+            reports.push_back(msSince(start) / 1000.0);
+        }
         row.cells = stats.cells;
         row.triangles = stats.triangles;
         totals.push_back(stats.totalSeconds);
@@ -389,6 +398,7 @@ Status measureMeshRow(Mesher& mesher, const Evaluator& evaluator, const MeshOpti
     for (const auto& times : stageTimes) // NaN: the stage did not run for this scene
         row.stages.push_back(times.empty() ? std::nan("") : median(times));
     row.total = median(totals);
+    if (args.report) row.report = median(reports);
     return Ok{};
 }
 
@@ -428,6 +438,7 @@ void printMeshRows(const std::vector<MeshRow>& rows, const std::vector<std::stri
         std::printf(" %*s", int(std::max<size_t>(stage.size(), 8)), stage.c_str());
     std::printf(" %8s", "total s");
     if (args.measureError) std::printf(" %9s %9s", "max err", "p99 err");
+    if (args.report) std::printf(" %8s", "report s");
     std::printf("\n");
     for (const MeshRow& r : rows) {
         const std::string cells = std::to_string(r.cells.x) + "x" + std::to_string(r.cells.y) +
@@ -445,6 +456,7 @@ void printMeshRows(const std::vector<MeshRow>& rows, const std::vector<std::stri
         }
         std::printf(" %8.3f", r.total);
         if (args.measureError) std::printf(" %9.3f %9.3f", r.maxError, r.p99Error);
+        if (args.report) std::printf(" %8.3f", r.report);
         std::printf("\n");
     }
     std::printf(

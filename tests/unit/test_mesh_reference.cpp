@@ -562,6 +562,47 @@ TEST(MeshChecks, SelfIntersectionsOfTrianglePairs) {
     EXPECT_EQ(r.total(), 1u) << r.str();
 }
 
+// The quick proofs that a pair does not meet (a plane between them) agree with the exact tests
+// on seeded random pairs placed to meet, nearly meet or touch within the tolerance: apart, with
+// a vertex in common, in one plane or leaning out of it by about the tolerance.
+TEST(MeshChecks, QuickSelfIntersectionProofsAgreeWithTheExactTests) {
+    std::mt19937 rng(7);
+    auto uni = [&](float a, float b) { return std::uniform_real_distribution<float>(a, b)(rng); };
+    const double tolerance = 1e-6;
+    const float lean[] = {0.0f, 3e-7f, -3e-7f, 3e-6f, -3e-6f, 1e-3f, -1e-3f, 0.2f};
+    size_t meeting = 0;
+    for (int pair = 0; pair < 20000; ++pair) {
+        const glm::vec3 o(uni(-1, 1), uni(-1, 1), uni(-1, 1));
+        const glm::vec3 u(uni(-1, 1), uni(-1, 1), uni(-1, 1)),
+            w(uni(-1, 1), uni(-1, 1), uni(-1, 1));
+        const std::array<glm::vec3, 3> a = {o, o + u, o + w};
+        const glm::vec3 n = glm::normalize(glm::cross(u, w));
+        std::array<glm::vec3, 3> b;
+        for (glm::vec3& p : b) // in a's plane around it, leaning out of it
+            p = o + uni(-0.5f, 1.5f) * u + uni(-0.5f, 1.5f) * w + lean[rng() % 8] * n;
+        std::array<int, 3> shared = {-1, -1, -1};
+        if (pair % 2) { // a's corner k as b's first vertex
+            const int k = int(rng() % 3);
+            shared[0] = k;
+            b[0] = a[size_t(k)];
+            if (pair % 4 == 3) { // b rises from the corner just past the tolerance, reaching far
+                const float rise = lean[1 + rng() % 4];
+                for (size_t i = 1; i < 3; ++i)
+                    b[i] = o + uni(-1, 3) * u + uni(-1, 3) * w + rise * n;
+            }
+        }
+        const Mesh mesh = twoTriangles(a, b, shared);
+        const SelfIntersections quick = findSelfIntersections(mesh, tolerance, 1e-3, nullptr);
+        const SelfIntersections exact =
+            findSelfIntersections(mesh, tolerance, 1e-3, nullptr, false);
+        ASSERT_EQ(quick.total(), exact.total()) << "pair " << pair << ": " << exact.str();
+        meeting += exact.total();
+    }
+    // Both outcomes are common, so the comparison means something.
+    EXPECT_GT(meeting, 2000u);
+    EXPECT_LT(meeting, 18000u);
+}
+
 // Meshes of many triangles: closed surfaces that do not meet themselves, two that cross, and one
 // with a vertex pushed through the far side.
 TEST(MeshChecks, SelfIntersectionsOfClosedMeshes) {

@@ -12,6 +12,7 @@
 #include <functional>
 #include <numeric>
 #include <optional>
+#include <thread>
 #include <vector>
 
 namespace sdfcsg {
@@ -111,8 +112,19 @@ std::vector<float> wallThickness(const Mesh& mesh, const Evaluator& evaluator) {
 }
 
 MeshReport reportMesh(const Mesh& mesh, const Evaluator& evaluator, float minWall, size_t samples) {
+    // The walls (from the field) on a thread of their own beside the mesh's own checks; they
+    // need only the bounds of the vertices that the triangles use.
+    Aabb bounds;
+    for (const uint32_t v : mesh.indices)
+        if (v < mesh.vertexCount()) {
+            bounds.min = glm::min(bounds.min, mesh.positions[v]);
+            bounds.max = glm::max(bounds.max, mesh.positions[v]);
+        }
+    Printability walls;
+    std::thread measure([&] { walls = printability(mesh, evaluator, minWall, samples, bounds); });
     MeshReport r = reportMesh(mesh);
-    r.printability = printability(mesh, evaluator, minWall, samples, r.bounds);
+    measure.join();
+    r.printability = walls;
     return r;
 }
 

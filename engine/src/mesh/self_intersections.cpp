@@ -112,10 +112,65 @@ bool trianglesMeet(const Triangle& a, const Triangle& b, double tolerance) {
     return false;
 }
 
+// Quick proofs that two triangles do not meet, tried before the exact tests above (each proof
+// only skips pairs those tests would pass). A plane with one triangle on its closed inner side and
+// the other's vertices more than `tolerance` beyond it keeps them apart: the triangle's own plane
+// (either side), or the plane through one of its sides and its normal (outward: away from the
+// third vertex). Two triangles with a common vertex v touch there: the far one's other vertices
+// must be beyond the plane, and the points of it within `tolerance` of the plane, a tip at v no
+// longer than tolerance / (their least depth) * (its longest side from v), must stay farther than
+// `tolerance` from the near one's side opposite v, which lies `height` from v.
+bool beyond(dvec3 origin, dvec3 outward, const Triangle& far, int shared, double tolerance,
+            double height) {
+    double least = 1e300, reach = 0.0;
+    for (int i = 0; i < 3; ++i) {
+        if (i == shared) continue;
+        least = std::min(least, glm::dot(far.v[i] - origin, outward));
+        if (shared >= 0) reach = std::max(reach, glm::length(far.v[i] - far.v[shared]));
+    }
+    if (!(least > tolerance)) return false;
+    return shared < 0 || height * least > tolerance * (least + reach);
+}
+
+// Whether a plane of `a` (see beyond()) keeps `b` apart; `sharedA`, `sharedB`: the places of a
+// common vertex in each, or -1.
+bool planeOfASeparates(const Triangle& a, const Triangle& b, int sharedA, int sharedB,
+                       double tolerance) {
+    if (!a.hasPlane()) return false;
+    // a's height over its side opposite the shared vertex.
+    double height = 0.0;
+    if (sharedA >= 0) {
+        const dvec3 side = a.v[(sharedA + 2) % 3] - a.v[(sharedA + 1) % 3];
+        const double length = glm::length(side);
+        if (!(length > 0.0)) return false;
+        height = glm::length(glm::cross(side, a.v[sharedA] - a.v[(sharedA + 1) % 3])) / length;
+    }
+    const dvec3 origin = a.v[sharedA >= 0 ? sharedA : 0];
+    if (beyond(origin, a.normal, b, sharedB, tolerance, height) ||
+        beyond(origin, -a.normal, b, sharedB, tolerance, height))
+        return true;
+    for (int i = 0; i < 3; ++i) {
+        const dvec3 p = a.v[i], q = a.v[(i + 1) % 3];
+        // With a common vertex, only the two sides through it.
+        if (sharedA >= 0 && i != sharedA && (i + 1) % 3 != sharedA) continue;
+        const dvec3 outward = glm::cross(q - p, a.normal); // away from the third vertex
+        const double length = glm::length(outward);
+        if (!(length > 0.0)) continue;
+        if (beyond(p, outward / length, b, sharedB, tolerance, height)) return true;
+    }
+    return false;
+}
+
+bool separated(const Triangle& a, const Triangle& b, int sharedA, int sharedB, double tolerance) {
+    return planeOfASeparates(a, b, sharedA, sharedB, tolerance) ||
+           planeOfASeparates(b, a, sharedB, sharedA, tolerance);
+}
+
 } // namespace
 
 SelfIntersections findSelfIntersections(const Mesh& mesh, double tolerance, double foldAngle,
-                                        std::vector<std::pair<uint32_t, uint32_t>>* pairs) {
+                                        std::vector<std::pair<uint32_t, uint32_t>>* pairs,
+                                        bool quick) {
     using glm::dvec3;
     SelfIntersections r;
     const size_t n = mesh.triangleCount();
@@ -161,7 +216,30 @@ SelfIntersections findSelfIntersections(const Mesh& mesh, double tolerance, doub
                 for (int x = c0.x; x <= c1.x; ++x)
                     listed.push_back({key({x, y, z}), t});
     }
-    std::sort(listed.begin(), listed.end());
+    const bool twoThreads = listed.size() >= 100000 && std::thread::hardware_concurrency() >= 2;
+    if (twoThreads) { // each half sorted by a thread of its own, then merged
+        const auto half = listed.begin() + ptrdiff_t(listed.size() / 2);
+        std::thread helper([&] { std::sort(half, listed.end()); });
+        std::sort(listed.begin(), half);
+        helper.join();
+        std::inplace_merge(listed.begin(), half, listed.end());
+    } else {
+        std::sort(listed.begin(), listed.end());
+    }
+    // The grown bounds of listed[i] in single precision, rounded outwards, side by side in the
+    // order of `listed`: most pairs of a cell are told apart by these alone, without reading the
+    // triangles (which the test below then does in double precision).
+    struct Box {
+        glm::vec3 lo, hi;
+    };
+    std::vector<Box> boxes(listed.size());
+    for (size_t i = 0; i < listed.size(); ++i) {
+        const Triangle& t = triangles[listed[i].second];
+        for (int k = 0; k < 3; ++k) {
+            boxes[i].lo[k] = std::nextafter(float(t.lo[k] - tolerance), -HUGE_VALF);
+            boxes[i].hi[k] = std::nextafter(float(t.hi[k] + tolerance), HUGE_VALF);
+        }
+    }
 
     auto describe = [&](uint32_t t) {
         std::ostringstream s;
@@ -188,6 +266,9 @@ SelfIntersections findSelfIntersections(const Mesh& mesh, double tolerance, doub
                 ++cellEnd;
             for (size_t j = i; j < cellEnd; ++j)
                 for (size_t k = j + 1; k < cellEnd; ++k) {
+                    if (glm::any(glm::greaterThan(boxes[j].lo, boxes[k].hi)) ||
+                        glm::any(glm::greaterThan(boxes[k].lo, boxes[j].hi)))
+                        continue;
                     const uint32_t ta = listed[j].second, tb = listed[k].second;
                     const Triangle &a = triangles[ta], &b = triangles[tb];
                     const dvec3 overlapLo = glm::max(a.lo, b.lo) - tolerance;
@@ -207,8 +288,11 @@ SelfIntersections findSelfIntersections(const Mesh& mesh, double tolerance, doub
                                 onlyA -= x, onlyB -= y;
                             }
                     if (shared == 0) {
-                        if (trianglesMeet(a, b, tolerance)) found(r.crossing, ta, tb, "cross");
+                        if (!(quick && separated(a, b, -1, -1, tolerance)) &&
+                            trianglesMeet(a, b, tolerance))
+                            found(r.crossing, ta, tb, "cross");
                     } else if (shared == 1) {
+                        if (quick && separated(a, b, inA, inB, tolerance)) continue;
                         const dvec3 &a1 = a.v[(inA + 1) % 3], &a2 = a.v[(inA + 2) % 3];
                         const dvec3 &b1 = b.v[(inB + 1) % 3], &b2 = b.v[(inB + 2) % 3];
                         if (segmentMeetsTriangle(a1, a2, b, tolerance) ||
@@ -236,7 +320,7 @@ SelfIntersections findSelfIntersections(const Mesh& mesh, double tolerance, doub
     size_t middle = listed.size() / 2;
     while (middle > 0 && middle < listed.size() && listed[middle].first == listed[middle - 1].first)
         ++middle;
-    if (listed.size() < 100000 || std::thread::hardware_concurrency() < 2) {
+    if (!twoThreads) {
         scan(0, listed.size(), r, pairs);
         return r;
     }
