@@ -47,9 +47,9 @@ struct SelfIntersections {
 // search (two, on meshes of some 30,000 triangles or more). Most pairs near each other are told
 // apart by a plane between them, by quick proofs that skip only pairs the exact tests would pass;
 // `quick` false leaves every pair to the exact tests (for the tests to compare).
-SelfIntersections
-findSelfIntersections(const Mesh& mesh, double tolerance = -1.0, double foldAngle = 1e-3,
-                      std::vector<std::pair<uint32_t, uint32_t>>* pairs = nullptr,
-                      bool quick = true);
+SelfIntersections findSelfIntersections(const Mesh& mesh, double tolerance = -1.0,
+                                        double foldAngle = 1e-3,
+                                        std::vector<std::pair<uint32_t, uint32_t>>* pairs = nullptr,
+                                        bool quick = true);
 
 } // namespace sdfcsg::detail
