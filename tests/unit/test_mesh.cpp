@@ -130,6 +130,17 @@ TEST_F(MeshTest, PrintabilityOfAnalyticSolids) {
     EXPECT_EQ(report.printability->thinArea, 0.0);
 }
 
+// A mesh with triangles, every one usable, every edge shared by two of them in opposite
+// directions.
+void expectClosedManifold(const Mesh& mesh) {
+    const MeshProperties m = measureMesh(mesh);
+    EXPECT_GT(m.triangles, 0u);
+    EXPECT_EQ(m.badTriangles, 0u) << m.str();
+    EXPECT_EQ(m.boundaryEdges, 0u) << m.str();
+    EXPECT_EQ(m.nonManifoldEdges, 0u) << m.str();
+    EXPECT_EQ(m.misorientedEdges, 0u) << m.str();
+}
+
 // About `count` small primitives of random kinds, sizes, places and turns (sheets often thinner
 // than a cell among them), in sharp unions and smooth groups, with a few cut away: two sheets
 // meet across cells' faces all over such scenes.
@@ -209,12 +220,7 @@ TEST_F(MeshTest, ManySmallPrimitivesMeshClosedAndManifoldAtEveryResolution) {
             options.resolution = resolution;
             auto mesh = (*mesher)->extract(options);
             ASSERT_TRUE(mesh) << mesh.error().str();
-            const MeshProperties m = measureMesh(*mesh);
-            EXPECT_GT(m.triangles, 0u);
-            EXPECT_EQ(m.badTriangles, 0u) << m.str();
-            EXPECT_EQ(m.boundaryEdges, 0u) << m.str();
-            EXPECT_EQ(m.nonManifoldEdges, 0u) << m.str();
-            EXPECT_EQ(m.misorientedEdges, 0u) << m.str();
+            expectClosedManifold(*mesh);
         }
     }
 }
@@ -292,12 +298,7 @@ TEST_F(MeshTest, RandomTreesOfEveryKindMeshClosedAndManifold) {
             auto mesh = (*mesher)->extract(options, &stats);
             ASSERT_TRUE(mesh) << mesh.error().str();
             EXPECT_FALSE(stats.surfaceCut);
-            const MeshProperties m = measureMesh(*mesh);
-            EXPECT_GT(m.triangles, 0u);
-            EXPECT_EQ(m.badTriangles, 0u) << m.str();
-            EXPECT_EQ(m.boundaryEdges, 0u) << m.str();
-            EXPECT_EQ(m.nonManifoldEdges, 0u) << m.str();
-            EXPECT_EQ(m.misorientedEdges, 0u) << m.str();
+            expectClosedManifold(*mesh);
         }
     }
 }
