@@ -601,7 +601,17 @@ SDF_FN bool domainClamps(uint kind) { return kind >= kKindTwist && kind <= kKind
 // The node's value in its local units from the least of its candidates' values.
 SDF_FN float domainFinish(uint kind, vec3 p, float best, vec4 a, vec4 b) {
     if (kind == kKindRepeat) return min(best, a.w);
-    if (kind == kKindPolarRepeat) return a.w >= 0.0f ? min(best, length(vec2(p.x, p.z)) * a.w) : best;
+    if (kind == kKindPolarRepeat) {
+        // The copies left out lie at least the angle gamma away from p about the axis, at least
+        // b.y from the axis, and between heights b.z and b.w: they are no nearer than that
+        // region, whose distance from p depends on p's radius and height alone (a.w: cos gamma;
+        // above 1 when every copy that can reach p was a candidate).
+        if (a.w > 1.0f) return best;
+        float r = length(vec2(p.x, p.z)), rho = max(r * a.w, b.y);
+        float across = sqrt(max(r * r + rho * rho - 2.0f * r * rho * a.w, 0.0f));
+        float along = max(max(b.z - p.y, p.y - b.w), 0.0f);
+        return min(best, length(vec2(across, along)));
+    }
     if (kind == kKindExtrude) {
         // The profile's value and |z| against the half height a.x, with edges of radius a.y
         // (IQ's opExtrusion around the profile shrunk by the rounding).

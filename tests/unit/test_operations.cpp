@@ -85,6 +85,26 @@ TEST(Operations, PolarRepeatIsTheUnionOfItsTurnedCopies) {
                     R"({"type": "union", "children": [)" + copies + "]}", 2.5f, 0.3f);
 }
 
+// Copies that reach past their sectors leave some out of the candidates; the bound that stands
+// for those grows away from them along the axis too, so that a shell of the repetition has no
+// sheet along the axis (it had one, endless, where the bound was the distance from the axis).
+TEST(Operations, ShellOfAPolarRepeatHasNoSurfaceAlongTheAxis) {
+    const Scene scene = parseRoot(R"({"type": "shell", "thickness": 0.1, "children": [
+        {"type": "polar_repeat", "count": 7, "radius": 1.2, "children": [
+            {"type": "sphere", "radius": 0.8}]}]})");
+    const Evaluator e(scene);
+    for (float y = -20.0f; y <= 20.0f; y += 0.25f) {
+        for (float r : {0.0f, 0.05f, 0.2f}) {
+            const glm::vec3 p(r, y, 0.5f * r);
+            ASSERT_GT(e.distance(p), 0.0f) << "at " << p.x << ", " << p.y << ", " << p.z;
+        }
+        // On the axis, every copy's ball is equally near, and the shell's surface half its
+        // thickness nearer: the value is no more than that.
+        const float onAxis = std::sqrt(1.44f + y * y) - 0.8f - 0.05f;
+        EXPECT_LE(e.distance(glm::vec3(0.0f, y, 0.0f)), onAxis + 1e-5f) << "at height " << y;
+    }
+}
+
 TEST(Operations, MirrorOfAHalfIsItAndItsImage) {
     const std::string ball = R"({"type": "sphere", "radius": 0.3, "translate": [0.5, 0.2, 0]})";
     const std::string image = R"({"type": "sphere", "radius": 0.3, "translate": [-0.5, 0.2, 0]})";

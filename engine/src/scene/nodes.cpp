@@ -456,19 +456,21 @@ Params repeatKernel(const Params& v, vec3 lo, vec3 hi) {
 
 // Polar repeat: count N, radius, sector angle, and the copies either side of the nearest that
 // can reach a point (M), from the child's angular half extent beta seen from the axis. Beyond
-// them the copies are at least gamma = (M + 1) sector - beta away in angle, so at least
-// |p.xz| sin(gamma) away: slot 3 holds sin(min(gamma, 90 degrees)) when M > 0, else -1 (exact);
-// a child that reaches the axis takes every copy.
+// them the copies are at least gamma = (M + 1) sector - beta away in angle, at least x0 (the
+// child's nearest x, moved out by the radius) from the axis and within the child's heights:
+// slot 3 holds cos(gamma) when M > 0, else 2 (exact), slots 5 to 7 x0 and the heights
+// (shaders/sdf.glsl, domainFinish). A child that reaches the axis takes every copy.
 Params polarKernel(const Params& v, vec3 lo, vec3 hi) {
     const float n = v[0], sector = float(2.0 * 3.14159265358979323846 / double(v[0]));
     const float x0 = lo.x + v[1], z = std::max(-lo.z, hi.z);
     const float beta = x0 > 0.0f ? std::atan2(z, x0) : 3.14159265f;
     float m = std::ceil(beta / sector - 0.5f);
     if (2.0f * m + 2.0f >= n) m = n; // every copy
-    float g = -1.0f;
+    float c = 2.0f;
+    // The angle a hair smaller, so that rounding keeps the region around the copies left out.
     if (m > 0.0f && m < n)
-        g = std::sin(std::min((m + 1.0f) * sector - beta, 1.5707963f)) * (1.0f - 1e-6f);
-    return {n, v[1], sector, g, m};
+        c = std::cos(std::min((m + 1.0f) * sector - beta, 3.14159265f) * (1.0f - 1e-6f));
+    return {n, v[1], sector, c, m, std::max(x0, 0.0f), lo.y, hi.y};
 }
 
 // Profiles reach this far along z, in both directions: as fields of space they are prisms, and
