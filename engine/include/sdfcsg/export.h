@@ -12,13 +12,19 @@
 namespace sdfcsg {
 
 enum class MeshFormat {
+    // PLY and OBJ carry vertex colours only (Mesh::colors).
     Ply, // binary little-endian PLY: float positions and normals, uchar RGB colours, uint indices
     Obj, // Wavefront OBJ: "v x y z r g b" (the common colour extension), "vn", "f a//a b//b c//c"
     Stl, // binary STL for printing: z up as 3MF, facet normals from the winding, no colours
-    Glb, // glTF 2.0 binary: POSITION, NORMAL, COLOR_0 (linear), indices, one mesh and node
+    // glTF 2.0 binary: POSITION, NORMAL, COLOR_0 (linear), indices, one mesh and node. With
+    // Mesh::triangleColors, one primitive per colour (8-bit) on the shared vertices, each with a
+    // material of that base colour, and no COLOR_0.
+    Glb,
     // 3MF (3D Manufacturing Format, core and materials specifications), as slicers read it: one
-    // object, z up (the scene's y becomes z), per-vertex sRGB colours as a colour group, in a
-    // unit (one scene unit is one of it)
+    // object, z up (the scene's y becomes z), in a unit (one scene unit is one of it). With
+    // Mesh::triangleColors, a base material per colour (8-bit sRGB) and one per triangle (p1),
+    // so that a slicer assigns filaments by region; otherwise per-vertex sRGB colours as a
+    // colour group.
     ThreeMf,
 };
 
