@@ -5,10 +5,8 @@
 #pragma once
 
 #include "mesh/mc_tables.h"
-#include "mesh/mesh_colors.h"
 #include "mesh/mesh_dual.h"
 
-#include <sdfcsg/compile.h>
 #include <sdfcsg/eval.h>
 #include <sdfcsg/mesh.h>
 
@@ -376,22 +374,16 @@ ReferenceMesh referenceDualMeshOf(const Distance& distance, const Color& color,
     return out;
 }
 
-// With the extraction's last step for scenes of several colours (detail::splitColourBorders, on
-// the host as in engine/src/mesh/mesh.cpp).
 inline ReferenceMesh referenceMesh(const Evaluator& evaluator, const ReferenceGrid& grid,
                                    uint32_t refineSteps = 3,
                                    MeshMethod method = MeshMethod::MarchingCubes) {
-    ReferenceMesh out =
-        method == MeshMethod::DualContouring
-            ? referenceDualMeshOf([&](glm::vec3 p) { return evaluator.distance(p); },
-                                  [&](glm::vec3 p) { return evaluator.sample(p).color; }, grid,
-                                  refineSteps)
-            : referenceMeshOf([&](glm::vec3 p) { return evaluator.distance(p); },
-                              [&](glm::vec3 p) { return evaluator.sample(p).color; }, grid,
-                              refineSteps);
-    if (evaluator.nodes().size() < kTapeMinNodes && detail::hasSeveralColours(evaluator))
-        detail::splitColourBorders(out.mesh, evaluator, grid.voxelSize);
-    return out;
+    if (method == MeshMethod::DualContouring)
+        return referenceDualMeshOf([&](glm::vec3 p) { return evaluator.distance(p); },
+                                   [&](glm::vec3 p) { return evaluator.sample(p).color; }, grid,
+                                   refineSteps);
+    return referenceMeshOf([&](glm::vec3 p) { return evaluator.distance(p); },
+                           [&](glm::vec3 p) { return evaluator.sample(p).color; }, grid,
+                           refineSteps);
 }
 
 // The grid the GPU mesher reports having used.

@@ -582,16 +582,11 @@ void expectMatchesReference(Context& context, const Scene& scene, const std::str
         const MeshComparison diff = compareMeshes(*mesh, reference.mesh, tolerance);
         // Dual contouring decides by thresholds whether an edge point lies on a sharp edge and
         // which directions constrain a vertex, so rounding may move a few vertices (and the
-        // triangles around them): 1 in 200, no more; and where colours meet, a vertex moved so
-        // may change whether an edge is cut at the border (mesh_colors.h): 1 in 500 vertices.
-        // Marching cubes must agree everywhere.
+        // triangles around them): 1 in 200, no more. Marching cubes must agree everywhere.
         const bool same =
             method == MeshMethod::MarchingCubes
                 ? diff.same()
-                : diff.verticesA <= diff.verticesB + diff.verticesB / 500 &&
-                      diff.verticesB <= diff.verticesA + diff.verticesA / 500 &&
-                      diff.trianglesA <= diff.trianglesB + diff.trianglesB / 250 &&
-                      diff.trianglesB <= diff.trianglesA + diff.trianglesA / 250 &&
+                : diff.verticesA == diff.verticesB && diff.trianglesA == diff.trianglesB &&
                       diff.unmatchedVertices + diff.normalMismatches + diff.colorMismatches <=
                           diff.verticesA / 200 &&
                       diff.unmatchedTriangles <= diff.trianglesA / 50;

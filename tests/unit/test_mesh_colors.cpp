@@ -100,7 +100,9 @@ std::vector<uint32_t> borderVertices(const Mesh& mesh) {
 
 class MeshColors : public GpuTest {
   protected:
-    Mesh extract(const Scene& scene, const MeshOptions& options, MeshStats* stats) {
+    // With the colour regions that every test here is about.
+    Mesh extract(const Scene& scene, MeshOptions options, MeshStats* stats) {
+        options.colorRegions = true;
         auto mesh = extractMesh(context(), scene, options, stats);
         if (!mesh) {
             ADD_FAILURE() << mesh.error().str();
@@ -203,6 +205,24 @@ TEST(MeshColorsHost, CuttingKeepsTheVolumeAndTheTopology) {
         std::string first;
         EXPECT_LE(wrongColours(mesh, evaluator, h, &first), mesh.triangleCount() / 2000) << first;
     }
+}
+
+// Without MeshOptions::colorRegions the mesh has no colour per triangle, and its vertices are
+// those of the regions' mesh before the vertices that its cuts add (at 64 cells the rim's
+// vertices lie on the border itself, and it adds none).
+TEST_F(MeshColors, RegionsOnlyWhenAskedFor) {
+    const Scene scene = sceneFrom(kBoxMinusBall);
+    MeshOptions options;
+    options.resolution = 64;
+    auto plain = extractMesh(context(), scene, options);
+    ASSERT_TRUE(plain) << plain.error().str();
+    EXPECT_TRUE(plain->triangleColors.empty());
+    MeshStats stats;
+    const Mesh regions = extract(scene, options, &stats);
+    EXPECT_EQ(regions.triangleColors.size(), regions.triangleCount());
+    ASSERT_GE(regions.vertexCount(), plain->vertexCount());
+    for (size_t v = 0; v < plain->vertexCount(); ++v)
+        ASSERT_EQ(plain->positions[v], regions.positions[v]) << "vertex " << v;
 }
 
 // A smooth union of two colours blends them: no border, no new vertex, blended colours kept.

@@ -37,6 +37,9 @@ inline constexpr LengthUnit kDefaultLengthUnit = LengthUnit::Centimeter;
 // The format named by a path's extension (case-insensitive), or nullopt.
 std::optional<MeshFormat> meshFormatFromPath(const std::filesystem::path& path);
 std::string_view meshFormatName(MeshFormat format); // "ply", "obj", "stl", "glb", "3mf"
+// Whether the format writes Mesh::triangleColors (glTF and 3MF), so that a mesh for it is worth
+// extracting with MeshOptions::colorRegions.
+bool formatHasTriangleColors(MeshFormat format);
 
 // A unit from its short name ("mm", "cm", "m", "inch"), or nullopt.
 std::optional<LengthUnit> lengthUnitFromName(std::string_view name);

@@ -512,6 +512,10 @@ std::string_view meshFormatName(MeshFormat format) {
     return "?";
 }
 
+bool formatHasTriangleColors(MeshFormat format) {
+    return format == MeshFormat::Glb || format == MeshFormat::ThreeMf;
+}
+
 std::string encodeMesh(const Mesh& mesh, MeshFormat format, LengthUnit unit) {
     switch (format) {
     case MeshFormat::Ply:

@@ -865,10 +865,11 @@ void Extraction::finish() {
         detail::splitTouchingSheets(mesh);
         stage("sheets", t1);
     }
-    // Colour borders, where there can be any: the CPU's whole tree is too slow for scenes of
-    // pruned tapes, which keep blended vertex colours.
+    // Colour borders, where asked for and where there can be any: the CPU's whole tree is too
+    // slow for scenes of pruned tapes, which keep blended vertex colours.
     const Evaluator& evaluator = *m.evaluator;
-    if (evaluator.nodes().size() < kTapeMinNodes && detail::hasSeveralColours(evaluator)) {
+    if (options.colorRegions && evaluator.nodes().size() < kTapeMinNodes &&
+        detail::hasSeveralColours(evaluator)) {
         const auto t0 = Clock::now();
         detail::splitColourBorders(mesh, evaluator, g.h);
         stage("colours", t0);

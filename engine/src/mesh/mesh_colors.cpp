@@ -315,11 +315,15 @@ size_t splitColourBorders(Mesh& mesh, const Evaluator& evaluator, float h) {
     };
     // Drops the points that would turn a piece over, face it against the field's gradient at its
     // centre (across a crease) or leave it without area, until none does.
+    // Only the triangles beside a dropped point need another look.
     const float leastArea = 1e-6f * h * h;
+    std::vector<uint8_t> recheck(vertices, 1);
     for (bool dropped = true; dropped;) {
         dropped = false;
+        std::vector<uint32_t> ends;
         for (size_t i = 0; i < cut.size(); ++i) {
             const uint32_t* v = idx + 3 * size_t(cut[i]);
+            if (!recheck[v[0]] && !recheck[v[1]] && !recheck[v[2]]) continue;
             uint32_t mid[3], pieces[6][3];
             midsOf(v, mid);
             centre = &centres[i];
@@ -339,9 +343,16 @@ size_t splitColourBorders(Mesh& mesh, const Evaluator& evaluator, float h) {
             }
             if (fine) continue;
             for (int k = 0; k < 3; ++k)
-                if (mid[k] != kNone) borderOf.erase(edgeKey(v[k], v[(k + 1) % 3]));
+                if (mid[k] != kNone) {
+                    borderOf.erase(edgeKey(v[k], v[(k + 1) % 3]));
+                    ends.push_back(v[k]);
+                    ends.push_back(v[(k + 1) % 3]);
+                }
             dropped = true;
         }
+        std::fill(recheck.begin(), recheck.end(), 0);
+        for (uint32_t e : ends)
+            recheck[e] = 1;
     }
 
     // The new vertices: the border points that stayed, then the centres that are used.
