@@ -324,6 +324,11 @@ Options:
   --format F             ply, obj, stl, glb or 3mf, instead of OUT's extension
   --unit U               3MF only: what one scene unit is, mm, cm (default), m or inch
   --method M             dc (dual contouring, the default) or mc (marching cubes)
+  --color-regions on|off cut the mesh where the scene's colour jumps (a hard union or
+                         difference of differently coloured parts) and give each triangle
+                         one colour: on (default) for .glb and .3mf, which write a colour
+                         per triangle; off (default for the others) keeps vertex colours,
+                         which blend across a border
   --resolution N         cells along the longest axis of the bounds (default 128)
   --voxel-size H         cell edge length in scene units, instead of --resolution
   --bounds X0,Y0,Z0,X1,Y1,Z1
@@ -413,7 +418,7 @@ int cmdMesh(int argc, char** argv) {
     Args args("mesh", argc, argv,
               {"-o", "--output", "--resolution", "--voxel-size", "--bounds", "--device",
                "--evaluation", "--unit", "--method", "--simplify", "--target-triangles", "--format",
-               "--report-json", "--min-wall"},
+               "--report-json", "--min-wall", "--color-regions"},
               {"--stats", "--report", "--validation", "--help", "-h"});
     if (args.has("--help") || args.has("-h")) return std::fputs(kMeshHelp, stdout), kOk;
     if (!args.error.empty()) return usageError("mesh", args.error);
@@ -439,6 +444,13 @@ int cmdMesh(int argc, char** argv) {
     }
 
     sdfcsg::MeshOptions options;
+    options.colorRegions = sdfcsg::formatHasTriangleColors(*format);
+    if (args.has("--color-regions")) {
+        const std::string regions = args.get("--color-regions");
+        if (regions != "on" && regions != "off")
+            return usageError("mesh", "--color-regions expects on or off, got '" + regions + "'");
+        options.colorRegions = regions == "on";
+    }
     if (args.has("--method")) {
         const std::string method = args.get("--method");
         if (method != "dc" && method != "mc")

@@ -190,6 +190,7 @@ void startMesh(Viewer& v) {
     MeshOptions o;
     o.resolution = uint32_t(v.meshResolution);
     o.method = v.meshMethod == 1 ? MeshMethod::MarchingCubes : MeshMethod::DualContouring;
+    o.colorRegions = true; // the mesh may be exported to 3MF or glTF, which carry its regions
     if (v.customBounds)
         o.bounds = Aabb{glm::vec3(v.boundsMin[0], v.boundsMin[1], v.boundsMin[2]),
                         glm::vec3(v.boundsMax[0], v.boundsMax[1], v.boundsMax[2])};

@@ -70,8 +70,10 @@ case_render() {
 
 # Meshes: every format, with counts that agree with --stats; exit codes; no temporaries.
 case_mesh() {
+    # glTF would cut the mesh along mesh_a's colour borders (below), the others do not.
     for f in ply obj stl glb; do
-        check "mesh $f" 0 "$bin" mesh "$mesh_a" -o "part.$f" --resolution 24 --bounds $box --stats
+        check "mesh $f" 0 "$bin" mesh "$mesh_a" -o "part.$f" --resolution 24 --bounds $box --stats \
+            --color-regions off
         expect_text "mesh $f closed" out.txt "surface:   inside the bounds (the mesh is closed)"
         grep '^mesh:' out.txt >"counts.$f.txt"
     done
@@ -103,12 +105,32 @@ case_mesh() {
     # One scene unit is a centimetre unless --unit says otherwise.
     check "mesh 3mf" 0 "$bin" mesh "$mesh_a" -o part.3mf --resolution 24 --bounds $box
     check "mesh 3mf in mm" 0 "$bin" mesh "$mesh_a" -o part-mm.3mf --resolution 24 --bounds $box --unit mm
+    # The 3MF is cut along its colour borders (--color-regions is on for it), the PLY only when
+    # asked; without the cut the 3MF carries the PLY's vertex colours.
+    check "mesh ply with colour regions" 0 "$bin" mesh "$mesh_a" -o regions.ply --resolution 24 \
+        --bounds $box --color-regions on --stats
+    regions=$(sed -n 's/^mesh: *\([0-9]*\) vertices, \([0-9]*\) triangles$/\1 vertices, \2 triangles/p' out.txt)
+    [ "$regions" != "$vertices vertices, $triangles triangles" ] ||
+        { echo "FAIL --color-regions on cut nothing: $regions"; failures=$((failures + 1)); }
+    check "mesh 3mf without colour regions" 0 "$bin" mesh "$mesh_a" -o vertex.3mf --resolution 24 \
+        --bounds $box --color-regions off
+    check "mesh bad colour regions" 2 "$bin" mesh "$mesh_a" -o bad.3mf --color-regions yes
+    expect_text "mesh bad colour regions message" err.txt "sdfcsg mesh: --color-regions expects on or off, got 'yes'"
     if command -v python3 >/dev/null 2>&1; then
-        python3 "$src/tests/cli/read_3mf.py" part.3mf part.ply centimeter >out.txt 2>&1 &&
-            grep -q "^3mf: $vertices vertices, $triangles triangles, 2 colours" out.txt ||
+        python3 "$src/tests/cli/read_3mf.py" part.3mf regions.ply centimeter >out.txt 2>&1 &&
+            grep -q "^3mf: $regions, 2 colours per triangle" out.txt ||
             { echo "FAIL part.3mf:"; cat out.txt; failures=$((failures + 1)); }
-        python3 "$src/tests/cli/read_3mf.py" part-mm.3mf part.ply millimeter >out.txt 2>&1 ||
+        python3 "$src/tests/cli/read_3mf.py" part-mm.3mf regions.ply millimeter >out.txt 2>&1 ||
             { echo "FAIL part-mm.3mf:"; cat out.txt; failures=$((failures + 1)); }
+        python3 "$src/tests/cli/read_3mf.py" vertex.3mf part.ply centimeter >out.txt 2>&1 &&
+            grep -q "^3mf: $vertices vertices, $triangles triangles, 2 colours per corner" out.txt ||
+            { echo "FAIL vertex.3mf:"; cat out.txt; failures=$((failures + 1)); }
+        # A scene of one colour: its vertices' colours, as a colour group.
+        "$bin" mesh "$src/assets/scenes/chess_pawn.json" -o pawn.ply --resolution 24 >/dev/null 2>&1 &&
+            "$bin" mesh "$src/assets/scenes/chess_pawn.json" -o pawn.3mf --resolution 24 >/dev/null 2>&1 &&
+            python3 "$src/tests/cli/read_3mf.py" pawn.3mf pawn.ply centimeter >out.txt 2>&1 &&
+            grep -q "^3mf: .* 1 colours per corner" out.txt ||
+            { echo "FAIL pawn.3mf:"; cat out.txt; failures=$((failures + 1)); }
     else
         echo "skipped reading part.3mf back: python3 not found"
     fi

@@ -4,9 +4,11 @@ same mesh (sdfcsg's binary PLY: x y z nx ny nz as floats, red green blue as byte
 
 Usage: read_3mf.py MESH.3mf MESH.ply UNIT. Checks: the archive's CRCs, the content types and the
 relationship to the model, the unit, every PLY vertex turned z up ((x, y, z) -> (x, -z, y)) and
-every triangle and vertex colour, a closed mesh (each edge used once in each direction), and
-colour indices in range. Prints one line of counts; exits 1 with a message on the first
-failure."""
+every triangle, a closed mesh (each edge used once in each direction), and colour indices in
+range. Colours come as a colour group with each corner's colour (p1, p2, p3), checked against
+the PLY's vertex colours, or, for a mesh with a colour per triangle, as base materials with one
+per triangle (p1 alone), each one of the PLY's vertex colours. Prints one line of counts; exits
+1 with a message on the first failure."""
 import struct
 import sys
 import xml.etree.ElementTree as ET
@@ -71,13 +73,28 @@ def main():
     mesh = objects[0].find(CORE + "mesh")
     vertices = [(single(v.get("x")), single(v.get("y")), single(v.get("z")))
                 for v in mesh.find(CORE + "vertices")]
-    triangles = [(int(t.get("v1")), int(t.get("v2")), int(t.get("v3")),
-                  int(t.get("p1")), int(t.get("p2")), int(t.get("p3")))
-                 for t in mesh.find(CORE + "triangles")]
+    materials = model.find("%sresources/%sbasematerials" % (CORE, CORE))
     group = model.find("%sresources/%scolorgroup" % (CORE, MAT))
-    if group is None or group.get("id") != objects[0].get("pid"):
-        fail("the object's colour group is missing")
-    colours = [c.get("color") for c in group]
+    per_triangle = materials is not None
+    if per_triangle:
+        if materials.get("id") != objects[0].get("pid") or group is not None:
+            fail("the object's base materials are missing, or a colour group is there too")
+        colours = [b.get("displaycolor") for b in materials]
+        if any(b.get("name") is None for b in materials):
+            fail("a base material without a name")
+        triangles = []
+        for t in mesh.find(CORE + "triangles"):
+            if t.get("p2") is not None or t.get("p3") is not None:
+                fail("a triangle of one base material names p2 or p3")
+            p = int(t.get("p1"))
+            triangles.append((int(t.get("v1")), int(t.get("v2")), int(t.get("v3")), p, p, p))
+    else:
+        if group is None or group.get("id") != objects[0].get("pid"):
+            fail("the object's colour group is missing")
+        colours = [c.get("color") for c in group]
+        triangles = [(int(t.get("v1")), int(t.get("v2")), int(t.get("v3")),
+                      int(t.get("p1")), int(t.get("p2")), int(t.get("p3")))
+                     for t in mesh.find(CORE + "triangles")]
 
     points, ply_colours, ply_triangles = read_ply(ply)
     if len(vertices) != len(points):
@@ -93,7 +110,7 @@ def main():
         for k in range(3):
             if not 0 <= t[3 + k] < len(colours):
                 fail("colour index %d out of range" % t[3 + k])
-            if colours[t[3 + k]] != ply_colours[t[k]]:
+            if not per_triangle and colours[t[3 + k]] != ply_colours[t[k]]:
                 fail("vertex %d has colour %s, the PLY %s" % (t[k], colours[t[3 + k]],
                                                              ply_colours[t[k]]))
             edge = (t[k], t[(k + 1) % 3])
@@ -102,9 +119,19 @@ def main():
             edges.add(edge)
     if any((b, a) not in edges for a, b in edges):
         fail("the mesh is not closed")
+    if per_triangle:
+        if len(set(colours)) != len(colours):
+            fail("a colour has two base materials")
+        used = set(t[3] for t in triangles)
+        for i, colour in enumerate(colours):
+            if i not in used:
+                fail("base material %d (%s) colours no triangle" % (i, colour))
+            if colour not in ply_colours:
+                fail("base material %s is the colour of no vertex" % colour)
     zs = [v[2] for v in vertices]
-    print("3mf: %d vertices, %d triangles, %d colours, z from %g to %g" %
-          (len(vertices), len(triangles), len(colours), min(zs), max(zs)))
+    print("3mf: %d vertices, %d triangles, %d colours %s, z from %g to %g" %
+          (len(vertices), len(triangles), len(colours),
+           "per triangle" if per_triangle else "per corner", min(zs), max(zs)))
 
 
 main()

@@ -449,6 +449,10 @@ struct GlbData : MeshData {
     std::string bin;      // the BIN chunk, padding included
     Json json;
     std::vector<std::string> attributes; // attribute names of the primitive, in JSON order
+    size_t primitives = 0;
+    // Per triangle, its primitive's material's baseColorFactor (linear RGB), where the
+    // primitives name materials; the triangles come primitive after primitive.
+    std::vector<glm::vec3> triangleColors;
 };
 
 inline GlbData readGlb(std::string_view bytes) {
@@ -549,15 +553,45 @@ inline GlbData readGlb(std::string_view bytes) {
         for (size_t i = 0; i < count; ++i)
             target->push_back(br.vec3());
     }
-    size_t count = 0;
-    auto indices = accessorBytes(primitive->get("indices"), 5125, "SCALAR", 4, count);
-    if (!indices) {
-        out.error = "indices: not a readable UNSIGNED_INT SCALAR accessor";
-        return out;
+    // Every primitive shares the first one's vertex attributes (the same accessors).
+    const Json* materials = out.json.get("materials");
+    for (const Json& p : meshes->at(0)->get("primitives")->array) {
+        const Json* attributes = p.get("attributes");
+        if (!attributes ||
+            attributes->object.size() != primitive->get("attributes")->object.size()) {
+            out.error = "a primitive with other attributes than the first";
+            return out;
+        }
+        for (const auto& [name, index] : attributes->object) {
+            const Json* first = primitive->get("attributes")->get(name);
+            if (!first || first->number != index.number) {
+                out.error = "a primitive with other attributes than the first";
+                return out;
+            }
+        }
+        size_t count = 0;
+        auto indices = accessorBytes(p.get("indices"), 5125, "SCALAR", 4, count);
+        if (!indices) {
+            out.error = "indices: not a readable UNSIGNED_INT SCALAR accessor";
+            return out;
+        }
+        ByteReader br(*indices);
+        for (size_t i = 0; i < count; ++i)
+            out.indices.push_back(br.u32());
+        if (const Json* m = p.get("material")) {
+            const Json* material = materials ? materials->at(size_t(m->number)) : nullptr;
+            const Json* pbr = material ? material->get("pbrMetallicRoughness") : nullptr;
+            const Json* factor = pbr ? pbr->get("baseColorFactor") : nullptr;
+            if (!factor || factor->array.size() != 4) {
+                out.error = "a primitive's material has no baseColorFactor";
+                return out;
+            }
+            const glm::vec3 colour(factor->at(0)->number, factor->at(1)->number,
+                                   factor->at(2)->number);
+            out.triangleColors.insert(out.triangleColors.end(), count / 3, colour);
+        }
+        ++out.primitives;
     }
-    ByteReader br(*indices);
-    for (size_t i = 0; i < count; ++i)
-        out.indices.push_back(br.u32());
     return out;
 }
 

@@ -183,6 +183,35 @@ TEST(Export, GlbRoundTripsWithLinearColours) {
     EXPECT_NEAR(glb.colors[0][1], 0.21404f, 1e-5f);
 }
 
+// With triangle colours: one primitive per colour on the shared vertices, each triangle once with
+// its colour as its material's base colour (linear), and no COLOR_0.
+TEST(Export, GlbHasOnePrimitivePerTriangleColour) {
+    Mesh mesh = boxMesh();
+    const glm::vec3 palette[3] = {{1.0f, 0.2f, 0.0f}, {0.0f, 0.6f, 1.0f}, {0.4f, 0.4f, 0.4f}};
+    for (size_t t = 0; t < mesh.triangleCount(); ++t)
+        mesh.triangleColors.push_back(palette[(t / 2) % 3]); // each face one colour
+    GlbData glb = readGlb(encodeMesh(mesh, MeshFormat::Glb));
+    ASSERT_EQ(glb.error, "");
+    EXPECT_EQ(glb.attributes, (std::vector<std::string>{"POSITION", "NORMAL"}));
+    EXPECT_EQ(glb.positions, mesh.positions);
+    EXPECT_EQ(glb.primitives, 3u);
+    ASSERT_EQ(glb.indices.size(), mesh.indices.size());
+    ASSERT_EQ(glb.triangleColors.size(), mesh.triangleCount());
+    std::vector<bool> found(mesh.triangleCount(), false);
+    for (size_t t = 0; t < glb.triangleColors.size(); ++t) {
+        size_t match = mesh.triangleCount();
+        for (size_t u = 0; u < mesh.triangleCount(); ++u)
+            if (!found[u] &&
+                std::equal(&glb.indices[3 * t], &glb.indices[3 * t] + 3, &mesh.indices[3 * u]))
+                match = u;
+        ASSERT_LT(match, mesh.triangleCount()) << "triangle " << t;
+        found[match] = true;
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(glb.triangleColors[t][c], srgbToLinear(mesh.triangleColors[match][c]),
+                        1e-6f);
+    }
+}
+
 TEST(Export, GlbStructure) {
     const Mesh mesh = boxMesh();
     const std::string bytes = encodeMesh(mesh, MeshFormat::Glb);

@@ -12,13 +12,19 @@
 namespace sdfcsg {
 
 enum class MeshFormat {
+    // PLY and OBJ carry vertex colours only (Mesh::colors).
     Ply, // binary little-endian PLY: float positions and normals, uchar RGB colours, uint indices
     Obj, // Wavefront OBJ: "v x y z r g b" (the common colour extension), "vn", "f a//a b//b c//c"
     Stl, // binary STL for printing: z up as 3MF, facet normals from the winding, no colours
-    Glb, // glTF 2.0 binary: POSITION, NORMAL, COLOR_0 (linear), indices, one mesh and node
+    // glTF 2.0 binary: POSITION, NORMAL, COLOR_0 (linear), indices, one mesh and node. With
+    // Mesh::triangleColors, one primitive per colour (8-bit) on the shared vertices, each with a
+    // material of that base colour, and no COLOR_0.
+    Glb,
     // 3MF (3D Manufacturing Format, core and materials specifications), as slicers read it: one
-    // object, z up (the scene's y becomes z), per-vertex sRGB colours as a colour group, in a
-    // unit (one scene unit is one of it)
+    // object, z up (the scene's y becomes z), in a unit (one scene unit is one of it). With
+    // Mesh::triangleColors, a base material per colour (8-bit sRGB) and one per triangle (p1),
+    // so that a slicer assigns filaments by region; otherwise per-vertex sRGB colours as a
+    // colour group.
     ThreeMf,
 };
 
@@ -31,6 +37,9 @@ inline constexpr LengthUnit kDefaultLengthUnit = LengthUnit::Centimeter;
 // The format named by a path's extension (case-insensitive), or nullopt.
 std::optional<MeshFormat> meshFormatFromPath(const std::filesystem::path& path);
 std::string_view meshFormatName(MeshFormat format); // "ply", "obj", "stl", "glb", "3mf"
+// Whether the format writes Mesh::triangleColors (glTF and 3MF), so that a mesh for it is worth
+// extracting with MeshOptions::colorRegions.
+bool formatHasTriangleColors(MeshFormat format);
 
 // A unit from its short name ("mm", "cm", "m", "inch"), or nullopt.
 std::optional<LengthUnit> lengthUnitFromName(std::string_view name);

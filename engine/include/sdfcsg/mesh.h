@@ -18,6 +18,13 @@
 // inside the bounds, closed and manifold, with triangles wound counter-clockwise seen from
 // outside.
 //
+// Colours: each vertex takes the scene's colour where it lies. Where parts of different colours
+// meet in a hard union or difference, the colour jumps along the curve where their surfaces meet;
+// with MeshOptions::colorRegions, in a scene of more than one colour, each edge that crosses such a
+// border gets a vertex on it (found by bisection on the surface, in the CPU evaluator's field), and
+// the triangles are cut there, so every triangle lies in one colour (Mesh::triangleColors). Smooth
+// blends have no border and keep blended vertex colours (engine/src/mesh/mesh_colors.h).
+//
 // The grid is processed in bricks of SDFCSG_MESH_BRICK^3 cells (shaders/shared.h). A brick whose
 // centre lies farther from the surface than its half-diagonal cannot contain surface (the field
 // is 1-Lipschitz) and is skipped, so the cost follows the surface area, not the volume.
@@ -42,12 +49,18 @@
 namespace sdfcsg {
 
 // An indexed triangle mesh in host memory. positions, normals and colors have one entry per
-// vertex; indices has three per triangle.
+// vertex; indices has three per triangle, and triangleColors none or one per triangle.
 struct Mesh {
     std::vector<glm::vec3> positions; // scene units
     std::vector<glm::vec3> normals;   // unit length, pointing out of the solid
     std::vector<glm::vec3> colors;    // the scene's colours (0..1, as written in the scene)
     std::vector<uint32_t> indices;    // counter-clockwise seen from outside
+    // Empty, or each triangle's colour: the scene's colour at its centre (moved onto the
+    // surface). Set by Mesher::extract with MeshOptions::colorRegions for scenes of more than
+    // one colour (below kTapeMinNodes nodes), whose meshes have an edge wherever the colour jumps,
+    // so that each triangle lies in one colour; the exporters then write 3MF and glTF in regions of
+    // one colour. A vertex on such a border keeps one of the colours that meet there in `colors`.
+    std::vector<glm::vec3> triangleColors;
 
     size_t vertexCount() const { return positions.size(); }
     size_t triangleCount() const { return indices.size() / 3; }
@@ -72,6 +85,12 @@ struct MeshOptions {
     // Host memory the extraction may use for its working buffers, in bytes; a request that
     // needs more fails with ErrorKind::Limit before the heavy work starts.
     size_t memoryBudget = size_t(4) << 30;
+    // Cut the mesh along the borders where the colour jumps and set Mesh::triangleColors (see
+    // Colours above), for outputs that carry a colour per triangle (formatHasTriangleColors in
+    // sdfcsg/export.h). A host pass that follows each border in the field: on mesh_a, two
+    // colours at 256 cells, about half as long again as the extraction. Off, each vertex keeps
+    // the colour where it lies and triangles across a border blend the two.
+    bool colorRegions = false;
     // Called from the calling thread with the fraction done (0..1), at least once per batch of
     // bricks; returning false cancels the extraction (ErrorKind::Cancelled).
     std::function<bool(float)> progress;

@@ -63,6 +63,36 @@ bool hasNormals(const Mesh& mesh) {
 bool hasColors(const Mesh& mesh) {
     return !mesh.positions.empty() && mesh.colors.size() == mesh.positions.size();
 }
+bool hasTriangleColors(const Mesh& mesh) {
+    return mesh.triangleCount() > 0 && mesh.triangleColors.size() == mesh.triangleCount();
+}
+
+uint32_t rgbOf(glm::vec3 c) {
+    return uint32_t(toByte(c.r)) << 16 | uint32_t(toByte(c.g)) << 8 | toByte(c.b);
+}
+
+// The distinct colours of `colors` as 8-bit RGB (0xRRGGBB), ascending, and each entry's place
+// among them.
+std::vector<uint32_t> distinctColors(const std::vector<glm::vec3>& colors,
+                                     std::vector<uint32_t>& placeOf) {
+    std::vector<uint32_t> rgb(colors.size());
+    for (size_t i = 0; i < rgb.size(); ++i)
+        rgb[i] = rgbOf(colors[i]);
+    std::vector<uint32_t> distinct = rgb;
+    std::sort(distinct.begin(), distinct.end());
+    distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+    placeOf.resize(rgb.size());
+    for (size_t i = 0; i < rgb.size(); ++i)
+        placeOf[i] =
+            uint32_t(std::lower_bound(distinct.begin(), distinct.end(), rgb[i]) - distinct.begin());
+    return distinct;
+}
+
+std::string hexColor(uint32_t rgb) {
+    char text[8];
+    std::snprintf(text, sizeof text, "#%06X", rgb);
+    return text;
+}
 
 std::string encodePly(const Mesh& mesh) {
     const bool normals = hasNormals(mesh), colors = hasColors(mesh);
@@ -232,28 +262,60 @@ std::string encodeGlb(const Mesh& mesh) {
             cat(attributes,
                 {attributes.empty() ? "" : ",", "\"", name, "\":", to_string(accessorCount++)});
         };
+        // With triangle colours, one primitive per colour, each with its material, on the
+        // shared vertices; COLOR_0 would multiply the material's colour, so it is left out.
+        const bool regions = hasTriangleColors(mesh);
+        std::vector<uint32_t> materialOf;
+        const std::vector<uint32_t> materials =
+            regions ? distinctColors(mesh.triangleColors, materialOf) : std::vector<uint32_t>{};
         bin.reserve(mesh.vertexCount() * 36 + mesh.indices.size() * 4);
         addVec3("POSITION", mesh.positions, false, true);
         if (hasNormals(mesh)) addVec3("NORMAL", mesh.normals, false, false);
-        if (hasColors(mesh)) addVec3("COLOR_0", mesh.colors, true, false);
+        if (hasColors(mesh) && !regions) addVec3("COLOR_0", mesh.colors, true, false);
 
-        const size_t indexOffset = bin.size(), indexCount = mesh.triangleCount() * 3;
-        uint32_t lo = UINT32_MAX, hi = 0;
-        for (size_t i = 0; i < indexCount; ++i) {
-            lo = std::min(lo, mesh.indices[i]);
-            hi = std::max(hi, mesh.indices[i]);
-            putU32(bin, mesh.indices[i]);
+        // The triangles of each material in their order (all of them, without triangle colours).
+        std::vector<std::vector<uint32_t>> groups(regions ? materials.size() : 1);
+        for (size_t t = 0; t < mesh.triangleCount(); ++t)
+            groups[regions ? materialOf[t] : 0].push_back(uint32_t(t));
+        std::string primitives;
+        for (size_t g = 0; g < groups.size(); ++g) {
+            const size_t indexOffset = bin.size(), indexCount = groups[g].size() * 3;
+            uint32_t lo = UINT32_MAX, hi = 0;
+            for (uint32_t t : groups[g])
+                for (int k = 0; k < 3; ++k) {
+                    const uint32_t i = mesh.indices[3 * size_t(t) + k];
+                    lo = std::min(lo, i);
+                    hi = std::max(hi, i);
+                    putU32(bin, i);
+                }
+            addView(indexOffset, kElementArrayBuffer);
+            cat(accessors, {R"(,{"bufferView":)", to_string(accessorCount), R"(,"componentType":)",
+                            to_string(kUnsignedInt), R"(,"count":)", to_string(indexCount),
+                            R"(,"type":"SCALAR","min":[)", to_string(lo), R"(],"max":[)",
+                            to_string(hi), "]}"});
+            cat(primitives, {g ? "," : "", R"({"attributes":{)", attributes, R"(},"indices":)",
+                             to_string(accessorCount++), R"(,"mode":)", to_string(kTriangles)});
+            if (regions) cat(primitives, {R"(,"material":)", to_string(g)});
+            primitives += '}';
         }
-        addView(indexOffset, kElementArrayBuffer);
-        cat(accessors,
-            {R"(,{"bufferView":)", to_string(accessorCount), R"(,"componentType":)",
-             to_string(kUnsignedInt), R"(,"count":)", to_string(indexCount),
-             R"(,"type":"SCALAR","min":[)", to_string(lo), R"(],"max":[)", to_string(hi), "]}"});
+        std::string materialList;
+        for (size_t g = 0; g < materials.size(); ++g) {
+            const uint32_t rgb = materials[g];
+            std::string factor = "[";
+            for (int c = 0; c < 3; ++c) {
+                factor += formatNumber(srgbToLinear(float((rgb >> (16 - 8 * c)) & 0xFF) / 255.0f));
+                factor += ',';
+            }
+            factor += "1]";
+            cat(materialList, {g ? "," : "", R"({"name":")", hexColor(rgb),
+                               R"(","pbrMetallicRoughness":{"baseColorFactor":)", factor,
+                               R"(,"metallicFactor":0,"roughnessFactor":1}})"});
+        }
 
         cat(json, {R"("scenes":[{"nodes":[0]}],"nodes":[{"mesh":0,"name":"sdfcsg"}],)",
-                   R"("meshes":[{"primitives":[{"attributes":{)", attributes, R"(},"indices":)",
-                   to_string(accessorCount), R"(,"mode":)", to_string(kTriangles), "}]}],",
-                   R"("buffers":[{"byteLength":)", to_string(bin.size()), "}],",
+                   R"("meshes":[{"primitives":[)", primitives, "]}],"});
+        if (regions) cat(json, {R"("materials":[)", materialList, "],"});
+        cat(json, {R"("buffers":[{"byteLength":)", to_string(bin.size()), "}],",
                    R"("bufferViews":[)", views, "],", R"("accessors":[)", accessors, "]}"});
     }
 
@@ -292,8 +354,8 @@ const char* unitName(LengthUnit unit) {
     return "millimeter";
 }
 
-// The model part of a 3MF package: vertices turned z up (zUp), triangles with their corners'
-// colours, and one build item.
+// The model part of a 3MF package: vertices turned z up (zUp), triangles with their own colours
+// or their corners', and one build item.
 // The specification forbids a triangle that names a vertex twice; such a triangle has no area
 // and is left out.
 std::string threeMfModel(const Mesh& mesh, LengthUnit unit) {
@@ -304,33 +366,27 @@ std::string threeMfModel(const Mesh& mesh, LengthUnit unit) {
            "xmlns=\"http://schemas.microsoft.com/3dmanufacturing/core/2015/02\" "
            "xmlns:m=\"http://schemas.microsoft.com/3dmanufacturing/material/2015/02\">\n"
            "<metadata name=\"Application\">sdfcsg</metadata>\n<resources>\n";
-    // The distinct colours, each once, and each vertex's place among them.
+    // The distinct colours, each once, and each vertex's (or with triangle colours, each
+    // triangle's) place among them. Triangle colours are base materials, one per colour, which
+    // slicers offer to assign filaments to; vertex colours a colour group, blended across each
+    // triangle.
+    const bool regions = hasTriangleColors(mesh);
     std::vector<uint32_t> colorOf;
-    if (colors) {
-        std::vector<uint32_t> rgb(mesh.vertexCount());
-        for (size_t i = 0; i < rgb.size(); ++i) {
-            const glm::vec3 c = mesh.colors[i];
-            rgb[i] = uint32_t(toByte(c.r)) << 16 | uint32_t(toByte(c.g)) << 8 | toByte(c.b);
+    if (regions) {
+        out += " <basematerials id=\"1\">\n";
+        for (uint32_t c : distinctColors(mesh.triangleColors, colorOf)) {
+            const std::string hex = hexColor(c);
+            out += "  <base name=\"" + hex + "\" displaycolor=\"" + hex + "\"/>\n";
         }
-        std::vector<uint32_t> distinct = rgb;
-        std::sort(distinct.begin(), distinct.end());
-        distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+        out += " </basematerials>\n";
+    } else if (colors) {
         out += " <m:colorgroup id=\"1\">\n";
-        for (uint32_t c : distinct) {
-            char text[8];
-            std::snprintf(text, sizeof text, "%06X", c);
-            out += "  <m:color color=\"#";
-            out += text;
-            out += "\"/>\n";
-        }
+        for (uint32_t c : distinctColors(mesh.colors, colorOf))
+            out += "  <m:color color=\"" + hexColor(c) + "\"/>\n";
         out += " </m:colorgroup>\n";
-        colorOf.resize(rgb.size());
-        for (size_t i = 0; i < rgb.size(); ++i)
-            colorOf[i] = uint32_t(std::lower_bound(distinct.begin(), distinct.end(), rgb[i]) -
-                                  distinct.begin());
     }
-    out += colors ? " <object id=\"2\" type=\"model\" pid=\"1\" pindex=\"0\">\n"
-                  : " <object id=\"2\" type=\"model\">\n";
+    out += colors || regions ? " <object id=\"2\" type=\"model\" pid=\"1\" pindex=\"0\">\n"
+                             : " <object id=\"2\" type=\"model\">\n";
     out += "  <mesh>\n   <vertices>\n";
     out.reserve(out.size() + mesh.vertexCount() * 48 + mesh.triangleCount() * 64);
     for (const glm::vec3& v : mesh.positions) {
@@ -349,7 +405,9 @@ std::string threeMfModel(const Mesh& mesh, LengthUnit unit) {
         out += "    <triangle";
         for (int k = 0; k < 3; ++k)
             out += " v" + std::to_string(k + 1) + "=\"" + std::to_string(v[k]) + "\"";
-        if (colors)
+        if (regions)
+            out += " p1=\"" + std::to_string(colorOf[t]) + "\"";
+        else if (colors)
             for (int k = 0; k < 3; ++k)
                 out += " p" + std::to_string(k + 1) + "=\"" + std::to_string(colorOf[v[k]]) + "\"";
         out += "/>\n";
@@ -392,6 +450,9 @@ std::optional<std::string> meshProblem(const Mesh& mesh) {
     if (!mesh.colors.empty() && mesh.colors.size() != n)
         return std::to_string(mesh.colors.size()) + " colours for " + std::to_string(n) +
                " vertices";
+    if (!mesh.triangleColors.empty() && mesh.triangleColors.size() != mesh.indices.size() / 3)
+        return std::to_string(mesh.triangleColors.size()) + " triangle colours for " +
+               std::to_string(mesh.indices.size() / 3) + " triangles";
     for (size_t i = 0; i < mesh.indices.size(); ++i)
         if (mesh.indices[i] >= n)
             return "index " + std::to_string(i) + " is " + std::to_string(mesh.indices[i]) +
@@ -449,6 +510,10 @@ std::string_view meshFormatName(MeshFormat format) {
         return "3mf";
     }
     return "?";
+}
+
+bool formatHasTriangleColors(MeshFormat format) {
+    return format == MeshFormat::Glb || format == MeshFormat::ThreeMf;
 }
 
 std::string encodeMesh(const Mesh& mesh, MeshFormat format, LengthUnit unit) {

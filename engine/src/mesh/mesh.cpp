@@ -22,6 +22,7 @@
 #include "codegen/shader_compile.h"
 #include "gpu/vk.h"
 #include "mesh/mc_tables.h"
+#include "mesh/mesh_colors.h"
 #include "mesh/mesh_dual.h"
 #include "render/camera.h"
 
@@ -863,6 +864,15 @@ void Extraction::finish() {
         const auto t1 = Clock::now();
         detail::splitTouchingSheets(mesh);
         stage("sheets", t1);
+    }
+    // Colour borders, where asked for and where there can be any: the CPU's whole tree is too
+    // slow for scenes of pruned tapes, which keep blended vertex colours.
+    const Evaluator& evaluator = *m.evaluator;
+    if (options.colorRegions && evaluator.nodes().size() < kTapeMinNodes &&
+        detail::hasSeveralColours(evaluator)) {
+        const auto t0 = Clock::now();
+        detail::splitColourBorders(mesh, evaluator, g.h);
+        stage("colours", t0);
     }
     stats.surfaceCut = status[0] != 0;
     stats.vertices = mesh.vertexCount();

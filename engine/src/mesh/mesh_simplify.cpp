@@ -20,6 +20,7 @@
 // block.
 #include "sdfcsg/mesh.h"
 
+#include "mesh/mesh_colors.h"
 #include "mesh/mesh_simplify.h"
 
 #include "sdfcsg/compile.h"
@@ -383,18 +384,54 @@ std::vector<glm::vec3> withHeldCopies(const std::vector<glm::vec3>& positions,
     return out;
 }
 
-// Vertices with a neighbour of another colour: holding them keeps every one-coloured patch's
-// outline where it is, and a collapse inside a patch joins vertices of the same colour, so the
-// colour of every point of the surface stays what it was.
+// Vertices with a neighbour of another colour, or on triangles of different colours: holding
+// them keeps every one-coloured patch's outline where it is, and a collapse inside a patch joins
+// vertices of the same colour, so the colour of every point of the surface stays what it was.
 std::vector<bool> colourOutlines(const Mesh& mesh) {
     std::vector<bool> held(mesh.vertexCount(), false);
-    if (mesh.colors.size() != mesh.vertexCount()) return held;
-    for (size_t t = 0; t + 3 <= mesh.indices.size(); t += 3)
-        for (int i = 0; i < 3; ++i) {
-            const uint32_t a = mesh.indices[t + i], b = mesh.indices[t + (i + 1) % 3];
-            if (mesh.colors[a] != mesh.colors[b]) held[a] = held[b] = true;
-        }
+    if (mesh.colors.size() == mesh.vertexCount())
+        for (size_t t = 0; t + 3 <= mesh.indices.size(); t += 3)
+            for (int i = 0; i < 3; ++i) {
+                const uint32_t a = mesh.indices[t + i], b = mesh.indices[t + (i + 1) % 3];
+                if (mesh.colors[a] != mesh.colors[b]) held[a] = held[b] = true;
+            }
+    if (mesh.triangleColors.size() == mesh.triangleCount()) {
+        std::vector<uint32_t> first(mesh.vertexCount(), UINT32_MAX);
+        for (size_t t = 0; t < mesh.triangleCount(); ++t)
+            for (int i = 0; i < 3; ++i) {
+                uint32_t& f = first[mesh.indices[3 * t + i]];
+                if (f == UINT32_MAX)
+                    f = uint32_t(t);
+                else if (mesh.triangleColors[f] != mesh.triangleColors[t])
+                    held[mesh.indices[3 * t + i]] = true;
+            }
+    }
     return held;
+}
+
+// The colour of each triangle of `indices`, a simplification of `mesh`'s triangles: a corner that
+// no outline holds lay inside one patch of one colour, and every triangle around it still does;
+// a triangle of held corners alone takes the field's colour at its centre.
+std::vector<glm::vec3> simplifiedColours(const Mesh& mesh, const std::vector<uint32_t>& indices,
+                                         const Evaluator& evaluator, float spacing) {
+    const std::vector<bool> outline = colourOutlines(mesh);
+    std::vector<glm::vec3> patch(mesh.vertexCount());
+    for (size_t t = 0; t < mesh.triangleCount(); ++t)
+        for (int i = 0; i < 3; ++i)
+            patch[mesh.indices[3 * t + i]] = mesh.triangleColors[t];
+    std::vector<glm::vec3> colours(indices.size() / 3);
+    for (size_t t = 0; t < colours.size(); ++t) {
+        const uint32_t* v = &indices[3 * t];
+        const int free = !outline[v[0]] ? 0 : !outline[v[1]] ? 1 : !outline[v[2]] ? 2 : -1;
+        colours[t] =
+            free >= 0
+                ? patch[v[free]]
+                : detail::surfaceColour(
+                      evaluator,
+                      (mesh.positions[v[0]] + mesh.positions[v[1]] + mesh.positions[v[2]]) / 3.0f,
+                      spacing);
+    }
+    return colours;
 }
 
 // Holds the vertices around each fault: those within kHoldRadius spacings or, if all of those
@@ -815,12 +852,44 @@ void optimizeMeshOrder(Mesh& mesh, bool fast) {
         mesh = Mesh{};
         return;
     }
+    // meshoptimizer reorders whole triangles, each with its corners in their order; a triangle's
+    // colour follows it, found among the triangles of the same first corner.
+    const bool triangleColours = mesh.triangleColors.size() == mesh.triangleCount();
+    std::vector<uint32_t> before, byFirst, firstStart;
+    if (triangleColours) {
+        before = mesh.indices;
+        firstStart.assign(n + 1, 0);
+        for (size_t t = 0; t < mesh.triangleCount(); ++t)
+            ++firstStart[before[3 * t] + 1];
+        for (size_t v = 0; v < n; ++v)
+            firstStart[v + 1] += firstStart[v];
+        byFirst.resize(mesh.triangleCount());
+        std::vector<uint32_t> fill(firstStart.begin(), firstStart.end() - 1);
+        for (size_t t = 0; t < mesh.triangleCount(); ++t)
+            byFirst[fill[before[3 * t]]++] = uint32_t(t);
+    }
     if (fast)
         meshopt_optimizeVertexCacheFifo(mesh.indices.data(), mesh.indices.data(),
                                         mesh.indices.size(), n, kFifoCache);
     else
         meshopt_optimizeVertexCache(mesh.indices.data(), mesh.indices.data(), mesh.indices.size(),
                                     n);
+    if (triangleColours) {
+        std::vector<glm::vec3> colours(mesh.triangleCount());
+        std::vector<bool> taken(mesh.triangleCount(), false);
+        for (size_t o = 0; o < colours.size(); ++o) {
+            const uint32_t* v = &mesh.indices[3 * o];
+            for (uint32_t j = firstStart[v[0]]; j < firstStart[v[0] + 1]; ++j) {
+                const uint32_t t = byFirst[j];
+                if (!taken[t] && before[3 * t + 1] == v[1] && before[3 * t + 2] == v[2]) {
+                    taken[t] = true;
+                    colours[o] = mesh.triangleColors[t];
+                    break;
+                }
+            }
+        }
+        mesh.triangleColors = std::move(colours);
+    }
     std::vector<uint32_t> remap(n);
     const size_t kept =
         meshopt_optimizeVertexFetchRemap(remap.data(), mesh.indices.data(), mesh.indices.size(), n);
@@ -889,6 +958,8 @@ Result<Mesh> simplifyMesh(const Mesh& mesh, const Evaluator& evaluator,
     result.positions = mesh.positions;
     result.normals = mesh.normals;
     result.colors = mesh.colors;
+    if (mesh.triangleColors.size() == mesh.triangleCount())
+        result.triangleColors = simplifiedColours(mesh, indices, evaluator, simplifier.spacing());
     result.indices = std::move(indices);
     const auto simplified = Clock::now();
     optimizeMeshOrder(result);
