@@ -558,6 +558,28 @@ TEST_F(MeshTest, BenchmarkScenesAreClosedWithVerticesOnTheSurface) {
     }
 }
 
+// The benchmark scenes at the benchmark's resolutions (sdfcsg bench --mesh): closed, manifold and
+// consistently oriented, each from one compiled scene.
+TEST_F(MeshTest, BenchmarkScenesAreClosedAndManifoldAtTheBenchmarkResolutions) {
+    const std::filesystem::path dir = std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/bench";
+    for (const char* name : {"molecule_1k", "groups_1k", "flat_4k", "forest_10k"}) {
+        SCOPED_TRACE(name);
+        const Scene scene = loadOrDie(dir / (std::string(name) + ".json"));
+        auto mesher = Mesher::create(context(), scene);
+        ASSERT_TRUE(mesher) << mesher.error().str();
+        for (uint32_t resolution : {128u, 256u, 512u}) {
+            SCOPED_TRACE("at " + std::to_string(resolution));
+            MeshOptions options;
+            options.resolution = resolution;
+            MeshStats stats;
+            auto mesh = (*mesher)->extract(options, &stats);
+            ASSERT_TRUE(mesh) << mesh.error().str();
+            EXPECT_FALSE(stats.surfaceCut);
+            expectClosedManifold(*mesh);
+        }
+    }
+}
+
 // The GPU result against the CPU reference on the grid the GPU reports, by each method: same
 // counts, same vertices (positions, normals, colours) within float tolerance, same oriented
 // triangles.
