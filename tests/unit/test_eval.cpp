@@ -237,6 +237,68 @@ TEST(Eval, PrimitiveBoundsAreTight) {
     EXPECT_NEAR(Evaluator(turned).bounds().max.z, 1.0f, 1e-4f);
 }
 
+// The box that framing and the mesh grid take: every point inside the solid lies in it (dense
+// samples over the bounds, for every scene of the bounds tests), and where Boolean operations
+// say more than their operands' boxes, it is within 5% of the sampled solid's box.
+Aabb sampledSolid(const Evaluator& eval, const Aabb& within, int n, float& spacing) {
+    Aabb solid;
+    const glm::vec3 step = (within.max - within.min) / float(n);
+    spacing = std::max(step.x, std::max(step.y, step.z));
+    for (int i = 0; i <= n; ++i)
+        for (int j = 0; j <= n; ++j)
+            for (int k = 0; k <= n; ++k) {
+                const glm::vec3 p = within.min + glm::vec3(i, j, k) * step;
+                if (eval.distance(p) >= 0.0f) continue;
+                solid.min = glm::min(solid.min, p);
+                solid.max = glm::max(solid.max, p);
+            }
+    return solid;
+}
+
+TEST(Eval, SolidBoundsHoldTheSolid) {
+    for (const Scene& scene : boundsScenes()) {
+        SCOPED_TRACE(scene.file);
+        const Evaluator eval(scene);
+        const Aabb& tight = eval.solidBounds();
+        const Aabb& loose = eval.bounds();
+        for (int a = 0; a < 3; ++a) {
+            EXPECT_GE(tight.min[a], loose.min[a]);
+            EXPECT_LE(tight.max[a], loose.max[a]);
+        }
+        if (!loose.finite()) continue;
+        float spacing = 0.0f;
+        const Aabb solid = sampledSolid(eval, loose, 48, spacing);
+        for (int a = 0; a < 3; ++a) {
+            EXPECT_LE(tight.min[a], solid.min[a] + 1e-5f) << "axis " << a;
+            EXPECT_GE(tight.max[a], solid.max[a] - 1e-5f) << "axis " << a;
+        }
+    }
+}
+
+TEST(Eval, SolidBoundsOfBooleansAreTight) {
+    const Scene scenes[] = {
+        // Two boxes overlapping in a corner: the overlap, not the smaller box.
+        makeScene(intersect({box(2, 2, 2), box(2, 2, 2).at(1, 1, 1)})),
+        // The same, smooth, inside a union with a ball.
+        makeScene(unite({intersect({box(2, 2, 2), box(2, 4, 2).at(1, 1, 1)}, 0.1f),
+                         sphere(0.3f).at(0.5f, 0.5f, 0.5f)})),
+        // A box that spans a rounded box across two axes cuts it along the third.
+        makeScene(subtract({roundBox(1.6f, 0.6f, 1.0f, 0.08f), box(2, 0.4f, 2).at(0, 0.4f, 0)})),
+    };
+    for (const Scene& scene : scenes) {
+        const Evaluator eval(scene);
+        float spacing = 0.0f;
+        const Aabb solid = sampledSolid(eval, eval.bounds(), 96, spacing);
+        const Aabb& tight = eval.solidBounds();
+        for (int a = 0; a < 3; ++a) {
+            const float size = solid.max[a] - solid.min[a];
+            EXPECT_LE(tight.max[a] - tight.min[a], 1.05f * size + 2.0f * spacing) << "axis " << a;
+            EXPECT_LE(tight.min[a], solid.min[a]);
+            EXPECT_GE(tight.max[a], solid.max[a]);
+        }
+    }
+}
+
 // Skipping never changes a single bit of the result.
 TEST(Eval, SkippingGivesIdenticalValues) {
     std::vector<Scene> scenes = bundledScenes();

@@ -78,8 +78,14 @@ class Evaluator {
     // nodes, for many points; the first call prunes (about 0.1 s for 1,000 nodes), and copies
     // of this evaluator share the result.
     float prunedDistance(glm::vec3 p) const;
-    // Bounds of the whole solid; infinite along axes where a plane reaches.
+    // Bounds of the whole solid; infinite along axes where a plane reaches. The evaluation
+    // skips by them: the field is at least their box's signed distance.
     const Aabb& bounds() const { return nodes_[0].bounds; }
+    // The box the solid lies in, within bounds() and tighter where a Boolean operation allows:
+    // an intersection within the overlap of its operands' boxes, a difference within its first
+    // operand's. The field may be below its signed distance, so nothing skips by it; framing
+    // and the mesh grid take it.
+    const Aabb& solidBounds() const { return solidBounds_; }
     // The finite box the solid lies in, as tight as the bounds know it: bounds() on every side
     // where they are finite (a difference lies within its first operand, whatever it subtracts),
     // elsewhere the box around the finite primitives (a ground plane makes bounds() infinite);
@@ -96,6 +102,7 @@ class Evaluator {
   private:
     struct Pruned; // eval.cpp
     std::vector<FlatNode> nodes_;
+    Aabb solidBounds_;
     bool skipping_ = true;
     std::shared_ptr<Pruned> pruned_;
 };

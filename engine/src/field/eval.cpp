@@ -90,6 +90,30 @@ Aabb infiniteBox() {
     return Aabb{glm::vec3(-INFINITY), glm::vec3(INFINITY)};
 }
 
+// How far a union's smooth blend reaches beyond its operands' boxes. Each fold goes at most k/4
+// below the smaller operand (k/2 chamfered, k (1 - 1/sqrt 2) round), and however many operands,
+// the fold never goes more than k below their minimum: every blend grows with each operand, and
+// blends m - k and m to m - k, so from operands >= m every fold stays >= m - k. Boxes widened by
+// the lesser of the two then bound it.
+float smoothGrowth(const FlatNode& n) {
+    if (!(n.smooth > 0.0f)) return 0.0f;
+    const float folds = float(n.children.size() - 1);
+    const float dip = n.blend == 2 ? 0.5f : n.blend == 1 ? 0.29289322f : 0.25f;
+    return n.smooth * std::min(1.0f, dip * folds) * (1.0f + 1e-5f);
+}
+
+// Whether a linear map takes each axis onto an axis (turns by right angles, mirrors, scales).
+bool axisAligned(const glm::dmat3& m) {
+    for (int c = 0; c < 3; ++c) {
+        int along = 0;
+        const double largest = std::max({std::abs(m[c].x), std::abs(m[c].y), std::abs(m[c].z)});
+        for (int r = 0; r < 3; ++r)
+            along += std::abs(m[c][r]) > 1e-9 * largest;
+        if (along != 1) return false;
+    }
+    return true;
+}
+
 float volume(const Aabb& b) {
     glm::vec3 e = b.max - b.min;
     return e.x * e.y * e.z;
@@ -386,18 +410,8 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
                 box.min = glm::min(box.min, nodes_[c].bounds.min);
                 box.max = glm::max(box.max, nodes_[c].bounds.max);
             }
-            // Each fold goes at most k/4 below the smaller operand (k/2 chamfered, k (1 - 1/sqrt 2)
-            // round), and however many operands, the fold never goes more than k below their
-            // minimum: every blend grows with each operand, and blends m - k and m to m - k, so
-            // from operands >= m every fold stays >= m - k. Boxes widened by the lesser of the
-            // two then bound it.
-            if (n.smooth > 0.0f) {
-                const float folds = float(n.children.size() - 1);
-                const float dip = n.blend == 2 ? 0.5f : n.blend == 1 ? 0.29289322f : 0.25f;
-                float grow = n.smooth * std::min(1.0f, dip * folds) * (1.0f + 1e-5f);
-                box.min -= grow;
-                box.max += grow;
-            }
+            box.min -= smoothGrowth(n);
+            box.max += smoothGrowth(n);
             n.bounds = box;
         } else if (n.kind == NodeKind::Intersection) {
             // A smooth maximum is never below the sharp one, so any operand's box bounds it.
@@ -409,6 +423,55 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
             n.bounds = nodes_[n.children[0]].bounds;
         }
     }
+
+    // Pass 3, children first: the box the solid lies in, as tight as the Boolean operations
+    // allow (solidBounds()). The bounds above stand in for a node's value wherever the
+    // evaluation skips it, so they must stay below that value; this box need not. An
+    // intersection lies within the overlap of its operands' boxes, yet its value may be below
+    // that overlap's distance (near a corner of it), so only here does it take the overlap, and
+    // the operations above follow from there.
+    std::vector<Aabb> tight(count);
+    for (size_t i = count; i-- > 0;) {
+        const FlatNode& n = nodes_[i];
+        const KindInfo& info = kindInfo(n.kind);
+        Aabb box = n.bounds;
+        const Aabb* child = n.children.empty() ? nullptr : &tight[n.children[0]];
+        if (n.kind == NodeKind::Union) {
+            box = Aabb{};
+            for (uint32_t c : n.children) {
+                box.min = glm::min(box.min, tight[c].min - smoothGrowth(n));
+                box.max = glm::max(box.max, tight[c].max + smoothGrowth(n));
+            }
+        } else if (n.kind == NodeKind::Intersection) {
+            for (uint32_t c : n.children) {
+                box.min = glm::max(box.min, tight[c].min);
+                box.max = glm::min(box.max, tight[c].max);
+            }
+        } else if (n.kind == NodeKind::Difference) {
+            box = *child;
+            // A box turned by right angles at most fills its bounds: where it spans the first
+            // operand's box across two axes, it cuts that box along the third.
+            for (size_t k = 1; k < n.children.size(); ++k) {
+                const uint32_t c = n.children[k];
+                if (nodes_[c].kind != NodeKind::Box || !axisAligned(acc[c].toWorld)) continue;
+                const Aabb& cut = nodes_[c].bounds;
+                for (int a = 0; a < 3; ++a) {
+                    const int b = (a + 1) % 3, d = (a + 2) % 3;
+                    if (!(cut.min[b] <= box.min[b] && cut.max[b] >= box.max[b] &&
+                          cut.min[d] <= box.min[d] && cut.max[d] >= box.max[d]))
+                        continue;
+                    if (cut.min[a] <= box.min[a]) box.min[a] = std::max(box.min[a], cut.max[a]);
+                    if (cut.max[a] >= box.max[a]) box.max[a] = std::min(box.max[a], cut.min[a]);
+                }
+            }
+        } else if (child && child->finite() && !child->empty()) {
+            glm::vec3 lo, hi;
+            info.boundsAround(n.params, child->min, child->max, lo, hi);
+            box = info.role == Role::Domain ? toFrame(i, lo, hi) : Aabb{lo, hi};
+        }
+        tight[i] = Aabb{glm::max(box.min, n.bounds.min), glm::min(box.max, n.bounds.max)};
+    }
+    if (count) solidBounds_ = tight[0];
 }
 
 float Evaluator::distance(glm::vec3 p) const {

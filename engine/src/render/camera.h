@@ -102,7 +102,7 @@ inline Aabb finitePrimitiveBounds(const Evaluator& evaluator) {
 
 // Evaluator::finiteBounds() (sdfcsg/eval.h), here for the renderer and the mesher.
 inline Aabb finiteSceneBounds(const Evaluator& evaluator) {
-    const Aabb root = evaluator.bounds();
+    const Aabb root = evaluator.solidBounds();
     const Aabb parts = finitePrimitiveBounds(evaluator);
     Aabb box;
     for (int a = 0; a < 3; ++a) {
