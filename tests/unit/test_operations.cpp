@@ -105,6 +105,19 @@ TEST(Operations, ShellOfAPolarRepeatHasNoSurfaceAlongTheAxis) {
     }
 }
 
+// As the node table describes it: bent by 90 degrees per unit, a bar's point at x = 1 lands on
+// (0.59, 0.80), 1 from the axis, and not where an arc of radius 2/pi would take it.
+TEST(Operations, BendCurlsABarAsDocumented) {
+    const Scene scene = parseRoot(R"({"type": "bend", "angle": 90, "children": [
+        {"type": "capsule", "a": [-1, 0, 0], "b": [1, 0, 0], "radius": 0.02}]})");
+    const Evaluator e(scene);
+    EXPECT_LT(e.distance(glm::vec3(0.5946f, 0.8040f, 0.0f)), 0.0f);
+    EXPECT_LT(e.distance(glm::vec3(-0.5946f, 0.8040f, 0.0f)), 0.0f);
+    const float r = 2.0f / 3.14159265f;
+    EXPECT_GT(e.distance(glm::vec3(r * std::sin(1.0f / r), r * (1.0f - std::cos(1.0f / r)), 0.0f)),
+              0.01f);
+}
+
 TEST(Operations, MirrorOfAHalfIsItAndItsImage) {
     const std::string ball = R"({"type": "sphere", "radius": 0.3, "translate": [0.5, 0.2, 0]})";
     const std::string image = R"({"type": "sphere", "radius": 0.3, "translate": [-0.5, 0.2, 0]})";

@@ -843,8 +843,12 @@ constexpr KindInfo kKinds[] = {
      "bend",
      true,
      kBend,
-     "Its child bent in the xy plane about the z axis, turning by the given angle per unit "
-     "along x: a bar along x becomes an arc. The field is divided by the bend's Lipschitz "
+     "Its child bent in the xy plane: each point is turned about the z axis by minus the angle "
+     "times its x before the child is evaluated, so a bar along x curls towards +y (for a "
+     "positive angle) into a U, its point at x = s landing s from the z axis, turned by the "
+     "angle times its new x: bent by 90 degrees per unit, the bar's first unit ends at (0.59, "
+     "0.80). Not an arc of one radius; near the axis, where the turn is small, close to "
+     "y = angle x^2 (the angle in radians). The field is divided by the bend's Lipschitz "
      "bound.",
      R"("angle": 30)",
      {},
