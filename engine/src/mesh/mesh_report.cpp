@@ -2,6 +2,7 @@
 // vertices, self-intersections by mesh/self_intersections.cpp.
 #include "sdfcsg/mesh_report.h"
 
+#include "mesh/radix_sort.h"
 #include "mesh/self_intersections.h"
 #include "sdfcsg/compile.h"
 
@@ -134,10 +135,13 @@ MeshReport reportMesh(const Mesh& mesh) {
     r.triangles = mesh.triangleCount();
     std::vector<bool> used(r.vertices, false);
     Pieces pieces(r.vertices);
-    // Per side of a triangle: (lower vertex << 32 | higher vertex) << 1 | (1 when it runs from
-    // the lower to the higher). Sorted, the uses of each edge lie together.
-    std::vector<uint64_t> sides;
-    sides.reserve(mesh.indices.size());
+    // Per side of a triangle: lower vertex << bits | higher vertex (`bits` the vertex numbers'
+    // width), in `forward` where it runs from the lower to the higher, else in `backward`.
+    // Sorted, the uses of each edge lie together in each.
+    const int bits = detail::bitsFor(r.vertices);
+    std::vector<uint64_t> forward, backward;
+    forward.reserve(mesh.indices.size() / 2 + 1);
+    backward.reserve(mesh.indices.size() / 2 + 1);
     size_t unusable = 0; // triangles with indices out of range or repeated
     for (size_t t = 0; t < r.triangles; ++t) {
         const uint32_t* v = &mesh.indices[3 * t];
@@ -158,20 +162,25 @@ MeshReport reportMesh(const Mesh& mesh) {
             r.bounds.min = glm::min(r.bounds.min, mesh.positions[from]);
             r.bounds.max = glm::max(r.bounds.max, mesh.positions[from]);
             const uint64_t lo = std::min(from, to), hi = std::max(from, to);
-            sides.push_back((lo << 32 | hi) << 1 | (from < to ? 1u : 0u));
+            (from < to ? forward : backward).push_back(lo << bits | hi);
         }
     }
-    std::sort(sides.begin(), sides.end());
-    for (size_t i = 0; i < sides.size();) {
-        size_t end = i, forward = 0;
-        for (; end < sides.size() && sides[end] >> 1 == sides[i] >> 1; ++end)
-            forward += sides[end] & 1u;
-        const size_t uses = end - i;
+    detail::radixSort(forward, 0, 2 * bits);
+    detail::radixSort(backward, 0, 2 * bits);
+    for (size_t f = 0, b = 0; f < forward.size() || b < backward.size();) {
+        const uint64_t edge = b == backward.size()                              ? forward[f]
+                              : f == forward.size() || backward[b] < forward[f] ? backward[b]
+                                                                                : forward[f];
+        size_t along = 0, against = 0;
+        for (; f < forward.size() && forward[f] == edge; ++f)
+            ++along;
+        for (; b < backward.size() && backward[b] == edge; ++b)
+            ++against;
+        const size_t uses = along + against;
         ++r.edges;
         r.boundaryEdges += uses == 1;
         r.nonManifoldEdges += uses > 2;
-        r.misorientedEdges += uses == 2 && forward != 1;
-        i = end;
+        r.misorientedEdges += uses == 2 && along != 1;
     }
     size_t usedVertices = 0;
     for (uint32_t v = 0; v < r.vertices; ++v) {

@@ -1,5 +1,7 @@
 #include "mesh/self_intersections.h"
 
+#include "mesh/radix_sort.h"
+
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
@@ -201,11 +203,20 @@ SelfIntersections findSelfIntersections(const Mesh& mesh, double tolerance, doub
     // A uniform grid of cells about twice the mean triangle's size; each triangle is listed in
     // every cell its bounds (grown by the tolerance) reach, and each pair is tested only in the
     // cell that holds the low corner of the overlap of their grown bounds.
+    // Cells are numbered from a corner one cell below the grown bounds, each axis in as many bits
+    // as its cells need (21 at most: past that, far cells share numbers, which only joins their
+    // lists).
     const double cell = std::max(2.0 * extent / double(valid.size()), 1e-30);
-    auto cellOf = [&](dvec3 p) { return glm::ivec3(glm::floor((p - lo) / cell)); };
-    auto key = [](glm::ivec3 c) {
-        return (uint64_t(uint32_t(c.x) & 0x1fffff) << 42) |
-               (uint64_t(uint32_t(c.y) & 0x1fffff) << 21) | uint64_t(uint32_t(c.z) & 0x1fffff);
+    const dvec3 corner = lo - tolerance - cell;
+    auto cellOf = [&](dvec3 p) { return glm::ivec3(glm::floor((p - corner) / cell)); };
+    const glm::ivec3 last = cellOf(hi + tolerance);
+    const int bx = std::min(detail::bitsFor(uint64_t(last.x) + 1), 21);
+    const int by = std::min(detail::bitsFor(uint64_t(last.y) + 1), 21);
+    const int bz = std::min(detail::bitsFor(uint64_t(last.z) + 1), 21);
+    auto key = [&](glm::ivec3 c) {
+        return uint64_t(uint32_t(c.x) & ((1u << bx) - 1)) |
+               uint64_t(uint32_t(c.y) & ((1u << by) - 1)) << bx |
+               uint64_t(uint32_t(c.z) & ((1u << bz) - 1)) << (bx + by);
     };
     std::vector<std::pair<uint64_t, uint32_t>> listed;
     for (uint32_t t : valid) {
@@ -216,16 +227,10 @@ SelfIntersections findSelfIntersections(const Mesh& mesh, double tolerance, doub
                 for (int x = c0.x; x <= c1.x; ++x)
                     listed.push_back({key({x, y, z}), t});
     }
+    // Listed in the order of the triangles, so that the stable sort keeps each cell's in it.
     const bool twoThreads = listed.size() >= 100000 && std::thread::hardware_concurrency() >= 2;
-    if (twoThreads) { // each half sorted by a thread of its own, then merged
-        const auto half = listed.begin() + ptrdiff_t(listed.size() / 2);
-        std::thread helper([&] { std::sort(half, listed.end()); });
-        std::sort(listed.begin(), half);
-        helper.join();
-        std::inplace_merge(listed.begin(), half, listed.end());
-    } else {
-        std::sort(listed.begin(), listed.end());
-    }
+    radixSort(listed, 0, bx + by + bz,
+              [](const std::pair<uint64_t, uint32_t>& entry) { return entry.first; });
     // The grown bounds of listed[i] in single precision, rounded outwards, side by side in the
     // order of `listed`: most pairs of a cell are told apart by these alone, without reading the
     // triangles (which the test below then does in double precision).
