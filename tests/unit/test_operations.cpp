@@ -118,6 +118,18 @@ TEST(Operations, BendCurlsABarAsDocumented) {
               0.01f);
 }
 
+// Spacing means nothing along an axis of one copy, so 0 is accepted there: the same field.
+TEST(Operations, RepeatTakesSpacingZeroAlongAnAxisOfOneCopy) {
+    const Evaluator zero(parseRoot(R"({"type": "repeat", "count": [4, 1, 1],
+        "spacing": [0.6, 0, 0], "children": [)" +
+                                   kPart + "]}"));
+    const Evaluator one(parseRoot(R"({"type": "repeat", "count": [4, 1, 1],
+        "spacing": [0.6, 1, 1], "children": [)" +
+                                  kPart + "]}"));
+    for (glm::vec3 p : randomPoints(3, 2000, 2.5f))
+        ASSERT_EQ(zero.distance(p), one.distance(p)) << p.x << " " << p.y << " " << p.z;
+}
+
 TEST(Operations, MirrorOfAHalfIsItAndItsImage) {
     const std::string ball = R"({"type": "sphere", "radius": 0.3, "translate": [0.5, 0.2, 0]})";
     const std::string image = R"({"type": "sphere", "radius": 0.3, "translate": [-0.5, 0.2, 0]})";

@@ -243,6 +243,15 @@ std::vector<BadInput> badInputs() {
         {"round box radius too large",
          scene(R"({"type": "round_box", "size": [1, 2, 3], "radius": 0.6})"),
          "scene.json: root.radius: expected at most half the smallest size (0.5), got 0.6"},
+        {"repeat spacing 0 along an axis of copies",
+         scene(R"({"type": "repeat", "count": [1, 3, 1], "spacing": [1, 0, 0], "children": [
+             {"type": "sphere", "radius": 0.2}]})"),
+         "scene.json: root.spacing: expected a spacing greater than 0 along y, which has 3 "
+         "copies, got 0"},
+        {"repeat spacing negative",
+         scene(R"({"type": "repeat", "count": [2, 1, 1], "spacing": [1, -1, 0], "children": [
+             {"type": "sphere", "radius": 0.2}]})"),
+         "scene.json: root.spacing[1]: expected a non-negative number, got -1"},
         {"capped torus angle beyond a turn",
          scene(R"({"type": "capped_torus", "major_radius": 1, "minor_radius": 0.2, "angle": 400})"),
          "scene.json: root.angle: expected at most 360, got 400"},

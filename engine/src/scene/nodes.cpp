@@ -317,12 +317,13 @@ constexpr ParamInfo kRepeat[] = {
     {"count", Vec3, Count, 0, true, {}, "copies", "Copies along x, y and z (1: no repetition)."},
     {"spacing",
      Vec3,
-     Positive,
+     NonNegative,
      3,
      true,
      {},
      "length",
-     "Distance between neighbouring copies' centres along x, y and z."},
+     "Distance between neighbouring copies' centres along x, y and z: greater than 0 on an "
+     "axis of more than one copy, any on an axis of one."},
 };
 constexpr ParamInfo kPolarRepeat[] = {
     {"count", Number, Count, 0, true, {}, "copies", "Copies around the axis."},
@@ -441,10 +442,19 @@ float stretch(float a) {
 // When some axis needs M > 0, copies further away are at least G away, and the value is at most
 // G (so that it stays continuous and 1-Lipschitz); with M = 0 everywhere it is exact.
 Params repeatKernel(const Params& v, vec3 lo, vec3 hi) {
-    Params k{v[3], v[4], v[5], 3.4e38f, v[0], v[1], v[2], 0.0f};
+    // An axis of one copy has no spacing to speak of (the scene may give 0); 1 keeps the
+    // candidate's index finite.
+    Params k{v[0] > 1.0f ? v[3] : 1.0f,
+             v[1] > 1.0f ? v[4] : 1.0f,
+             v[2] > 1.0f ? v[5] : 1.0f,
+             3.4e38f,
+             v[0],
+             v[1],
+             v[2],
+             0.0f};
     uint32_t packed = 0;
     for (int a = 0; a < 3; ++a) {
-        const float s = v[3 + a], n = v[a], ext = std::max(-lo[a], hi[a]);
+        const float s = k[a], n = v[a], ext = std::max(-lo[a], hi[a]);
         const float m = std::clamp(std::ceil(ext / s - 0.5f), 0.0f, 255.0f);
         packed |= uint32_t(m) << (8 * a);
         if (n > 1.0f && 2.0f * m + 2.0f < n && m > 0.0f)

@@ -462,6 +462,16 @@ std::optional<dom::array> SceneReader::readNode(element value, std::string path,
             node.outline = *outline;
         }
     }
+    if (kind->kind == NodeKind::Repeat && paramsOk) {
+        for (int a = 0; a < 3; ++a)
+            if (node.params[a] > 1.0f && !(node.params[3 + a] > 0.0f)) {
+                problems_.add(member(p, "spacing"),
+                              std::string("expected a spacing greater than 0 along ") + "xyz"[a] +
+                                  ", which has " + formatFloat(node.params[a]) + " copies, got " +
+                                  formatFloat(node.params[3 + a]));
+                break;
+            }
+    }
     if (kind->kind == NodeKind::RoundBox && paramsOk) {
         const float* size = node.params.data();
         float limit = 0.5f * std::min({size[0], size[1], size[2]});
