@@ -327,8 +327,12 @@ bool uploadMesh(Presenter& p, DeviceMesh& m, const Mesh& mesh, std::string& erro
             vertices[i] = vertex(i);
         std::memcpy(bytes + vertexBytes, mesh.indices.data(), indexBytes);
         auto* corners = reinterpret_cast<MeshVertex*>(bytes + vertexBytes + indexBytes);
-        for (size_t i = 0; i < mesh.indices.size(); ++i)
+        const bool flat = mesh.triangleColors.size() == mesh.triangleCount();
+        for (size_t i = 0; i < mesh.indices.size(); ++i) {
             corners[i] = vertex(mesh.indices[i]);
+            if (flat) corners[i].color = mesh.triangleColors[i / 3];
+        }
+        m.triangleColours = flat;
         vk::flushBuffer(p.device, staging);
         submitNow(p, [&](VkCommandBuffer cmd) {
             VkBufferCopy region = {0, 0, total};
@@ -434,7 +438,7 @@ void drawMesh(Presenter& p, const MeshView& view, const float background[3]) {
     vkCmdPushConstants(p.cmd, p.meshLayout, stages, 0, sizeof c, &c);
     vkCmdBindPipeline(p.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p.meshPipelines[view.closed]);
     const DeviceMesh& m = shownMesh(p, view);
-    if (view.wireframe) {
+    if (view.wireframe || m.triangleColours) {
         vkCmdBindVertexBuffers(p.cmd, 0, 1, &m.buffer.buffer, &m.cornerOffset);
         vkCmdDraw(p.cmd, m.indexCount, 1, 0, 0);
     } else {

@@ -21,6 +21,8 @@ struct DeviceMesh {
     vk::Buffer buffer;
     VkDeviceSize indexOffset = 0, cornerOffset = 0;
     uint32_t indexCount = 0; // 0: no mesh
+    // A colour per triangle (Mesh::triangleColors): drawn from the corners, which carry it.
+    bool triangleColours = false;
 };
 
 struct Presenter {

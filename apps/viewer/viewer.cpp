@@ -42,9 +42,11 @@ double now() {
 
 namespace {
 
-// `mesh` with the vertices whose wall is thinner than `minWall` red.
+// `mesh` with the vertices whose wall is thinner than `minWall` red (in vertex colours, so
+// without its colour per triangle).
 Mesh thinWallsRed(const Mesh& mesh, const std::vector<float>& walls, float minWall) {
     Mesh red = mesh;
+    red.triangleColors.clear();
     for (size_t i = 0; i < red.colors.size() && i < walls.size(); ++i)
         if (walls[i] < minWall) red.colors[i] = glm::vec3(0.9f, 0.1f, 0.05f);
     return red;
