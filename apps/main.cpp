@@ -582,6 +582,10 @@ const char* kValidateHelp = R"(Usage: sdfcsg validate SCENE...
 
 Parses and validates each scene (current or legacy format) and prints every problem found,
 one per line as FILE: JSON.PATH: MESSAGE (or FILE:LINE:COLUMN: MESSAGE for syntax errors).
+For a valid scene, notes where an offset, a shell or a smooth blend acts on a field that is
+not a distance (under a twist, bend or taper, a scale that differs between axes, an
+ellipsoid, or within another smooth blend), and by how much it lands off, as
+FILE: JSON.PATH: note: MESSAGE.
 Exits with 0 if all scenes are valid, 1 if any is not, 3 if a file cannot be read.
 )";
 
@@ -600,6 +604,10 @@ int cmdValidate(int argc, char** argv) {
         }
         std::printf("%s: ok (%zu node%s)\n", path.c_str(), scene->nodes.size(),
                     scene->nodes.size() == 1 ? "" : "s");
+        const sdfcsg::Evaluator evaluator(*scene);
+        for (const sdfcsg::FieldNote& note : sdfcsg::fieldNotes(*scene, evaluator))
+            std::printf("%s: %s: note: %s\n", path.c_str(), note.path.c_str(),
+                        note.message.c_str());
     }
     return worst;
 }

@@ -48,6 +48,11 @@ case_validate() {
     printf '{"version": 1, "root": {"type": "sphere", "radius": 1}}' >one.json
     check "validate one node" 0 "$bin" validate one.json
     expect_text "validate counts in the singular" out.txt "one.json: ok (1 node)"
+    # A valid scene whose offset acts on a field that is not a distance: a note, exit 0.
+    printf '{"version": 1, "root": {"type": "offset", "distance": 0.3, "children": [%s]}}' \
+        '{"type": "twist", "angle": 90, "children": [{"type": "box", "size": [1, 2, 1]}]}' >twisted.json
+    check "validate notes" 0 "$bin" validate twisted.json
+    expect_text "validate note" out.txt "twisted.json: root: note: offset over a field that is not a distance (twist at root.children[0] divides its field by up to 2.06): the surface lies 0.3 to 0.617 from the child's instead of 0.3"
 
     printf '{"version": 1, "root": {"type": "sphere", "radius": -1}}' >bad.json
     check "validate bad" 1 "$bin" validate bad.json

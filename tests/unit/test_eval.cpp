@@ -299,6 +299,46 @@ TEST(Eval, SolidBoundsOfBooleansAreTight) {
     }
 }
 
+// Offsets, shells and smooth blends over fields that are not distances are noted, with how far
+// off they land; over distances, and in the bundled scenes, nothing is.
+TEST(Eval, FieldNotesNameWhatDependsOnDistancesThatAreNot) {
+    const Scene scene = parseRoot(R"({"type": "union", "children": [
+        {"type": "offset", "distance": 0.3, "children": [
+            {"type": "twist", "angle": 90, "children": [{"type": "box", "size": [1, 2, 1]}]}]},
+        {"type": "shell", "thickness": 0.1, "children": [
+            {"type": "sphere", "radius": 0.5, "scale": [1, 2, 1]}]},
+        {"type": "union", "smooth": 0.2, "children": [
+            {"type": "ellipsoid", "radii": [0.5, 0.3, 0.4]}, {"type": "sphere", "radius": 0.3}]},
+        {"type": "offset", "distance": -0.05, "children": [
+            {"type": "intersection", "smooth": 0.1, "children": [
+                {"type": "sphere", "radius": 0.3}, {"type": "box", "size": [0.5, 0.5, 0.5]}]}]},
+        {"type": "offset", "distance": 0.2, "children": [
+            {"type": "difference", "children": [
+                {"type": "box", "size": [1, 1, 1]}, {"type": "sphere", "radius": 0.6}]}]}]})");
+    const std::vector<FieldNote> notes = fieldNotes(scene, Evaluator(scene));
+    ASSERT_EQ(notes.size(), 4u);
+    EXPECT_EQ(notes[0].path, "root.children[0]");
+    EXPECT_EQ(notes[0].message,
+              "offset over a field that is not a distance (twist at root.children[0].children[0] "
+              "divides its field by up to 2.06): the surface lies 0.3 to 0.617 from the child's "
+              "instead of 0.3");
+    EXPECT_EQ(notes[1].message,
+              "shell over a field that is not a distance (sphere at root.children[1].children[0], "
+              "scaled unevenly: its field below the distance by up to 2): the skin is 0.1 to 0.2 "
+              "thick instead of 0.1");
+    EXPECT_EQ(notes[2].message,
+              "smooth union over a field that is not a distance (ellipsoid at "
+              "root.children[2].children[0]: a bound, below the distance by up to 1.67): the "
+              "blend reaches up to 0.333 instead of 0.2");
+    EXPECT_EQ(notes[3].path, "root.children[3]");
+    EXPECT_EQ(notes[3].message,
+              "offset over a field that is not a distance (smooth blend at "
+              "root.children[3].children[0]: no distance within 0.1 of its seam): the offset "
+              "there is not 0.05");
+    for (const Scene& bundled : bundledScenes())
+        EXPECT_TRUE(fieldNotes(bundled, Evaluator(bundled)).empty()) << bundled.file;
+}
+
 // Skipping never changes a single bit of the result.
 TEST(Eval, SkippingGivesIdenticalValues) {
     std::vector<Scene> scenes = bundledScenes();

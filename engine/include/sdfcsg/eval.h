@@ -107,6 +107,18 @@ class Evaluator {
     std::shared_ptr<Pruned> pruned_;
 };
 
+// Where a scene's field stops being a distance, and an operation that moves or blends by its
+// values depends on it: an `offset` or `shell` (which place the surface at a value), or a smooth
+// union, intersection, difference or mirror (whose blend width is measured in values). A field
+// stops being a distance under twist, bend and taper (divided by their Lipschitz bound), a
+// scale that differs between axes (the smallest factor), an ellipsoid, and within a smooth
+// blend's radius. One note per dependent node, naming it by its JSON path.
+struct FieldNote {
+    std::string path;    // the dependent node, e.g. "root.children[1]"
+    std::string message; // what it depends on, where that stops being a distance, and how much
+};
+std::vector<FieldNote> fieldNotes(const Scene& scene, const Evaluator& evaluator);
+
 // Whether the solid is certainly empty: its bounds are empty, or finite and split into boxes
 // whose centres each lie outside, farther from the surface than the box's half-diagonal (every
 // field is 1-Lipschitz). False where some point is inside, or a few thousand values do not

@@ -1,0 +1,115 @@
+// Where a scene's field stops being a distance, and which operations depend on it being one
+// (sdfcsg/eval.h, fieldNotes). Offsets, shells and smooth blends act on the field's values: over
+// a field whose values lie below the distance by up to a factor L, an offset r lands between r
+// and L r from the child's surface, a shell of thickness t is t to L t thick, and a blend of
+// radius k reaches up to L k.
+#include "sdfcsg/eval.h"
+#include "sdfcsg/nodes.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <string>
+
+namespace sdfcsg {
+namespace {
+
+// Where a subtree's field stops being a distance: the cause with the largest factor.
+struct Loss {
+    bool any = false;
+    float factor = 0.0f; // values down to distance / factor; 0 where unknown (a blend)
+    std::string cause;   // "twist at root.children[0] divides its field by up to 1.41"
+};
+
+std::string number(float x) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3g", double(x));
+    return text;
+}
+
+// The node's "smooth" parameter (Booleans and mirror), or 0.
+float smoothOf(const Node& n) {
+    for (const ParamInfo& p : kindInfo(n.kind).params)
+        if (p.name == "smooth") return n.params[p.slot];
+    return 0.0f;
+}
+
+// What the node itself does to the distance, besides its children.
+Loss ownLoss(const Node& n, const FlatNode& flat) {
+    const std::string at = std::string(kindInfo(n.kind).name) + " at " + n.path;
+    float factor = 1.0f;
+    std::string how;
+    if (n.kind == NodeKind::Twist || n.kind == NodeKind::Bend || n.kind == NodeKind::Taper) {
+        factor = flat.params[7] > 0.0f ? 1.0f / flat.params[7] : 1.0f;
+        how = " divides its field by up to ";
+    } else if (n.kind == NodeKind::Ellipsoid) {
+        const float lo = std::min({n.params[0], n.params[1], n.params[2]});
+        const float hi = std::max({n.params[0], n.params[1], n.params[2]});
+        factor = hi / lo;
+        how = ": a bound, below the distance by up to ";
+    }
+    const glm::vec3 s = n.transform.scale;
+    const float stretch = std::max({s.x, s.y, s.z}) / std::min({s.x, s.y, s.z});
+    if (stretch > factor) {
+        factor = stretch;
+        how = ", scaled unevenly: its field below the distance by up to ";
+    }
+    if (factor > 1.001f) return {true, factor, at + how + number(factor)};
+    if (smoothOf(n) > 0.0f)
+        return {true, 0.0f,
+                "smooth blend at " + n.path + ": no distance within " + number(smoothOf(n)) +
+                    " of its seam"};
+    return {};
+}
+
+bool worse(const Loss& a, const Loss& b) { // a weighs more than b
+    return a.any && (!b.any || a.factor > b.factor);
+}
+
+// The note of a dependent node over a child field with `loss`.
+std::string noteOf(const Node& n, const Loss& loss) {
+    const std::string kind =
+        (smoothOf(n) > 0.0f ? "smooth " : "") + std::string(kindInfo(n.kind).name);
+    const float factor = loss.factor;
+    std::string effect;
+    if (n.kind == NodeKind::Offset) {
+        const float r = std::abs(n.params[0]);
+        effect = factor > 0.0f ? "the surface lies " + number(r) + " to " + number(r * factor) +
+                                     " from the child's instead of " + number(r)
+                               : "the offset there is not " + number(r);
+    } else if (n.kind == NodeKind::Shell) {
+        const float t = n.params[0];
+        effect = factor > 0.0f ? "the skin is " + number(t) + " to " + number(t * factor) +
+                                     " thick instead of " + number(t)
+                               : "the skin there is not " + number(t) + " thick";
+    } else {
+        const float k = smoothOf(n);
+        effect = factor > 0.0f
+                     ? "the blend reaches up to " + number(k * factor) + " instead of " + number(k)
+                     : "the blend there does not reach " + number(k);
+    }
+    return kind + " over a field that is not a distance (" + loss.cause + "): " + effect;
+}
+
+} // namespace
+
+std::vector<FieldNote> fieldNotes(const Scene& scene, const Evaluator& evaluator) {
+    const size_t count = std::min(scene.nodes.size(), evaluator.nodes().size());
+    std::vector<Loss> losses(count); // each subtree's, children first
+    std::vector<FieldNote> notes;
+    for (size_t i = count; i-- > 0;) {
+        const Node& n = scene.nodes[i];
+        Loss loss;
+        for (uint32_t c : n.children)
+            if (c < count && worse(losses[c], loss)) loss = losses[c];
+        const bool dependent =
+            n.kind == NodeKind::Offset || n.kind == NodeKind::Shell || smoothOf(n) > 0.0f;
+        if (dependent && loss.any) notes.push_back({n.path, noteOf(n, loss)});
+        const Loss own = ownLoss(n, evaluator.nodes()[i]);
+        if (worse(own, loss) || (own.any && !loss.any)) loss = own;
+        losses[i] = loss;
+    }
+    std::reverse(notes.begin(), notes.end()); // in the file's order
+    return notes;
+}
+
+} // namespace sdfcsg
