@@ -293,7 +293,8 @@ ReferenceMesh referenceDualMeshOf(const Distance& distance, const Color& color,
     Mesh& mesh = out.mesh;
     auto cellIndex = [&](glm::uvec3 c) { return (size_t(c.z) * n.y + c.y) * n.x + c.x; };
     std::vector<uint32_t> firstVertex(size_t(n.x) * n.y * n.z, 0);
-    std::vector<glm::vec3> smooth; // per vertex: the mean of its edge points
+    std::vector<glm::vec3> smooth;        // per vertex: the mean of its edge points
+    std::vector<detail::EdgePoint> edges; // per quad: its edge point
     for (uint32_t z = 0; z < n.z; ++z)
         for (uint32_t y = 0; y < n.y; ++y)
             for (uint32_t x = 0; x < n.x; ++x) {
@@ -368,8 +369,14 @@ ReferenceMesh referenceDualMeshOf(const Distance& distance, const Color& color,
                     uint32_t* t = quad[field.inside(s) ? 1 : 0];
                     std::rotate(t + 3, t + 3 + axis, t + 6); // names the axis (foldQuads)
                     mesh.indices.insert(mesh.indices.end(), t, t + 6);
+                    const uint32_t k = field.point(s, axis);
+                    edges.push_back({field.points.positions[k], field.points.normals[k],
+                                     field.points.colors[k]});
                 }
+    // The host steps of Extraction::finish() in engine/src/mesh/mesh.cpp.
     detail::foldQuads(mesh, smooth, distance, grid.voxelSize);
+    detail::splitTouchingSheets(mesh);
+    detail::separateCrossings(mesh, edges, grid.origin, grid.voxelSize);
     out.surfaceCut = field.surfaceCut;
     return out;
 }

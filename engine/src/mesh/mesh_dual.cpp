@@ -1,9 +1,13 @@
 #include "mesh/mesh_dual.h"
 
+#include "mesh/self_intersections.h"
+
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <thread>
 
@@ -395,6 +399,174 @@ size_t splitTouchingSheets(Mesh& mesh) {
         }
     }
     return cut;
+}
+
+namespace {
+
+// A quad's corners in order around its edge, from its two triangles as foldQuads() wrote them:
+// (a, b, c), (a, c, d) or (a, b, d), (b, c, d).
+std::array<uint32_t, 4> cornersOf(const uint32_t* t) {
+    return t[3] == t[0] ? std::array<uint32_t, 4>{t[0], t[1], t[2], t[5]}
+                        : std::array<uint32_t, 4>{t[0], t[1], t[4], t[2]};
+}
+
+} // namespace
+
+Separation separateCrossings(Mesh& mesh, const std::vector<EdgePoint>& edges, glm::vec3 origin,
+                             float h) {
+    Separation result;
+    const size_t quads = mesh.indices.size() / 6;
+    if (quads == 0 || edges.size() != quads) return result;
+    const size_t dualVertices = mesh.positions.size();
+    // Each dual vertex's cell, numbered densely: a vertex lies strictly inside its cell (kInset
+    // in shaders/mesh_triangles.comp), so its floor names the cell.
+    std::vector<uint32_t> cellOf(dualVertices);
+    {
+        std::vector<std::pair<uint64_t, uint32_t>> keys(dualVertices);
+        for (size_t v = 0; v < dualVertices; ++v) {
+            const glm::vec3 c = glm::max(glm::floor((mesh.positions[v] - origin) / h), 0.0f);
+            keys[v] = {uint64_t(c.x) | uint64_t(c.y) << 21 | uint64_t(c.z) << 42, uint32_t(v)};
+        }
+        std::sort(keys.begin(), keys.end());
+        uint32_t cell = 0;
+        for (size_t i = 0; i < keys.size(); ++i) {
+            if (i > 0 && keys[i].first != keys[i - 1].first) ++cell;
+            cellOf[keys[i].second] = cell;
+        }
+    }
+    std::vector<uint8_t> marked(dualVertices, 0); // by cell number
+    std::vector<uint32_t> verticesIn(dualVertices, 0);
+    for (uint32_t cell : cellOf)
+        ++verticesIn[cell];
+    const std::vector<uint32_t> original = std::move(mesh.indices);
+    mesh.indices = original;
+
+    // The quad across each side (k from corner k to k + 1) of each quad, made when first needed:
+    // the two quads around the two crossed edges of the face between the side's two cells.
+    constexpr uint32_t kNone = UINT32_MAX;
+    std::vector<uint32_t> across, facePoint, edgePoint;
+    auto sideAcross = [&](size_t q, int k) {
+        if (across.empty()) {
+            std::vector<std::pair<uint64_t, uint32_t>> sides;
+            sides.reserve(4 * quads);
+            for (size_t i = 0; i < quads; ++i) {
+                const std::array<uint32_t, 4> c = cornersOf(&original[6 * i]);
+                for (int j = 0; j < 4; ++j) {
+                    const uint32_t a = c[size_t(j)], b = c[size_t(j + 1) % 4];
+                    sides.push_back({uint64_t(std::min(a, b)) << 32 | std::max(a, b),
+                                     uint32_t(4 * i + size_t(j))});
+                }
+            }
+            std::sort(sides.begin(), sides.end());
+            across.assign(4 * quads, kNone);
+            facePoint.assign(4 * quads, kNone);
+            for (size_t i = 0; i < sides.size();) {
+                size_t end = i;
+                while (end < sides.size() && sides[end].first == sides[i].first)
+                    ++end;
+                if (end - i == 2) {
+                    across[sides[i].second] = sides[i + 1].second;
+                    across[sides[i + 1].second] = sides[i].second;
+                }
+                i = end;
+            }
+        }
+        return across[4 * q + size_t(k)];
+    };
+    auto addVertex = [&](glm::vec3 p, glm::vec3 n, glm::vec3 c) {
+        mesh.positions.push_back(p);
+        mesh.normals.push_back(n);
+        mesh.colors.push_back(c);
+        return uint32_t(mesh.positions.size() - 1);
+    };
+    // The point F of side k of quad q, shared with the quad across it; none where no single
+    // quad lies across.
+    auto faceOf = [&](size_t q, int k) {
+        const uint32_t other = sideAcross(q, k);
+        if (other == kNone) return kNone;
+        uint32_t& f = facePoint[4 * q + size_t(k)];
+        if (f == kNone) {
+            const EdgePoint &e = edges[q], &o = edges[other / 4];
+            const glm::vec3 n = e.normal + o.normal;
+            f = addVertex(0.5f * (e.position + o.position),
+                          glm::length(n) > 0.0f ? glm::normalize(n) : e.normal, e.color);
+            facePoint[other] = f;
+        }
+        return f;
+    };
+    auto edgeOf = [&](size_t q) {
+        if (edgePoint.empty()) edgePoint.assign(quads, kNone);
+        if (edgePoint[q] == kNone)
+            edgePoint[q] = addVertex(edges[q].position, edges[q].normal, edges[q].color);
+        return edgePoint[q];
+    };
+    // The mesh from the marks, and each triangle's quad.
+    std::vector<uint32_t> quadOf;
+    auto build = [&] {
+        mesh.indices.clear();
+        quadOf.clear();
+        for (size_t q = 0; q < quads; ++q) {
+            const uint32_t* t = &original[6 * q];
+            const std::array<uint32_t, 4> c = cornersOf(t);
+            bool any = false;
+            for (uint32_t v : c)
+                any = any || marked[cellOf[v]];
+            if (!any) {
+                mesh.indices.insert(mesh.indices.end(), t, t + 6);
+                quadOf.insert(quadOf.end(), 2, uint32_t(q));
+                continue;
+            }
+            const uint32_t e = edgeOf(q);
+            uint32_t polygon[8];
+            int count = 0;
+            for (int k = 0; k < 4; ++k) {
+                const uint32_t a = c[size_t(k)], b = c[size_t(k + 1) % 4];
+                polygon[count++] = a;
+                if (marked[cellOf[a]] || marked[cellOf[b]])
+                    if (const uint32_t f = faceOf(q, k); f != kNone) polygon[count++] = f;
+            }
+            for (int k = 0; k < count; ++k) {
+                mesh.indices.insert(mesh.indices.end(), {e, polygon[k], polygon[(k + 1) % count]});
+                quadOf.push_back(uint32_t(q));
+            }
+        }
+    };
+    constexpr size_t kRounds = 6;
+    std::vector<std::pair<uint32_t, uint32_t>> pairs;
+    for (size_t round = 0;; ++round) {
+        pairs.clear();
+        findSelfIntersections(mesh, -1.0, 1e-3, &pairs);
+        result.remaining = pairs.size();
+        if (pairs.empty() || round == kRounds) break;
+        size_t newly = 0;
+        for (const auto& [a, b] : pairs)
+            for (uint32_t t : {a, b})
+                for (int k = 0; k < 3; ++k)
+                    if (const uint32_t v = mesh.indices[3 * size_t(t) + size_t(k)];
+                        v < dualVertices && !marked[cellOf[v]]) {
+                        marked[cellOf[v]] = 1;
+                        ++newly;
+                    }
+        if (newly == 0) break;
+        result.cells += newly;
+        result.rounds = round + 1;
+        // A marked cell with several vertices (pieces of surface, or copies of one vertex for
+        // two sheets that touch): each goes to the mean of its quads' edge points, which lies in
+        // the convex hull of its loop of chords, where its fan stays; loops whose hulls are apart
+        // then give fans that are apart.
+        std::vector<glm::vec3> sum(dualVertices, glm::vec3(0.0f));
+        std::vector<uint32_t> count(dualVertices, 0);
+        for (size_t q = 0; q < quads; ++q)
+            for (uint32_t v : cornersOf(&original[6 * q]))
+                if (marked[cellOf[v]] && verticesIn[cellOf[v]] > 1) {
+                    sum[v] += edges[q].position;
+                    ++count[v];
+                }
+        for (size_t v = 0; v < dualVertices; ++v)
+            if (count[v] > 0) mesh.positions[v] = sum[v] / float(count[v]);
+        build();
+    }
+    return result;
 }
 
 } // namespace sdfcsg::detail

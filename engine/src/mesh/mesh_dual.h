@@ -39,4 +39,32 @@ void foldQuads(Mesh& mesh, const std::vector<glm::vec3>& smooth, const Distance&
 // many edges were cut.
 size_t splitTouchingSheets(Mesh& mesh);
 
+// Where a quad's grid edge crosses the surface: the point, its normal and its colour.
+struct EdgePoint {
+    glm::vec3 position, normal, color;
+};
+
+// What separateCrossings() did: its rounds, the cells it split, and the pairs of triangles that
+// still cross (in cells it could not make embedded, as one vertex serving two sheets).
+struct Separation {
+    size_t rounds = 0, cells = 0, remaining = 0;
+};
+
+// Splits the quads near crossing triangles into pieces that each lie in one cell (Ju and Udeshi,
+// "Intersection-free contouring on an octree grid", 2006), where the check finds crossings.
+// `mesh` holds the quads as foldQuads() and splitTouchingSheets() left them, two triangles each;
+// `edges` their edge points, in the same order; `origin` and `h` the grid's corner and cell edge.
+// A marked cell's quads become fans from their edge point E around the polygon of their four
+// vertices with, between two vertices of which one lies in a marked cell, the point F on the
+// face between the two cells, halfway between the edge points of the two quads that share that
+// side: each triangle (E, F, v) then lies in v's cell, and the triangles of one vertex form a fan
+// from a point inside its (convex) cell to a loop of chords on the cell's faces, which is
+// embedded. Triangles (E, v, w) of two unmarked vertices stay in the box of their two cells, and
+// quads with no marked cell keep their two triangles, sharp features included. Rounds repeat,
+// marking the cells of the vertices of triangles that still cross, until none do or a few rounds
+// have passed. Only triangles of quads near others that may cross them are checked (see
+// suspects() in mesh_dual.cpp), so that meshes with nothing to fix pay little.
+Separation separateCrossings(Mesh& mesh, const std::vector<EdgePoint>& edges, glm::vec3 origin,
+                             float h);
+
 } // namespace sdfcsg::detail
