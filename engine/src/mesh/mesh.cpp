@@ -57,9 +57,9 @@ constexpr uint64_t kBytesPerActive = 4 + SDFCSG_MESH_RECORD * 4 + 16 + 16;
 constexpr uint64_t kBytesPerBatchBrick = 4 * (SDFCSG_MESH_BRICK_BLOCK + SDFCSG_MESH_BRICK_EDGES);
 constexpr uint64_t kBytesPerVertex = 12 * 4 * 2; // GPU output and host mesh (or edge data)
 constexpr uint64_t kBytesPerTriangle = 3 * 4 * 2;
-// Dual contouring: seven words per quad of two triangles on the GPU, three on the host, and
-// half the quad's edge point (nine floats).
-constexpr uint64_t kBytesPerDualTriangle = 14 + 12 + 18;
+// Dual contouring: seven words per quad of two triangles on the GPU, and six plus the number of
+// its edge point on the host.
+constexpr uint64_t kBytesPerDualTriangle = 14 + 14;
 // The normal at an edge point, from four taps this many cells from its centre; for dual
 // contouring also around centres kDualNormalOffset cells off the point either way (see
 // placeVertices() in shaders/mesh_field.comp), whose taps must keep clear of the planes that
@@ -609,8 +609,8 @@ struct Extraction {
     std::vector<glm::uvec4> bases;
     glm::u64vec4 totals{0};
     Mesh mesh;
-    std::vector<glm::vec3> smooth;        // dual contouring: where foldQuads moves folding vertices
-    std::vector<detail::EdgePoint> edges; // dual contouring: each quad's edge point
+    std::vector<glm::vec3> smooth;   // dual contouring: where foldQuads moves folding vertices
+    std::vector<uint32_t> quadEdges; // dual contouring: each quad's edge point in the edge data
 
     void stage(const char* name, Clock::time_point t0) {
         const double seconds = secondsSince(t0);
@@ -807,7 +807,7 @@ void Extraction::beginTriangles() {
     mesh.normals.resize(totals.z);
     mesh.colors.resize(totals.z);
     smooth.resize(totals.z);
-    edges.resize(totals.w / 2);
+    quadEdges.resize(totals.w / 2);
 }
 
 // The triangles (marching cubes) or dual (dual contouring) pass over a batch.
@@ -844,23 +844,20 @@ Status Extraction::triangles(uint32_t batch) {
         }
     }
     if (dual) {
-        // Each quad's triangles, and its edge point from the edge data (as in mesh_field.comp).
+        // Each quad's triangles, and the number of its edge point in the edge data.
         const uint32_t* words = m.mapped<uint32_t>(SDFCSG_BINDING_MESH_INDICES);
-        const float* hermite = m.mapped<float>(SDFCSG_BINDING_MESH_HERMITE);
         for (uint64_t q = first / 2; q < end / 2; ++q, words += 7) {
             std::memcpy(mesh.indices.data() + 6 * q, words, 24);
-            const float* e = hermite + 12 * uint64_t(words[6]);
-            edges[q] = {glm::vec3(e[0], e[1], e[2]), glm::vec3(e[4], e[5], e[6]),
-                        glm::vec3(e[3], e[7], e[11])};
+            quadEdges[q] = words[6];
         }
-    } else if (batchTriangles >
-               0) { // an empty vector's data() may be null, which memcpy must not get
+    } else if (batchTriangles > 0) {
+        // An empty vector's data() may be null, which memcpy must not get.
         std::memcpy(mesh.indices.data() + uint64_t(first) * 3,
                     m.mapped<uint32_t>(SDFCSG_BINDING_MESH_INDICES), batchTriangles * 12);
     }
     stage("download", t0);
     notePeak(map.size() * 4 + mesh.positions.capacity() * 36 + smooth.capacity() * 12 +
-             mesh.indices.capacity() * 4);
+             mesh.indices.capacity() * 4 + quadEdges.capacity() * 4);
     if (!progress(1)) return cancelled();
     return Ok{};
 }
@@ -881,10 +878,14 @@ void Extraction::finish() {
         detail::foldQuads(mesh, smooth, distance, g.h);
         stage("quads", t0);
         const auto t1 = Clock::now();
+        const size_t copiesFrom = mesh.vertexCount();
         detail::splitTouchingSheets(mesh);
         stage("sheets", t1);
         const auto t2 = Clock::now();
-        detail::separateCrossings(mesh, edges, g.origin, g.h);
+        // The edge data, which the vertices pass wrote, lies where the dual pass read it.
+        detail::separateCrossings(mesh, copiesFrom, quadEdges,
+                                  m.mapped<detail::EdgePoint>(SDFCSG_BINDING_MESH_HERMITE),
+                                  g.origin, g.h);
         stage("crossings", t2);
     }
     stats.surfaceCut = status[0] != 0;

@@ -39,10 +39,18 @@ void foldQuads(Mesh& mesh, const std::vector<glm::vec3>& smooth, const Distance&
 // many edges were cut.
 size_t splitTouchingSheets(Mesh& mesh);
 
-// Where a quad's grid edge crosses the surface: the point, its normal and its colour.
+// A point where a grid edge crosses the surface, as the vertices pass writes it
+// (shaders/mesh_field.comp): its position and colour, its normal, and a second normal where it
+// lies on a sharp edge.
 struct EdgePoint {
-    glm::vec3 position, normal, color;
+    glm::vec3 position;
+    float red;
+    glm::vec3 normal;
+    float green;
+    glm::vec3 other;
+    float blue;
 };
+static_assert(sizeof(EdgePoint) == 48);
 
 // What separateCrossings() did: its rounds, the cells it split, and the pairs of triangles that
 // still cross (in cells it could not make embedded, as one vertex serving two sheets).
@@ -52,8 +60,9 @@ struct Separation {
 
 // Splits the quads near crossing triangles into pieces that each lie in one cell (Ju and Udeshi,
 // "Intersection-free contouring on an octree grid", 2006), where the check finds crossings.
-// `mesh` holds the quads as foldQuads() and splitTouchingSheets() left them, two triangles each;
-// `edges` their edge points, in the same order; `origin` and `h` the grid's corner and cell edge.
+// `mesh` holds the quads as foldQuads() and splitTouchingSheets() left them, two triangles each,
+// and from `copiesFrom` on the copies that splitTouchingSheets() made; `quadEdges` numbers each
+// quad's edge point in `points`; `origin` and `h` are the grid's corner and cell edge.
 // A marked cell's quads become fans from their edge point E around the polygon of their four
 // vertices with, between two vertices of which one lies in a marked cell, the point F on the
 // face between the two cells, halfway between the edge points of the two quads that share that
@@ -64,7 +73,7 @@ struct Separation {
 // marking the cells of the vertices of triangles that still cross, until none do or a few rounds
 // have passed. Only triangles of quads near others that may cross them are checked (see
 // suspects() in mesh_dual.cpp), so that meshes with nothing to fix pay little.
-Separation separateCrossings(Mesh& mesh, const std::vector<EdgePoint>& edges, glm::vec3 origin,
-                             float h);
+Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<uint32_t>& quadEdges,
+                             const EdgePoint* points, glm::vec3 origin, float h);
 
 } // namespace sdfcsg::detail
