@@ -404,11 +404,56 @@ size_t splitTouchingSheets(Mesh& mesh) {
 
 namespace {
 
+// kInset in shaders/mesh_triangles.comp: how far vertices keep from their cells' faces, in cells.
+constexpr float kInset = 0.005f;
+
 // A quad's corners in order around its edge, from its two triangles as foldQuads() wrote them:
 // (a, b, c), (a, c, d) or (a, b, d), (b, c, d).
 std::array<uint32_t, 4> cornersOf(const uint32_t* t) {
     return t[3] == t[0] ? std::array<uint32_t, 4>{t[0], t[1], t[2], t[5]}
                         : std::array<uint32_t, 4>{t[0], t[1], t[4], t[2]};
+}
+
+// starWedges() state per vertex: how many of its quads' wedges hold the first direction of the
+// plane it is seen in, and whether one of its quads folds there.
+constexpr uint8_t kWraps = 0x7f, kFolds = 0x80;
+
+// Quad t (its two triangles as foldQuads() wrote them) seen from each of its corners v along the
+// direction whose plane `view` holds (u, w per vertex): the quad must lie in the wedge at v between
+// its sides from v, turning less than half a turn counter-clockwise, with its far corner strictly
+// inside and both triangles facing the viewer; else v's state gets kFolds. Where every quad of v
+// does so and the wedges wrap once around v (exactly one holds the plane's first direction, counted
+// in v's state), the quads around v are a disk that the view maps one-to-one: none of them crosses
+// another.
+void starWedges(const Mesh& mesh, const uint32_t* t, const std::vector<glm::vec3>& view,
+                float margin, std::vector<uint8_t>& state) {
+    const std::array<uint32_t, 4> c = cornersOf(t);
+    const bool ac = t[3] == t[0]; // split along a-c, else b-d
+    for (int i = 0; i < 4; ++i) {
+        const uint32_t v = c[size_t(i)];
+        const glm::vec3 p = mesh.positions[v], u = view[2 * size_t(v)], w = view[2 * size_t(v) + 1];
+        auto seen = [&](uint32_t k) {
+            const glm::vec3 d = mesh.positions[k] - p;
+            return glm::vec2(glm::dot(d, u), glm::dot(d, w));
+        };
+        const glm::vec2 next = seen(c[size_t(i + 1) % 4]), far = seen(c[size_t(i + 2) % 4]),
+                        prev = seen(c[size_t(i + 3) % 4]);
+        auto cross = [](glm::vec2 x, glm::vec2 y) { return x.x * y.y - x.y * y.x; };
+        // Each point must lie farther than `margin` from the lines it must not cross, and so
+        // farther from the other quads than the check's tolerance: nearer, it would count as
+        // meeting them.
+        auto apart = [&](glm::vec2 x, glm::vec2 y) {
+            return cross(x, y) >
+                   margin * (std::abs(x.x) + std::abs(x.y) + std::abs(y.x) + std::abs(y.y));
+        };
+        const bool throughV = ac == (i % 2 == 0);
+        const bool opens = apart(next, prev) && apart(next, far) && apart(far, prev) &&
+                           (throughV || apart(far - next, prev - next));
+        if (!opens)
+            state[v] |= kFolds;
+        else if (next.y <= 0.0f && prev.y > 0.0f)
+            ++state[v];
+    }
 }
 
 } // namespace
@@ -433,10 +478,10 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
     // of a cell come one after another (the dual pass writes them so), the copies after all.
     std::vector<uint32_t> cellOf(dualVertices);
     std::vector<uint8_t> shared(dualVertices, 0);
+    std::vector<std::pair<uint64_t, uint32_t>> group; // the shared vertices by cell
     {
         std::vector<uint64_t> copied(key.begin() + std::ptrdiff_t(copiesFrom), key.end());
         std::sort(copied.begin(), copied.end());
-        std::vector<std::pair<uint64_t, uint32_t>> group;
         for (size_t v = 0; v < dualVertices; ++v) {
             cellOf[v] = uint32_t(v);
             shared[v] =
@@ -450,6 +495,22 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
             if (group[i - 1].first == group[i].first)
                 cellOf[group[i].second] = cellOf[group[i - 1].second];
     }
+    // Quad q's edge point, kept off the ends of its grid edge (the edge that its four cells lie
+    // around: along the axis on which their places agree) by kInset of a cell, as the vertices
+    // are kept off their cells' faces: where a sample lies on the surface, the points of all its
+    // crossed edges lie there, and the pieces of the cells around it would meet at one point.
+    auto edgePosition = [&](uint32_t q) {
+        const std::array<uint32_t, 4> c = cornersOf(&mesh.indices[6 * size_t(q)]);
+        int axis = 0;
+        for (int k = 0; k < 3; ++k) {
+            auto at = [&](uint32_t v) { return (key[v] >> (21 * k)) & 0x1fffff; };
+            if (at(c[0]) == at(c[1]) && at(c[0]) == at(c[2]) && at(c[0]) == at(c[3])) axis = k;
+        }
+        const float lo = origin[axis] + float((key[c[0]] >> (21 * axis)) & 0x1fffff) * h;
+        glm::vec3 p = edge(q).position;
+        p[axis] = std::clamp(p[axis], lo + kInset * h, lo + (1.0f - kInset) * h);
+        return p;
+    };
     std::vector<uint8_t> marked(dualVertices, 0); // by cell, at the vertex that names it
     auto isMarked = [&](uint32_t v) { return marked[cellOf[v]] != 0; };
     auto anyMarked = [&](const std::array<uint32_t, 4>& c) {
@@ -457,27 +518,59 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
     };
     auto quad = [&](size_t q) { return &mesh.indices[6 * q]; };
 
-    // The quads the check looks at (`near`, by corner): those that may cross others, and all
-    // that share a cell with them, which are the only ones their triangles can reach (a quad's
-    // triangles lie inside the four cells around its edge, its vertices being inside them). A
-    // quad may cross others where it folds (its two triangles more than 30 degrees from one
-    // plane) or where a cell of it holds several vertices; one whose four cells hold a vertex
-    // each and that is nearly flat stays clear of its neighbours as the nearly flat surface it
-    // stands for does. On the benchmark scenes this leaves a few percent of the triangles to
-    // check (mesh_a at 256: 11,000 of 436,000, at its sharp edges).
-    constexpr float kFlatQuad = 0.866f; // cos 30 degrees
-    std::vector<uint8_t> near(dualVertices, 0);
+    // The quads the check looks at: those with a corner whose quads may cross (`near`). Two
+    // triangles that cross lie in quads that share a cell (a quad's triangles lie inside the four
+    // cells around its edge, its vertices being inside them). Where that cell holds one vertex,
+    // both quads hold it, and they cannot cross where that vertex's quads are seen along its
+    // normal without overlap (starOpen()); where it holds several, each is near.
+    std::vector<uint8_t> near(shared);
+    float margin = 0.0f; // four times the check's tolerance (see findSelfIntersections)
+    {
+        glm::vec3 lo(INFINITY), hi(-INFINITY);
+        for (const glm::vec3& p : mesh.positions) {
+            lo = glm::min(lo, p);
+            hi = glm::max(hi, p);
+        }
+        margin = 4e-6f * glm::length(hi - lo);
+    }
+    // Each vertex is seen along the sum of its quads' normals (by area), which faces every quad
+    // of a vertex on a sharp edge or corner of the solid as well as any direction can: a basis
+    // of the plane across it, right-handed with it (Duff et al. 2017), per vertex.
+    std::vector<glm::vec3> view(2 * dualVertices, glm::vec3(0.0f));
     for (size_t q = 0; q < quads; ++q) {
         const uint32_t* t = quad(q);
-        const std::array<uint32_t, 4> c = cornersOf(t);
         const std::vector<glm::vec3>& p = mesh.positions;
-        const glm::vec3 n0 = glm::cross(p[t[1]] - p[t[0]], p[t[2]] - p[t[0]]);
-        const glm::vec3 n1 = glm::cross(p[t[4]] - p[t[3]], p[t[5]] - p[t[3]]);
-        const float d = glm::dot(n0, n1);
-        if (d <= 0.0f || d * d < kFlatQuad * kFlatQuad * glm::dot(n0, n0) * glm::dot(n1, n1) ||
-            shared[c[0]] || shared[c[1]] || shared[c[2]] || shared[c[3]])
-            for (uint32_t v : c)
-                near[v] = 1;
+        const glm::vec3 n = glm::cross(p[t[1]] - p[t[0]], p[t[2]] - p[t[0]]) +
+                            glm::cross(p[t[4]] - p[t[3]], p[t[5]] - p[t[3]]);
+        for (uint32_t v : cornersOf(t))
+            view[2 * size_t(v)] += n;
+    }
+    for (size_t v = 0; v < dualVertices; ++v) {
+        const float length = glm::length(view[2 * v]);
+        const glm::vec3 n = length > 0.0f ? view[2 * v] / length : mesh.normals[v];
+        const float sign = std::copysign(1.0f, n.z), a = -1.0f / (sign + n.z), b = n.x * n.y * a;
+        view[2 * v] = glm::vec3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
+        view[2 * v + 1] = glm::vec3(b, sign + n.y * n.y * a, -n.y);
+    }
+    {
+        std::vector<uint8_t> state[2];
+        auto range = [&](int part, size_t begin, size_t end) {
+            state[part].assign(dualVertices, 0);
+            for (size_t q = begin; q < end; ++q)
+                starWedges(mesh, quad(q), view, margin, state[part]);
+        };
+        if (quads < 65536 || std::thread::hardware_concurrency() < 2) {
+            range(0, 0, quads);
+            state[1].assign(dualVertices, 0);
+        } else {
+            std::thread helper(range, 1, quads / 2, quads);
+            range(0, 0, quads / 2);
+            helper.join();
+        }
+        for (size_t v = 0; v < dualVertices; ++v) {
+            const unsigned a = state[0][v], b = state[1][v];
+            if (((a | b) & kFolds) || (a & kWraps) + (b & kWraps) != 1) near[v] = 1;
+        }
     }
 
     // The quads around each vertex of a marked cell, (vertex, quad) sorted, remade each round.
@@ -510,10 +603,10 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
         }
         if (found != 1) return UINT32_MAX;
         const EdgePoint &e = edge(q), &o = edge(other);
+        const glm::vec3 between = 0.5f * (edgePosition(q) + edgePosition(other));
         const glm::vec3 n = e.normal + o.normal;
         const uint32_t f =
-            addVertex(0.5f * (e.position + o.position),
-                      glm::length(n) > 0.0f ? glm::normalize(n) : e.normal, colorOf(e));
+            addVertex(between, glm::length(n) > 0.0f ? glm::normalize(n) : e.normal, colorOf(e));
         facePoints.emplace(side, f);
         return f;
     };
@@ -521,7 +614,7 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
     auto edgeOf = [&](uint32_t q) {
         if (auto it = edgePoints.find(q); it != edgePoints.end()) return it->second;
         const EdgePoint& p = edge(q);
-        const uint32_t e = addVertex(p.position, p.normal, colorOf(p));
+        const uint32_t e = addVertex(edgePosition(q), p.normal, colorOf(p));
         edgePoints.emplace(q, e);
         return e;
     };
@@ -598,9 +691,14 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
                 reach[v] = 1;
                 if (!isMarked(v)) continue;
                 around.push_back({v, q});
-                if (shared[v]) sums.push_back({v, edge(q).position});
+                if (shared[v]) sums.push_back({v, edgePosition(q)});
             }
         }
+        // A reached cell of several vertices is reached at all of them.
+        for (const auto& [k, v] : group)
+            if (reach[v]) reach[cellOf[v]] = 1;
+        for (const auto& [k, v] : group)
+            if (reach[cellOf[v]]) reach[v] = 1;
         std::sort(around.begin(), around.end());
         std::sort(sums.begin(), sums.end(),
                   [](const auto& x, const auto& y) { return x.first < y.first; });
@@ -615,14 +713,18 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
     }
     // The split quads into the mesh: each its first two triangles in its own place, the rest at
     // the end.
-    std::vector<uint32_t> fan, extra;
+    // All fans are made before any quad is written over: making one reads its neighbours.
+    std::vector<uint32_t> fans, ends;
     for (uint32_t q : split) {
-        fan.clear();
-        trianglesOf(q, fan);
-        std::copy(fan.begin(), fan.begin() + 6, quad(q));
-        extra.insert(extra.end(), fan.begin() + 6, fan.end());
+        trianglesOf(q, fans);
+        ends.push_back(uint32_t(fans.size()));
     }
-    mesh.indices.insert(mesh.indices.end(), extra.begin(), extra.end());
+    for (size_t i = 0, begin = 0; i < split.size(); begin = ends[i++]) {
+        std::copy(fans.begin() + std::ptrdiff_t(begin), fans.begin() + std::ptrdiff_t(begin + 6),
+                  quad(split[i]));
+        mesh.indices.insert(mesh.indices.end(), fans.begin() + std::ptrdiff_t(begin + 6),
+                            fans.begin() + ends[i]);
+    }
     return result;
 }
 
