@@ -418,13 +418,13 @@ std::array<uint32_t, 4> cornersOf(const uint32_t* t) {
 // plane it is seen in, and whether one of its quads folds there.
 constexpr uint8_t kWraps = 0x7f, kFolds = 0x80;
 
-// Quad t (its two triangles as foldQuads() wrote them) seen from each of its corners v along the
-// direction whose plane `view` holds (u, w per vertex): the quad must lie in the wedge at v between
-// its sides from v, turning less than half a turn counter-clockwise, with its far corner strictly
-// inside and both triangles facing the viewer; else v's state gets kFolds. Where every quad of v
-// does so and the wedges wrap once around v (exactly one holds the plane's first direction, counted
-// in v's state), the quads around v are a disk that the view maps one-to-one: none of them crosses
-// another.
+// Quad t (its two triangles as foldQuads() wrote them) seen from each of its corners v along v's
+// normal (`view` holds the plane across it, two vectors per vertex): the quad must lie in the wedge
+// at v between its sides from v, turning less than half a turn counter-clockwise, with its far
+// corner strictly inside and both triangles facing the viewer; else v's state gets kFolds. Where
+// every quad of v does so and the wedges wrap once around v (exactly one holds the plane's first
+// direction, counted in v's state), the quads around v are a disk that the view maps one-to-one:
+// none of them crosses another.
 void starWedges(const Mesh& mesh, const uint32_t* t, const std::vector<glm::vec3>& view,
                 float margin, std::vector<uint8_t>& state) {
     const std::array<uint32_t, 4> c = cornersOf(t);
@@ -468,10 +468,17 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
     copiesFrom = std::min(copiesFrom, dualVertices);
     // Each dual vertex's cell: a vertex lies strictly inside its cell (kInset in
     // shaders/mesh_triangles.comp), so its floor names the cell.
+    // And the plane that starWedges() sees it in: across its normal, a basis right-handed with
+    // it (Duff et al. 2017).
     std::vector<uint64_t> key(dualVertices);
+    std::vector<glm::vec3> view(2 * dualVertices);
     for (size_t v = 0; v < dualVertices; ++v) {
         const glm::vec3 c = glm::max(glm::floor((mesh.positions[v] - origin) / h), 0.0f);
         key[v] = uint64_t(c.x) | uint64_t(c.y) << 21 | uint64_t(c.z) << 42;
+        const glm::vec3 n = mesh.normals[v];
+        const float sign = std::copysign(1.0f, n.z), a = -1.0f / (sign + n.z), b = n.x * n.y * a;
+        view[2 * v] = glm::vec3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
+        view[2 * v + 1] = glm::vec3(b, sign + n.y * n.y * a, -n.y);
     }
     // cellOf[v]: v, or for a vertex that shares its cell (`shared`: several pieces of surface,
     // or copies for sheets that touch), the first vertex of the cell, which names it. The pieces
@@ -532,25 +539,6 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
             hi = glm::max(hi, p);
         }
         margin = 4e-6f * glm::length(hi - lo);
-    }
-    // Each vertex is seen along the sum of its quads' normals (by area), which faces every quad
-    // of a vertex on a sharp edge or corner of the solid as well as any direction can: a basis
-    // of the plane across it, right-handed with it (Duff et al. 2017), per vertex.
-    std::vector<glm::vec3> view(2 * dualVertices, glm::vec3(0.0f));
-    for (size_t q = 0; q < quads; ++q) {
-        const uint32_t* t = quad(q);
-        const std::vector<glm::vec3>& p = mesh.positions;
-        const glm::vec3 n = glm::cross(p[t[1]] - p[t[0]], p[t[2]] - p[t[0]]) +
-                            glm::cross(p[t[4]] - p[t[3]], p[t[5]] - p[t[3]]);
-        for (uint32_t v : cornersOf(t))
-            view[2 * size_t(v)] += n;
-    }
-    for (size_t v = 0; v < dualVertices; ++v) {
-        const float length = glm::length(view[2 * v]);
-        const glm::vec3 n = length > 0.0f ? view[2 * v] / length : mesh.normals[v];
-        const float sign = std::copysign(1.0f, n.z), a = -1.0f / (sign + n.z), b = n.x * n.y * a;
-        view[2 * v] = glm::vec3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
-        view[2 * v + 1] = glm::vec3(b, sign + n.y * n.y * a, -n.y);
     }
     {
         std::vector<uint8_t> state[2];
