@@ -466,10 +466,9 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
     auto edge = [&](uint32_t q) -> const EdgePoint& { return points[quadEdges[q]]; };
     const size_t dualVertices = mesh.positions.size();
     copiesFrom = std::min(copiesFrom, dualVertices);
-    // Each dual vertex's cell: a vertex lies strictly inside its cell (kInset in
-    // shaders/mesh_triangles.comp), so its floor names the cell.
-    // And the plane that starWedges() sees it in: across its normal, a basis right-handed with
-    // it (Duff et al. 2017).
+    // Each dual vertex's cell (a vertex lies strictly inside its cell, kInset in
+    // shaders/mesh_triangles.comp, so its floor names the cell), and the plane that starWedges()
+    // sees it in: across its normal, a basis right-handed with it (Duff et al. 2017).
     std::vector<uint64_t> key(dualVertices);
     std::vector<glm::vec3> view(2 * dualVertices);
     for (size_t v = 0; v < dualVertices; ++v) {
@@ -529,7 +528,7 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
     // triangles that cross lie in quads that share a cell (a quad's triangles lie inside the four
     // cells around its edge, its vertices being inside them). Where that cell holds one vertex,
     // both quads hold it, and they cannot cross where that vertex's quads are seen along its
-    // normal without overlap (starOpen()); where it holds several, each is near.
+    // normal without overlap (starWedges()); where it holds several, each is near.
     std::vector<uint8_t> near(shared);
     float margin = 0.0f; // four times the check's tolerance (see findSelfIntersections)
     {
@@ -688,8 +687,8 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
         for (const auto& [k, v] : group)
             if (reach[cellOf[v]]) reach[v] = 1;
         std::sort(around.begin(), around.end());
-        std::sort(sums.begin(), sums.end(),
-                  [](const auto& x, const auto& y) { return x.first < y.first; });
+        std::stable_sort(sums.begin(), sums.end(),
+                         [](const auto& x, const auto& y) { return x.first < y.first; });
         for (size_t k = 0; k < sums.size();) {
             size_t end = k;
             glm::vec3 sum(0.0f);
@@ -700,8 +699,7 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
         }
     }
     // The split quads into the mesh: each its first two triangles in its own place, the rest at
-    // the end.
-    // All fans are made before any quad is written over: making one reads its neighbours.
+    // the end. All fans are made before any quad is written over: making one reads others.
     std::vector<uint32_t> fans, ends;
     for (uint32_t q : split) {
         trianglesOf(q, fans);
