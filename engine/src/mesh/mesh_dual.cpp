@@ -456,6 +456,18 @@ void starWedges(const Mesh& mesh, const uint32_t* t, const std::vector<glm::vec3
     }
 }
 
+// Runs f(begin, end, half) over [0, n), in two halves on two threads where n is large enough to
+// pay for the second.
+template <class F> void inHalves(size_t n, F&& f) {
+    if (n < 65536 || std::thread::hardware_concurrency() < 2) {
+        f(size_t(0), n, 0);
+        return;
+    }
+    std::thread helper([&] { f(n / 2, n, 1); });
+    f(size_t(0), n / 2, 0);
+    helper.join();
+}
+
 } // namespace
 
 Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<uint32_t>& quadEdges,
@@ -471,14 +483,17 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
     // sees it in: across its normal, a basis right-handed with it (Duff et al. 2017).
     std::vector<uint64_t> key(dualVertices);
     std::vector<glm::vec3> view(2 * dualVertices);
-    for (size_t v = 0; v < dualVertices; ++v) {
-        const glm::vec3 c = glm::max(glm::floor((mesh.positions[v] - origin) / h), 0.0f);
-        key[v] = uint64_t(c.x) | uint64_t(c.y) << 21 | uint64_t(c.z) << 42;
-        const glm::vec3 n = mesh.normals[v];
-        const float sign = std::copysign(1.0f, n.z), a = -1.0f / (sign + n.z), b = n.x * n.y * a;
-        view[2 * v] = glm::vec3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
-        view[2 * v + 1] = glm::vec3(b, sign + n.y * n.y * a, -n.y);
-    }
+    inHalves(dualVertices, [&](size_t begin, size_t end, int) {
+        for (size_t v = begin; v < end; ++v) {
+            const glm::vec3 c = glm::max(glm::floor((mesh.positions[v] - origin) / h), 0.0f);
+            key[v] = uint64_t(c.x) | uint64_t(c.y) << 21 | uint64_t(c.z) << 42;
+            const glm::vec3 n = mesh.normals[v];
+            const float sign = std::copysign(1.0f, n.z), a = -1.0f / (sign + n.z);
+            const float b = n.x * n.y * a;
+            view[2 * v] = glm::vec3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
+            view[2 * v + 1] = glm::vec3(b, sign + n.y * n.y * a, -n.y);
+        }
+    });
     // cellOf[v]: v, or for a vertex that shares its cell (`shared`: several pieces of surface,
     // or copies for sheets that touch), the first vertex of the cell, which names it. The pieces
     // of a cell come one after another (the dual pass writes them so), the copies after all.
@@ -541,19 +556,12 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
     }
     {
         std::vector<uint8_t> state[2];
-        auto range = [&](int part, size_t begin, size_t end) {
-            state[part].assign(dualVertices, 0);
+        state[1].assign(dualVertices, 0);
+        inHalves(quads, [&](size_t begin, size_t end, int part) {
+            if (part == 0) state[0].assign(dualVertices, 0);
             for (size_t q = begin; q < end; ++q)
                 starWedges(mesh, quad(q), view, margin, state[part]);
-        };
-        if (quads < 65536 || std::thread::hardware_concurrency() < 2) {
-            range(0, 0, quads);
-            state[1].assign(dualVertices, 0);
-        } else {
-            std::thread helper(range, 1, quads / 2, quads);
-            range(0, 0, quads / 2);
-            helper.join();
-        }
+        });
         for (size_t v = 0; v < dualVertices; ++v) {
             const unsigned a = state[0][v], b = state[1][v];
             if (((a | b) & kFolds) || (a & kWraps) + (b & kWraps) != 1) near[v] = 1;

@@ -216,7 +216,7 @@ SelfIntersections findSelfIntersections(const Mesh& mesh, double tolerance, doub
                 for (int x = c0.x; x <= c1.x; ++x)
                     listed.push_back({key({x, y, z}), t});
     }
-    const bool twoThreads = listed.size() >= 100000 && std::thread::hardware_concurrency() >= 2;
+    const bool twoThreads = listed.size() >= 30000 && std::thread::hardware_concurrency() >= 2;
     if (twoThreads) { // each half sorted by a thread of its own, then merged
         const auto half = listed.begin() + ptrdiff_t(listed.size() / 2);
         std::thread helper([&] { std::sort(half, listed.end()); });
