@@ -404,6 +404,10 @@ size_t splitTouchingSheets(Mesh& mesh) {
 
 namespace {
 
+bool finite(glm::vec3 v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
 // kInset in shaders/mesh_triangles.comp: how far vertices keep from their cells' faces, in cells.
 constexpr float kInset = 0.005f;
 
@@ -516,21 +520,48 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
             if (group[i - 1].first == group[i].first)
                 cellOf[group[i].second] = cellOf[group[i - 1].second];
     }
-    // Quad q's edge point, kept off the ends of its grid edge (the edge that its four cells lie
-    // around: along the axis on which their places agree) by kInset of a cell, as the vertices
-    // are kept off their cells' faces: where a sample lies on the surface, the points of all its
-    // crossed edges lie there, and the pieces of the cells around it would meet at one point.
+    // Quad q's edge point on its grid edge (the edge that its four cells lie around: along the
+    // axis on which their places agree, at the greater of their places across it), kept off the
+    // edge's ends by kInset of a cell, as the vertices are kept off their cells' faces: where a
+    // sample lies on the surface, the points of all its crossed edges lie there, and the pieces
+    // of the cells around it would meet at one point. Where the vertices pass found no point on
+    // the edge (a few come back far off it, or not numbers), the edge's middle.
     auto edgePosition = [&](uint32_t q) {
         const std::array<uint32_t, 4> c = cornersOf(&mesh.indices[6 * size_t(q)]);
+        auto at = [&](uint32_t v, int k) { return (key[v] >> (21 * k)) & 0x1fffff; };
         int axis = 0;
+        for (int k = 0; k < 3; ++k)
+            if (at(c[0], k) == at(c[1], k) && at(c[0], k) == at(c[2], k) &&
+                at(c[0], k) == at(c[3], k))
+                axis = k;
+        const glm::vec3 point = edge(q).position;
+        glm::vec3 p;
         for (int k = 0; k < 3; ++k) {
-            auto at = [&](uint32_t v) { return (key[v] >> (21 * k)) & 0x1fffff; };
-            if (at(c[0]) == at(c[1]) && at(c[0]) == at(c[2]) && at(c[0]) == at(c[3])) axis = k;
+            const uint64_t line = std::max({at(c[0], k), at(c[1], k), at(c[2], k), at(c[3], k)});
+            const float lo = origin[k] + float(line) * h;
+            if (k != axis) // the shader's own rounding of the grid line, where it is one
+                p[k] = std::abs(point[k] - lo) <= 1e-3f * h ? point[k] : lo;
+            else
+                p[k] = std::isfinite(point[k])
+                           ? std::clamp(point[k], lo + kInset * h, lo + (1.0f - kInset) * h)
+                           : lo + 0.5f * h;
         }
-        const float lo = origin[axis] + float((key[c[0]] >> (21 * axis)) & 0x1fffff) * h;
-        glm::vec3 p = edge(q).position;
-        p[axis] = std::clamp(p[axis], lo + kInset * h, lo + (1.0f - kInset) * h);
         return p;
+    };
+    // Its normal and colour, or where they are not numbers, its vertices' mean normal and the
+    // first one's colour.
+    auto edgeNormal = [&](uint32_t q) {
+        const glm::vec3 n = edge(q).normal;
+        if (finite(n) && glm::dot(n, n) > 0.5f) return n;
+        glm::vec3 sum(0.0f);
+        for (uint32_t v : cornersOf(&mesh.indices[6 * size_t(q)]))
+            sum += mesh.normals[v];
+        return glm::length(sum) > 0.0f ? glm::normalize(sum) : glm::vec3(0.0f, 0.0f, 1.0f);
+    };
+    auto edgeColor = [&](uint32_t q) {
+        const EdgePoint& e = edge(q);
+        const glm::vec3 rgb(e.red, e.green, e.blue);
+        return finite(rgb) ? rgb : mesh.colors[mesh.indices[6 * size_t(q)]];
     };
     std::vector<uint8_t> marked(dualVertices, 0); // by cell, at the vertex that names it
     auto isMarked = [&](uint32_t v) { return marked[cellOf[v]] != 0; };
@@ -570,7 +601,6 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
 
     // The quads around each vertex of a marked cell, (vertex, quad) sorted, remade each round.
     std::vector<std::pair<uint32_t, uint32_t>> around;
-    auto colorOf = [](const EdgePoint& p) { return glm::vec3(p.red, p.green, p.blue); };
     auto addVertex = [&](glm::vec3 p, glm::vec3 n, glm::vec3 c) {
         mesh.positions.push_back(p);
         mesh.normals.push_back(n);
@@ -597,19 +627,17 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
             }
         }
         if (found != 1) return UINT32_MAX;
-        const EdgePoint &e = edge(q), &o = edge(other);
         const glm::vec3 between = 0.5f * (edgePosition(q) + edgePosition(other));
-        const glm::vec3 n = e.normal + o.normal;
-        const uint32_t f =
-            addVertex(between, glm::length(n) > 0.0f ? glm::normalize(n) : e.normal, colorOf(e));
+        const glm::vec3 n = edgeNormal(q) + edgeNormal(other);
+        const uint32_t f = addVertex(
+            between, glm::length(n) > 0.0f ? glm::normalize(n) : edgeNormal(q), edgeColor(q));
         facePoints.emplace(side, f);
         return f;
     };
     std::unordered_map<uint32_t, uint32_t> edgePoints; // quad -> E
     auto edgeOf = [&](uint32_t q) {
         if (auto it = edgePoints.find(q); it != edgePoints.end()) return it->second;
-        const EdgePoint& p = edge(q);
-        const uint32_t e = addVertex(edgePosition(q), p.normal, colorOf(p));
+        const uint32_t e = addVertex(edgePosition(q), edgeNormal(q), edgeColor(q));
         edgePoints.emplace(q, e);
         return e;
     };
