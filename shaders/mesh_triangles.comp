@@ -433,13 +433,17 @@ void emitQuads(uint slot, uvec3 brick) {
         uvec3 t0 = inside ? uvec3(q0, q1, q2) : uvec3(q0, q3, q2);
         uvec3 t1 = inside ? uvec3(q0, q2, q3) : uvec3(q0, q2, q1);
         t1 = axis == 0u ? t1 : axis == 1u ? t1.yzx : t1.zxy;
-        uint o = (first + 2u * i) * 3u;
+        // Seven words per quad: its triangles, then its edge point's number in the edge data,
+        // which the host splits the quad at where its triangles cross others
+        // (separateCrossings in mesh_dual.cpp).
+        uint o = (first / 2u + i) * 7u;
         indices[o + 0u] = t0.x;
         indices[o + 1u] = t0.y;
         indices[o + 2u] = t0.z;
         indices[o + 3u] = t1.x;
         indices[o + 4u] = t1.y;
         indices[o + 5u] = t1.z;
+        indices[o + 6u] = vertexIndex(uvec3(l), edgeAt(uvec3(0u), axis));
     }
 }
 

@@ -293,7 +293,9 @@ ReferenceMesh referenceDualMeshOf(const Distance& distance, const Color& color,
     Mesh& mesh = out.mesh;
     auto cellIndex = [&](glm::uvec3 c) { return (size_t(c.z) * n.y + c.y) * n.x + c.x; };
     std::vector<uint32_t> firstVertex(size_t(n.x) * n.y * n.z, 0);
-    std::vector<glm::vec3> smooth; // per vertex: the mean of its edge points
+    std::vector<glm::vec3> smooth;             // per vertex: the mean of its edge points
+    std::vector<detail::EdgePoint> edgePoints; // per quad: its edge point, numbered in quadEdges
+    std::vector<uint32_t> quadEdges;
     for (uint32_t z = 0; z < n.z; ++z)
         for (uint32_t y = 0; y < n.y; ++y)
             for (uint32_t x = 0; x < n.x; ++x) {
@@ -368,8 +370,18 @@ ReferenceMesh referenceDualMeshOf(const Distance& distance, const Color& color,
                     uint32_t* t = quad[field.inside(s) ? 1 : 0];
                     std::rotate(t + 3, t + 3 + axis, t + 6); // names the axis (foldQuads)
                     mesh.indices.insert(mesh.indices.end(), t, t + 6);
+                    const uint32_t k = field.point(s, axis);
+                    const glm::vec3 c = field.points.colors[k];
+                    quadEdges.push_back(uint32_t(edgePoints.size()));
+                    edgePoints.push_back({field.points.positions[k], c.r, field.points.normals[k],
+                                          c.g, field.others[k], c.b});
                 }
+    // The host steps of Extraction::finish() in engine/src/mesh/mesh.cpp.
     detail::foldQuads(mesh, smooth, distance, grid.voxelSize);
+    const size_t copiesFrom = mesh.vertexCount();
+    detail::splitTouchingSheets(mesh);
+    detail::separateCrossings(mesh, copiesFrom, quadEdges, edgePoints.data(), grid.origin,
+                              grid.voxelSize);
     out.surfaceCut = field.surfaceCut;
     return out;
 }

@@ -131,7 +131,7 @@ TEST_F(MeshTest, PrintabilityOfAnalyticSolids) {
 }
 
 // A mesh with triangles, every one usable, every edge shared by two of them in opposite
-// directions.
+// directions, and no two meeting but where they share a side or a vertex.
 void expectClosedManifold(const Mesh& mesh) {
     const MeshProperties m = measureMesh(mesh);
     EXPECT_GT(m.triangles, 0u);
@@ -139,6 +139,8 @@ void expectClosedManifold(const Mesh& mesh) {
     EXPECT_EQ(m.boundaryEdges, 0u) << m.str();
     EXPECT_EQ(m.nonManifoldEdges, 0u) << m.str();
     EXPECT_EQ(m.misorientedEdges, 0u) << m.str();
+    const SelfIntersections crossings = findSelfIntersections(mesh);
+    EXPECT_EQ(crossings.total(), 0u) << crossings.str();
 }
 
 // About `count` small primitives of random kinds, sizes, places and turns (sheets often thinner
@@ -203,9 +205,10 @@ Scene smallPrimitives(uint32_t seed, int count) {
     return makeScene(unite(std::move(parts)), "<small primitives " + std::to_string(seed) + ">");
 }
 
-// Every such scene meshes closed, manifold and consistently oriented at resolutions odd and even,
-// including where two sheets touch across a cell's face (splitTouchingSheets): 40 scenes of about
-// 180 nodes (one tape kernel for all) at 5 resolutions; SDFCSG_MESH_SEEDS=N runs N scenes
+// Every such scene meshes closed, manifold, consistently oriented and without self-intersections
+// at resolutions odd and even, including where two sheets touch across a cell's face
+// (splitTouchingSheets) and where cells of several vertices cross (separateCrossings): 40 scenes of
+// about 180 nodes (one tape kernel for all) at 5 resolutions; SDFCSG_MESH_SEEDS=N runs N scenes
 // (docs/robustness.md, "Mesh properties").
 TEST_F(MeshTest, ManySmallPrimitivesMeshClosedAndManifoldAtEveryResolution) {
     const char* seeds = std::getenv("SDFCSG_MESH_SEEDS");
@@ -271,7 +274,7 @@ std::string randomTreeJson(std::mt19937& rng, int depth) {
 }
 
 // Seeded random trees of every kind and operation (randomTreeJson), meshed at odd resolutions:
-// closed, manifold and consistently oriented every time.
+// closed, manifold, consistently oriented and without self-intersections every time.
 TEST_F(MeshTest, RandomTreesOfEveryKindMeshClosedAndManifold) {
     const char* seeds = std::getenv("SDFCSG_MESH_SEEDS");
     const uint32_t count = seeds ? uint32_t(std::strtoul(seeds, nullptr, 10)) : 24u;
@@ -577,6 +580,34 @@ TEST_F(MeshTest, BenchmarkScenesAreClosedAndManifoldAtTheBenchmarkResolutions) {
             EXPECT_FALSE(stats.surfaceCut);
             expectClosedManifold(*mesh);
         }
+    }
+}
+
+// A thousand small primitives in smooth groups (assets/bench/groups_1k.json), many of them
+// smaller than a cell at these resolutions, whose cells hold several pieces of surface: dual
+// contouring's triangles crossed there (37 and 171 pairs at 75 and 101 before the quads around
+// them were split into pieces inside their cells, separateCrossings in mesh_dual.cpp). No pair
+// meets now, the mesh is still closed and manifold, and the split adds edge and face points,
+// which lie within the cell's diagonal of the surface like every vertex.
+TEST_F(MeshTest, CellsOfSeveralPiecesMeshWithoutSelfIntersections) {
+    const Scene scene =
+        loadOrDie(std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/bench/groups_1k.json");
+    const Evaluator evaluator(scene);
+    auto mesher = Mesher::create(context(), scene);
+    ASSERT_TRUE(mesher) << mesher.error().str();
+    for (uint32_t resolution : {75u, 101u}) {
+        SCOPED_TRACE("at " + std::to_string(resolution));
+        MeshOptions options;
+        options.resolution = resolution;
+        MeshStats stats;
+        auto mesh = (*mesher)->extract(options, &stats);
+        ASSERT_TRUE(mesh) << mesh.error().str();
+        EXPECT_FALSE(stats.surfaceCut);
+        expectClosedManifold(*mesh);
+        float worst = 0.0f;
+        for (const glm::vec3& p : mesh->positions)
+            worst = std::max(worst, std::abs(evaluator.prunedDistance(p)));
+        EXPECT_LE(worst, std::sqrt(3.0f) * stats.voxelSize);
     }
 }
 

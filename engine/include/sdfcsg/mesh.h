@@ -13,7 +13,10 @@
 //   Flat faces stay flat, and the sharp edges and corners of the solid stay sharp. Where a
 //   sharp edge runs close along a grid line or plane, vertices of cells on both sides can land
 //   on it and cross over; a quad that then faces against its vertices' normals has its vertices
-//   moved to the mean of their edge points instead (smooth there, as surface nets are).
+//   moved to the mean of their edge points instead (smooth there, as surface nets are). Where
+//   triangles still cross, as in cells of several pieces of surface (parts smaller than a
+//   cell), the quads around those cells are split into triangles that each lie inside one
+//   cell, through the edge points and points on the cells' faces, so that none crosses another.
 // Either way the mesh is indexed and welded by construction and, wherever the surface lies
 // inside the bounds, closed and manifold, with triangles wound counter-clockwise seen from
 // outside.

@@ -58,6 +58,9 @@ constexpr uint64_t kBytesPerActive = 4 + SDFCSG_MESH_RECORD * 4 + 16 + 16;
 constexpr uint64_t kBytesPerBatchBrick = 4 * (SDFCSG_MESH_BRICK_BLOCK + SDFCSG_MESH_BRICK_EDGES);
 constexpr uint64_t kBytesPerVertex = 12 * 4 * 2; // GPU output and host mesh (or edge data)
 constexpr uint64_t kBytesPerTriangle = 3 * 4 * 2;
+// Dual contouring: seven words per quad of two triangles on the GPU, and six plus the number of
+// its edge point on the host.
+constexpr uint64_t kBytesPerDualTriangle = 14 + 14;
 // The normal at an edge point, from four taps this many cells from its centre; for dual
 // contouring also around centres kDualNormalOffset cells off the point either way (see
 // placeVertices() in shaders/mesh_field.comp), whose taps must keep clear of the planes that
@@ -607,7 +610,8 @@ struct Extraction {
     std::vector<glm::uvec4> bases;
     glm::u64vec4 totals{0};
     Mesh mesh;
-    std::vector<glm::vec3> smooth; // dual contouring: where foldQuads moves folding vertices
+    std::vector<glm::vec3> smooth;   // dual contouring: where foldQuads moves folding vertices
+    std::vector<uint32_t> quadEdges; // dual contouring: each quad's edge point in the edge data
 
     void stage(const char* name, Clock::time_point t0) {
         const double seconds = secondsSince(t0);
@@ -749,7 +753,7 @@ Status Extraction::classify(MeshPush& push) {
     if (!progress(1)) return cancelled();
 
     const uint64_t meshBytes = dual ? totals.x * kBytesPerVertex + totals.z * kBytesPerVertex +
-                                          totals.w * kBytesPerTriangle
+                                          totals.w * kBytesPerDualTriangle
                                     : totals.x * kBytesPerVertex + totals.y * kBytesPerTriangle;
     if (totals.x > UINT32_MAX || totals.z > UINT32_MAX ||
         fixedBytes + meshBytes > options.memoryBudget)
@@ -804,6 +808,7 @@ void Extraction::beginTriangles() {
     mesh.normals.resize(totals.z);
     mesh.colors.resize(totals.z);
     smooth.resize(totals.z);
+    quadEdges.resize(totals.w / 2);
 }
 
 // The triangles (marching cubes) or dual (dual contouring) pass over a batch.
@@ -816,7 +821,10 @@ Status Extraction::triangles(uint32_t batch) {
     push.vertexBase = firstVertex;
 
     auto t0 = Clock::now();
-    if (auto ok = m.reserve(SDFCSG_BINDING_MESH_INDICES, batchTriangles * 12); !ok) return ok;
+    // Dual contouring writes seven words per quad of two triangles (see emitQuads in
+    // shaders/mesh_triangles.comp).
+    if (auto ok = m.reserve(SDFCSG_BINDING_MESH_INDICES, batchTriangles * (dual ? 14 : 12)); !ok)
+        return ok;
     if (dual) {
         if (auto ok = m.reserve(SDFCSG_BINDING_MESH_VERTICES, (endVertex - firstVertex) * 48); !ok)
             return ok;
@@ -836,12 +844,21 @@ Status Extraction::triangles(uint32_t batch) {
             smooth[o] = glm::vec3(v[9], v[10], v[11]);
         }
     }
-    if (batchTriangles > 0) // an empty vector's data() may be null, which memcpy must not get
+    if (dual) {
+        // Each quad's triangles, and the number of its edge point in the edge data.
+        const uint32_t* words = m.mapped<uint32_t>(SDFCSG_BINDING_MESH_INDICES);
+        for (uint64_t q = first / 2; q < end / 2; ++q, words += 7) {
+            std::memcpy(mesh.indices.data() + 6 * q, words, 24);
+            quadEdges[q] = words[6];
+        }
+    } else if (batchTriangles > 0) {
+        // An empty vector's data() may be null, which memcpy must not get.
         std::memcpy(mesh.indices.data() + uint64_t(first) * 3,
                     m.mapped<uint32_t>(SDFCSG_BINDING_MESH_INDICES), batchTriangles * 12);
+    }
     stage("download", t0);
     notePeak(map.size() * 4 + mesh.positions.capacity() * 36 + smooth.capacity() * 12 +
-             mesh.indices.capacity() * 4);
+             mesh.indices.capacity() * 4 + quadEdges.capacity() * 4);
     if (!progress(1)) return cancelled();
     return Ok{};
 }
@@ -862,8 +879,15 @@ void Extraction::finish() {
         detail::foldQuads(mesh, smooth, distance, g.h);
         stage("quads", t0);
         const auto t1 = Clock::now();
+        const size_t copiesFrom = mesh.vertexCount();
         detail::splitTouchingSheets(mesh);
         stage("sheets", t1);
+        const auto t2 = Clock::now();
+        // The edge data, which the vertices pass wrote, lies where the dual pass read it.
+        detail::separateCrossings(mesh, copiesFrom, quadEdges,
+                                  m.mapped<detail::EdgePoint>(SDFCSG_BINDING_MESH_HERMITE),
+                                  g.origin, g.h);
+        stage("crossings", t2);
     }
     // Colour borders, where asked for and where there can be any: the CPU's whole tree is too
     // slow for scenes of pruned tapes, which keep blended vertex colours.

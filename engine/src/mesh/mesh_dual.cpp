@@ -1,11 +1,16 @@
 #include "mesh/mesh_dual.h"
 
+#include "mesh/self_intersections.h"
+
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <thread>
+#include <unordered_map>
 
 namespace sdfcsg::detail {
 
@@ -395,6 +400,354 @@ size_t splitTouchingSheets(Mesh& mesh) {
         }
     }
     return cut;
+}
+
+namespace {
+
+bool finite(glm::vec3 v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+// kInset in shaders/mesh_triangles.comp: how far vertices keep from their cells' faces, in cells.
+constexpr float kInset = 0.005f;
+
+// A quad's corners in order around its edge, from its two triangles as foldQuads() wrote them:
+// (a, b, c), (a, c, d) or (a, b, d), (b, c, d).
+std::array<uint32_t, 4> cornersOf(const uint32_t* t) {
+    return t[3] == t[0] ? std::array<uint32_t, 4>{t[0], t[1], t[2], t[5]}
+                        : std::array<uint32_t, 4>{t[0], t[1], t[4], t[2]};
+}
+
+// starWedges() state per vertex: how many of its quads' wedges hold the first direction of the
+// plane it is seen in, and whether one of its quads folds there.
+constexpr uint8_t kWraps = 0x7f, kFolds = 0x80;
+
+// Quad t (its two triangles as foldQuads() wrote them) seen from each of its corners v along v's
+// normal (`view` holds the plane across it, two vectors per vertex): the quad must lie in the wedge
+// at v between its sides from v, turning less than half a turn counter-clockwise, with its far
+// corner strictly inside and both triangles facing the viewer; else v's state gets kFolds. Where
+// every quad of v does so and the wedges wrap once around v (exactly one holds the plane's first
+// direction, counted in v's state), the quads around v are a disk that the view maps one-to-one:
+// none of them crosses another.
+void starWedges(const Mesh& mesh, const uint32_t* t, const std::vector<glm::vec3>& view,
+                float margin, std::vector<uint8_t>& state) {
+    const std::array<uint32_t, 4> c = cornersOf(t);
+    const bool ac = t[3] == t[0]; // split along a-c, else b-d
+    for (int i = 0; i < 4; ++i) {
+        const uint32_t v = c[size_t(i)];
+        const glm::vec3 p = mesh.positions[v], u = view[2 * size_t(v)], w = view[2 * size_t(v) + 1];
+        auto seen = [&](uint32_t k) {
+            const glm::vec3 d = mesh.positions[k] - p;
+            return glm::vec2(glm::dot(d, u), glm::dot(d, w));
+        };
+        const glm::vec2 next = seen(c[size_t(i + 1) % 4]), far = seen(c[size_t(i + 2) % 4]),
+                        prev = seen(c[size_t(i + 3) % 4]);
+        auto cross = [](glm::vec2 x, glm::vec2 y) { return x.x * y.y - x.y * y.x; };
+        // Each point must lie farther than `margin` from the lines it must not cross, and so
+        // farther from the other quads than the check's tolerance: nearer, it would count as
+        // meeting them.
+        auto apart = [&](glm::vec2 x, glm::vec2 y) {
+            return cross(x, y) >
+                   margin * (std::abs(x.x) + std::abs(x.y) + std::abs(y.x) + std::abs(y.y));
+        };
+        const bool throughV = ac == (i % 2 == 0);
+        const bool opens = apart(next, prev) && apart(next, far) && apart(far, prev) &&
+                           (throughV || apart(far - next, prev - next));
+        if (!opens)
+            state[v] |= kFolds;
+        else if (next.y <= 0.0f && prev.y > 0.0f)
+            ++state[v];
+    }
+}
+
+// Runs f(begin, end, half) over [0, n), in two halves on two threads where n is large enough to
+// pay for the second.
+template <class F> void inHalves(size_t n, F&& f) {
+    if (n < 65536 || std::thread::hardware_concurrency() < 2) {
+        f(size_t(0), n, 0);
+        return;
+    }
+    std::thread helper([&] { f(n / 2, n, 1); });
+    f(size_t(0), n / 2, 0);
+    helper.join();
+}
+
+} // namespace
+
+Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<uint32_t>& quadEdges,
+                             const EdgePoint* points, glm::vec3 origin, float h) {
+    Separation result;
+    const size_t quads = mesh.indices.size() / 6;
+    if (quads == 0 || quadEdges.size() != quads) return result;
+    auto edge = [&](uint32_t q) -> const EdgePoint& { return points[quadEdges[q]]; };
+    const size_t dualVertices = mesh.positions.size();
+    copiesFrom = std::min(copiesFrom, dualVertices);
+    // Each dual vertex's cell (a vertex lies strictly inside its cell, kInset in
+    // shaders/mesh_triangles.comp, so its floor names the cell), and the plane that starWedges()
+    // sees it in: across its normal, a basis right-handed with it (Duff et al. 2017).
+    std::vector<uint64_t> key(dualVertices);
+    std::vector<glm::vec3> view(2 * dualVertices);
+    inHalves(dualVertices, [&](size_t begin, size_t end, int) {
+        for (size_t v = begin; v < end; ++v) {
+            const glm::vec3 c = glm::max(glm::floor((mesh.positions[v] - origin) / h), 0.0f);
+            key[v] = uint64_t(c.x) | uint64_t(c.y) << 21 | uint64_t(c.z) << 42;
+            const glm::vec3 n = mesh.normals[v];
+            const float sign = std::copysign(1.0f, n.z), a = -1.0f / (sign + n.z);
+            const float b = n.x * n.y * a;
+            view[2 * v] = glm::vec3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
+            view[2 * v + 1] = glm::vec3(b, sign + n.y * n.y * a, -n.y);
+        }
+    });
+    // cellOf[v]: v, or for a vertex that shares its cell (`shared`: several pieces of surface,
+    // or copies for sheets that touch), the first vertex of the cell, which names it. The pieces
+    // of a cell come one after another (the dual pass writes them so), the copies after all.
+    std::vector<uint32_t> cellOf(dualVertices);
+    std::vector<uint8_t> shared(dualVertices, 0);
+    std::vector<std::pair<uint64_t, uint32_t>> group; // the shared vertices by cell
+    {
+        std::vector<uint64_t> copied(key.begin() + std::ptrdiff_t(copiesFrom), key.end());
+        std::sort(copied.begin(), copied.end());
+        for (size_t v = 0; v < dualVertices; ++v) {
+            cellOf[v] = uint32_t(v);
+            shared[v] =
+                v >= copiesFrom || (v > 0 && key[v - 1] == key[v]) ||
+                (v + 1 < copiesFrom && key[v + 1] == key[v]) ||
+                (!copied.empty() && std::binary_search(copied.begin(), copied.end(), key[v]));
+            if (shared[v]) group.push_back({key[v], uint32_t(v)});
+        }
+        std::sort(group.begin(), group.end());
+        for (size_t i = 1; i < group.size(); ++i)
+            if (group[i - 1].first == group[i].first)
+                cellOf[group[i].second] = cellOf[group[i - 1].second];
+    }
+    // Quad q's edge point on its grid edge (the edge that its four cells lie around: along the
+    // axis on which their places agree, at the greater of their places across it), kept off the
+    // edge's ends by kInset of a cell, as the vertices are kept off their cells' faces: where a
+    // sample lies on the surface, the points of all its crossed edges lie there, and the pieces
+    // of the cells around it would meet at one point. Where the vertices pass found no point on
+    // the edge (a few come back far off it, or not numbers), the edge's middle.
+    auto edgePosition = [&](uint32_t q) {
+        const std::array<uint32_t, 4> c = cornersOf(&mesh.indices[6 * size_t(q)]);
+        auto at = [&](uint32_t v, int k) { return (key[v] >> (21 * k)) & 0x1fffff; };
+        int axis = 0;
+        for (int k = 0; k < 3; ++k)
+            if (at(c[0], k) == at(c[1], k) && at(c[0], k) == at(c[2], k) &&
+                at(c[0], k) == at(c[3], k))
+                axis = k;
+        const glm::vec3 point = edge(q).position;
+        glm::vec3 p;
+        for (int k = 0; k < 3; ++k) {
+            const uint64_t line = std::max({at(c[0], k), at(c[1], k), at(c[2], k), at(c[3], k)});
+            const float lo = origin[k] + float(line) * h;
+            if (k != axis) // the shader's own rounding of the grid line, where it is one
+                p[k] = std::abs(point[k] - lo) <= 1e-3f * h ? point[k] : lo;
+            else
+                p[k] = std::isfinite(point[k])
+                           ? std::clamp(point[k], lo + kInset * h, lo + (1.0f - kInset) * h)
+                           : lo + 0.5f * h;
+        }
+        return p;
+    };
+    // Its normal and colour, or where they are not numbers, its vertices' mean normal and the
+    // first one's colour.
+    auto edgeNormal = [&](uint32_t q) {
+        const glm::vec3 n = edge(q).normal;
+        if (finite(n) && glm::dot(n, n) > 0.5f) return n;
+        glm::vec3 sum(0.0f);
+        for (uint32_t v : cornersOf(&mesh.indices[6 * size_t(q)]))
+            sum += mesh.normals[v];
+        return glm::length(sum) > 0.0f ? glm::normalize(sum) : glm::vec3(0.0f, 0.0f, 1.0f);
+    };
+    auto edgeColor = [&](uint32_t q) {
+        const EdgePoint& e = edge(q);
+        const glm::vec3 rgb(e.red, e.green, e.blue);
+        return finite(rgb) ? rgb : mesh.colors[mesh.indices[6 * size_t(q)]];
+    };
+    std::vector<uint8_t> marked(dualVertices, 0); // by cell, at the vertex that names it
+    auto isMarked = [&](uint32_t v) { return marked[cellOf[v]] != 0; };
+    auto anyMarked = [&](const std::array<uint32_t, 4>& c) {
+        return isMarked(c[0]) || isMarked(c[1]) || isMarked(c[2]) || isMarked(c[3]);
+    };
+    auto quad = [&](size_t q) { return &mesh.indices[6 * q]; };
+
+    // The quads the check looks at: those with a corner whose quads may cross (`near`). Two
+    // triangles that cross lie in quads that share a cell (a quad's triangles lie inside the four
+    // cells around its edge, its vertices being inside them). Where that cell holds one vertex,
+    // both quads hold it, and they cannot cross where that vertex's quads are seen along its
+    // normal without overlap (starWedges()); where it holds several, each is near.
+    std::vector<uint8_t> near(shared);
+    float margin = 0.0f; // four times the check's tolerance (see findSelfIntersections)
+    {
+        glm::vec3 lo(INFINITY), hi(-INFINITY);
+        for (const glm::vec3& p : mesh.positions) {
+            lo = glm::min(lo, p);
+            hi = glm::max(hi, p);
+        }
+        margin = 4e-6f * glm::length(hi - lo);
+    }
+    {
+        std::vector<uint8_t> state[2];
+        state[1].assign(dualVertices, 0);
+        inHalves(quads, [&](size_t begin, size_t end, int part) {
+            if (part == 0) state[0].assign(dualVertices, 0);
+            for (size_t q = begin; q < end; ++q)
+                starWedges(mesh, quad(q), view, margin, state[part]);
+        });
+        for (size_t v = 0; v < dualVertices; ++v) {
+            const unsigned a = state[0][v], b = state[1][v];
+            if (((a | b) & kFolds) || (a & kWraps) + (b & kWraps) != 1) near[v] = 1;
+        }
+    }
+
+    // The quads around each vertex of a marked cell, (vertex, quad) sorted, remade each round.
+    std::vector<std::pair<uint32_t, uint32_t>> around;
+    auto addVertex = [&](glm::vec3 p, glm::vec3 n, glm::vec3 c) {
+        mesh.positions.push_back(p);
+        mesh.normals.push_back(n);
+        mesh.colors.push_back(c);
+        return uint32_t(mesh.positions.size() - 1);
+    };
+    // The point F on side (a, b) of quad q, halfway between the edge points of q and of the
+    // quad across the side (around the other crossed edge of the face between the cells of a
+    // and b; a point of the face on the chord where the surface crosses it), shared by the two;
+    // none where no single quad lies across. One of a and b lies in a marked cell.
+    std::unordered_map<uint64_t, uint32_t> facePoints; // side (lower << 32 | higher) -> F
+    auto faceOf = [&](uint32_t q, uint32_t a, uint32_t b) -> uint32_t {
+        const uint64_t side = uint64_t(std::min(a, b)) << 32 | std::max(a, b);
+        if (auto it = facePoints.find(side); it != facePoints.end()) return it->second;
+        const uint32_t v = isMarked(a) ? a : b, w = v == a ? b : a;
+        uint32_t other = UINT32_MAX, found = 0;
+        for (auto it = std::lower_bound(around.begin(), around.end(), std::pair{v, 0u});
+             it != around.end() && it->first == v; ++it) {
+            if (it->second == q) continue;
+            const std::array<uint32_t, 4> c = cornersOf(quad(it->second));
+            if (std::find(c.begin(), c.end(), w) != c.end()) {
+                other = it->second;
+                ++found;
+            }
+        }
+        if (found != 1) return UINT32_MAX;
+        const glm::vec3 between = 0.5f * (edgePosition(q) + edgePosition(other));
+        const glm::vec3 n = edgeNormal(q) + edgeNormal(other);
+        const uint32_t f = addVertex(
+            between, glm::length(n) > 0.0f ? glm::normalize(n) : edgeNormal(q), edgeColor(q));
+        facePoints.emplace(side, f);
+        return f;
+    };
+    std::unordered_map<uint32_t, uint32_t> edgePoints; // quad -> E
+    auto edgeOf = [&](uint32_t q) {
+        if (auto it = edgePoints.find(q); it != edgePoints.end()) return it->second;
+        const uint32_t e = addVertex(edgePosition(q), edgeNormal(q), edgeColor(q));
+        edgePoints.emplace(q, e);
+        return e;
+    };
+    // The triangles of quad q under the marks, into `out`: its own two, or its fan from E.
+    auto trianglesOf = [&](uint32_t q, std::vector<uint32_t>& out) {
+        const uint32_t* t = quad(q);
+        const std::array<uint32_t, 4> c = cornersOf(t);
+        if (!anyMarked(c)) {
+            out.insert(out.end(), t, t + 6);
+            return;
+        }
+        const uint32_t e = edgeOf(q);
+        uint32_t polygon[8];
+        int count = 0;
+        for (int k = 0; k < 4; ++k) {
+            const uint32_t a = c[size_t(k)], b = c[size_t(k + 1) % 4];
+            polygon[count++] = a;
+            if (isMarked(a) || isMarked(b))
+                if (const uint32_t f = faceOf(q, a, b); f != UINT32_MAX) polygon[count++] = f;
+        }
+        for (int k = 0; k < count; ++k)
+            out.insert(out.end(), {e, polygon[k], polygon[(k + 1) % count]});
+    };
+
+    // Rounds over the triangles of the quads near others, in a mesh of their own that shares
+    // the positions (`probe`); the whole mesh takes the split quads at the end. After the
+    // first, a round checks only the quads that share a cell with a split one (`split`, their
+    // corners `reach`): the others are as the first round found them, apart.
+    std::vector<uint32_t> probe, split;
+    std::vector<uint8_t> reach;
+    std::vector<std::pair<uint32_t, uint32_t>> pairs;
+    constexpr size_t kRounds = 6;
+    for (size_t round = 0;; ++round) {
+        const std::vector<uint8_t>& checked = round == 0 ? near : reach;
+        probe.clear();
+        for (uint32_t q = 0; q < quads; ++q) {
+            const std::array<uint32_t, 4> c = cornersOf(quad(q));
+            if (checked[c[0]] || checked[c[1]] || checked[c[2]] || checked[c[3]])
+                trianglesOf(q, probe);
+        }
+        pairs.clear();
+        if (!probe.empty()) {
+            std::swap(mesh.indices, probe);
+            findSelfIntersections(mesh, -1.0, 1e-3, &pairs);
+            std::swap(mesh.indices, probe);
+        }
+        result.remaining = pairs.size();
+        if (pairs.empty() || round == kRounds) break;
+        size_t newly = 0;
+        for (const auto& [a, b] : pairs)
+            for (uint32_t t : {a, b})
+                for (int k = 0; k < 3; ++k)
+                    if (const uint32_t v = probe[3 * size_t(t) + size_t(k)];
+                        v < dualVertices && !isMarked(v)) {
+                        marked[cellOf[v]] = 1;
+                        ++newly;
+                    }
+        if (newly == 0) break; // what crosses lies in cells already split
+        result.cells += newly;
+        result.rounds = round + 1;
+        // A marked cell with several vertices (pieces of surface, or copies of one vertex for
+        // two sheets that touch): each goes to the mean of its quads' edge points, inside the
+        // convex hull of its loop of chords, where its fan then stays; loops whose hulls are
+        // apart give fans that are apart.
+        around.clear();
+        split.clear();
+        if (reach.empty()) reach.assign(dualVertices, 0);
+        std::vector<std::pair<uint32_t, glm::vec3>> sums; // vertex, its quads' edge points
+        for (uint32_t q = 0; q < quads; ++q) {
+            const std::array<uint32_t, 4> c = cornersOf(quad(q));
+            if (!anyMarked(c)) continue;
+            split.push_back(q);
+            for (uint32_t v : c) {
+                reach[v] = 1;
+                if (!isMarked(v)) continue;
+                around.push_back({v, q});
+                if (shared[v]) sums.push_back({v, edgePosition(q)});
+            }
+        }
+        // A reached cell of several vertices is reached at all of them.
+        for (const auto& [k, v] : group)
+            if (reach[v]) reach[cellOf[v]] = 1;
+        for (const auto& [k, v] : group)
+            if (reach[cellOf[v]]) reach[v] = 1;
+        std::sort(around.begin(), around.end());
+        std::stable_sort(sums.begin(), sums.end(),
+                         [](const auto& x, const auto& y) { return x.first < y.first; });
+        for (size_t k = 0; k < sums.size();) {
+            size_t end = k;
+            glm::vec3 sum(0.0f);
+            for (; end < sums.size() && sums[end].first == sums[k].first; ++end)
+                sum += sums[end].second;
+            mesh.positions[sums[k].first] = sum / float(end - k);
+            k = end;
+        }
+    }
+    // The split quads into the mesh: each its first two triangles in its own place, the rest at
+    // the end. All fans are made before any quad is written over: making one reads others.
+    std::vector<uint32_t> fans, ends;
+    for (uint32_t q : split) {
+        trianglesOf(q, fans);
+        ends.push_back(uint32_t(fans.size()));
+    }
+    for (size_t i = 0, begin = 0; i < split.size(); begin = ends[i++]) {
+        std::copy(fans.begin() + std::ptrdiff_t(begin), fans.begin() + std::ptrdiff_t(begin + 6),
+                  quad(split[i]));
+        mesh.indices.insert(mesh.indices.end(), fans.begin() + std::ptrdiff_t(begin + 6),
+                            fans.begin() + ends[i]);
+    }
+    return result;
 }
 
 } // namespace sdfcsg::detail

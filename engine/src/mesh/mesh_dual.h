@@ -39,4 +39,44 @@ void foldQuads(Mesh& mesh, const std::vector<glm::vec3>& smooth, const Distance&
 // many edges were cut.
 size_t splitTouchingSheets(Mesh& mesh);
 
+// A point where a grid edge crosses the surface, as the vertices pass writes it
+// (shaders/mesh_field.comp): its position and colour, its normal, and a second normal where it
+// lies on a sharp edge.
+struct EdgePoint {
+    glm::vec3 position;
+    float red;
+    glm::vec3 normal;
+    float green;
+    glm::vec3 other;
+    float blue;
+};
+static_assert(sizeof(EdgePoint) == 48);
+
+// What separateCrossings() did: its rounds, the cells it split, and the pairs of triangles that
+// still cross (in cells it could not make embedded, as one vertex serving two sheets).
+struct Separation {
+    size_t rounds = 0, cells = 0, remaining = 0;
+};
+
+// Splits the quads around crossing triangles into pieces that each lie in one cell (Ju and
+// Udeshi, "Intersection-free contouring on an octree grid", 2006), where the check finds
+// crossings. `mesh` holds the quads as foldQuads() and splitTouchingSheets() left them, two
+// triangles each, and from `copiesFrom` on the copies that splitTouchingSheets() made;
+// `quadEdges` numbers each quad's edge point in `points` (kept off the ends of its grid edge);
+// `origin` and `h` are the grid's corner and cell edge.
+// A marked cell's quads become fans from their edge point E around the polygon of their four
+// vertices with, between two vertices of which one lies in a marked cell, the point F on the
+// face between the two cells, halfway between the edge points of the two quads that share that
+// side: each triangle (E, F, v) then lies in v's cell, and the triangles of one vertex form a fan
+// from a point inside its (convex) cell to a loop of chords on the cell's faces, which is
+// embedded. A marked cell's vertices, where it has several, move to the means of their loops'
+// edge points, so that loops whose hulls are apart give fans that are apart. Triangles (E, v, w)
+// of two unmarked vertices stay in the box of their two cells, and quads with no marked cell keep
+// their two triangles, sharp features included. Rounds repeat, marking the cells of the vertices
+// of triangles that still cross, until none do or a few rounds have passed. Only the quads around
+// cells of several vertices and around vertices whose quads may cross (starWedges() in
+// mesh_dual.cpp) are checked, so that meshes with nothing to fix pay little.
+Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<uint32_t>& quadEdges,
+                             const EdgePoint* points, glm::vec3 origin, float h);
+
 } // namespace sdfcsg::detail

@@ -228,7 +228,7 @@ SelfIntersections findSelfIntersections(const Mesh& mesh, double tolerance, doub
                     listed.push_back({key({x, y, z}), t});
     }
     // Listed in the order of the triangles, so that the stable sort keeps each cell's in it.
-    const bool twoThreads = listed.size() >= 100000 && std::thread::hardware_concurrency() >= 2;
+    const bool twoThreads = listed.size() >= 30000 && std::thread::hardware_concurrency() >= 2;
     radixSort(listed, 0, bx + by + bz,
               [](const std::pair<uint64_t, uint32_t>& entry) { return entry.first; });
     // The grown bounds of listed[i] in single precision, rounded outwards, side by side in the

@@ -44,7 +44,7 @@ struct SelfIntersections {
 // as degenerate. `tolerance` defaults to 1e-6 of the diagonal of the mesh's bounds, above the
 // rounding of float positions and far below any feature a mesher should make. `pairs`, if
 // given, receives every pair found (triangle numbers), in the same order however many threads
-// search (two, on meshes of some 30,000 triangles or more). Most pairs near each other are told
+// search (two, on meshes of some 10,000 triangles or more). Most pairs near each other are told
 // apart by a plane between them, by quick proofs that skip only pairs the exact tests would pass;
 // `quick` false leaves every pair to the exact tests (for the tests to compare).
 SelfIntersections findSelfIntersections(const Mesh& mesh, double tolerance = -1.0,
