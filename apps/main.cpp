@@ -278,9 +278,9 @@ int cmdRender(int argc, char** argv) {
     sdfcsg::ContextOptions contextOptions;
     contextOptions.device = args.get("--device");
     if (args.has("--validation")) contextOptions.validation = 1;
+    catchInterrupts(); // from here on, an interruption is reported (the watchdog's grace)
     auto context = sdfcsg::Context::create(contextOptions);
     if (!context) return fail(context.error());
-    catchInterrupts();
     auto renderer = sdfcsg::Renderer::create(**context, *scene, rendererOptions);
     if (!renderer) return fail(renderer.error());
     auto image = [&] {
@@ -512,6 +512,7 @@ int cmdMesh(int argc, char** argv) {
 
     sdfcsg::Evaluation evaluation = sdfcsg::Evaluation::Auto;
     if (!parseEvaluation(args, "mesh", evaluation)) return kUsage;
+    catchInterrupts(); // from here on, an interruption is reported (the watchdog's grace)
     auto scene = load(args.positional[0]);
     if (!scene) return fail(scene.error());
     if (auto fits = sdfcsg::checkEvaluation(*scene, evaluation); !fits) return fail(fits.error());
@@ -520,7 +521,6 @@ int cmdMesh(int argc, char** argv) {
     if (args.has("--validation")) contextOptions.validation = 1;
     auto context = sdfcsg::Context::create(contextOptions);
     if (!context) return fail(context.error());
-    catchInterrupts();
     auto t0 = Clock::now();
     auto mesher = sdfcsg::Mesher::create(**context, *scene, evaluation);
     if (!mesher) return fail(mesher.error());
