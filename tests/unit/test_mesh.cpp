@@ -143,6 +143,20 @@ void expectClosedManifold(const Mesh& mesh) {
     EXPECT_EQ(crossings.total(), 0u) << crossings.str();
 }
 
+// The mesher's scene at each resolution: inside the bounds, and expectClosedManifold().
+void expectClosedAtEach(Mesher& mesher, std::initializer_list<uint32_t> resolutions) {
+    for (uint32_t resolution : resolutions) {
+        SCOPED_TRACE("at " + std::to_string(resolution));
+        MeshOptions options;
+        options.resolution = resolution;
+        MeshStats stats;
+        auto mesh = mesher.extract(options, &stats);
+        ASSERT_TRUE(mesh) << mesh.error().str();
+        EXPECT_FALSE(stats.surfaceCut);
+        expectClosedManifold(*mesh);
+    }
+}
+
 // About `count` small primitives of random kinds, sizes, places and turns (sheets often thinner
 // than a cell among them), in sharp unions and smooth groups, with a few cut away: two sheets
 // meet across cells' faces all over such scenes.
@@ -293,16 +307,7 @@ TEST_F(MeshTest, RandomTreesOfEveryKindMeshClosedAndManifold) {
         const Scene scene = sceneFrom(json);
         auto mesher = Mesher::create(context(), scene);
         ASSERT_TRUE(mesher) << mesher.error().str();
-        for (uint32_t resolution : {37u, 64u, 96u, 131u}) {
-            SCOPED_TRACE("at " + std::to_string(resolution));
-            MeshOptions options;
-            options.resolution = resolution;
-            MeshStats stats;
-            auto mesh = (*mesher)->extract(options, &stats);
-            ASSERT_TRUE(mesh) << mesh.error().str();
-            EXPECT_FALSE(stats.surfaceCut);
-            expectClosedManifold(*mesh);
-        }
+        expectClosedAtEach(**mesher, {37u, 64u, 96u, 131u});
     }
 }
 
@@ -570,16 +575,7 @@ TEST_F(MeshTest, BenchmarkScenesAreClosedAndManifoldAtTheBenchmarkResolutions) {
         const Scene scene = loadOrDie(dir / (std::string(name) + ".json"));
         auto mesher = Mesher::create(context(), scene);
         ASSERT_TRUE(mesher) << mesher.error().str();
-        for (uint32_t resolution : {128u, 256u, 512u}) {
-            SCOPED_TRACE("at " + std::to_string(resolution));
-            MeshOptions options;
-            options.resolution = resolution;
-            MeshStats stats;
-            auto mesh = (*mesher)->extract(options, &stats);
-            ASSERT_TRUE(mesh) << mesh.error().str();
-            EXPECT_FALSE(stats.surfaceCut);
-            expectClosedManifold(*mesh);
-        }
+        expectClosedAtEach(**mesher, {128u, 256u, 512u});
     }
 }
 
