@@ -3,8 +3,8 @@
 // crosses a horizontal (and a vertical) line at most once. Word 0 tells the layout, word 1 holds
 // the outline's box (lo xy, hi xy); the two give the node's kernel parameters (eval.cpp).
 //
-// A small outline (at most kGridOutlineWords) is listed by contour, for a loop over all of it or
-// for code that writes it out (codegen.cpp): word 0 is (0, contours, 0, 0); from word 2, per
+// A small outline (at most kGridOutlineWords) is listed by contour, for a loop over all of it:
+// word 0 is (0, contours, 0, 0); from word 2, per
 // contour its box and (first segment from word 2, lines, -, quadratics), then its lines, a word
 // each (a, b), then its quadratics, two each ((a, b), (c, -)).
 //
