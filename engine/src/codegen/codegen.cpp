@@ -10,6 +10,7 @@
 #include "codegen/gpu_nodes.h"
 #include "field/prune.h"
 #include "field/sdf.h"
+#include "scene/outline.h"
 
 #include <algorithm>
 #include <array>
@@ -76,12 +77,14 @@ class Emitter {
         }
     }
 
-    // The buffer-mode wrappers, e.g. `float boxNode(uint i, vec3 p)`, for the kinds in use. Every
-    // mode reads polygon and text outlines from the node buffer: written out as code, a
-    // 13-character text took glslang and llvmpipe 4 to 16 s and 500 MB to compile, and its
-    // frame was no faster.
+    // The buffer-mode wrappers, e.g. `float boxNode(uint i, vec3 p)`, for the kinds in use; with
+    // values inlined, the outlines written out as code.
     void helpers() {
-        if (lit_) return;
+        if (lit_) {
+            for (uint32_t i = 0; i < scene_.nodes.size(); ++i)
+                if (inlinedOutline(i)) outlineFunction(i);
+            return;
+        }
         std::array<bool, kNodeKindCount> used{};
         for (const Node& n : scene_.nodes)
             used[size_t(n.kind)] = true;
@@ -170,6 +173,55 @@ class Emitter {
 
   private:
     void indent(uint32_t depth) { out_.append(4 * (depth + 1), ' '); }
+
+    // Whether node i's outline (polygon, text) is written out as code: a small one, listed by
+    // contour (outline.h) in at most kInlinedOutlineWords, whose loops would read every segment
+    // from the node buffer, which costs a CPU device (lavapipe) about ten times the frame
+    // (a revolved polygon of 12 or 35 points), while written out they are literals. A larger
+    // one is read from the buffer: written out, the code grows faster than the loop's cost
+    // (a 13-character text took 4 to 16 s and 500 MB to compile, and drew slower than the loop).
+    bool inlinedOutline(uint32_t i) const {
+        const Node& n = scene_.nodes[i];
+        return lit_ && n.outline && (*n.outline)[0].x == 0.0f &&
+               n.outline->size() <= detail::kInlinedOutlineWords;
+    }
+
+    static std::string vec2Literal(float x, float y) {
+        std::string s;
+        const float v[2] = {x, y};
+        appendVector(s, v, 2);
+        return s;
+    }
+
+    // sdOutline (shaders/sdf.glsl) unrolled over node i's outline: `float outline<i>(vec3 p)`.
+    void outlineFunction(uint32_t i) {
+        const glm::vec4* w = scene_.nodes[i].outline->data() + 2; // the contours
+        out_ += "float outline" + std::to_string(i) +
+                "(vec3 p3) {\n    vec2 p = p3.xy;\n    float best = 1e30, winding = 0.0;\n"
+                "    bool holds;\n";
+        const uint32_t contours = uint32_t(w[1].z);
+        for (uint32_t g = 0; g < contours; ++g) {
+            const glm::vec4 box = w[2 * g], range = w[2 * g + 1];
+            out_ += "    holds = all(greaterThanEqual(p, " + vec2Literal(box.x, box.y) +
+                    ")) && all(lessThanEqual(p, " + vec2Literal(box.z, box.w) + "));\n";
+            uint32_t at = uint32_t(range.x);
+            for (uint32_t s = 0; s < uint32_t(range.y); ++s, ++at) {
+                const std::string a = vec2Literal(w[at].x, w[at].y),
+                                  b = vec2Literal(w[at].z, w[at].w);
+                out_ += "    if (holds) winding += lineCrossing(p, " + a + ", " + b + ");\n";
+                out_ += "    best = min(best, sqSegment2(p, " + a + ", " + b + "));\n";
+            }
+            for (uint32_t s = 0; s < uint32_t(range.w); ++s, at += 2) {
+                const std::string a = vec2Literal(w[at].x, w[at].y),
+                                  b = vec2Literal(w[at].z, w[at].w),
+                                  c = vec2Literal(w[at + 1].x, w[at + 1].y);
+                out_ += "    if (holds) winding += quadraticCrossing(p, " + a + ", " + c + ", " +
+                        b + ");\n";
+                out_ += "    best = min(best, sqQuadratic2(p, " + a + ", " + c + ", " + b + "));\n";
+            }
+        }
+        out_ += "    return winding != 0.0 ? -sqrt(best) : sqrt(best);\n}\n\n";
+    }
 
     // The point the code at hand evaluates at: p, or inside domain operations the candidate
     // point of the innermost one.
@@ -365,10 +417,12 @@ class Emitter {
             out_ += ", ";
         }
         const KindInfo& info = kindInfo(scene_.nodes[i].kind);
-        out_ += std::string(info.function) + '(';
+        const bool outline = inlinedOutline(i); // its data is in the function's code
+        out_ += outline ? "outline" + std::to_string(i) : std::string(info.function);
+        out_ += '(';
         localPoint(i, point());
         const float params[8] = {g.p0.x, g.p0.y, g.p0.z, g.p0.w, g.p1.x, g.p1.y, g.p1.z, g.p1.w};
-        for (const KernelArg& arg : info.args) {
+        for (const KernelArg& arg : outline ? std::span<const KernelArg>{} : info.args) {
             out_ += ", ";
             appendVector(out_, params + arg.slot, arg.count);
         }
