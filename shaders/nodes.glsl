@@ -5,6 +5,7 @@ struct Node {
     vec4 p0, p1;           // kernel parameters (half extents etc.), see kernelParams() in sdf.h
     vec4 color;            // rgb resolved colour; w: accumulated scale (world = scale * local)
     vec4 bmin;             // xyz: world bounds minimum; w: smooth radius in world units
+                           // (primitives: 1 where the value is floored at the bounds)
     vec4 bmax;             // xyz: world bounds maximum; w: blend profile (sdf.glsl)
 };
 
@@ -32,6 +33,14 @@ float boundsDistance(vec3 bmin, vec3 bmax, vec3 p) {
 
 float nodeBoundsDistance(uint i, vec3 p) {
     return boundsDistance(nodes[i].bmin.xyz, nodes[i].bmax.xyz, p);
+}
+
+// Primitive i's value d at p, floored at its bounds' signed distance where it is flagged (a scale
+// that differs per axis: FlatNode::boundsFloor in sdfcsg/eval.h). A branch, not a select: the
+// flag is the same for every lane, and most primitives lack it.
+float floorAtBounds(uint i, vec3 p, float d) {
+    if (nodes[i].bmin.w != 0.0) d = max(d, nodeBoundsDistance(i, p));
+    return d;
 }
 
 // Helpers for the generated scene code (engine/src/codegen/codegen.cpp), which also defines one

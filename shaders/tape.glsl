@@ -38,8 +38,9 @@ float tapePrimitive(uint kind, uint i, vec3 p) {
         return length(p - ball.xyz) - ball.w;
     }
 #endif
-    return sdPrimitive(kind, toLocal(i, p), nodes[i].p0, nodes[i].p1, SDFCSG_TAPE_KINDS) *
-           nodes[i].color.w;
+    return floorAtBounds(
+        i, p, sdPrimitive(kind, toLocal(i, p), nodes[i].p0, nodes[i].p1, SDFCSG_TAPE_KINDS) *
+                  nodes[i].color.w);
 }
 
 const uint kTapeUnion = kKindUnion, kTapeIntersection = kKindIntersection;

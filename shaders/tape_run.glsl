@@ -94,7 +94,7 @@ TAPE_VALUE TAPE_RUN(uint begin, uint end, vec3 p) {
             } else {
                 float v = domainFinish(k, local[depth], TAPE_DIST(best[depth]), TAPE_A(i),
                                        TAPE_B(i)) * TAPE_SCALE(i);
-                if (domainClamps(k)) v = max(v, nodeBoundsDistance(i, outer[depth]));
+                v = max(v, nodeBoundsDistance(i, outer[depth])); // eval.cpp's floor
                 stack[++top] = acc;
                 acc = TAPE_WITH(best[depth], v);
                 p = outer[depth];

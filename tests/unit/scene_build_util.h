@@ -1,6 +1,7 @@
 // Scenes built in code for the evaluator and code generator tests: a small tree literal that
-// flattens into Scene's pre-order node array, a seeded random scene generator, a scene from its
-// root node's JSON, and seeded random points.
+// flattens into Scene's pre-order node array, seeded random scene generators (of Booleans over
+// common primitives, and as JSON of every kind of the node table), a scene from its root node's
+// JSON, and seeded random points.
 #pragma once
 
 #include <sdfcsg/scene.h>
@@ -12,6 +13,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <initializer_list>
 #include <optional>
@@ -232,6 +234,79 @@ inline Scene randomScene(uint32_t seed, int count, int maxDepth = 6, bool planes
         top.push_back(build(build, 1));
     return makeScene(unite(std::move(top), uni(0.0f, 0.3f)),
                      "<random " + std::to_string(seed) + ">");
+}
+
+// What randomTreeJson() draws besides its trees of every kind.
+struct TreeOptions {
+    bool scalesPerAxis = false; // half the nodes scaled by a factor per axis
+    bool planes = false;        // planes among the primitives: unbounded solids, clipping ones
+};
+
+// A random tree of every kind of the node table but the text (slow to compile) and, unless
+// options.planes, the plane (unbounded), each from its example in the table (sdfcsg/nodes.h),
+// turned, moved and scaled at random: operations over random subtrees (Booleans sharp or with
+// their example's blend), 2D profiles under extrude or revolve, primitives at the leaves.
+inline std::string randomTreeJson(std::mt19937& rng, int depth, const TreeOptions& options = {}) {
+    auto uni = [&](float a, float b) { return std::uniform_real_distribution<float>(a, b)(rng); };
+    std::vector<const KindInfo*> primitives, profiles, operations;
+    for (const KindInfo& k : nodeKinds()) {
+        if ((k.kind == NodeKind::Plane && !options.planes) || k.kind == NodeKind::Text) continue;
+        (isProfile(k.kind) ? profiles : k.operation ? operations : primitives).push_back(&k);
+    }
+    auto pick = [&](const std::vector<const KindInfo*>& from) { return from[rng() % from.size()]; };
+    // A profile moves and turns in its plane only: its cross-section at z = 0 is what counts.
+    auto node = [&](const KindInfo& k, const std::string& members, const std::string& children) {
+        const bool flat = isProfile(k.kind);
+        char transform[200];
+        std::snprintf(transform, sizeof transform,
+                      R"(, "translate": [%.3f, %.3f, %.3f], "rotate": [%.1f, %.1f, %.1f], )"
+                      R"("scale": %.3f)",
+                      uni(-0.4f, 0.4f), uni(-0.4f, 0.4f), flat ? 0.0f : uni(-0.4f, 0.4f),
+                      flat ? 0.0f : uni(-180, 180), flat ? 0.0f : uni(-180, 180), uni(-180, 180),
+                      uni(0.45f, 0.8f));
+        std::string json = R"({"type": ")" + std::string(k.name) + "\"";
+        if (!members.empty()) json += ", " + members;
+        if (!children.empty()) json += R"(, "children": [)" + children + "]";
+        json += transform;
+        if (options.scalesPerAxis && rng() % 2) {
+            // The factors of the last two axes, after the first's (a profile's z scales nothing).
+            char factors[64];
+            std::snprintf(factors, sizeof factors, ", %.3f, %.3f]", uni(0.45f, 0.8f),
+                          uni(0.45f, 0.8f));
+            json.insert(json.rfind(' ') + 1, "[");
+            json += factors;
+        }
+        return json + "}";
+    };
+    if (depth == 0 || rng() % 3 == 0) {
+        const KindInfo& leaf = *pick(primitives);
+        return node(leaf, std::string(leaf.example), "");
+    }
+    const KindInfo& op = *pick(operations);
+    if (op.kind == NodeKind::Extrude || op.kind == NodeKind::Revolve) {
+        const KindInfo& profile = *pick(profiles);
+        return node(op, std::string(op.example), node(profile, std::string(profile.example), ""));
+    }
+    std::string children = randomTreeJson(rng, depth - 1, options);
+    std::string members(op.example);
+    if (op.role == Role::Boolean) {
+        children += ", " + randomTreeJson(rng, depth - 1, options);
+        if (rng() % 2) members.clear(); // sharp
+    }
+    return node(op, members, children);
+}
+
+// A scene of four random trees of depth 3 (randomTreeJson) side by side in a union, as JSON.
+inline std::string randomTreesJson(uint32_t seed, const TreeOptions& options = {}) {
+    std::mt19937 rng(seed);
+    std::string json = R"({"version": 1, "root": {"type": "union", "children": [)";
+    for (int part = 0; part < 4; ++part) {
+        char at[96];
+        std::snprintf(at, sizeof at, R"({"type": "union", "translate": [%d, %d, 0], "children": [)",
+                      part % 2 * 2 - 1, part / 2 * 2 - 1);
+        json += (part ? ", " : "") + std::string(at) + randomTreeJson(rng, 3, options) + "]}";
+    }
+    return json + "]}}";
 }
 
 // The bundled scenes, assets/scenes/*.json, sorted by name.

@@ -184,6 +184,47 @@ TEST(Eval, BoundsAreLowerBounds) {
     }
 }
 
+// Scenes whose values would fall below their boxes' distance but for the floor of the bounds:
+// scales that differ per axis, on a primitive or on an operation (the field is the local one
+// times the smallest factor, so far along the largest it grows more slowly than the box's
+// distance); a repetition whose copies reach past their neighbours (its value is capped by the
+// distance to the copies it leaves out); random trees of every kind scaled per axis.
+std::vector<Scene> stretchedScenes() {
+    std::vector<Scene> scenes = {
+        parseRoot(R"({"type": "union", "scale": [1, 0.5, 2], "rotate": [20, 35, 10], "children": [
+            {"type": "box", "size": [1, 0.6, 0.8]},
+            {"type": "sphere", "radius": 0.5, "translate": [1, 0.5, 0]},
+            {"type": "torus", "major_radius": 0.6, "minor_radius": 0.2, "translate": [-0.8, 0, 0.5]}
+            ]})"),
+        parseRoot(R"({"type": "union", "children": [{"type": "sphere", "radius": 0.3},
+            {"type": "repeat", "count": [6, 1, 1], "spacing": [0.5, 1, 1], "children": [
+                {"type": "box", "size": [0.9, 0.3, 0.3]}]}]})"),
+    };
+    for (uint32_t seed = 1; seed <= 8; ++seed) {
+        const std::string name = "<random trees " + std::to_string(seed) + ">";
+        auto scene = parseScene(randomTreesJson(seed, {.scalesPerAxis = true}), name);
+        EXPECT_TRUE(scene) << scene.error().str();
+        if (scene) scenes.push_back(std::move(*scene));
+    }
+    return scenes;
+}
+
+TEST(Eval, BoundsAreLowerBoundsWhereScalesDifferPerAxis) {
+    for (const Scene& scene : stretchedScenes()) {
+        SCOPED_TRACE(scene.file);
+        Evaluator eval(scene);
+        std::vector<glm::vec3> points = randomPoints(9, 600, reach(eval));
+        for (uint32_t i = 0; i < eval.nodes().size(); ++i) {
+            const Aabb& box = eval.nodes()[i].bounds;
+            if (eval.nodes()[i].frame != kWorldFrame) continue;
+            for (glm::vec3 p : points)
+                ASSERT_GE(eval.distance(p, i), box.signedDistance(p) - 1e-5f)
+                    << "node " << i << " (" << kindInfo(eval.nodes()[i].kind).name << ") at " << p.x
+                    << " " << p.y << " " << p.z;
+        }
+    }
+}
+
 // Points on each node's own surface (found by Newton steps along the numerical gradient) lie in
 // its box.
 TEST(Eval, BoundsContainTheSurface) {
@@ -344,6 +385,8 @@ TEST(Eval, SkippingGivesIdenticalValues) {
     std::vector<Scene> scenes = bundledScenes();
     for (uint32_t seed = 20; seed < 40; ++seed)
         scenes.push_back(randomScene(seed, 60, 6, seed % 2 == 0));
+    for (Scene& scene : stretchedScenes())
+        scenes.push_back(std::move(scene));
     for (const Scene& scene : scenes) {
         Evaluator on(scene), off(scene);
         off.setBoundsSkipping(false);

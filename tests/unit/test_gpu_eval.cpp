@@ -154,6 +154,23 @@ TEST_F(GpuEval, BlendProfilesMatchTheCpu) {
     }
 }
 
+// An operation scaled per axis and turned: its operands' fields are their local ones times the
+// smallest factor, below their boxes' distance but for the floor of the bounds, so that the
+// kernels that skip by those boxes, those that do not and the CPU agree; and a repetition whose
+// copies reach past their neighbours (its value capped by the copies it leaves out).
+TEST_F(GpuEval, ScalesPerAxisAndRepetitionsMatchTheCpu) {
+    Scene scene = parseOrDie(R"({"version": 1, "root": {"type": "union", "children": [
+        {"type": "union", "scale": [1, 0.5, 2], "rotate": [20, 35, 10], "children": [
+            {"type": "box", "size": [1, 0.6, 0.8], "color": [0.9, 0.3, 0.1]},
+            {"type": "sphere", "radius": 0.5, "translate": [1, 0.5, 0]},
+            {"type": "torus", "major_radius": 0.6, "minor_radius": 0.2, "translate": [-0.8, 0, 0.5]}
+            ]},
+        {"type": "repeat", "count": [6, 1, 1], "spacing": [0.5, 1, 1], "translate": [0, 2, 0],
+         "children": [{"type": "box", "size": [0.9, 0.3, 0.3], "color": [0.1, 0.4, 0.9]}]}]}})");
+    ASSERT_FALSE(scene.nodes.empty());
+    expectGpuMatchesCpu(context(), scene, 4096);
+}
+
 class BundledEval : public GpuTest, public ::testing::WithParamInterface<fs::path> {};
 
 TEST_P(BundledEval, MatchesTheCpu) {

@@ -242,67 +242,13 @@ TEST_F(MeshTest, ManySmallPrimitivesMeshClosedAndManifoldAtEveryResolution) {
     }
 }
 
-// A random tree of every kind of the node table but the plane and text (unbounded; slow to
-// compile), each from its example in the table (sdfcsg/nodes.h), turned, moved and scaled at
-// random: operations over random subtrees (Booleans sharp or with their example's blend), 2D
-// profiles under extrude or revolve, primitives at the leaves.
-std::string randomTreeJson(std::mt19937& rng, int depth) {
-    auto uni = [&](float a, float b) { return std::uniform_real_distribution<float>(a, b)(rng); };
-    std::vector<const KindInfo*> primitives, profiles, operations;
-    for (const KindInfo& k : nodeKinds()) {
-        if (k.kind == NodeKind::Plane || k.kind == NodeKind::Text) continue;
-        (isProfile(k.kind) ? profiles : k.operation ? operations : primitives).push_back(&k);
-    }
-    auto pick = [&](const std::vector<const KindInfo*>& from) { return from[rng() % from.size()]; };
-    // A profile moves and turns in its plane only: its cross-section at z = 0 is what counts.
-    auto node = [&](const KindInfo& k, const std::string& members, const std::string& children) {
-        const bool flat = isProfile(k.kind);
-        char transform[160];
-        std::snprintf(transform, sizeof transform,
-                      R"(, "translate": [%.3f, %.3f, %.3f], "rotate": [%.1f, %.1f, %.1f], )"
-                      R"("scale": %.3f)",
-                      uni(-0.4f, 0.4f), uni(-0.4f, 0.4f), flat ? 0.0f : uni(-0.4f, 0.4f),
-                      flat ? 0.0f : uni(-180, 180), flat ? 0.0f : uni(-180, 180), uni(-180, 180),
-                      uni(0.45f, 0.8f));
-        std::string json = R"({"type": ")" + std::string(k.name) + "\"";
-        if (!members.empty()) json += ", " + members;
-        if (!children.empty()) json += R"(, "children": [)" + children + "]";
-        return json + transform + "}";
-    };
-    if (depth == 0 || rng() % 3 == 0) {
-        const KindInfo& leaf = *pick(primitives);
-        return node(leaf, std::string(leaf.example), "");
-    }
-    const KindInfo& op = *pick(operations);
-    if (op.kind == NodeKind::Extrude || op.kind == NodeKind::Revolve) {
-        const KindInfo& profile = *pick(profiles);
-        return node(op, std::string(op.example), node(profile, std::string(profile.example), ""));
-    }
-    std::string children = randomTreeJson(rng, depth - 1);
-    std::string members(op.example);
-    if (op.role == Role::Boolean) {
-        children += ", " + randomTreeJson(rng, depth - 1);
-        if (rng() % 2) members.clear(); // sharp
-    }
-    return node(op, members, children);
-}
-
 // Seeded random trees of every kind and operation (randomTreeJson), meshed at odd resolutions:
 // closed, manifold, consistently oriented and without self-intersections every time.
 TEST_F(MeshTest, RandomTreesOfEveryKindMeshClosedAndManifold) {
     const char* seeds = std::getenv("SDFCSG_MESH_SEEDS");
     const uint32_t count = seeds ? uint32_t(std::strtoul(seeds, nullptr, 10)) : 24u;
     for (uint32_t seed = 0; seed < count; ++seed) {
-        std::mt19937 rng(1000 + seed);
-        std::string json = R"({"version": 1, "root": {"type": "union", "children": [)";
-        for (int part = 0; part < 4; ++part) {
-            char at[96];
-            std::snprintf(at, sizeof at,
-                          R"({"type": "union", "translate": [%d, %d, 0], "children": [)",
-                          part % 2 * 2 - 1, part / 2 * 2 - 1);
-            json += (part ? ", " : "") + std::string(at) + randomTreeJson(rng, 3) + "]}";
-        }
-        json += "]}}";
+        const std::string json = randomTreesJson(1000 + seed);
         SCOPED_TRACE("seed " + std::to_string(seed) + ": " + json);
         const Scene scene = sceneFrom(json);
         auto mesher = Mesher::create(context(), scene);

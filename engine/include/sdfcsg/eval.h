@@ -49,6 +49,10 @@ struct FlatNode {
     std::array<float, kMaxParams> params; // the kernel's parameters (half extents, unit normal,
                                           // ...): KindInfo::kernel and ::kernelAround
     Aabb bounds; // bounds in the frame; the node's value at p is >= bounds.signedDistance(p)
+    // Primitives: the value is the larger of the formula's and bounds.signedDistance(p), which
+    // the formula alone would fall below (a scale that differs per axis). Domain operations'
+    // values always are.
+    bool boundsFloor = false;
     std::vector<uint32_t> children;
     // Polygon and text: Node::outline; the parameters then hold the glyph count (slot 1) and
     // the outline's extents (slots 2-5).

@@ -92,7 +92,7 @@ class Emitter {
             if (info.operation || !used[size_t(info.kind)]) continue;
             out_ += "float ";
             out_ += info.name;
-            out_ += "Node(uint i, vec3 p) {\n    return ";
+            out_ += "Node(uint i, vec3 p) {\n    return floorAtBounds(i, p, ";
             out_ += info.function;
             out_ += "(toLocal(i, p)";
             for (const KernelArg& arg : info.args) {
@@ -101,7 +101,7 @@ class Emitter {
                 out_ += '.';
                 out_ += swizzle(arg.slot, arg.count);
             }
-            out_ += ") * nodes[i].color.w;\n}\n";
+            out_ += ") * nodes[i].color.w);\n}\n";
         }
         out_ += '\n';
     }
@@ -328,8 +328,6 @@ class Emitter {
     }
 
     void closeDomain(uint32_t i, uint32_t child, uint32_t depth) {
-        const Node& n = scene_.nodes[i];
-        const uint32_t kind = uint32_t(n.kind);
         points_.pop_back();
         const std::string level = std::to_string(points_.size());
         const std::string local = "l" + level, best = "b" + level;
@@ -355,8 +353,7 @@ class Emitter {
             value += " * ";
             appendFloat(value, (*lit_)[i].color.w);
         }
-        if (sdf::domainClamps(kind))
-            value = "max(" + value + ", " + boundsDistanceOf(i, point()) + ")";
+        value = "max(" + value + ", " + boundsDistanceOf(i, point()) + ")"; // eval.cpp's floor
         indent(depth + 1);
         var(i);
         out_ += " = ";
@@ -418,6 +415,8 @@ class Emitter {
         }
         const KindInfo& info = kindInfo(scene_.nodes[i].kind);
         const bool outline = inlinedOutline(i); // its data is in the function's code
+        const bool floored = g.bmin.w != 0.0f;  // FlatNode::boundsFloor
+        if (floored) out_ += "max(";
         out_ += outline ? "outline" + std::to_string(i) : std::string(info.function);
         out_ += '(';
         localPoint(i, point());
@@ -431,6 +430,7 @@ class Emitter {
             out_ += " * ";
             appendFloat(out_, g.color.w);
         }
+        if (floored) out_ += ", " + boundsDistanceOf(i, point()) + ")";
         if (sample_) out_ += ')';
     }
 

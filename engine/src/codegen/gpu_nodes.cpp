@@ -30,7 +30,10 @@ std::vector<GpuNode> packNodes(const Evaluator& evaluator) {
         g.p0 = glm::vec4(n.params[0], n.params[1], n.params[2], n.params[3]);
         g.p1 = glm::vec4(n.params[4], n.params[5], n.params[6], n.params[7]);
         g.color = glm::vec4(n.color, n.scale);
-        g.bmin = glm::vec4(clampHuge(n.bounds.min), n.smooth);
+        // Primitives: w is 1 where the value is floored at the bounds (FlatNode::boundsFloor).
+        const bool primitive = kindInfo(n.kind).role == Role::Primitive;
+        g.bmin = glm::vec4(clampHuge(n.bounds.min),
+                           primitive ? (n.boundsFloor ? 1.0f : 0.0f) : n.smooth);
         // Domain operations: w holds their child's index, whose bounds the tape machine reads.
         const bool domain = kindInfo(n.kind).role == Role::Domain;
         g.bmax = glm::vec4(clampHuge(n.bounds.max), domain ? float(n.children[0]) : float(n.blend));

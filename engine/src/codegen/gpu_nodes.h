@@ -10,7 +10,8 @@
 
 namespace sdfcsg::detail {
 
-// std430 layout of `struct Node` in shaders/nodes.glsl; keep the two in step.
+// std430 layout of `struct Node` in shaders/nodes.glsl; keep the two in step. A primitive has no
+// blend radius: its bmin.w is 1 where its value is floored at its bounds (FlatNode::boundsFloor).
 struct GpuNode {
     glm::vec4 row0, row1, row2; // world -> local affine rows: local.x = dot(row0, vec4(p, 1))
     glm::vec4 p0, p1;           // kernel parameters, slots 0..3 and 4..7 (sdf::kernelParams)

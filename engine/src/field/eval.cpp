@@ -132,6 +132,7 @@ template <class V> V leaf(const FlatNode& n, glm::vec3 p) {
     float d = sdf::evalPrimitive(n.kind, localPoint(n, p), n.params,
                                  n.outline ? n.outline->data() : nullptr) *
               n.scale;
+    if (n.boundsFloor) d = std::max(d, n.bounds.signedDistance(p));
     if constexpr (std::is_same_v<V, float>)
         return d;
     else
@@ -176,7 +177,12 @@ template <class V> V withDistance(V v, float d) {
 // k beyond the running value, a subtrahend when they lie at least k beyond its negation; with
 // sdf.glsl's exact operator ends, the skipped operand could not have changed the result. A
 // domain operation evaluates its child at each of its candidate points (sdf.glsl, domainPoint)
-// whose bounds could lower the least value so far, as shaders/tape.glsl does.
+// whose bounds could lower the least value so far, as shaders/tape.glsl does, and its value is
+// floored at its bounds' signed distance: a repetition's is capped by the distance to the
+// copies it leaves out, a stretching operation's divided by its Lipschitz bound, a scale per
+// axis multiplies any by its smallest factor, and every one of them grows more slowly than the
+// box's distance somewhere. The floor keeps the value a distance bound of the same sign (the
+// box holds the solid), and makes it what the skipping above relies on.
 template <class V>
 V evaluate(const std::vector<FlatNode>& nodes, uint32_t root, glm::vec3 p, bool skipping) {
     struct Frame {
@@ -236,7 +242,7 @@ V evaluate(const std::vector<FlatNode>& nodes, uint32_t root, glm::vec3 p, bool 
                 }
                 float d = sdf::domainFinish(kind, f.local, dist(f.acc), kernelA(op), kernelB(op)) *
                           op.scale;
-                if (sdf::domainClamps(kind)) d = std::max(d, op.bounds.signedDistance(f.outer));
+                d = std::max(d, op.bounds.signedDistance(f.outer));
                 value = withDistance(f.acc, d);
                 p = f.outer;
                 stack.pop_back();
@@ -303,6 +309,7 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
         glm::dvec3 offset{0.0},
             origin{0.0}; // local = toLocal*p + offset; world = toWorld*l + origin
         double scale = 1.0;
+        bool uneven = false; // some scale on the way differs per axis
     };
     const Acc identity;
     std::vector<Acc> acc(count);
@@ -334,6 +341,7 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
         a.toWorld = up.toWorld * (r * scaling);
         a.origin = up.toWorld * t + up.origin;
         a.scale = up.scale * std::min({s.x, s.y, s.z});
+        a.uneven = up.uneven || s.x != s.y || s.y != s.z;
 
         FlatNode& n = nodes_[i];
         n.kind = src.kind;
@@ -341,6 +349,9 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
         n.toLocal = glm::mat3(a.toLocal);
         n.offset = glm::vec3(a.offset);
         n.scale = float(a.scale);
+        // Times the smallest factor, a field grows more slowly than its box's distance along
+        // the other axes (at 1/2 of it along the largest of factors 1 and 2).
+        n.boundsFloor = !isOperation(src.kind) && a.uneven;
         n.color = src.color ? *src.color : upNode ? upNode->color : kDefaultColor;
         n.params = sdf::kernelParams(src.kind, src.params);
         if (hasOutline(src.kind)) {
