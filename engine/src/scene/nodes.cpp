@@ -1,5 +1,8 @@
 #include "sdfcsg/nodes.h"
 
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
 #include <algorithm>
 #include <cmath>
 
@@ -233,7 +236,26 @@ constexpr ParamInfo kText[] = {
      false,
      {1, 0, 0},
      "length",
-     "Font size: the height of the font's em square (capitals are about 0.7 of it)."},
+     "Font size: the height of the font's em square (capitals are about 0.7 of it). Give "
+     "size, width or height, not two of them."},
+    {"width",
+     Number,
+     Positive,
+     1,
+     false,
+     {0, 0, 0},
+     "length",
+     "The width of the text's ink (its outlines' extents, spaces at the ends left out): the "
+     "font size that makes it so, instead of size."},
+    {"height",
+     Number,
+     Positive,
+     2,
+     false,
+     {0, 0, 0},
+     "length",
+     "The height of the text's ink, from the lowest descender to the highest glyph top of this "
+     "text: the font size that makes it so, instead of size."},
     {"font",
      Text,
      Any,
@@ -406,6 +428,40 @@ constexpr ParamInfo kTaper[] = {
      {},
      "factor",
      "Scale of x and z at y = +height/2 (1 at y = -height/2)."},
+};
+constexpr std::string_view kEases[] = {"linear", "smoothstep", "smootherstep"};
+constexpr ParamInfo kBendLinear[] = {
+    {"p0",
+     Vec3,
+     Any,
+     0,
+     false,
+     {0, 0, 0},
+     "point",
+     "Where the offset starts: points whose projection on the line through p0 and p1 falls "
+     "before p0 are not moved."},
+    {"p1",
+     Vec3,
+     Any,
+     3,
+     true,
+     {},
+     "point",
+     "Where the offset is complete: points whose projection falls beyond p1 move by all of it. "
+     "Not p0."},
+    {"offset", Vec3, Any, 6, true, {}, "length", "How far the child moves at p1 and beyond."},
+    {"ease",
+     Choice,
+     Any,
+     9,
+     false,
+     {1, 0, 0},
+     "profile",
+     "How the offset grows from p0 to p1: \"linear\" (kinks at both ends), \"smoothstep\" "
+     "(an S, 3 t^2 - 2 t^3: steepest, 1.5 times the linear slope, half way) or "
+     "\"smootherstep\" (6 t^5 - 15 t^4 + 10 t^3: smoother ends, 1.875 times the slope).",
+     3.4e38f,
+     kEases},
 };
 
 // Kernel parameters and local bounds (see KindInfo::kernel and ::bounds).
@@ -903,6 +959,31 @@ constexpr KindInfo kKinds[] = {
          const float least = std::min({scale(lo.y), scale(hi.y), 1.0f, top});
          const float slope = std::abs(top - 1.0f) / (2.0f * hh);
          return std::max(1.0f / least, 1.0f) + reach(lo, hi) * slope / (least * least);
+     }},
+    {NodeKind::BendLinear,
+     "bend_linear",
+     true,
+     kBendLinear,
+     "Its child moved by part of the offset that grows, along the line from p0 to p1, from none "
+     "to all of it: an S-shaped jog in a bar, a kink in a pipe. A point whose projection on "
+     "that line lies the fraction t of the way from p0 to p1 (clamped to 0..1) sees the child "
+     "at itself less offset times ease(t). The field is divided by the map's Lipschitz bound, "
+     "1 + |offset| ease' / |p1 - p0| (ease' the ease's steepest slope).",
+     R"("p0": [-0.5, 0, 0], "p1": [0.5, 0, 0], "offset": [0, 0.4, 0], "ease": "smoothstep")",
+     {},
+     {},
+     nullptr,
+     nullptr,
+     Role::Domain,
+     [](const Params& v, vec3, vec3) -> Params {
+         const vec3 p0(v[0], v[1], v[2]), axis = vec3(v[3], v[4], v[5]) - p0;
+         const vec3 u = axis / glm::dot(axis, axis);
+         return {u.x, u.y, u.z, glm::dot(p0, u), v[6], v[7], v[8], v[9]};
+     },
+     [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
+         // The child's points move by the offset times ease(t), which lies in 0..1.
+         const vec3 offset(k[4], k[5], k[6]);
+         outLo = glm::min(lo, lo + offset), outHi = glm::max(hi, hi + offset);
      }},
     {NodeKind::Extrude,
      "extrude",
