@@ -257,6 +257,41 @@ TEST_F(MeshTest, RandomTreesOfEveryKindMeshClosedAndManifold) {
     }
 }
 
+// The grid of the default bounds hugs the solid: along every axis where the solid is bounded,
+// its size is within 5% of the solid's true size (sampled over the grid's box) plus the margin
+// of cells the mesher adds on either side and a cell of rounding; for every bundled scene, and
+// for scenes whose operands' boxes are far larger than their solid (clippedScenes: an
+// intersection of two offset boxes, a woven mat, a storage box cut by planes).
+TEST_F(MeshTest, GridHugsTheSolid) {
+    std::vector<Scene> scenes = clippedScenes();
+    for (const auto& path : bundledScenePaths())
+        scenes.push_back(loadOrDie(path));
+    for (const Scene& scene : scenes) {
+        SCOPED_TRACE(scene.file);
+        const Evaluator evaluator(scene);
+        MeshOptions options;
+        options.resolution = 64;
+        MeshStats stats;
+        extract(scene, options, &stats);
+        const Aabb& grid = stats.bounds;
+        const float margin = 2.0f * stats.voxelSize; // resolution / 32 cells (planGrid)
+        float spacing = 0.0f;
+        const Aabb solid = sampledSolid(evaluator, grid, 80, spacing);
+        ASSERT_FALSE(solid.empty());
+        for (int a = 0; a < 3; ++a) {
+            if (!std::isfinite(evaluator.solidBounds().min[a]) ||
+                !std::isfinite(evaluator.solidBounds().max[a]))
+                continue; // a ground plane: the grid frames the finite parts
+            const float size = solid.max[a] - solid.min[a];
+            EXPECT_LE(grid.max[a] - grid.min[a],
+                      1.05f * size + 2.0f * margin + stats.voxelSize + 2.0f * spacing)
+                << "axis " << a;
+            EXPECT_LE(grid.min[a], solid.min[a]) << "axis " << a;
+            EXPECT_GE(grid.max[a], solid.max[a]) << "axis " << a;
+        }
+    }
+}
+
 TEST_F(MeshTest, TorusHasEulerCharacteristicZero) {
     const Scene scene = sceneFrom(R"({"version": 1, "root": {"type": "torus",
         "major_radius": 0.7, "minor_radius": 0.25, "rotate": [30, 0, 20]}})");

@@ -85,10 +85,12 @@ class Evaluator {
     // Bounds of the whole solid; infinite along axes where a plane reaches. The evaluation
     // skips by them: the field is at least their box's signed distance.
     const Aabb& bounds() const { return nodes_[0].bounds; }
-    // The box the solid lies in, within bounds() and tighter where a Boolean operation allows:
-    // an intersection within the overlap of its operands' boxes, a difference within its first
-    // operand's. The field may be below its signed distance, so nothing skips by it; framing
-    // and the mesh grid take it.
+    // The box the solid lies in, within bounds() and tighter where the operations allow: an
+    // intersection within the overlap of its operands' boxes, clipped by the half-spaces of its
+    // planes; a difference within its first operand's, less what a subtracted box or plane
+    // removes from it; a twist or polar repetition within its child's radius about the y axis.
+    // The field may be below its signed distance, so nothing skips by it; framing and the mesh
+    // grid take it.
     const Aabb& solidBounds() const { return solidBounds_; }
     // The finite box the solid lies in, as tight as the bounds know it: bounds() on every side
     // where they are finite (a difference lies within its first operand, whatever it subtracts),
