@@ -545,7 +545,11 @@ TEST(Eval, DeepTreesNeedNoRecursion) {
 }
 
 TEST(Eval, FrameCameraSeesTheWholeScene) {
-    for (const Scene& scene : {primitiveGallery(), randomScene(3, 30)}) {
+    std::vector<Scene> scenes = {primitiveGallery(), randomScene(3, 30)};
+    for (Scene& scene : clippedScenes())
+        scenes.push_back(std::move(scene));
+    for (const Scene& scene : scenes) {
+        SCOPED_TRACE(scene.file);
         Evaluator eval(scene);
         for (float aspect : {0.5f, 1.0f, 16.0f / 9.0f}) {
             Camera cam = frameCamera(eval, aspect, 40.0f);
@@ -554,34 +558,53 @@ TEST(Eval, FrameCameraSeesTheWholeScene) {
             glm::vec3 up = glm::cross(right, forward);
             EXPECT_GT(cam.eye.z - cam.target.z, 0.0f) << "looks from the front";
             EXPECT_GT(cam.eye.y - cam.target.y, 0.0f) << "looks from above";
+            EXPECT_GT(cam.eye.x - cam.target.x, 0.0f) << "looks from the right";
             float tanV = std::tan(glm::radians(20.0f)), tanH = tanV * aspect;
-            // Every corner of the scene's box is in view; with a plane making that infinite,
-            // every corner of every finite primitive's box.
-            std::vector<Aabb> boxes;
-            if (eval.bounds().finite())
-                boxes.push_back(eval.bounds());
-            else
-                for (const FlatNode& n : eval.nodes())
-                    if (!kindInfo(n.kind).operation && n.bounds.finite() && n.frame == kWorldFrame)
-                        boxes.push_back(n.bounds);
-            ASSERT_FALSE(boxes.empty());
-            for (const Aabb& b : boxes) {
-                for (int c = 0; c < 8; ++c) {
-                    glm::vec3 corner(c & 1 ? b.max.x : b.min.x, c & 2 ? b.max.y : b.min.y,
-                                     c & 4 ? b.max.z : b.min.z);
-                    glm::vec3 v = corner - cam.eye;
-                    float z = glm::dot(v, forward);
-                    ASSERT_GT(z, 0.0f);
-                    EXPECT_LE(std::abs(glm::dot(v, right)) / z, tanH);
-                    EXPECT_LE(std::abs(glm::dot(v, up)) / z, tanV);
-                }
+            // Every corner of the box the solid lies in is in view, and some corner is near
+            // the view's edge (the solid fills the picture).
+            const Aabb b = eval.finiteBounds();
+            float fill = 0.0f;
+            for (int c = 0; c < 8; ++c) {
+                glm::vec3 corner(c & 1 ? b.max.x : b.min.x, c & 2 ? b.max.y : b.min.y,
+                                 c & 4 ? b.max.z : b.min.z);
+                glm::vec3 v = corner - cam.eye;
+                float z = glm::dot(v, forward);
+                ASSERT_GT(z, 0.0f);
+                EXPECT_LE(std::abs(glm::dot(v, right)) / z, tanH);
+                EXPECT_LE(std::abs(glm::dot(v, up)) / z, tanV);
+                fill = std::max({fill, std::abs(glm::dot(v, right)) / z / tanH,
+                                 std::abs(glm::dot(v, up)) / z / tanV});
             }
+            EXPECT_GT(fill, 0.85f);
         }
     }
     // Nothing finite: a sensible default.
     Camera cam = frameCamera(Evaluator(makeScene(plane({0, 1, 0}, 0))), 1.0f);
     EXPECT_TRUE(std::isfinite(cam.eye.x + cam.eye.y + cam.eye.z));
     EXPECT_GT(glm::length(cam.eye - cam.target), 0.0f);
+}
+
+// A flat part is seen at a slant, from its broad side: a plate lying down, standing across the
+// view or standing along it, and a woven mat, are seen at least 30 degrees off their plane and
+// at least 25 degrees off their normal (a three-quarter view).
+TEST(Eval, FrameCameraSeesFlatPartsAtASlant) {
+    struct Flat {
+        Scene scene;
+        glm::vec3 normal;
+    };
+    std::vector<Flat> flats = {
+        {makeScene(box(4, 0.1f, 3)), {0, 1, 0}},
+        {makeScene(box(4, 3, 0.1f)), {0, 0, 1}},
+        {makeScene(box(0.1f, 3, 4)), {1, 0, 0}},
+        {clippedScenes()[1], {0, 1, 0}},
+    };
+    for (const Flat& flat : flats) {
+        SCOPED_TRACE(flat.scene.file);
+        const Camera cam = frameCamera(Evaluator(flat.scene), 4.0f / 3.0f);
+        const float along = std::abs(glm::dot(glm::normalize(cam.target - cam.eye), flat.normal));
+        EXPECT_GE(along, std::sin(glm::radians(30.0f)));
+        EXPECT_LE(along, std::cos(glm::radians(25.0f)));
+    }
 }
 
 TEST(Eval, PackedNodesMirrorTheEvaluator) {

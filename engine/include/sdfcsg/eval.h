@@ -131,7 +131,11 @@ std::vector<FieldNote> fieldNotes(const Scene& scene, const Evaluator& evaluator
 // settle it.
 bool provablyEmpty(const Evaluator& evaluator);
 
-// A camera looking at the finite part of the scene's bounds from the front and slightly above.
+// A camera looking at the box the solid lies in (Evaluator::finiteBounds()) from a three-quarter
+// view of that box's largest face (the front unless the top or the side is a quarter larger),
+// from the right, above and in front, as near as it can be with every corner of the box within
+// the view, a tenth inside its edges. `aspect` is the image's width over its height, `fov` the
+// vertical field of view in degrees.
 Camera frameCamera(const Evaluator& evaluator, float aspect, float fov = 45.0f);
 
 } // namespace sdfcsg

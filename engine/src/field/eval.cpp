@@ -798,26 +798,53 @@ bool provablyEmpty(const Evaluator& evaluator) {
     return true;
 }
 
+namespace {
+
+// Where the eye lies from a box's centre: a three-quarter view of its largest face, that face's
+// normal turned some 35 to 40 degrees off towards the right, the top and the front, so that the
+// face is seen open and its two neighbours at a slant; a flat part is never seen edge-on. The
+// front (xy) is the largest unless another is a quarter larger; the top (xz) before the side.
+glm::vec3 threeQuarter(glm::vec3 size) {
+    const float front = size.x * size.y, top = size.x * size.z, side = size.y * size.z;
+    glm::vec3 w(0.45f, 0.55f, 0.6f);
+    if (top > 1.25f * front && top >= side)
+        w.y = 1.0f;
+    else if (side > 1.25f * front)
+        w.x = 1.0f;
+    else
+        w.z = 1.0f;
+    return glm::normalize(w);
+}
+
+} // namespace
+
 Camera frameCamera(const Evaluator& evaluator, float aspect, float fov) {
     Camera camera;
     camera.fov = fov;
-    Aabb box = evaluator.bounds();
-    if (!box.finite()) {
-        box = Aabb{};
-        for (const FlatNode& n : evaluator.nodes()) {
-            if (isOperation(n.kind) || !n.bounds.finite() || n.frame != kWorldFrame) continue;
-            box.min = glm::min(box.min, n.bounds.min);
-            box.max = glm::max(box.max, n.bounds.max);
-        }
+    const Aabb box = evaluator.nodes().empty() ? Aabb{glm::vec3(-1.0f), glm::vec3(1.0f)}
+                                               : evaluator.finiteBounds();
+    const glm::vec3 centre = 0.5f * (box.max + box.min), half = 0.5f * (box.max - box.min);
+    const glm::vec3 direction = threeQuarter(glm::max(box.max - box.min, glm::vec3(1e-6f)));
+    // The camera's axes as makeRayCamera (sdfcsg/camera.h) makes them.
+    const glm::vec3 right = glm::normalize(glm::cross(-direction, camera.up));
+    const glm::vec3 up = glm::cross(right, -direction);
+    // The nearest eye from which every corner lies within the view, a tenth inside its edges: a
+    // corner at v from the centre lies at depth D - v.direction, and needs |v.right| and |v.up|
+    // within that depth times the half-angles' tangents.
+    const float tanV = 0.9f * std::tan(0.5f * glm::radians(fov));
+    const float tanH = tanV * std::max(aspect, 1e-3f);
+    // At least as far as frames a ball of radius 1e-3: a solid smaller than that is framed as
+    // one, not from a hair's breadth.
+    const float halfH = std::atan(std::tan(0.5f * glm::radians(fov)) * std::max(aspect, 1e-3f));
+    float distance = 1.1e-3f / std::sin(std::min(0.5f * glm::radians(fov), halfH));
+    for (int c = 0; c < 8; ++c) {
+        const glm::vec3 v((c & 1 ? 1.0f : -1.0f) * half.x, (c & 2 ? 1.0f : -1.0f) * half.y,
+                          (c & 4 ? 1.0f : -1.0f) * half.z);
+        const float depth = glm::dot(v, direction);
+        distance =
+            std::max({distance, depth + std::abs(glm::dot(v, right)) / tanH,
+                      depth + std::abs(glm::dot(v, up)) / tanV, depth + 1e-3f * glm::length(half)});
     }
-    if (box.empty()) box = Aabb{glm::vec3(-1.0f), glm::vec3(1.0f)};
-
-    glm::vec3 centre = 0.5f * (box.min + box.max);
-    float radius = std::max(0.5f * glm::length(box.max - box.min), 1e-3f);
-    float halfV = 0.5f * glm::radians(fov);
-    float halfH = std::atan(std::tan(halfV) * std::max(aspect, 1e-3f));
-    float distance = 1.1f * radius / std::sin(std::min(halfV, halfH));
-    glm::vec3 direction = glm::normalize(glm::vec3(0.0f, 0.35f, 1.0f)); // front, ~20 deg up
     camera.eye = centre + direction * distance;
     camera.target = centre;
     return camera;
