@@ -2,15 +2,16 @@
 // The mesh-extraction passes that evaluate the scene, one kernel specialised three ways:
 //   cull:     one invocation per brick; marks the bricks that may hold surface. The field is
 //             1-Lipschitz, so a brick whose centre value exceeds its half-diagonal holds none.
-//   classify: one workgroup per brick of the batch, one invocation per z-plane (mesh_rows.glsl).
-//             Samples the brick's block, finds the crossed edges and the cells the surface
-//             passes through, numbers the brick's vertices (by sample, then axis) and counts
-//             its triangles. The brick's record keeps, per owned row, the number of its first
-//             vertex and its crossed edges, then the block's signs, for the triangle pass.
-//   vertices: one workgroup per brick of the batch, one invocation per crossed edge; places the
-//             vertex on the edge (linear estimate, then regula falsi on the field), and gives it
-//             the field's normal (four-tap tetrahedral differences) and the scene's colour; for
-//             dual contouring, also a second normal where the point lies on a sharp edge.
+//   classify: one workgroup per brick of the batch: its SDFCSG_MESH_CLASSIFY_X invocations
+//             sample the brick's block, then one invocation per z-plane (mesh_rows.glsl) finds
+//             the crossed edges and the cells the surface passes through, numbers the brick's
+//             vertices (by sample, then axis) and counts its triangles. The brick's record
+//             keeps, per owned row, the number of its first vertex and its crossed edges, then
+//             the block's signs, for the triangle pass.
+//   vertices: one invocation per crossed edge of the batch; places the vertex on the edge
+//             (linear estimate, then regula falsi on the field), and gives it the field's
+//             normal (four-tap tetrahedral differences) and the scene's colour; for dual
+//             contouring, also a second normal where the point lies on a sharp edge.
 #extension GL_GOOGLE_include_directive : require
 
 #include "shared.h"
@@ -89,7 +90,11 @@ void classify() {
     uvec3 brick = brickCoords(activeBricks[slot]) * SDFCSG_MESH_BRICK;
     uint plane = gl_LocalInvocationID.x;
 
-    for (uint r = plane; r < kSignRows; r += SDFCSG_MESH_BRICK) {
+    // The samples, up to three rows per invocation (SDFCSG_MESH_CLASSIFY_X of them): llvmpipe
+    // ends every loop of an invocation for good once they have run 65535 rounds together (over
+    // all loops, the scene's own included), so no invocation evaluates the scene more than 27
+    // times.
+    for (uint r = plane; r < kSignRows; r += gl_WorkGroupSize.x) {
         uvec3 s = brick + uvec3(0u, r % kSide, r / kSide);
         uint bits = 0u;
         float d = 0.0;
@@ -110,11 +115,13 @@ void classify() {
     }
     barrier();
 
-    // First walk: counts (edge vertices | marching-cubes triangles << 16, dual vertices | dual
-    // triangles << 16). Second walk: vertex numbers, records and the edge list.
+    // The first SDFCSG_MESH_BRICK invocations walk a z-plane each. First walk: counts (edge
+    // vertices | marching-cubes triangles << 16, dual vertices | dual triangles << 16). Second
+    // walk: vertex numbers, records and the edge list.
+    const bool walks = plane < SDFCSG_MESH_BRICK;
     uvec2 planeTotal = uvec2(0u);
     bool cut = false;
-    for (uint y = 0u; y < SDFCSG_MESH_BRICK; ++y) {
+    for (uint y = 0u; walks && y < SDFCSG_MESH_BRICK; ++y) {
         uvec3 s0 = brick + uvec3(0u, y, plane);
         Row row = rowAt(s0, y, plane);
         planeTotal.x +=
@@ -133,7 +140,7 @@ void classify() {
     uvec2 before = planePrefix(planeTotal, total);
     uint next = before.x & 0xffffu; // brick-local number of the next edge vertex
     uint nextDual = before.y & 0xffffu;
-    for (uint y = 0u; y < SDFCSG_MESH_BRICK; ++y) {
+    for (uint y = 0u; walks && y < SDFCSG_MESH_BRICK; ++y) {
         Row row = rowAt(brick + uvec3(0u, y, plane), y, plane);
         uint r = y + SDFCSG_MESH_BRICK * plane;
         records[record + 2u * r] = next;
@@ -164,13 +171,25 @@ void classify() {
 }
 
 void placeVertices() {
-    uint batchSlot = gl_WorkGroupID.x;
-    if (batchSlot >= push.count) return;
+    // One crossed edge of the batch per invocation, not a loop over a brick's edges: llvmpipe
+    // ends every loop of an invocation for good once they have run 65535 rounds together (its
+    // "loop limiter", counted over all loops, nested or not), and a scene's own loops (repeats,
+    // outlines) times such a loop reached that, leaving edge points unwritten. The edge's brick
+    // is the last of the batch whose first edge is not past it.
+    if (push.count == 0u) return;
+    uint e = gl_GlobalInvocationID.x, batchFirst = bases[push.first].x;
+    uint batchSlot = 0u;
+    for (uint span = push.count; span > 1u;) {
+        uint part = span / 2u;
+        if (bases[push.first + batchSlot + part].x - batchFirst <= e) batchSlot += part;
+        span -= part;
+    }
     uint slot = push.first + batchSlot;
-    uvec3 b = brickCoords(activeBricks[slot]) * SDFCSG_MESH_BRICK;
     uint count = counts[slot].x;
+    uint v = e - (bases[slot].x - batchFirst); // the edge's number in its brick
     uint first = bases[slot].x - push.vertexBase;
-    for (uint v = gl_LocalInvocationID.x; v < count; v += SDFCSG_MESH_GROUP_X) {
+    if (v < count) {
+        uvec3 b = brickCoords(activeBricks[slot]) * SDFCSG_MESH_BRICK;
         uint edge = edges[batchSlot * SDFCSG_MESH_BRICK_EDGES + v];
         uint owned = edge / 3u, axis = edge % 3u;
         uvec3 l = uvec3(owned % SDFCSG_MESH_BRICK, (owned / SDFCSG_MESH_BRICK) % SDFCSG_MESH_BRICK,

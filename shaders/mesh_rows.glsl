@@ -1,5 +1,5 @@
-// Brick-wide work of the classify and triangle passes. Their workgroups have one invocation per
-// z-plane of the brick (SDFCSG_MESH_BRICK of them), each walking its plane's rows of owned
+// Brick-wide work of the classify and triangle passes. In their workgroups one invocation per
+// z-plane of the brick (the first SDFCSG_MESH_BRICK of them) walks its plane's rows of owned
 // samples along x. A row's signs are one word (bit x: sample x is inside), so its crossed edges
 // and the cells that the surface passes through are a few bit operations; and a brick needs one
 // barrier for its prefix sum, not one per step of a tree scan (CPU drivers run such a workgroup
@@ -16,10 +16,11 @@ shared uint insideRows[kSignRows];
 shared uvec2 planeTotals[SDFCSG_MESH_BRICK];
 
 // Returns the sum of `planeTotal` over the planes before this invocation's; `total` gets the
-// sum over all planes. Every invocation of the workgroup must call it.
+// sum over all planes. Every invocation of the workgroup must call it; those past the planes'
+// have no total.
 uvec2 planePrefix(uvec2 planeTotal, out uvec2 total) {
     uint plane = gl_LocalInvocationID.x;
-    planeTotals[plane] = planeTotal;
+    if (plane < SDFCSG_MESH_BRICK) planeTotals[plane] = planeTotal;
     barrier();
     uvec2 before = uvec2(0u);
     total = uvec2(0u);

@@ -46,6 +46,7 @@
 #define SDFCSG_MESH_BRICK_BLOCK 729      // SDFCSG_MESH_BRICK_SAMPLES^3
 #define SDFCSG_MESH_BRICK_EDGES 1536     // 3 edges per owned sample
 #define SDFCSG_MESH_GROUP_X 64           // cull and vertex passes
+#define SDFCSG_MESH_CLASSIFY_X 32        // classify pass: at most 3 rows of 9 samples each
 #define SDFCSG_MESH_RECORD 401           // 3 * 8 * 8 + 9 * 9 + 2 * 8 * 8
 #define SDFCSG_MESH_NO_BRICK 0xffffffffu // brick map entry of a skipped brick
 

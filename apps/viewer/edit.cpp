@@ -18,6 +18,81 @@ Error usage(const Scene& scene, uint32_t node, std::string message) {
                  Diagnostic{scene.file, scene.nodes[node].path, std::move(message)});
 }
 
+// A use's value as JSON text: the shortest text of a float (a value that is not finite reads as
+// null, which the loader refuses), a string quoted as JSON.
+std::string jsonNumber(float value) {
+    if (!std::isfinite(value)) return "null";
+    char text[32];
+    auto [end, ec] = std::to_chars(text, text + sizeof text, value);
+    return std::string(text, end);
+}
+std::string jsonString(std::string_view text) {
+    std::string out = "\"";
+    for (char c : text) {
+        if (c == '"' || c == '\\') {
+            out += '\\';
+            out += c;
+        } else if (static_cast<unsigned char>(c) < 0x20) {
+            char escaped[8];
+            std::snprintf(escaped, sizeof escaped, "\\u%04x", unsigned(c));
+            out += escaped;
+        } else {
+            out += c;
+        }
+    }
+    return out + "\"";
+}
+
+// Refuses an edit of a node that lies in a copy, naming the use that makes it.
+std::optional<Error> inCopy(const Scene& scene, uint32_t node) {
+    const int use = copyingUse(scene, node);
+    if (use < 0) return std::nullopt;
+    const Node& u = scene.nodes[use];
+    return usage(scene, node,
+                 "this node lies in the copy that the use of \"" + u.use->definition + "\" at " +
+                     u.path +
+                     " makes; change the definitions in the scene file, or the use's parameters");
+}
+
+// An operation that may take children: a use's one child is its copy.
+bool takesChildren(const Node& node) {
+    return kindInfo(node.kind).operation && !node.use;
+}
+
+const Definition* definitionOf(const Scene& scene, const Node& node) {
+    if (!node.use) return nullptr;
+    for (const Definition& d : scene.definitions)
+        if (d.name == node.use->definition) return &d;
+    return nullptr;
+}
+
+// Sets a use's value for a parameter of its definition, as JSON text; false when the definition
+// has no such parameter.
+bool setArgument(const Scene& scene, Node& node, std::string_view key, std::string json) {
+    const Definition* d = definitionOf(scene, node);
+    if (!d || std::none_of(d->parameters.begin(), d->parameters.end(),
+                           [&](const NamedValue& p) { return p.name == key; }))
+        return false;
+    for (NamedValue& a : node.use->arguments)
+        if (a.name == key) {
+            a.json = std::move(json);
+            return true;
+        }
+    node.use->arguments.push_back({std::string(key), std::move(json)});
+    return true;
+}
+
+// What a use has to set: "translate, ..., color and the parameters of "leg": height, radius".
+std::string useValues(const Scene& scene, const Node& node) {
+    std::string out = "translate, rotate, scale, color";
+    const Definition* d = definitionOf(scene, node);
+    if (!d || d->parameters.empty()) return out;
+    out += " and the parameters of \"" + node.use->definition + "\": ";
+    for (size_t i = 0; i < d->parameters.size(); ++i)
+        out += (i ? ", " : "") + d->parameters[i].name;
+    return out;
+}
+
 Error badNode(const Scene& scene, uint32_t node) {
     return Error::message(ErrorKind::Usage, scene.file,
                           "no node " + std::to_string(node) + " (the scene has " +
@@ -121,8 +196,16 @@ Scene inLoadedOrder(const Scene& scene) {
 
 std::string nodeLabel(const Scene& scene, uint32_t node) {
     const Node& n = scene.nodes[node];
-    std::string kind(kindInfo(n.kind).name);
+    std::string kind = n.use ? "use of " + n.use->definition : std::string(kindInfo(n.kind).name);
     return n.name.empty() ? kind : n.name + " (" + kind + ")";
+}
+
+int copyingUse(const Scene& scene, uint32_t node) {
+    if (node >= scene.nodes.size()) return -1;
+    int outermost = -1;
+    for (int n = parentOf(scene, node); n >= 0; n = parentOf(scene, uint32_t(n)))
+        if (scene.nodes[n].use) outermost = n;
+    return outermost;
 }
 
 int parentOf(const Scene& scene, uint32_t node) {
@@ -167,6 +250,7 @@ Result<Scene> revalidate(const Scene& scene) {
 Result<Scene> setValue(const Scene& scene, uint32_t node, std::string_view key,
                        std::span<const float> values) {
     if (node >= scene.nodes.size()) return badNode(scene, node);
+    if (auto refused = inCopy(scene, node)) return *refused;
     Scene edited = scene;
     Node& n = edited.nodes[node];
     auto expect = [&](size_t count) -> std::optional<Error> {
@@ -194,6 +278,21 @@ Result<Scene> setValue(const Scene& scene, uint32_t node, std::string_view key,
             if (auto e = expect(3)) return *e;
             n.color = glm::vec3(values[0], values[1], values[2]);
         }
+    } else if (n.use) {
+        std::string json;
+        if (values.size() == 3) {
+            json = "[";
+            for (size_t i = 0; i < 3; ++i)
+                json += (i ? ", " : "") + jsonNumber(values[i]);
+            json += "]";
+        } else if (!values.empty()) {
+            if (auto e = expect(1)) return *e;
+            json = jsonNumber(values[0]);
+        }
+        if (values.empty() || !setArgument(scene, n, key, json))
+            return usage(scene, node,
+                         "a use has no value \"" + std::string(key) + "\" (it has " +
+                             useValues(scene, n) + ")");
     } else if (const ParamInfo* p = findParam(n.kind, key); p && p->type == ValueType::Points) {
         if (auto e = expect(2 * n.points.size())) return *e; // moves the points it has
         for (size_t i = 0; i < n.points.size(); ++i)
@@ -215,8 +314,16 @@ Result<Scene> setValue(const Scene& scene, uint32_t node, std::string_view key,
 Result<Scene> setText(const Scene& scene, uint32_t node, std::string_view key,
                       std::string_view text) {
     if (node >= scene.nodes.size()) return badNode(scene, node);
+    if (auto refused = inCopy(scene, node)) return *refused;
     Scene edited = scene;
     Node& n = edited.nodes[node];
+    if (n.use) {
+        if (!setArgument(scene, n, key, jsonString(text)))
+            return usage(scene, node,
+                         "a use has no text \"" + std::string(key) + "\" (it has " +
+                             useValues(scene, n) + ")");
+        return revalidate(edited);
+    }
     const ParamInfo* p = findParam(n.kind, key);
     if (!p || p->type != ValueType::Text)
         return usage(scene, node,
@@ -228,7 +335,8 @@ Result<Scene> setText(const Scene& scene, uint32_t node, std::string_view key,
 
 Result<Scene> addChild(const Scene& scene, uint32_t parent, NodeKind kind, uint32_t* newIndex) {
     if (parent >= scene.nodes.size()) return badNode(scene, parent);
-    if (!kindInfo(scene.nodes[parent].kind).operation)
+    if (auto refused = inCopy(scene, parent)) return *refused;
+    if (!takesChildren(scene.nodes[parent]))
         return usage(scene, parent, "only an operation can take children");
     Scene edited = scene;
     if (isProfile(kind) && !cutsProfiles(scene, int(parent))) { // a profile comes extruded
@@ -258,6 +366,7 @@ Result<Scene> addChild(const Scene& scene, uint32_t parent, NodeKind kind, uint3
 
 Result<Scene> removeNode(const Scene& scene, uint32_t node) {
     if (node >= scene.nodes.size()) return badNode(scene, node);
+    if (auto refused = inCopy(scene, node)) return *refused;
     int parent = parentOf(scene, node);
     if (parent < 0) return usage(scene, node, "the root cannot be removed");
     if (scene.nodes[parent].children.size() == 1)
@@ -272,6 +381,9 @@ Result<Scene> removeNode(const Scene& scene, uint32_t node) {
 
 Result<Scene> changeKind(const Scene& scene, uint32_t node, NodeKind kind) {
     if (node >= scene.nodes.size()) return badNode(scene, node);
+    if (auto refused = inCopy(scene, node)) return *refused;
+    if (scene.nodes[node].use)
+        return usage(scene, node, "a use is a copy of its definition and has no kind to change");
     Scene edited = scene;
     Node& n = edited.nodes[node];
     bool wasOperation = kindInfo(n.kind).operation;
@@ -292,6 +404,7 @@ Result<Scene> changeKind(const Scene& scene, uint32_t node, NodeKind kind) {
 
 Result<Scene> moveNode(const Scene& scene, uint32_t node, int delta, uint32_t* newIndex) {
     if (node >= scene.nodes.size()) return badNode(scene, node);
+    if (auto refused = inCopy(scene, node)) return *refused;
     int parent = parentOf(scene, node);
     if (parent < 0) return usage(scene, node, "the root has no siblings");
     Scene edited = scene;
@@ -309,9 +422,11 @@ Result<Scene> reparentNode(const Scene& scene, uint32_t node, uint32_t parent, u
                            uint32_t* newIndex) {
     if (node >= scene.nodes.size()) return badNode(scene, node);
     if (parent >= scene.nodes.size()) return badNode(scene, parent);
+    if (auto refused = inCopy(scene, node)) return *refused;
+    if (auto refused = inCopy(scene, parent)) return *refused;
     int from = parentOf(scene, node);
     if (from < 0) return usage(scene, node, "the root cannot be moved");
-    if (!kindInfo(scene.nodes[parent].kind).operation)
+    if (!takesChildren(scene.nodes[parent]))
         return usage(scene, parent, "only an operation can take children");
     bool inside = false;
     forSubtree(scene, node, [&](uint32_t n) { inside = inside || n == parent; });
@@ -340,7 +455,7 @@ Result<Scene> reparentNode(const Scene& scene, uint32_t node, uint32_t parent, u
 
 Result<Scene> dropNode(const Scene& scene, uint32_t node, uint32_t target, uint32_t* newIndex) {
     if (target >= scene.nodes.size()) return badNode(scene, target);
-    if (kindInfo(scene.nodes[target].kind).operation)
+    if (takesChildren(scene.nodes[target]))
         return reparentNode(scene, node, target, kLastChild, newIndex);
     int parent = parentOf(scene, target);
     if (parent < 0) return usage(scene, target, "the root has no siblings");

@@ -15,8 +15,13 @@
 
 namespace sdfcsg::viewer {
 
-// "name (kind)", or the kind alone for an unnamed node.
+// "name (kind)", or the kind alone for an unnamed node; "use of leg" for a use.
 std::string nodeLabel(const Scene& scene, uint32_t node);
+
+// The outermost use whose copy holds `node` (the one written in the file), or -1 for a node in no
+// copy. A copy is made by the loader from its definition, so the edits below refuse to change
+// anything inside one: the definition, or the use's parameters, are what to change.
+int copyingUse(const Scene& scene, uint32_t node);
 
 // The parent of a node, or -1 for the root.
 int parentOf(const Scene& scene, uint32_t node);
@@ -34,10 +39,11 @@ Result<Scene> revalidate(const Scene& scene);
 
 // Sets one value of a node: a parameter of its kind ("radius", "size", "smooth", ...),
 // "translate", "rotate" or "scale", or "color" (no values: inherit the parent's colour again).
-// Errors name the key and what it expects.
+// On a use, a parameter of its definition sets the use's value for it (one number, or three as an
+// array). Errors name the key and what it expects.
 Result<Scene> setValue(const Scene& scene, uint32_t node, std::string_view key,
                        std::span<const float> values);
-// A text value (a text node's string or font).
+// A text value (a text node's string or font; on a use, a parameter of its definition).
 Result<Scene> setText(const Scene& scene, uint32_t node, std::string_view key,
                       std::string_view text);
 

@@ -10,8 +10,10 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <optional>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -60,6 +62,36 @@ void nodeTree(Viewer& v, uint32_t node, std::optional<std::pair<uint32_t, uint32
     }
 }
 
+// A use's values for its definition's parameters: numbers are dragged like a node's own, other
+// values (arrays, strings) shown as written.
+template <class Edit> void useArguments(Viewer& v, uint32_t id, Edit&& edited) {
+    const Node& n = v.scene->nodes[id];
+    const Definition* definition = nullptr;
+    for (const Definition& d : v.scene->definitions)
+        if (d.name == n.use->definition) definition = &d;
+    if (!definition) return;
+    for (const NamedValue& p : definition->parameters) {
+        std::string json = p.json;
+        bool given = false;
+        for (const NamedValue& a : n.use->arguments)
+            if (a.name == p.name) json = a.json, given = true;
+        const char* end = json.c_str() + json.size();
+        char* parsed = nullptr;
+        float value = std::strtof(json.c_str(), &parsed);
+        if (parsed == end && !json.empty()) {
+            if (ImGui::DragFloat(p.name.c_str(), &value, 0.01f, -1e6f, 1e6f, "%.3f"))
+                edited(p.name.c_str(), {value});
+            if (ImGui::IsItemDeactivatedAfterEdit()) v.doc.history().endMerge();
+        } else {
+            ImGui::Text("%s: %s", p.name.c_str(), json.c_str());
+        }
+        if (!given) {
+            ImGui::SameLine();
+            ImGui::TextDisabled("(default)");
+        }
+    }
+}
+
 void valueEditor(Viewer& v) {
     if (v.selected < 0 || v.selected >= int(v.scene->nodes.size())) {
         ImGui::TextDisabled("Click a node in the tree or the image to select it.");
@@ -70,11 +102,20 @@ void valueEditor(Viewer& v) {
     const KindInfo& info = kindInfo(n.kind);
     ImGui::Text("%s", nodeLabel(*v.scene, id).c_str());
     ImGui::TextDisabled("%s", n.path.c_str());
+    if (const int use = copyingUse(*v.scene, id); use >= 0) {
+        // The loader makes the copy from the definition: nothing here is the file's to change.
+        const Node& u = v.scene->nodes[use];
+        ImGui::TextWrapped("Part of the copy that the use of \"%s\" at %s makes: change the "
+                           "definition in the scene file, or the use's parameters.",
+                           u.use->definition.c_str(), u.path.c_str());
+        return;
+    }
     auto edited = [&](const char* key, std::vector<float> values) {
         commit(v, setValue(*v.scene, id, key, values), std::to_string(id) + key);
         v.lastInteraction = now(); // previews while a value is dragged, as while the camera moves
     };
-    for (const ParamInfo& p : info.params) {
+    if (n.use) useArguments(v, id, edited);
+    for (const ParamInfo& p : n.use ? std::span<const ParamInfo>() : info.params) {
         std::string name(p.name);
         float min = p.check == Check::Positive      ? 1e-3f
                     : p.check == Check::NonNegative ? 0.0f
@@ -143,7 +184,7 @@ void valueEditor(Viewer& v) {
 
     ImGui::Separator();
     // Structural edits: the renderer recompiles on the worker thread.
-    if (ImGui::BeginCombo("kind", std::string(info.name).c_str())) {
+    if (!n.use && ImGui::BeginCombo("kind", std::string(info.name).c_str())) {
         for (const KindInfo& k : nodeKinds())
             if (k.operation == info.operation &&
                 ImGui::Selectable(std::string(k.name).c_str(), k.kind == n.kind) &&
@@ -151,7 +192,7 @@ void valueEditor(Viewer& v) {
                 commit(v, changeKind(*v.scene, id, k.kind));
         ImGui::EndCombo();
     }
-    if (info.operation) {
+    if (info.operation && !n.use) {
         if (ImGui::BeginCombo("add child", "choose a kind")) {
             for (const KindInfo& k : nodeKinds())
                 if (ImGui::Selectable(std::string(k.name).c_str())) {

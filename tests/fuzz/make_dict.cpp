@@ -19,10 +19,13 @@ void word(std::string_view w) {
 } // namespace
 
 int main() {
-    // Keys outside the node table: the scene object, camera, lights, and the legacy format.
+    // Keys outside the node table: the scene object, camera, lights, definitions and uses, and
+    // the legacy format.
     for (std::string_view w :
-         {"version", "root", "camera", "eye", "target", "up", "fov", "lights", "direction",
-          "intensity", "background", "description", "nodes", "left", "right", "param1", "param2"})
+         {"version",     "root",       "camera",    "eye",       "target",     "up",
+          "fov",         "lights",     "direction", "intensity", "background", "description",
+          "definitions", "parameters", "node",      "use",       "definition", "nodes",
+          "left",        "right",      "param1",    "param2"})
         word(w);
     for (const sdfcsg::CommonKey& key : sdfcsg::commonNodeKeys())
         word(key.name);
@@ -33,7 +36,7 @@ int main() {
     }
     // Written as libFuzzer reads them: \\ is a backslash, \" a quote.
     for (std::string_view t : {"true", "false", "null", "1e38", "-0", "0.5", "[0, 0, 0]",
-                               "\\\\u0000", "\\\\ud800", "\\\"#"})
+                               "\\\\u0000", "\\\\ud800", "\\\"#", "\\\"$"})
         std::printf("\"%.*s\"\n", int(t.size()), t.data());
     return 0;
 }

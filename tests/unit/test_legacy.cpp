@@ -374,7 +374,7 @@ TEST(Legacy, AVersionMeansTheCurrentFormat) {
     ASSERT_FALSE(r);
     EXPECT_EQ(r.error().str(),
               "scene.json: unknown key \"nodes\"; valid keys: version, name, description, camera, "
-              "lights, background and root\n"
+              "lights, background, definitions and root\n"
               "scene.json: missing required key \"root\" (the top node of the scene)");
 }
 

@@ -191,6 +191,12 @@ TEST(LlmPrompt, LlmSchemaIsStrict) {
         }
     }
     EXPECT_GE(objects, size_t(kNodeKindCount));
+    // Strict mode cannot list the names a scene chooses: no definitions, no uses.
+    simdjson::dom::element absent;
+    EXPECT_TRUE(top["properties"]["definitions"].get(absent));
+    for (const char* name : {"definition", "parameter_value", "use"})
+        EXPECT_TRUE(defs[name].get(absent)) << name;
+    EXPECT_EQ(text.find("#/$defs/use"), std::string::npos);
     for (const KindInfo& kind : nodeKinds()) {
         simdjson::dom::object properties = defs[kind.name]["properties"];
         std::string_view type = properties["type"]["enum"].at(0);

@@ -591,12 +591,13 @@ TEST_F(MeshTest, CellsOfSeveralPiecesMeshWithoutSelfIntersections) {
 // The GPU result against the CPU reference on the grid the GPU reports, by each method: same
 // counts, same vertices (positions, normals, colours) within float tolerance, same oriented
 // triangles.
-void expectMatchesReference(Context& context, const Scene& scene, const std::string& label) {
+void expectMatchesReference(Context& context, const Scene& scene, const std::string& label,
+                            uint32_t resolution = 32) {
     for (MeshMethod method : {MeshMethod::DualContouring, MeshMethod::MarchingCubes}) {
         SCOPED_TRACE(label + (method == MeshMethod::MarchingCubes ? ", mc" : ", dc"));
         MeshOptions options;
         options.method = method;
-        options.resolution = 32;
+        options.resolution = resolution;
         MeshStats stats;
         auto mesh = extractMesh(context, scene, options, &stats);
         ASSERT_TRUE(mesh) << mesh.error().str();
@@ -650,6 +651,24 @@ TEST_F(MeshTest, MatchesTheCpuReference) {
           {"type": "capsule", "a": [-1, -0.3, 0.7], "b": [1, 0.2, 0.6], "radius": 0.25}]}})"),
                            "difference with smooth blend");
     expectMatchesReference(context(), randomScene(11, 16), "random scene 11");
+}
+
+// A repeat of a repeat of a part larger than its spacing: each evaluation runs hundreds of rounds
+// of the scene's loops, and llvmpipe ends every loop of an invocation for good after 65535 rounds
+// in all; the mesh passes keep each invocation's evaluations few enough (shaders/mesh_field.comp).
+// Dual contouring's vertices pass, which evaluates the field up to 15 times per edge, once looped
+// over a brick's edges and left the last edges of busy bricks unwritten.
+TEST_F(MeshTest, ScenesOfManyLoopRoundsMatchTheCpuReference) {
+    expectMatchesReference(context(), sceneFrom(R"({"version": 1, "root": {
+        "type": "elongate", "length": [0.6, 0.2, 0.4], "rotate": [32.5, -135.5, -125.7],
+        "scale": 0.471, "children": [
+          {"type": "repeat", "count": [3, 2, 4], "spacing": [1.1, 0.9, 0.8],
+           "rotate": [-67.3, -50.5, 156.3], "scale": 0.616, "children": [
+             {"type": "repeat", "count": [3, 2, 4], "spacing": [1.1, 0.9, 0.8],
+              "rotate": [-145.8, -154.5, -69.0], "scale": 0.532, "children": [
+                {"type": "octahedron", "radius": 0.9, "rotate": [-60.6, -80.2, -53.0],
+                 "scale": 0.509}]}]}]}})"),
+                           "a repeat of repeats", 64);
 }
 
 // Sharp unions of many primitives, separate or nested in a difference, against the reference.

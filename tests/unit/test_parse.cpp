@@ -75,13 +75,11 @@ std::vector<BadInput> badInputs() {
     std::string fiveLights = R"({"direction": [0, -1, 0]})";
     for (int i = 0; i < 4; ++i)
         fiveLights += R"(, {"direction": [0, -1, 0]})";
-    // Every kind's name in the table's order: "sphere, box, ..., extrude or revolve".
+    // Every kind's name in the table's order, then a use: "sphere, box, ..., revolve or use".
     std::string kinds;
     for (const KindInfo& k : nodeKinds())
-        kinds += (kinds.empty()                            ? ""
-                  : k.kind == NodeKind(kNodeKindCount - 1) ? " or "
-                                                           : ", ") +
-                 std::string(k.name);
+        kinds += (kinds.empty() ? "" : ", ") + std::string(k.name);
+    kinds += " or use";
     return {
         // JSON syntax: line and column of the first problem.
         {"empty", "", "scene.json:1:1: expected a JSON value, got end of input"},
@@ -151,7 +149,7 @@ std::vector<BadInput> badInputs() {
          R"(scene.json: unknown key "lihgts"; did you mean "lights"?)"},
         {"unknown top-level key", withSphere(R"("version": 1, "author": "me")"),
          "scene.json: unknown key \"author\"; valid keys: version, name, description, camera, "
-         "lights, background and root"},
+         "lights, background, definitions and root"},
         {"name too long", withSphere(R"("version": 1, "name": ")" + std::string(201, 'x') + "\""),
          "scene.json: name: expected a string of at most 200 characters, got 201 characters"},
         {"text too long", // 257 characters of two bytes each: counted as characters
@@ -382,7 +380,9 @@ void expectSameScene(const Scene& a, const Scene& b) {
         EXPECT_EQ(x.color, y.color);
         EXPECT_EQ(x.params, y.params);
         EXPECT_EQ(x.children, y.children);
+        EXPECT_EQ(x.use, y.use);
     }
+    EXPECT_EQ(a.definitions, b.definitions);
     EXPECT_EQ(a.camera.has_value(), b.camera.has_value());
     if (a.camera && b.camera) {
         EXPECT_EQ(a.camera->eye, b.camera->eye);

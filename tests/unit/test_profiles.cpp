@@ -465,7 +465,7 @@ TEST(Profiles, TextIsTheExactDistanceToItsGlyphs) {
     EXPECT_GT(inside, 200);
 }
 
-// Outlines too large to write into a kernel carry a grid of cells, each listing the segments
+// Outlines too large to loop over carry a grid of cells, each listing the segments
 // that can be nearest in it.
 TEST(Profiles, GriddedTextIsExactOnItsGrid) {
     auto text = detail::textOutline("sdfcsg gear", detail::defaultFontFile(), 0.6f);

@@ -98,7 +98,8 @@ TEST(Schema, TopLevel) {
     EXPECT_EQ(simdjson::to_string(s["required"]), R"(["version","root"])");
     EXPECT_FALSE(bool(s["additionalProperties"]));
     EXPECT_EQ(int64_t(s["properties"]["version"]["const"]), kSceneVersion);
-    for (const char* key : {"name", "description", "camera", "lights", "background", "root"})
+    for (const char* key :
+         {"name", "description", "camera", "lights", "background", "definitions", "root"})
         EXPECT_EQ(s["properties"][key].error(), simdjson::SUCCESS) << key;
 }
 
@@ -107,7 +108,8 @@ TEST(Schema, EveryKindAndParameterOfTheTableAppears) {
     std::vector<std::string> refs;
     for (auto r : defs["node"]["oneOf"].get_array())
         refs.emplace_back(std::string_view(r["$ref"]));
-    ASSERT_EQ(refs.size(), nodeKinds().size());
+    ASSERT_EQ(refs.size(), nodeKinds().size() + 1);
+    EXPECT_EQ(refs.back(), "#/$defs/use");
     for (const KindInfo& kind : nodeKinds()) {
         SCOPED_TRACE(std::string(kind.name));
         EXPECT_NE(std::find(refs.begin(), refs.end(), "#/$defs/" + std::string(kind.name)),

@@ -593,6 +593,77 @@ TEST(ViewerEdit, UndoRestoresTheSceneBeforeAReparent) {
     EXPECT_EQ(childNames(history.current(), "cut"), (Names{"inner", "block", "hole"}));
 }
 
+// A use is edited as the file has it: its transform, colour and parameters; its copy, made by the
+// loader from the definition, is refused.
+TEST(ViewerEdit, UsesAreEditedAndTheirCopiesRefused) {
+    auto loaded = parseScene(R"({"version": 1,
+      "definitions": {"leg": {"parameters": {"height": 1.0, "radius": 0.1},
+                              "node": {"type": "cylinder", "height": "$height", "radius": "$radius"}}},
+      "root": {"type": "union", "children": [
+        {"type": "use", "definition": "leg", "name": "front leg", "translate": [1, 0, 0]},
+        {"type": "use", "definition": "leg", "translate": [-1, 0, 0]},
+        {"type": "sphere", "name": "ball", "radius": 0.3}]}})",
+                             "uses.json");
+    ASSERT_TRUE(loaded) << loaded.error().str();
+    const Scene scene = *loaded;
+    const uint32_t front = *findNode(scene, "front leg");
+    const uint32_t copy = scene.nodes[front].children[0];
+    const uint32_t other = scene.nodes[0].children[1];
+    EXPECT_EQ(nodeLabel(scene, front), "front leg (use of leg)");
+    EXPECT_EQ(nodeLabel(scene, other), "use of leg");
+    EXPECT_EQ(copyingUse(scene, copy), int(front));
+    EXPECT_EQ(copyingUse(scene, front), -1);
+
+    float height[] = {2.5f};
+    auto taller = setValue(scene, front, "height", height);
+    ASSERT_TRUE(taller) << taller.error().str();
+    EXPECT_FLOAT_EQ(taller->nodes[taller->nodes[front].children[0]].params[1], 2.5f);
+    EXPECT_EQ(taller->nodes[front].use->arguments, (std::vector<NamedValue>{{"height", "2.5"}}));
+    EXPECT_FLOAT_EQ(taller->nodes[taller->nodes[other].children[0]].params[1], 1.0f);
+    EXPECT_EQ(taller->definitions, scene.definitions);
+    float t[] = {0, 2, 0};
+    auto moved = setValue(scene, front, "translate", t);
+    ASSERT_TRUE(moved);
+    EXPECT_EQ(moved->nodes[front].transform.translate, glm::vec3(0, 2, 0));
+    float negative[] = {-1.0f};
+    auto refused = setValue(scene, front, "radius", negative);
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error().str(), "uses.json: definitions.leg.node.radius: expected a positive "
+                                     "number, got -1 (in the use of \"leg\" at root.children[0])");
+    refused = setValue(scene, front, "smooth", height);
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error().str(),
+              "uses.json: root.children[0]: a use has no value \"smooth\" (it has translate, "
+              "rotate, scale, color and the parameters of \"leg\": height, radius)");
+
+    const std::string inCopy =
+        "uses.json: definitions.leg.node: this node lies in the copy that the use of \"leg\" at "
+        "root.children[0] makes; change the definitions in the scene file, or the use's "
+        "parameters";
+    refused = setValue(scene, copy, "height", height);
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error().str(), inCopy);
+    EXPECT_EQ(removeNode(scene, copy).error().str(), inCopy);
+    EXPECT_EQ(changeKind(scene, copy, NodeKind::Box).error().str(), inCopy);
+    EXPECT_EQ(moveNode(scene, copy, 1).error().str(), inCopy);
+    EXPECT_EQ(reparentNode(scene, copy, 0, kLastChild).error().str(), inCopy);
+    EXPECT_EQ(addChild(scene, front, NodeKind::Sphere).error().str(),
+              "uses.json: root.children[0]: only an operation can take children");
+    EXPECT_EQ(changeKind(scene, front, NodeKind::Intersection).error().str(),
+              "uses.json: root.children[0]: a use is a copy of its definition and has no kind to "
+              "change");
+
+    // Dropped on a use, a node goes before it; the use itself moves and goes like any node.
+    uint32_t dropped = 0;
+    auto before = dropNode(scene, *findNode(scene, "ball"), front, &dropped);
+    ASSERT_TRUE(before) << before.error().str();
+    EXPECT_EQ(before->nodes[before->nodes[0].children[0]].name, "ball");
+    auto removed = removeNode(scene, front);
+    ASSERT_TRUE(removed) << removed.error().str();
+    EXPECT_EQ(removed->nodes.size(), scene.nodes.size() - 2);
+    EXPECT_NE(toJson(*removed).find("\"definitions\""), std::string::npos);
+}
+
 TEST(ViewerEdit, SameNodeAfterAReload) {
     Scene before = twoSpheres();
     // Named nodes are found by name wherever they moved; unnamed ones by their JSON path.

@@ -30,10 +30,40 @@ struct Transform {
     glm::vec3 scale{1.0f};  // per axis, > 0; "scale": 2 in a file is [2, 2, 2]
 };
 
+// A parameter of a definition or an argument of a use: its name and its value as JSON text
+// ("2", "[1, 0, 0]", "\"#ff8000\""), which may be a number, a string or an array.
+struct NamedValue {
+    std::string name;
+    std::string json;
+    bool operator==(const NamedValue&) const = default;
+};
+
+// A named subtree that "use" nodes copy ("definitions" in a file; docs/scene-format.md,
+// "Definitions and uses"). Its node is kept as written, as JSON text, since its values may be
+// "$name" references to its parameters; the loader reads it again for each use.
+struct Definition {
+    std::string name;
+    std::vector<NamedValue> parameters; // in the order written, each with its default
+    std::string node; // JSON text of the node; toJson writes null if it is not JSON
+    bool operator==(const Definition&) const = default;
+};
+
+// A node written as {"type": "use", "definition": ...}. The loader makes it a union of one child,
+// a copy of the definition's node with the use's arguments, else the defaults, in place of the
+// "$name" references; the use's name, transform and colour are the union's. toJson writes the
+// use back, not its copy.
+struct Use {
+    std::string definition;            // a name in Scene::definitions
+    std::vector<NamedValue> arguments; // the parameters it sets, in the order written
+    bool operator==(const Use&) const = default;
+};
+
 struct Node {
     NodeKind kind = NodeKind::Sphere;
     std::string name; // optional label
-    std::string path; // JSON path in the source, e.g. "root.children[1]"
+    // JSON path in the source, e.g. "root.children[1]"; in the copy that a use makes, the path in
+    // the definition ("definitions.leg.node.children[0]"), the same for every copy.
+    std::string path;
     Transform transform;
     std::optional<glm::vec3> color;         // unset: inherited from the parent
     std::array<float, kMaxParams> params{}; // laid out by the kind's ParamInfo::slot
@@ -44,6 +74,8 @@ struct Node {
     // Polygon and text: the outline's glyph records and segments, made by the loader (the
     // layout is sdOutline's in shaders/sdf.glsl); shared by copies of the scene.
     std::shared_ptr<const std::vector<glm::vec4>> outline;
+    // Set on a use of a definition: this union's one child, and everything below it, is the copy.
+    std::optional<Use> use;
 };
 
 struct Camera {
@@ -77,11 +109,12 @@ struct SceneFiles {
 };
 
 struct Scene {
-    std::string file;             // where it came from, for messages
-    SceneFiles files;             // the rule it was loaded under, for parsing an edited copy
-    std::vector<Node> nodes;      // nodes[0] is the root; a parent always precedes its children
-    std::optional<Camera> camera; // unset: framed automatically from the scene's bounds
-    std::vector<Light> lights;    // empty: the default two-light rig (defaultLights())
+    std::string file;        // where it came from, for messages
+    SceneFiles files;        // the rule it was loaded under, for parsing an edited copy
+    std::vector<Node> nodes; // nodes[0] is the root; a parent always precedes its children
+    std::vector<Definition> definitions; // in the order written; the uses in `nodes` are expanded
+    std::optional<Camera> camera;        // unset: framed automatically from the scene's bounds
+    std::vector<Light> lights;           // empty: the default two-light rig (defaultLights())
     glm::vec3 background{0.60f, 0.72f, 0.85f};
     std::string name;        // optional title ("name" in the file)
     std::string description; // optional free text ("description" in the file)
@@ -90,6 +123,7 @@ struct Scene {
 // Limits enforced while loading, before any work that depends on the input's size.
 struct Limits {
     size_t maxFileBytes = 16u << 20; // 16 MiB
+    // Counted with every use expanded, before any copy is made.
     uint32_t maxNodes = 16384;
     uint32_t maxDepth = 64; // operations nested inside operations
 };

@@ -10,6 +10,7 @@
 #include "codegen/gpu_nodes.h"
 #include "field/prune.h"
 #include "field/sdf.h"
+#include "scene/outline.h"
 
 #include <algorithm>
 #include <array>
@@ -174,12 +175,15 @@ class Emitter {
     void indent(uint32_t depth) { out_.append(4 * (depth + 1), ' '); }
 
     // Whether node i's outline (polygon, text) is written out as code: a small one, listed by
-    // contour (outline.h), whose loops would read every segment from the node buffer, which
-    // costs a CPU device (lavapipe) several times the arithmetic, while written out they are
-    // literals. A larger one has a grid, whose cells list few segments.
+    // contour (outline.h) in at most kInlinedOutlineWords, whose loops would read every segment
+    // from the node buffer, which costs a CPU device (lavapipe) about ten times the frame
+    // (a revolved polygon of 12 or 35 points), while written out they are literals. A larger
+    // one is read from the buffer: written out, the code grows faster than the loop's cost
+    // (a 13-character text took 4 to 16 s and 500 MB to compile, and drew slower than the loop).
     bool inlinedOutline(uint32_t i) const {
         const Node& n = scene_.nodes[i];
-        return lit_ && n.outline && (*n.outline)[0].x == 0.0f;
+        return lit_ && n.outline && (*n.outline)[0].x == 0.0f &&
+               n.outline->size() <= detail::kInlinedOutlineWords;
     }
 
     static std::string vec2Literal(float x, float y) {

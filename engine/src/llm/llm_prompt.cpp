@@ -52,6 +52,12 @@ constexpr std::string_view kRules = R"(## How to build a scene
   are an "extrude" (thickness along z) of a 2D profile: "circle", "rectangle",
   "regular_polygon", "polygon" or "text". 2D profiles exist only inside extrude or revolve.
 - "blend" chooses the profile of "smooth": "smooth", "round" (a fillet) or "chamfer" (a bevel).
+- A part that recurs in other sizes or places (the legs of a table and of its chairs, the
+  windows of a house) can be written once under "definitions", with parameters and their
+  defaults, and placed by {"type": "use", "definition": NAME, "parameters": {...}} nodes, each
+  with its own translate, rotate, scale, color and name. Inside a definition's node, a value
+  "$name" stands for the parameter's value. Equal copies in a grid or a ring are cheaper as
+  "repeat" or "polar_repeat".
 - No other keys exist: an unknown key is an error.
 )";
 
@@ -64,6 +70,17 @@ std::string diagnosticLine(const Diagnostic& d) {
 }
 
 // ---- The strict schema, derived from sceneJsonSchema() ----
+//
+// Strict mode wants every key of every object listed, so it cannot say that the keys of
+// "definitions" and of a use's "parameters" are names of the scene's choosing: the strict schema
+// leaves out definitions and uses, and a model held to it writes each part out. Without a schema
+// (JSON mode, plain text) a model may write them, and the loader reads them as from a file.
+
+// The parts of the scene schema that the strict schema leaves out.
+bool leftOutOfStrict(std::string_view name) {
+    return name == "definitions" || name == "definition" || name == "parameter_value" ||
+           name == "use" || name == "#/$defs/use";
+}
 
 std::string constType(dom::element value) {
     if (value.is_string()) return "string";
@@ -99,6 +116,7 @@ std::string strictSchema(dom::element s, bool nullable, bool described) {
         std::string out = open() + R"("anyOf":[)";
         bool first = true;
         for (dom::element option : asArray(e)) {
+            if (std::string_view ref; !option["$ref"].get(ref) && leftOutOfStrict(ref)) continue;
             out += (first ? "" : ",") + strictSchema(option, false);
             first = false;
         }
@@ -122,6 +140,7 @@ std::string strictSchema(dom::element s, bool nullable, bool described) {
         std::string names;
         out += ",\"properties\":{";
         for (auto [key, value] : asObject(e)) {
+            if (leftOutOfStrict(key)) continue;
             const bool optional =
                 std::find(required.begin(), required.end(), key) == required.end();
             if (!names.empty()) {
@@ -192,6 +211,12 @@ std::string shape(dom::element s, dom::object defs) {
             out += (out.size() > 1 ? ", " : "") + jsonQuote(key) + ": " + shape(value, defs);
         return out + "}";
     }
+    if (type == "object" && !o["additionalProperties"].get(e) && e.is_object())
+        return "{NAME: " + shape(e, defs) + "}"; // keys of the scene's choosing
+    if (dom::array required; type == "object" && !o["required"].get(required) &&
+                             required.size() == 1 && required.at(0).is_string() &&
+                             required.at(0).get_string().value_unsafe() == "type")
+        return "NODE"; // a definition's node, which the schema checks only for its type
     return std::string(type);
 }
 
@@ -223,8 +248,9 @@ std::string sceneSystemPrompt() {
         "distance fields. You answer with one scene as a single JSON object, and nothing else: "
         "no prose, no code fences.\n\n## The scene format\n\n";
     out += topLevelKeys();
-    out += "A NODE is a primitive or an operation, chosen by \"type\". Operations (union, "
-           "intersection, difference) hold their operands in \"children\"; primitives are leaves. "
+    out += "A NODE is a primitive, an operation or a use of a definition, chosen by \"type\". "
+           "Operations (union, intersection, difference) hold their operands in \"children\"; "
+           "primitives are leaves. "
            "Lengths are in scene units, angles in degrees, colours in 0..1.\n\n";
     out += sceneFormatReference();
     out += "\n";
@@ -282,6 +308,7 @@ std::string sceneLlmSchema() {
         std::string defs = ",\"$defs\":{";
         bool first = true;
         for (auto [key, value] : asObject(top["$defs"].value_unsafe())) {
+            if (leftOutOfStrict(key)) continue;
             defs += (first ? "" : ",") + jsonQuote(key) + ":" + strictSchema(value, false);
             first = false;
         }

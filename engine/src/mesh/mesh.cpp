@@ -510,7 +510,7 @@ Status Mesher::Impl::buildPasses(const std::string& sceneGlsl) {
     if (spirv) {
         field = detail::createShaderModule(ctx, *spirv);
         cull = pipeline(field, spec(SDFCSG_MESH_PASS_CULL, SDFCSG_MESH_GROUP_X));
-        classify = pipeline(field, spec(SDFCSG_MESH_PASS_CLASSIFY, SDFCSG_MESH_BRICK));
+        classify = pipeline(field, spec(SDFCSG_MESH_PASS_CLASSIFY, SDFCSG_MESH_CLASSIFY_X));
         vertices = pipeline(field, spec(SDFCSG_MESH_PASS_VERTICES, SDFCSG_MESH_GROUP_X));
         // Every pipeline runs once on an empty batch, so drivers that compile at first use
         // (llvmpipe) have done so before the first extraction is timed.
@@ -774,7 +774,8 @@ Status Extraction::vertices(MeshPush push) {
         !ok)
         return ok;
     VkCommandBuffer cmd = m.begin(m.vertices);
-    m.dispatch(cmd, push, push.count);
+    m.dispatch(cmd, push,
+               detail::groupCount(uint32_t(totals.x - bases[push.first].x), SDFCSG_MESH_GROUP_X));
     m.finish(cmd);
     stage("vertices", t0);
 

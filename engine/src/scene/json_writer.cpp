@@ -139,6 +139,11 @@ void JsonWriter::boolean(bool value) {
     out_ += value ? "true" : "false";
 }
 
+void JsonWriter::null() {
+    beforeValue();
+    out_ += "null";
+}
+
 std::string JsonWriter::finish() {
     out_ += '\n';
     return std::move(out_);

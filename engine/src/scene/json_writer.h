@@ -30,6 +30,7 @@ class JsonWriter {
     void number(double value);
     void number(float value);
     void boolean(bool value);
+    void null();
     // The finished document, with a final newline.
     std::string finish();
 

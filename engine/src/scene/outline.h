@@ -3,10 +3,10 @@
 // crosses a horizontal (and a vertical) line at most once. Word 0 tells the layout, word 1 holds
 // the outline's box (lo xy, hi xy); the two give the node's kernel parameters (eval.cpp).
 //
-// A small outline (at most kGridOutlineWords) is listed by contour, for a loop over all of it or
-// for code that writes it out (codegen.cpp): word 0 is (0, contours, 0, 0); from word 2, per
-// contour its box and (first segment from word 2, lines, -, quadratics), then its lines, a word
-// each (a, b), then its quadratics, two each ((a, b), (c, -)).
+// A small outline (at most kGridOutlineWords) is listed by contour, for a loop over all of it or,
+// at most kInlinedOutlineWords, for code that writes it out (codegen.cpp): word 0 is (0, contours,
+// 0, 0); from word 2, per contour its box and (first segment from word 2, lines, -, quadratics),
+// then its lines, a word each (a, b), then its quadratics, two each ((a, b), (c, -)).
 //
 // A larger one is listed per cell of a grid over its box and two cells around it, each cell with
 // the segments that can be the nearest anywhere in it (a point's work is its cell's few
@@ -31,6 +31,9 @@ namespace sdfcsg::detail {
 // Outlines of more words than this get a grid; the most cells of a grid, and the most words of
 // its lists per segment (past them, a coarser grid).
 inline constexpr size_t kGridOutlineWords = 256;
+// Outlines of at most this many words (header included) are written into inlined kernels as
+// code (codegen.cpp); larger ones are read from the node buffer in every mode.
+inline constexpr size_t kInlinedOutlineWords = 128;
 inline constexpr size_t kMaxGridCells = size_t(1) << 16;
 inline constexpr size_t kGridWordsPerSegment = 256;
 

@@ -19,7 +19,9 @@
 #include <cfloat>
 #include <cmath>
 #include <cstdio>
+#include <deque>
 #include <fstream>
+#include <map>
 
 namespace sdfcsg {
 namespace {
@@ -86,10 +88,12 @@ const KindKeys& kindKeys(NodeKind kind) {
     return table[static_cast<size_t>(kind)];
 }
 
+// Every "type": the kinds, and "use" (a copy of a definition).
 std::vector<std::string_view> kindNameList() {
     std::vector<std::string_view> names;
     for (const KindInfo& k : nodeKinds())
         names.push_back(k.name);
+    names.push_back("use");
     return names;
 }
 
@@ -106,6 +110,127 @@ glm::vec3 normalised(glm::vec3 v) {
     return glm::vec3(d / len);
 }
 
+// ---- Definitions and uses ----
+//
+// A use is read as a union of one child, the copy: the walk reads the definition's node again,
+// in a Scope that gives its "$name" references the use's values. Before any copy is made, the
+// uses as written are checked: a use that comes back to its own definition is refused, and so
+// is a scene whose copies would pass Limits::maxNodes, so a hostile file costs no more than the
+// nodes it may have.
+
+// A definition may have at most this many parameters, so that what each copy keeps of its
+// values stays small.
+constexpr size_t kMaxParameters = 64;
+
+// Definition and parameter names: what follows "$" in a reference.
+bool isName(std::string_view s) {
+    auto letter = [](char c) {
+        return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_';
+    };
+    if (s.empty() || s.size() > kMaxNameCharacters || !letter(s[0])) return false;
+    return std::all_of(s.begin(), s.end(),
+                       [&](char c) { return letter(c) || (c >= '0' && c <= '9'); });
+}
+constexpr std::string_view kNameRule = "letters, digits and underscores, not starting with a digit";
+
+// The parameter that a "$name" string refers to, or nothing for any other value.
+std::optional<std::string_view> referenceIn(element value) {
+    if (!value.is_string()) return std::nullopt;
+    const std::string_view s = value.get_string().value_unsafe();
+    if (s.size() < 2 || s[0] != '$' || !isName(s.substr(1))) return std::nullopt;
+    return s.substr(1);
+}
+
+// What a parameter's value is, for messages; a use's value must be what the default is. Empty for
+// values that no parameter may have.
+std::string_view valueKind(element value) {
+    return value.is_number()   ? "a number"
+           : value.is_string() ? "a string"
+           : value.is_array()  ? "an array"
+                               : "";
+}
+
+// The definition a node as written uses: nothing for a node that is no use, "" for a use that
+// names none.
+std::optional<std::string_view> useOf(element value) {
+    if (!value.is_object()) return std::nullopt;
+    element type, name;
+    if (asObject(value).at_key("type").get(type) != simdjson::SUCCESS || !type.is_string() ||
+        type.get_string().value_unsafe() != "use")
+        return std::nullopt;
+    if (asObject(value).at_key("definition").get(name) != simdjson::SUCCESS || !name.is_string())
+        return std::string_view();
+    return name.get_string().value_unsafe();
+}
+
+// Visits the nodes of a tree as written, in pre-order, without going into the copies that uses
+// make: f(value, path) for each value in a node's place, until f returns false.
+template <class F> void forWrittenNodes(element root, std::string path, F&& f) {
+    struct Frame {
+        dom::array::iterator next, end;
+        std::string path; // of the children array
+        size_t index;
+    };
+    std::vector<Frame> stack;
+    auto visit = [&](element value, std::string at) {
+        if (!f(value, at)) return false;
+        element children;
+        if (value.is_object() && !useOf(value) &&
+            asObject(value).at_key("children").get(children) == simdjson::SUCCESS &&
+            children.is_array())
+            stack.push_back(
+                {asArray(children).begin(), asArray(children).end(), member(at, "children"), 0});
+        return true;
+    };
+    if (!visit(root, std::move(path))) return;
+    while (!stack.empty()) {
+        Frame& top = stack.back();
+        if (!(top.next != top.end)) {
+            stack.pop_back();
+            continue;
+        }
+        element value = *top.next;
+        ++top.next;
+        std::string at = item(top.path, top.index++);
+        if (!visit(value, std::move(at))) return; // `top` is not used after this
+    }
+}
+
+uint64_t addCapped(uint64_t a, uint64_t b) {
+    return a > UINT64_MAX - b ? UINT64_MAX : a + b;
+}
+
+// A definition as the reader knows it.
+struct DefinitionInfo {
+    std::string name;
+    std::string path; // "definitions.leg"
+    element node;     // when hasNode
+    bool hasNode = false;
+    std::vector<std::string_view> parameters; // names, in the order written
+    std::vector<element> defaults;
+    bool broken = false;   // refused: no copies are made
+    bool tooLarge = false; // a copy would pass the node limit
+    // A parameter was refused: its references cannot be judged, so the node is not read alone.
+    bool badParameters = false;
+    uint64_t size = 0; // nodes in one copy, with the copies its uses make
+};
+
+// What "$name" references mean where the walk is: in a copy, the use's values and else the
+// defaults; in a definition read on its own, the defaults.
+struct Scope {
+    uint32_t definition = 0;
+    std::vector<element> values; // per parameter of the definition
+    bool copy = false;
+    std::string usePath;          // of the use that made the copy
+    const Scope* outer = nullptr; // the copy the use lies in
+};
+
+// Where the walk goes from a node: into its children, or into the copy that a use makes.
+struct Next {
+    std::optional<dom::array> children;
+    const Scope* copy = nullptr;
+};
+
 class SceneReader {
   public:
     SceneReader(const ParseOptions& options, Problems& problems)
@@ -116,18 +241,41 @@ class SceneReader {
   private:
     void readCamera(element value, Scene& scene);
     void readLights(element value, Scene& scene);
-    void readTree(element root, Scene& scene);
-    // Appends the node at `value` to scene.nodes and returns its children when the walk
-    // should go on into them.
-    std::optional<dom::array> readNode(element value, std::string path, uint32_t depth,
-                                       Scene& scene);
+    void readDefinitions(element value, Scene& scene);
+    void readParameters(element value, const std::string& path, DefinitionInfo& info,
+                        Definition& definition);
+    // Refuses uses that recur and definitions whose copies would pass the node limit, then
+    // reads each definition on its own, with its defaults.
+    void checkDefinitions();
+    // Whether the tree under `root`, with the copies its uses make, keeps to the node limit;
+    // reports where it passes the limit when copies take it there.
+    bool fitsWithCopies(element root);
+    // Reads the tree under `root` (the scene's, or a definition's on its own in `scope`) into
+    // scene.nodes.
+    void readTree(element root, std::string path, Scene& scene, const Scope* scope);
+    // Appends the node at `value` to scene.nodes and says where the walk goes next.
+    Next readNode(element value, std::string path, uint32_t depth, Scene& scene);
+    Next readUse(dom::object object, uint32_t depth, Node& node);
+    void readCommon(const std::string& path, std::optional<element> name,
+                    std::optional<element> translate, std::optional<element> rotate,
+                    std::optional<element> scale, std::optional<element> color, Node& node);
     void readParam(const ParamInfo& p, std::optional<element> value, const std::string& path,
                    Node& node, bool& ok);
+    // The value that a "$name" string stands for where the walk is, or the value itself;
+    // nothing, and a problem reported, for a reference to no parameter.
+    std::optional<element> resolve(element value, const std::string& path);
+    // " (in the use of "leg" at root.children[0], ...)" in a copy, else "".
+    std::string context() const;
 
     const Limits& limits_;
     const SceneFiles& files_;
     Problems& problems_;
     size_t outlineWords_ = 0; // polygon and text outlines so far, in vec4s
+    std::vector<DefinitionInfo> definitions_;
+    std::map<std::string, uint32_t, std::less<>> definitionIndex_;
+    std::deque<Scope> scopes_; // stable addresses for the frames that point at them
+    const Scope* scope_ = nullptr;
+    bool copying_ = true; // false while definitions are read on their own
 };
 
 Scene SceneReader::read(element top) {
@@ -138,7 +286,7 @@ Scene SceneReader::read(element top) {
         return scene;
     }
     static constexpr std::string_view kKeys[] = {"version", "name",       "description", "camera",
-                                                 "lights",  "background", "root"};
+                                                 "lights",  "background", "definitions", "root"};
     auto v = readMembers(asObject(top), {}, kKeys, std::size(kKeys), {}, problems_);
     if (!v[0]) {
         problems_.add({}, "missing required key \"version\" (the format version, " +
@@ -158,11 +306,260 @@ Scene SceneReader::read(element top) {
     if (v[4]) readLights(*v[4], scene);
     if (v[5])
         if (auto c = readColor(*v[5], "background", problems_)) scene.background = *c;
-    if (v[6])
-        readTree(*v[6], scene);
-    else
+    problems_.setContext([this] { return context(); });
+    if (v[6]) {
+        readDefinitions(*v[6], scene);
+        checkDefinitions();
+    }
+    if (!v[7])
         problems_.add({}, "missing required key \"root\" (the top node of the scene)");
+    else if (fitsWithCopies(*v[7]))
+        readTree(*v[7], "root", scene, nullptr);
+    problems_.setContext({});
     return scene;
+}
+
+void SceneReader::readDefinitions(element value, Scene& scene) {
+    if (!value.is_object()) {
+        problems_.add("definitions", "expected an object of named definitions, each "
+                                     "{\"parameters\": {...}, \"node\": NODE}, got " +
+                                         describe(value));
+        return;
+    }
+    static constexpr std::string_view kKeys[] = {"parameters", "node"};
+    for (auto [key, body] : asObject(value)) {
+        if (!isName(key)) {
+            problems_.add("definitions", "expected a definition name of " + std::string(kNameRule) +
+                                             ", got " + quote(key));
+            continue;
+        }
+        if (definitionIndex_.contains(key)) {
+            problems_.add("definitions", "duplicate key " + quote(key));
+            continue;
+        }
+        DefinitionInfo info;
+        info.name = std::string(key);
+        info.path = member("definitions", key);
+        Definition written;
+        written.name = info.name;
+        if (!body.is_object()) {
+            problems_.add(info.path, "expected a definition (an object with \"node\" and "
+                                     "optionally \"parameters\"), got " +
+                                         describe(body));
+            info.broken = true;
+        } else {
+            auto v = readMembers(asObject(body), info.path, kKeys, std::size(kKeys),
+                                 " for a definition", problems_);
+            if (v[0]) readParameters(*v[0], member(info.path, "parameters"), info, written);
+            if (v[1]) {
+                info.node = *v[1];
+                info.hasNode = true;
+                written.node = jsonText(*v[1]);
+            } else {
+                problems_.add(info.path, "missing required key \"node\" (the node that uses "
+                                         "copy, whose values may be \"$name\" references to "
+                                         "the parameters)");
+                info.broken = true;
+            }
+        }
+        definitionIndex_.emplace(info.name, uint32_t(definitions_.size()));
+        definitions_.push_back(std::move(info));
+        scene.definitions.push_back(std::move(written));
+    }
+}
+
+void SceneReader::readParameters(element value, const std::string& path, DefinitionInfo& info,
+                                 Definition& definition) {
+    if (!value.is_object()) {
+        problems_.add(path, "expected an object of parameter names and their default values, "
+                            "got " +
+                                describe(value));
+        info.broken = info.badParameters = true;
+        return;
+    }
+    for (auto [name, fallback] : asObject(value)) {
+        const std::string at = member(path, name);
+        if (!isName(name)) {
+            problems_.add(path, "expected a parameter name of " + std::string(kNameRule) +
+                                    ", got " + quote(name));
+        } else if (std::find(info.parameters.begin(), info.parameters.end(), name) !=
+                   info.parameters.end()) {
+            problems_.add(path, "duplicate key " + quote(name));
+        } else if (info.parameters.size() == kMaxParameters) {
+            problems_.add(path,
+                          "too many parameters: a definition may have at most " +
+                              std::to_string(kMaxParameters),
+                          ErrorKind::Limit);
+            info.broken = info.badParameters = true;
+            return;
+        } else if (valueKind(fallback).empty()) {
+            problems_.add(at, "expected a default value (a number, a string or an array), got " +
+                                  describe(fallback));
+        } else if (referenceIn(fallback)) {
+            problems_.add(at, "expected a default value, got " + describe(fallback) +
+                                  ", a reference (a default cannot refer to a parameter)");
+        } else {
+            info.parameters.push_back(name);
+            info.defaults.push_back(fallback);
+            definition.parameters.push_back({std::string(name), jsonText(fallback)});
+            continue;
+        }
+        info.broken = info.badParameters = true;
+    }
+}
+
+void SceneReader::checkDefinitions() {
+    const size_t count = definitions_.size();
+    struct UseOf {
+        uint32_t definition;
+        std::string path;
+    };
+    std::vector<std::vector<UseOf>> uses(count);
+    std::vector<uint64_t> own(count, 0); // nodes written in each definition, its uses included
+    for (uint32_t d = 0; d < count; ++d) {
+        if (!definitions_[d].hasNode) continue;
+        forWrittenNodes(definitions_[d].node, member(definitions_[d].path, "node"),
+                        [&](element value, const std::string& path) {
+                            ++own[d];
+                            if (auto name = useOf(value)) {
+                                auto found = definitionIndex_.find(*name);
+                                if (found != definitionIndex_.end())
+                                    uses[d].push_back({found->second, path});
+                            }
+                            return true;
+                        });
+    }
+    auto name = [&](uint32_t d) { return quote(definitions_[d].name); };
+
+    // Depth first, with a stack of its own: a use of a definition still open closes a loop.
+    // Sizes are summed as each definition closes, after those it uses.
+    enum : uint8_t { kNew, kOpen, kDone };
+    std::vector<uint8_t> state(count, kNew);
+    std::vector<size_t> place(count, 0); // an open definition's place on the stack
+    struct Frame {
+        uint32_t definition;
+        size_t next;
+    };
+    std::vector<Frame> stack;
+    for (uint32_t start = 0; start < count; ++start) {
+        if (state[start] != kNew) continue;
+        state[start] = kOpen;
+        stack.push_back({start, 0});
+        while (!stack.empty()) {
+            const uint32_t d = stack.back().definition;
+            if (stack.back().next < uses[d].size()) {
+                const UseOf& use = uses[d][stack.back().next++];
+                if (state[use.definition] == kNew) {
+                    state[use.definition] = kOpen;
+                    place[use.definition] = stack.size();
+                    stack.push_back({use.definition, 0});
+                } else if (state[use.definition] == kOpen) {
+                    std::string loop = name(d) + " uses itself";
+                    if (use.definition != d) {
+                        loop = name(d) + " uses " + name(use.definition);
+                        for (size_t k = place[use.definition] + 1; k < stack.size(); ++k)
+                            loop += ", which uses " + name(stack[k].definition);
+                    }
+                    problems_.add(use.path, "recursive use: " + loop);
+                    for (size_t k = place[use.definition]; k < stack.size(); ++k)
+                        definitions_[stack[k].definition].broken = true;
+                }
+                continue;
+            }
+            DefinitionInfo& info = definitions_[d];
+            uint64_t size = own[d];
+            for (const UseOf& use : uses[d]) {
+                // Without its copies a definition would differ from what was written.
+                if (definitions_[use.definition].broken) info.broken = true;
+                size = addCapped(size, definitions_[use.definition].size);
+            }
+            info.size = size;
+            if (!info.broken && size > limits_.maxNodes) {
+                problems_.add(info.path,
+                              "too many nodes: a copy of this definition, with the copies its "
+                              "uses make, would have more than " +
+                                  std::to_string(limits_.maxNodes) + ", the most a scene may have",
+                              ErrorKind::Limit);
+                info.broken = info.tooLarge = true;
+            }
+            state[d] = kDone;
+            stack.pop_back();
+        }
+    }
+
+    // Each definition read on its own, with its defaults, so that its problems are reported
+    // once, at its own paths; a definition with problems is not copied.
+    copying_ = false;
+    const size_t outlineWords = outlineWords_; // the copies count, not these
+    for (uint32_t d = 0; d < count; ++d) {
+        DefinitionInfo& info = definitions_[d];
+        if (!info.hasNode || info.tooLarge || info.badParameters) continue;
+        Scope& scope = scopes_.emplace_back();
+        scope.definition = d;
+        scope.values = info.defaults;
+        Scene alone;
+        const size_t before = problems_.count();
+        readTree(info.node, member(info.path, "node"), alone, &scope);
+        if (problems_.count() != before) info.broken = true;
+    }
+    outlineWords_ = outlineWords;
+    copying_ = true;
+}
+
+bool SceneReader::fitsWithCopies(element root) {
+    uint64_t total = 0;
+    bool copies = false, fits = true;
+    forWrittenNodes(root, "root", [&](element value, const std::string& path) {
+        ++total;
+        std::string_view copied;
+        if (auto name = useOf(value)) {
+            auto found = definitionIndex_.find(*name);
+            if (found != definitionIndex_.end() && !definitions_[found->second].broken) {
+                total = addCapped(total, definitions_[found->second].size);
+                copies = true;
+                copied = *name;
+            }
+        }
+        if (total <= limits_.maxNodes) return true;
+        // Without copies so far, the walk reports it as it reads the nodes.
+        if (copies)
+            problems_.add(
+                path,
+                "too many nodes: a scene may have at most " + std::to_string(limits_.maxNodes) +
+                    ", counting the copies that uses make" +
+                    (copied.empty() ? std::string()
+                                    : ", and the copy of " + quote(copied) + " here passes that"),
+                ErrorKind::Limit);
+        fits = !copies;
+        return false;
+    });
+    return fits;
+}
+
+std::optional<element> SceneReader::resolve(element value, const std::string& path) {
+    const auto name = referenceIn(value);
+    if (!name) return value;
+    if (!scope_) {
+        problems_.add(path, describe(value) + " refers to a parameter, and only the nodes of "
+                                              "definitions have parameters");
+        return std::nullopt;
+    }
+    const DefinitionInfo& info = definitions_[scope_->definition];
+    for (size_t i = 0; i < info.parameters.size(); ++i)
+        if (info.parameters[i] == *name) return scope_->values[i];
+    std::string hint = didYouMean(*name, info.parameters);
+    if (hint.empty())
+        hint = info.parameters.empty() ? "; it has none" : "; it has " + joinNames(info.parameters);
+    problems_.add(path, describe(value) + " names no parameter of " + quote(info.name) + hint);
+    return std::nullopt;
+}
+
+std::string SceneReader::context() const {
+    std::string out;
+    for (const Scope* s = scope_; s && s->copy; s = s->outer)
+        out += (out.empty() ? " (in the use of " : ", in the use of ") +
+               quote(definitions_[s->definition].name) + " at " + s->usePath;
+    return out.empty() ? out : out + ")";
 }
 
 void SceneReader::readCamera(element value, Scene& scene) {
@@ -252,42 +649,58 @@ void SceneReader::readLights(element value, Scene& scene) {
     }
 }
 
-void SceneReader::readTree(element root, Scene& scene) {
+void SceneReader::readTree(element root, std::string path, Scene& scene, const Scope* scope) {
     struct Frame {
-        dom::array::iterator next, end;
+        dom::array::iterator next, end; // children still to read, when `children`
+        bool children;
+        const Scope* copy;  // a use's copy, to read before anything else
+        const Scope* scope; // where the frame's nodes lie
         uint32_t parent;
         uint32_t depth; // of the children
         size_t index;   // of the next child
     };
     std::vector<Frame> stack;
-    auto visit = [&](element value, std::string path, std::optional<uint32_t> parent,
-                     uint32_t depth) {
+    auto visit = [&](element value, std::string at, std::optional<uint32_t> parent, uint32_t depth,
+                     const Scope* in) {
+        scope_ = in;
         if (scene.nodes.size() >= limits_.maxNodes) {
-            problems_.add(std::move(path),
+            problems_.add(std::move(at),
                           "too many nodes: a scene may have at most " +
                               std::to_string(limits_.maxNodes),
                           ErrorKind::Limit);
             return false;
         }
         const auto index = static_cast<uint32_t>(scene.nodes.size());
-        auto children = readNode(value, std::move(path), depth, scene);
+        Next next = readNode(value, std::move(at), depth, scene);
         if (parent) scene.nodes[*parent].children.push_back(index);
-        if (children) stack.push_back({children->begin(), children->end(), index, depth + 1, 0});
+        if (next.children)
+            stack.push_back({next.children->begin(), next.children->end(), true, nullptr, in, index,
+                             depth + 1, 0});
+        else if (next.copy)
+            stack.push_back({{}, {}, false, next.copy, next.copy, index, depth + 1, 0});
         return true;
     };
-    if (!visit(root, "root", std::nullopt, 0)) return;
-    while (!stack.empty()) {
+    bool going = visit(root, std::move(path), std::nullopt, 0, scope);
+    while (going && !stack.empty()) {
         Frame& top = stack.back();
-        if (!(top.next != top.end)) {
+        const uint32_t parent = top.parent, depth = top.depth;
+        const Scope* in = top.scope;
+        if (top.copy) {
+            top.copy = nullptr;
+            const DefinitionInfo& info = definitions_[in->definition];
+            going = visit(info.node, member(info.path, "node"), parent, depth, in);
+            continue;
+        }
+        if (!top.children || !(top.next != top.end)) {
             stack.pop_back();
             continue;
         }
         element child = *top.next;
         ++top.next;
-        const uint32_t parent = top.parent, depth = top.depth;
-        std::string path = item(member(scene.nodes[parent].path, "children"), top.index++);
-        if (!visit(child, std::move(path), parent, depth)) return;
+        std::string at = item(member(scene.nodes[parent].path, "children"), top.index++);
+        going = visit(child, std::move(at), parent, depth, in);
     }
+    scope_ = nullptr;
 }
 
 void SceneReader::readParam(const ParamInfo& p, std::optional<element> value,
@@ -367,15 +780,14 @@ void SceneReader::readParam(const ParamInfo& p, std::optional<element> value,
     }
 }
 
-std::optional<dom::array> SceneReader::readNode(element value, std::string path, uint32_t depth,
-                                                Scene& scene) {
+Next SceneReader::readNode(element value, std::string path, uint32_t depth, Scene& scene) {
     scene.nodes.emplace_back();
     Node& node = scene.nodes.back();
     node.path = std::move(path);
     const std::string& p = node.path;
     if (!value.is_object()) {
         problems_.add(p, "expected a node (an object with \"type\"), got " + describe(value));
-        return std::nullopt;
+        return {};
     }
     dom::object object = asObject(value);
 
@@ -387,6 +799,7 @@ std::optional<dom::array> SceneReader::readNode(element value, std::string path,
         problems_.add(member(p, "type"), "expected a node type name, got " + describe(typeValue));
     } else {
         std::string_view name = typeValue.get_string().value_unsafe();
+        if (name == "use") return readUse(object, depth, node);
         kind = findKind(name);
         if (!kind) {
             std::string hint = didYouMean(name, kindNameList());
@@ -400,43 +813,34 @@ std::optional<dom::array> SceneReader::readNode(element value, std::string path,
         element children;
         if (object.at_key("children").get(children) == simdjson::SUCCESS && children.is_array() &&
             !tooDeep)
-            return asArray(children);
-        return std::nullopt;
+            return {asArray(children)};
+        return {};
     }
     node.kind = kind->kind;
 
     const KindKeys& keys = kindKeys(kind->kind);
     auto v =
         readMembers(object, p, keys.keys, keys.listed, " for " + article(kind->name), problems_);
-    auto valueOf = [&](std::string_view key) {
-        return v[static_cast<size_t>(std::find(keys.keys.begin(), keys.keys.end(), key) -
-                                     keys.keys.begin())];
+    // A reference to no parameter is reported by resolve(): the key counts as given, not missing.
+    std::vector<bool> unresolved(v.size(), false);
+    for (size_t i = 0; i < v.size(); ++i)
+        if (v[i] && keys.keys[i] != "type" && keys.keys[i] != "children") {
+            v[i] = resolve(*v[i], member(p, keys.keys[i]));
+            unresolved[i] = !v[i];
+        }
+    auto at = [&](std::string_view key) {
+        return static_cast<size_t>(std::find(keys.keys.begin(), keys.keys.end(), key) -
+                                   keys.keys.begin());
     };
+    auto valueOf = [&](std::string_view key) { return v[at(key)]; };
     bool paramsOk = true;
     for (const ParamInfo& param : kind->params)
-        readParam(param, valueOf(param.name), p, node, paramsOk);
-    if (auto e = valueOf("name"))
-        if (auto s = readString(*e, member(p, "name"), kMaxNameCharacters, problems_))
-            node.name = *s;
-    if (auto e = valueOf("translate"))
-        if (auto t = readVec3(*e, member(p, "translate"), Check::Any, problems_))
-            node.transform.translate = *t;
-    if (auto e = valueOf("rotate"))
-        if (auto r = readVec3(*e, member(p, "rotate"), Check::Any, problems_))
-            node.transform.rotate = *r;
-    if (auto e = valueOf("scale")) {
-        if (e->is_array()) {
-            if (auto s = readVec3(*e, member(p, "scale"), Check::Positive, problems_))
-                node.transform.scale = *s;
-        } else if (!e->is_number()) {
-            problems_.add(member(p, "scale"),
-                          "expected a positive number or an array of 3 positive numbers, got " +
-                              describe(*e));
-        } else if (auto s = readNumber(*e, member(p, "scale"), Check::Positive, problems_)) {
-            node.transform.scale = glm::vec3(static_cast<float>(*s));
-        }
-    }
-    if (auto e = valueOf("color")) node.color = readColor(*e, member(p, "color"), problems_);
+        if (unresolved[at(param.name)])
+            paramsOk = false;
+        else
+            readParam(param, valueOf(param.name), p, node, paramsOk);
+    readCommon(p, valueOf("name"), valueOf("translate"), valueOf("rotate"), valueOf("scale"),
+               valueOf("color"), node);
 
     if (kind->kind == NodeKind::Polygon && paramsOk) {
         if (std::string why = polygonProblem(node.points); !why.empty())
@@ -490,36 +894,171 @@ std::optional<dom::array> SceneReader::readNode(element value, std::string path,
             problems_.add(p, article(kind->name) + " takes no \"children\"; only operations (" +
                                  joinNames(operations, "and") + ") do");
         }
-        return std::nullopt;
+        return {};
     }
     if (!children) {
         problems_.add(p, "missing required key \"children\" (a non-empty array of nodes)");
-        return std::nullopt;
+        return {};
     }
     if (!children->is_array()) {
         problems_.add(member(p, "children"),
                       "expected a non-empty array of nodes, got " + describe(*children));
-        return std::nullopt;
+        return {};
     }
     dom::array array = asArray(*children);
     if (array.size() == 0) {
         problems_.add(member(p, "children"), "expected at least one child node, got []");
-        return std::nullopt;
+        return {};
     }
     if (kind->role != Role::Boolean && array.size() != 1) {
         problems_.add(member(p, "children"),
                       "expected exactly one child node (wrap several in a union), got " +
                           std::to_string(array.size()));
-        return std::nullopt;
+        return {};
     }
     if (tooDeep) {
         problems_.add(p,
                       "nesting too deep: more than " + std::to_string(limits_.maxDepth) +
                           " nested operations",
                       ErrorKind::Limit);
-        return std::nullopt;
+        return {};
     }
-    return array;
+    return {array};
+}
+
+void SceneReader::readCommon(const std::string& p, std::optional<element> name,
+                             std::optional<element> translate, std::optional<element> rotate,
+                             std::optional<element> scale, std::optional<element> color,
+                             Node& node) {
+    if (name)
+        if (auto s = readString(*name, member(p, "name"), kMaxNameCharacters, problems_))
+            node.name = *s;
+    if (translate)
+        if (auto t = readVec3(*translate, member(p, "translate"), Check::Any, problems_))
+            node.transform.translate = *t;
+    if (rotate)
+        if (auto r = readVec3(*rotate, member(p, "rotate"), Check::Any, problems_))
+            node.transform.rotate = *r;
+    if (scale) {
+        if (scale->is_array()) {
+            if (auto s = readVec3(*scale, member(p, "scale"), Check::Positive, problems_))
+                node.transform.scale = *s;
+        } else if (!scale->is_number()) {
+            problems_.add(member(p, "scale"),
+                          "expected a positive number or an array of 3 positive numbers, got " +
+                              describe(*scale));
+        } else if (auto s = readNumber(*scale, member(p, "scale"), Check::Positive, problems_)) {
+            node.transform.scale = glm::vec3(static_cast<float>(*s));
+        }
+    }
+    if (color) node.color = readColor(*color, member(p, "color"), problems_);
+}
+
+Next SceneReader::readUse(dom::object object, uint32_t depth, Node& node) {
+    const std::string& p = node.path;
+    static constexpr std::string_view kKeys[] = {"definition", "parameters", "type",  "name",
+                                                 "translate",  "rotate",     "scale", "color"};
+    auto v = readMembers(object, p, kKeys, std::size(kKeys), " for a use", problems_);
+    node.kind = NodeKind::Union;
+    for (const ParamInfo& q : kindInfo(NodeKind::Union).params)
+        node.params[q.slot] = q.fallback[0];
+    node.use.emplace();
+    for (size_t i = 3; i < std::size(kKeys); ++i)
+        if (v[i]) v[i] = resolve(*v[i], member(p, kKeys[i]));
+    readCommon(p, v[3], v[4], v[5], v[6], v[7], node);
+
+    const DefinitionInfo* info = nullptr;
+    uint32_t index = 0;
+    if (!v[0]) {
+        problems_.add(p, "missing required key \"definition\" (the name of one of the scene's "
+                         "\"definitions\")");
+    } else if (!v[0]->is_string()) {
+        problems_.add(member(p, "definition"),
+                      "expected the name of a definition, got " + describe(*v[0]));
+    } else {
+        const std::string_view name = v[0]->get_string().value_unsafe();
+        node.use->definition = std::string(name);
+        if (auto found = definitionIndex_.find(name); found != definitionIndex_.end()) {
+            index = found->second;
+            info = &definitions_[index];
+        } else {
+            // Once the problems are full, only counted: spare the suggestion search.
+            std::vector<std::string_view> names;
+            if (!problems_.full())
+                for (const DefinitionInfo& d : definitions_)
+                    names.push_back(d.name);
+            std::string hint = didYouMean(name, names);
+            if (definitions_.empty())
+                hint = "; the scene has no \"definitions\"";
+            else if (hint.empty() && !names.empty() && names.size() <= 8)
+                hint = "; the scene defines " + joinNames(names);
+            problems_.add(member(p, "definition"), "unknown definition " + quote(name) + hint);
+        }
+    }
+
+    // The use's values, checked against the definition's parameters and their defaults.
+    std::vector<std::optional<element>> values(info ? info->parameters.size() : 0);
+    bool valuesOk = true;
+    if (v[1] && !v[1]->is_object()) {
+        problems_.add(member(p, "parameters"),
+                      "expected an object of parameter values, got " + describe(*v[1]));
+        valuesOk = false;
+    } else if (v[1]) {
+        const std::string at = member(p, "parameters");
+        for (auto [key, value] : asObject(*v[1])) {
+            node.use->arguments.push_back({std::string(key), jsonText(value)});
+            if (!info) continue;
+            const auto found = std::find(info->parameters.begin(), info->parameters.end(), key);
+            if (found == info->parameters.end()) {
+                std::string hint = problems_.full() ? "" : didYouMean(key, info->parameters);
+                if (hint.empty())
+                    hint = info->parameters.empty() ? "; it has none"
+                                                    : "; it has " + joinNames(info->parameters);
+                problems_.add(at, "unknown parameter " + quote(key) + " of " + quote(info->name) +
+                                      hint);
+                valuesOk = false;
+                continue;
+            }
+            const size_t i = static_cast<size_t>(found - info->parameters.begin());
+            if (values[i]) {
+                problems_.add(at, "duplicate key " + quote(key));
+                valuesOk = false;
+                continue;
+            }
+            const auto resolved = resolve(value, member(at, key));
+            const std::string_view expected = valueKind(info->defaults[i]);
+            if (resolved && valueKind(*resolved) != expected) {
+                const std::string got = referenceIn(value)
+                                            ? describe(value) + ", which is " + describe(*resolved)
+                                            : describe(value);
+                problems_.add(member(at, key), "expected " + std::string(expected) +
+                                                   ", as the default of " + quote(key) + " in " +
+                                                   quote(info->name) + " is, got " + got);
+            }
+            if (!resolved || valueKind(*resolved) != expected) {
+                valuesOk = false;
+                continue;
+            }
+            values[i] = *resolved;
+        }
+    }
+    if (depth + 1 > limits_.maxDepth) {
+        problems_.add(p,
+                      "nesting too deep: more than " + std::to_string(limits_.maxDepth) +
+                          " nested operations (a use counts as one, above its copy)",
+                      ErrorKind::Limit);
+        return {};
+    }
+    if (!copying_ || !info || info->broken || !valuesOk) return {};
+    Scope& copy = scopes_.emplace_back();
+    copy.definition = index;
+    copy.values = info->defaults;
+    for (size_t i = 0; i < values.size(); ++i)
+        if (values[i]) copy.values[i] = *values[i];
+    copy.copy = true;
+    copy.usePath = p;
+    copy.outer = scope_;
+    return {std::nullopt, &copy};
 }
 
 // A polygon turned by a revolve, untransformed but for a shift, that meets the axis along an
@@ -542,6 +1081,21 @@ bool finite(glm::vec3 v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
+// " (in the use of "leg" at root.children[0], ...)" for a node in the copy that a use makes: the
+// uses above it, innermost first.
+std::string useContext(const Scene& scene, uint32_t node) {
+    std::vector<uint32_t> parent(scene.nodes.size(), UINT32_MAX);
+    for (uint32_t i = 0; i < scene.nodes.size(); ++i)
+        for (uint32_t c : scene.nodes[i].children)
+            parent[c] = i;
+    std::string out;
+    for (uint32_t n = parent[node]; n != UINT32_MAX; n = parent[n])
+        if (const Node& above = scene.nodes[n]; above.use)
+            out += (out.empty() ? " (in the use of " : ", in the use of ") +
+                   quote(above.use->definition) + " at " + above.path;
+    return out.empty() ? out : out + ")";
+}
+
 // Each value is within single precision on its own, but the renderer works in every node's local
 // units: scales multiply down the tree and translations are divided by them, and a product beyond
 // single precision would put inf into the generated code and the node buffer. Reports the first
@@ -551,6 +1105,9 @@ void checkCombinedTransforms(const Scene& scene, Problems& problems) {
     // The products of the smallest and of the largest factors: the parent's, until multiplied.
     std::vector<double> scale(scene.nodes.size(), 1.0), largest(scene.nodes.size(), 1.0);
     std::vector<bool> inCut(scene.nodes.size(), false); // inside an extrude or a revolve
+    auto report = [&](size_t i, std::string message) {
+        problems.add(scene.nodes[i].path, message + useContext(scene, uint32_t(i)));
+    };
     for (size_t i = 0; i < scene.nodes.size(); ++i) {
         const Node& node = scene.nodes[i];
         const glm::vec3 s = node.transform.scale;
@@ -564,17 +1121,15 @@ void checkCombinedTransforms(const Scene& scene, Problems& problems) {
         for (uint32_t c : node.children)
             inCut[c] = inCut[i] || cuts;
         if (isProfile(node.kind) && !inCut[i]) {
-            problems.add(node.path, article(info.name) +
-                                        " is a 2D profile: it must be inside an extrude or a "
-                                        "revolve");
+            report(i, article(info.name) + " is a 2D profile: it must be inside an extrude or a "
+                                           "revolve");
             return;
         }
         if (info.role == Role::Domain && node.kind != NodeKind::Mirror &&
             node.kind != NodeKind::Elongate && !node.children.empty() &&
             !evaluator.nodes()[node.children[0]].bounds.finite()) {
-            problems.add(node.path, article(info.name) +
-                                        " needs a bounded child, and its child reaches infinity "
-                                        "(a plane does)");
+            report(i, article(info.name) + " needs a bounded child, and its child reaches infinity "
+                                           "(a plane does)");
             return;
         }
         if (std::isfinite(f.scale) && f.scale > 0.0f && finite(f.toLocal[0]) &&
@@ -588,15 +1143,15 @@ void checkCombinedTransforms(const Scene& scene, Problems& problems) {
             std::string("the scales of this node and the operations above it multiply to ") +
             product;
         if (huge)
-            problems.add(node.path, combined + ", beyond single precision (about 3.4e+38)");
+            report(i, combined + ", beyond single precision (about 3.4e+38)");
         else if (scale[i] < FLT_MIN)
-            problems.add(node.path, combined + ", too small for single precision (about 1.2e-38)");
+            report(i, combined + ", too small for single precision (about 1.2e-38)");
         else if (!std::isfinite(f.smooth))
-            problems.add(node.path, "smooth times the scales above it is beyond single precision "
-                                    "(about 3.4e+38)");
+            report(i, "smooth times the scales above it is beyond single precision "
+                      "(about 3.4e+38)");
         else
-            problems.add(node.path, "the translation of this node, in the units of the scales "
-                                    "above it, is beyond single precision (about 3.4e+38)");
+            report(i, "the translation of this node, in the units of the scales "
+                      "above it, is beyond single precision (about 3.4e+38)");
         return;
     }
 }

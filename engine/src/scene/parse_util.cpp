@@ -19,6 +19,7 @@ void Problems::add(std::string path, std::string message, ErrorKind kind) {
         return;
     }
     if (diagnostics_.empty()) kind_ = kind;
+    if (context_ && !message.empty()) message += context_();
     diagnostics_.push_back({file_, std::move(path), std::move(message)});
 }
 
@@ -426,6 +427,78 @@ std::vector<std::optional<element>> readMembers(simdjson::dom::object object,
         problems.add(path, "unknown key " + quote(kv.key) + hint);
     }
     return values;
+}
+
+void writeJson(JsonWriter& w, element value, bool inlined) {
+    using Layout = JsonWriter::Layout;
+    struct Frame {
+        bool object, inlined;
+        simdjson::dom::object::iterator member, members;
+        simdjson::dom::array::iterator next, end;
+    };
+    std::vector<Frame> stack;
+    // Writes a scalar, or opens a container for the loop below to fill.
+    auto visit = [&](element e, bool inside) {
+        switch (e.type()) {
+        case element_type::OBJECT: {
+            simdjson::dom::object o = asObject(e);
+            w.beginObject(inside ? Layout::Inline : Layout::Block);
+            stack.push_back({true, inside, o.begin(), o.end(), {}, {}});
+            return;
+        }
+        case element_type::ARRAY: {
+            simdjson::dom::array a = asArray(e);
+            bool flat = true;
+            for (element item : a)
+                flat = flat && !item.is_object();
+            w.beginArray(inside || flat ? Layout::Inline : Layout::Block);
+            stack.push_back({false, inside || flat, {}, {}, a.begin(), a.end()});
+            return;
+        }
+        case element_type::STRING:
+            w.string(e.get_string().value_unsafe());
+            return;
+        case element_type::INT64:
+        case element_type::UINT64:
+        case element_type::DOUBLE:
+            w.number(e.get_double().value_unsafe());
+            return;
+        case element_type::BOOL:
+            w.boolean(e.get_bool().value_unsafe());
+            return;
+        case element_type::NULL_VALUE:
+            w.null();
+            return;
+        }
+    };
+    visit(value, inlined);
+    while (!stack.empty()) {
+        Frame& top = stack.back();
+        const bool inside = top.inlined;
+        if (top.object ? top.member == top.members : !(top.next != top.end)) {
+            top.object ? w.endObject() : w.endArray();
+            stack.pop_back();
+            continue;
+        }
+        element e;
+        if (top.object) {
+            w.key(top.member.key());
+            e = top.member.value();
+            ++top.member;
+        } else {
+            e = *top.next;
+            ++top.next;
+        }
+        visit(e, inside); // may grow the stack: `top` is not used after this
+    }
+}
+
+std::string jsonText(element value) {
+    JsonWriter w;
+    writeJson(w, value, true);
+    std::string text = w.finish();
+    if (text.ends_with('\n')) text.pop_back();
+    return text;
 }
 
 } // namespace sdfcsg::detail

@@ -5,10 +5,13 @@
 
 #include "sdfcsg/scene.h"
 
+#include "scene/json_writer.h"
+
 #include <simdjson.h>
 
 #include <glm/vec3.hpp>
 
+#include <functional>
 #include <initializer_list>
 #include <optional>
 #include <span>
@@ -41,7 +44,12 @@ class Problems {
     // Once full, further problems are counted but not kept; callers may skip costly checks.
     bool full() const { return diagnostics_.size() >= kMaxProblems; }
     bool empty() const { return diagnostics_.empty(); }
+    // Every problem added so far, kept or not.
+    size_t count() const { return diagnostics_.size() + dropped_; }
     void add(std::string path, std::string message, ErrorKind kind = ErrorKind::Validation);
+    // While set, what it returns is added to every message: where in the copies that uses make
+    // the problem lies (" (in the use of \"leg\" at root.children[0])"), or "".
+    void setContext(std::function<std::string()> context) { context_ = std::move(context); }
     // The collected problems; the error's kind is that of the first one.
     Error error() const;
     const std::string& file() const { return file_; }
@@ -51,6 +59,7 @@ class Problems {
     std::vector<Diagnostic> diagnostics_;
     ErrorKind kind_ = ErrorKind::Validation;
     size_t dropped_ = 0;
+    std::function<std::string()> context_;
 };
 
 // A JSON value as it appears in "got ...": -1, "abc", true, [1, 2], an object, ...
@@ -96,5 +105,13 @@ std::vector<std::optional<element>> readMembers(simdjson::dom::object object,
                                                 std::span<const std::string_view> keys,
                                                 size_t listed, std::string_view owner,
                                                 Problems& problems);
+
+// Writes a JSON value through the writer, iteratively (a definition's node may be deep): objects
+// one member a line and arrays on one line unless they hold objects, or everything on one line
+// when `inlined`. Numbers as formatNumber() writes them, so that a value written, read and
+// written again reads the same.
+void writeJson(JsonWriter& w, element value, bool inlined);
+// The same on one line, as a string: the JSON text of a value.
+std::string jsonText(element value);
 
 } // namespace sdfcsg::detail

@@ -3,6 +3,9 @@
 #include "sdfcsg/scene.h"
 
 #include "scene/json_writer.h"
+#include "scene/parse_util.h"
+
+#include <simdjson.h>
 
 #include <algorithm>
 #include <cmath>
@@ -34,16 +37,62 @@ void color(JsonWriter& w, std::string_view key, glm::vec3 c) {
     w.string(hex);
 }
 
-// Writes a node's own members, leaving the object open; "children" is written by the caller.
+// Writes JSON text (a definition's node, a parameter's value) in the writer's layout; null
+// where it is not JSON, which the loader refuses with a message.
+void jsonValue(JsonWriter& w, std::string_view text, bool inlined) {
+    simdjson::dom::parser parser;
+    simdjson::dom::element value;
+    auto error = parser.parse(text.data(), text.size()).get(value);
+    if (error == simdjson::DEPTH_ERROR && parser.allocate(text.size(), text.size() / 2 + 2) ==
+                                              simdjson::SUCCESS) // deeper than simdjson's default
+        error = parser.parse(text.data(), text.size()).get(value);
+    if (error)
+        w.null();
+    else
+        detail::writeJson(w, value, inlined);
+}
+
+// "parameters" of a definition or a use: {"name": value, ...} on one line.
+void namedValues(JsonWriter& w, const std::vector<NamedValue>& values) {
+    w.key("parameters");
+    w.beginObject(JsonWriter::Layout::Inline);
+    for (const NamedValue& v : values) {
+        w.key(v.name);
+        jsonValue(w, v.json, true);
+    }
+    w.endObject();
+}
+
+void definitions(JsonWriter& w, const std::vector<Definition>& list) {
+    w.key("definitions");
+    w.beginObject();
+    for (const Definition& d : list) {
+        w.key(d.name);
+        w.beginObject();
+        if (!d.parameters.empty()) namedValues(w, d.parameters);
+        w.key("node");
+        jsonValue(w, d.node, false);
+        w.endObject();
+    }
+    w.endObject();
+}
+
+// Writes a node's own members, leaving the object open; "children" is written by the caller. A
+// use is written as the use, not as the union that holds its copy.
 void nodeMembers(JsonWriter& w, const Node& node) {
     const KindInfo& kind = kindInfo(node.kind);
     w.key("type");
-    w.string(kind.name);
+    w.string(node.use ? std::string_view("use") : kind.name);
     if (!node.name.empty()) {
         w.key("name");
         w.string(node.name);
     }
-    for (const ParamInfo& p : kind.params) {
+    if (node.use) {
+        w.key("definition");
+        w.string(node.use->definition);
+        if (!node.use->arguments.empty()) namedValues(w, node.use->arguments);
+    }
+    for (const ParamInfo& p : node.use ? std::span<const ParamInfo>() : kind.params) {
         if (p.type == ValueType::Text) {
             if (p.required || !node.strings[p.slot].empty()) {
                 w.key(p.name);
@@ -104,7 +153,7 @@ void writeTree(JsonWriter& w, const std::vector<Node>& nodes) {
         ++written;
         w.beginObject();
         nodeMembers(w, nodes[i]);
-        if (!kindInfo(nodes[i].kind).operation) {
+        if (!kindInfo(nodes[i].kind).operation || nodes[i].use) {
             w.endObject();
             return;
         }
@@ -173,6 +222,7 @@ std::string toJson(const Scene& scene) {
         w.endArray();
     }
     if (scene.background != Scene{}.background) color(w, "background", scene.background);
+    if (!scene.definitions.empty()) definitions(w, scene.definitions);
     if (!scene.nodes.empty()) {
         w.key("root");
         writeTree(w, scene.nodes);

@@ -258,6 +258,19 @@ void kind(JsonWriter& w, const KindInfo& k) {
 
 namespace {
 
+// Definition and parameter names (what follows "$" in a reference): a string schema as an
+// object of its own, or (`inlined` false) its members in the object the caller has open.
+void nameBody(JsonWriter& w, bool inlined = true) {
+    if (inlined) w.beginObject(Layout::Inline);
+    w.key("type");
+    w.string("string");
+    w.key("pattern");
+    w.string("^[A-Za-z_][A-Za-z0-9_]*$");
+    w.key("maxLength");
+    w.number(200.0);
+    if (inlined) w.endObject();
+}
+
 // The scene object's own keys.
 void topProperties(JsonWriter& w) {
     w.key("properties");
@@ -298,7 +311,143 @@ void topProperties(JsonWriter& w) {
     ref(w, "items", "#/$defs/light");
     w.endObject();
     ref(w, "background", "#/$defs/color", "Background colour.");
+    w.key("definitions");
+    w.beginObject();
+    w.key("description");
+    w.string("Optional named subtrees that \"use\" nodes copy, each with parameters that its "
+             "node refers to as \"$name\".");
+    w.key("type");
+    w.string("object");
+    w.key("propertyNames");
+    nameBody(w);
+    ref(w, "additionalProperties", "#/$defs/definition");
+    w.endObject();
     ref(w, "root", "#/$defs/node", "The top node of the scene tree.");
+    w.endObject();
+}
+
+// A definition: its parameters with their defaults, and its node. The node is checked only as an
+// object with a type here: its values may be "$name" references, which the loader reads with each
+// use's values in place, and which a schema of the kinds' fields would refuse.
+void definitionDef(JsonWriter& w) {
+    w.key("definition");
+    w.beginObject();
+    w.key("description");
+    w.string("A named subtree that \"use\" nodes copy. Inside its node, a string \"$name\" in "
+             "place of a value stands for the parameter of that name: the use's value, else the "
+             "default. It must be valid with its defaults.");
+    w.key("type");
+    w.string("object");
+    w.key("properties");
+    w.beginObject();
+    w.key("parameters");
+    w.beginObject();
+    w.key("description");
+    w.string("The parameters and their default values: numbers, strings or arrays.");
+    w.key("type");
+    w.string("object");
+    w.key("propertyNames");
+    nameBody(w);
+    w.key("maxProperties");
+    w.number(64.0);
+    ref(w, "additionalProperties", "#/$defs/parameter_value");
+    w.endObject();
+    w.key("node");
+    w.beginObject();
+    w.key("description");
+    w.string("The subtree: a node whose values may be \"$name\" references to the parameters; "
+             "the loader checks it with each use's values.");
+    w.key("type");
+    w.string("object");
+    w.key("required");
+    strings(w, {"type"});
+    w.endObject();
+    w.endObject();
+    w.key("required");
+    strings(w, {"node"});
+    w.key("additionalProperties");
+    w.boolean(false);
+    w.endObject();
+
+    w.key("parameter_value");
+    w.beginObject();
+    w.key("description");
+    w.string("A parameter's value: of the same JSON type as its default.");
+    w.key("anyOf");
+    w.beginArray();
+    for (std::string_view type : {"number", "string", "array"}) {
+        w.beginObject(Layout::Inline);
+        w.key("type");
+        w.string(type);
+        w.endObject();
+    }
+    w.endArray();
+    w.endObject();
+}
+
+// A use: the name of a definition, values for some of its parameters, and the keys every node
+// may have besides children.
+void useDef(JsonWriter& w) {
+    w.key("use");
+    w.beginObject();
+    w.key("description");
+    w.string("A copy of a definition's node, with the given values in place of its parameters "
+             "(the defaults for the others), moved, coloured and named by the use's own keys.");
+    w.key("type");
+    w.string("object");
+    w.key("properties");
+    w.beginObject();
+    w.key("type");
+    w.beginObject();
+    w.key("description");
+    w.string("\"use\": a copy of a definition.");
+    w.key("const");
+    w.string("use");
+    w.endObject();
+    w.key("definition");
+    w.beginObject();
+    w.key("description");
+    w.string("The name of one of the scene's definitions.");
+    nameBody(w, false);
+    w.endObject();
+    w.key("parameters");
+    w.beginObject();
+    w.key("description");
+    w.string("Values for some of the definition's parameters, each of the JSON type of its "
+             "default.");
+    w.key("type");
+    w.string("object");
+    w.key("propertyNames");
+    nameBody(w);
+    ref(w, "additionalProperties", "#/$defs/parameter_value");
+    w.endObject();
+    for (const CommonKey& c : commonNodeKeys())
+        if (c.name != "type" && c.name != "children")
+            ref(w, c.name, "#/$defs/" + std::string(c.name));
+    w.endObject();
+    w.key("required");
+    strings(w, {"type", "definition"});
+    w.key("additionalProperties");
+    w.boolean(false);
+    w.key("examples");
+    w.beginArray();
+    w.beginObject(Layout::Inline);
+    w.key("type");
+    w.string("use");
+    w.key("definition");
+    w.string("leg");
+    w.key("parameters");
+    w.beginObject(Layout::Inline);
+    w.key("height");
+    w.number(0.8);
+    w.endObject();
+    w.key("translate");
+    w.beginArray(Layout::Inline);
+    for (double v : {0.5, 0.0, 0.5})
+        w.number(v);
+    w.endArray();
+    w.endObject();
+    w.endArray();
     w.endObject();
 }
 
@@ -382,7 +531,7 @@ void nodeDef(JsonWriter& w) {
     w.key("node");
     w.beginObject();
     w.key("description");
-    w.string("A primitive or an operation, chosen by \"type\".");
+    w.string("A primitive, an operation or a use of a definition, chosen by \"type\".");
     w.key("oneOf");
     w.beginArray();
     for (const KindInfo& k : nodeKinds()) {
@@ -391,10 +540,15 @@ void nodeDef(JsonWriter& w) {
         w.string("#/$defs/" + std::string(k.name));
         w.endObject();
     }
+    w.beginObject(Layout::Inline);
+    w.key("$ref");
+    w.string("#/$defs/use");
+    w.endObject();
     w.endArray();
     w.endObject();
     for (const KindInfo& k : nodeKinds())
         kind(w, k);
+    useDef(w);
 }
 
 } // namespace
@@ -433,6 +587,7 @@ std::string sceneJsonSchema() {
 
     cameraDef(w);
     lightDef(w);
+    definitionDef(w);
     nodeDef(w);
     w.endObject();
 
