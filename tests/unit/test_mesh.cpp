@@ -442,6 +442,32 @@ TEST_P(BundledSceneMesh, IsClosedManifoldWhereTheSurfaceFitsTheBounds) {
 INSTANTIATE_TEST_SUITE_P(Scenes, BundledSceneMesh, ::testing::ValuesIn(bundledScenes()),
                          sceneTestName);
 
+// The gear's rims and teeth cross the grid at every angle (it is turned 70 degrees about x), and
+// a grid moved by a fraction of a cell splits different cells there into fans
+// (separateCrossings in mesh_dual.cpp), whose triangles turned over where a cell's vertex lay on
+// the far side of the rim from its loop's chords. At resolutions even and odd around the
+// default, each moving the grid against the gear, its mesh is closed and manifold, no triangles
+// cross, and none faces against the field.
+TEST_F(MeshTest, GearIsEmbeddedAtEveryResolution) {
+    const Scene scene =
+        loadOrDie(std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes/gear.json");
+    const Evaluator evaluator(scene);
+    auto mesher = Mesher::create(context(), scene);
+    ASSERT_TRUE(mesher) << mesher.error().str();
+    for (uint32_t resolution : {64u, 96u, 101u, 118u, 128u, 142u, 151u, 200u}) {
+        SCOPED_TRACE("at " + std::to_string(resolution));
+        MeshOptions options;
+        options.resolution = resolution;
+        MeshStats stats;
+        auto mesh = (*mesher)->extract(options, &stats);
+        ASSERT_TRUE(mesh) << mesh.error().str();
+        EXPECT_FALSE(stats.surfaceCut);
+        const MeshProperties m = measureMesh(*mesh);
+        EXPECT_TRUE(m.closedManifold()) << m.str();
+        expectEmbedded(*mesh, evaluator, stats.voxelSize);
+    }
+}
+
 // Dual contouring keeps sharp edges: at resolution 128, points across every triangle of reference
 // scene A (in the benchmark's bounds, kReferenceBounds in apps/bench.cpp) and of the CSG part,
 // whose edges lie along circles and cross the grid at every angle, lie within a tenth of a cell
