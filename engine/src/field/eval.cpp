@@ -172,6 +172,16 @@ template <class V> V withDistance(V v, float d) {
         return glm::vec4(glm::vec3(v), d);
 }
 
+// A transition's value from its children's a and b at p (sdf.glsl, opTransition), floored at its
+// bounds' signed distance: the mix divided by its Lipschitz bound grows more slowly than that
+// distance outside the bounds (where it is positive, as both children are).
+template <class V> V transition(const FlatNode& op, glm::vec3 p, V a, V b) {
+    const float w =
+        sdf::transitionWeight(uint32_t(op.kind), localPoint(op, p), kernelA(op), kernelB(op));
+    const V v = sdf::opTransition(a, b, w, kernelB(op));
+    return withDistance(v, std::max(dist(v), op.bounds.signedDistance(p)));
+}
+
 // The generated code's walk, iteratively: a frame per open operation holds the running fold
 // and the next child to visit. Operand i > 0 of a union is skipped when its bounds lie at least
 // k beyond the running value, a subtrahend when they lie at least k beyond its negation; with
@@ -250,6 +260,8 @@ V evaluate(const std::vector<FlatNode>& nodes, uint32_t root, glm::vec3 p, bool 
             }
             if (f.next == 1) {
                 f.acc = value;
+            } else if (isTransition(op.kind)) {
+                f.acc = transition(op, p, f.acc, value);
             } else if (op.kind == NodeKind::Union) {
                 f.acc = sdf::opUnion(f.acc, value, op.smooth, op.blend);
             } else if (op.kind == NodeKind::Intersection) {
@@ -257,7 +269,9 @@ V evaluate(const std::vector<FlatNode>& nodes, uint32_t root, glm::vec3 p, bool 
             } else {
                 f.acc = sdf::opDifference(f.acc, value, op.smooth, op.blend);
             }
-            while (f.next < op.children.size() && skipping && op.kind != NodeKind::Intersection) {
+            // A transition needs both of its children everywhere.
+            while (f.next < op.children.size() && skipping && op.kind != NodeKind::Intersection &&
+                   !isTransition(op.kind)) {
                 float bd = nodes[op.children[f.next]].bounds.signedDistance(p);
                 float d = dist(f.acc);
                 bool skip = op.kind == NodeKind::Union ? bd - d >= op.smooth : bd + d >= op.smooth;
@@ -280,6 +294,10 @@ namespace detail {
 
 float primitiveValue(const FlatNode& node, glm::vec3 p) {
     return leaf<float>(node, p);
+}
+
+float transitionValue(const FlatNode& op, glm::vec3 p, float a, float b) {
+    return transition(op, p, a, b);
 }
 
 void primitiveValues(const FlatNode& node, const glm::vec3* p, uint32_t count, float* values) {
@@ -358,7 +376,8 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
             n.outline = src.outline;
             n.params = outlineParams(src.outline.get());
         }
-        const bool boolean = roleOf(src.kind) == Role::Boolean;
+        // Transitions keep other values in those slots.
+        const bool boolean = roleOf(src.kind) == Role::Boolean && !isTransition(src.kind);
         n.smooth = boolean ? float(double(src.params[0]) * a.scale) : 0.0f;
         n.blend = boolean ? uint32_t(src.params[1]) : 0u;
         n.children = src.children;
@@ -415,7 +434,7 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
                 }
                 n.params[7] = 1.0f / info.lipschitz(n.params, llo, lhi);
             }
-        } else if (n.kind == NodeKind::Union) {
+        } else if (n.kind == NodeKind::Union || isTransition(n.kind)) {
             Aabb box;
             for (uint32_t c : n.children) {
                 box.min = glm::min(box.min, nodes_[c].bounds.min);
@@ -424,6 +443,19 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
             box.min -= smoothGrowth(n);
             box.max += smoothGrowth(n);
             n.bounds = box;
+            if (isTransition(n.kind)) {
+                // Both children's surfaces lie in the box U, so within it neither value is
+                // farther from 0 than its diagonal, nor their difference from 2 diag(U) = D: the
+                // clamp of opTransition leaves the mix whole there. The mix grows at most
+                // 1 + D W fast (W: the weight's slope in the frame's units, the node's scale
+                // shrinking its local units), the clamped difference's term included.
+                n.params = info.kernelAround(scene.nodes[i].params, box.min, box.max);
+                const float reach = 2.0f * glm::length(box.max - box.min);
+                const float slope =
+                    sdf::transitionSlope(uint32_t(n.kind), kernelA(n), kernelB(n)) / n.scale;
+                n.params[6] = reach;
+                n.params[7] = 1.0f / (1.0f + reach * slope);
+            }
         } else if (n.kind == NodeKind::Intersection) {
             // A smooth maximum is never below the sharp one, so any operand's box bounds it.
             const Aabb* best = &nodes_[n.children[0]].bounds;
@@ -447,7 +479,8 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
         const KindInfo& info = kindInfo(n.kind);
         Aabb box = n.bounds;
         const Aabb* child = n.children.empty() ? nullptr : &tight[n.children[0]];
-        if (n.kind == NodeKind::Union) {
+        if (n.kind == NodeKind::Union || isTransition(n.kind)) {
+            // A transition's surface lies where one of its children's does, or between them.
             box = Aabb{};
             for (uint32_t c : n.children) {
                 box.min = glm::min(box.min, tight[c].min - smoothGrowth(n));
