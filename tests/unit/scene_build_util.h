@@ -291,7 +291,7 @@ inline std::string randomTreeJson(std::mt19937& rng, int depth, const TreeOption
     std::string members(op.example);
     if (op.role == Role::Boolean) {
         children += ", " + randomTreeJson(rng, depth - 1, options);
-        if (rng() % 2) members.clear(); // sharp
+        if (rng() % 2 && !isTransition(op.kind)) members.clear(); // sharp
     }
     return node(op, members, children);
 }

@@ -272,7 +272,7 @@ std::vector<BadInput> badInputs() {
         {"transition_radial r1 missing",
          scene(R"({"type": "transition_radial", "r0": 0.5, "children": [
              {"type": "sphere", "radius": 0.2}, {"type": "sphere", "radius": 0.3}]})"),
-         R"(scene.json: root: missing required key "r1" (a non-negative number))"},
+         R"(scene.json: root: missing required key "r1" (a positive number))"},
         {"transition_linear of a plane",
          scene(R"({"type": "transition_linear", "p1": [1, 0, 0], "children": [
              {"type": "sphere", "radius": 0.2}, {"type": "plane", "normal": [0, 1, 0]}]})"),

@@ -495,19 +495,19 @@ constexpr ParamInfo kTransitionRadial[] = {
      Number,
      NonNegative,
      3,
-     true,
-     {},
+     false,
+     {0, 0, 0},
      "length",
      "Within this distance of the centre, the first child."},
     {"r1",
      Number,
-     NonNegative,
+     Positive,
      4,
      true,
      {},
      "length",
      "From this distance of the centre on, the second child. Not r0; below r0 it turns the "
-     "morph inside out."},
+     "morph inside out (the second child within r1, the first beyond r0)."},
     {"ease", Choice, Any, 5, false, {1, 0, 0}, "profile", kEaseDoc, 3.4e38f, kEases},
 };
 
