@@ -2,6 +2,7 @@
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -533,6 +534,37 @@ float reachXY(vec3 lo, vec3 hi) {
     return std::sqrt(x * x + y * y);
 }
 
+// The box of the rectangle [lo, hi] of a plane turned by every angle from a0 to a1 (radians,
+// a0 <= a1, from the first axis towards the second: (u cos t - v sin t, u sin t + v cos t)):
+// the box of its corners' arcs, each reaching its ends and the axis directions it passes. Exact,
+// since the turned rectangle lies within the hull of its turned corners at every angle.
+void sweptRectangle(glm::vec2 lo, glm::vec2 hi, double a0, double a1, glm::vec2& outLo,
+                    glm::vec2& outHi) {
+    constexpr double kTurn = 2.0 * 3.14159265358979323846;
+    glm::dvec2 l(INFINITY), h(-INFINITY);
+    for (int c = 0; c < 4; ++c) {
+        const glm::dvec2 corner(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y);
+        const double r = std::sqrt(corner.x * corner.x + corner.y * corner.y);
+        const double phi = std::atan2(corner.y, corner.x);
+        auto reach = [&](double t) {
+            const glm::dvec2 q(r * std::cos(t), r * std::sin(t));
+            l = glm::min(l, q), h = glm::max(h, q);
+        };
+        if (a1 - a0 >= kTurn) {
+            l = glm::min(l, glm::dvec2(-r)), h = glm::max(h, glm::dvec2(r));
+            continue;
+        }
+        reach(phi + a0);
+        reach(phi + a1);
+        for (int quarter = 0; quarter < 4; ++quarter) {
+            const double t = quarter * 0.25 * kTurn;
+            const double first = t + std::ceil((phi + a0 - t) / kTurn) * kTurn;
+            if (first <= phi + a1) reach(first);
+        }
+    }
+    outLo = glm::vec2(l), outHi = glm::vec2(h);
+}
+
 // The largest singular value of the identity plus a column of length a, a bound of the twist's
 // and the bend's Jacobians where the turn per unit times the distance from the axis is a.
 float stretch(float a) {
@@ -930,8 +962,19 @@ constexpr KindInfo kKinds[] = {
      Role::Domain,
      polarKernel,
      [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
-         const float r = reach(lo + vec3(k[1], 0, 0), hi + vec3(k[1], 0, 0));
+         // The box of the copies' turned boxes; past 64 copies, close to the circle they reach.
+         const vec3 from = lo + vec3(k[1], 0, 0), to = hi + vec3(k[1], 0, 0);
+         const float r = reach(from, to);
          outLo = vec3(-r, lo.y, -r), outHi = vec3(r, hi.y, r);
+         if (k[0] > 64.0f) return;
+         glm::vec2 l(INFINITY), h(-INFINITY);
+         for (int i = 0; i < int(k[0]); ++i) {
+             glm::vec2 cl, ch;
+             const double a = double(i) * double(k[2]);
+             sweptRectangle({from.x, from.z}, {to.x, to.z}, a, a, cl, ch);
+             l = glm::min(l, cl), h = glm::max(h, ch);
+         }
+         outLo = vec3(l.x, lo.y, l.y), outHi = vec3(h.x, hi.y, h.y);
      }},
     {NodeKind::Mirror,
      "mirror",
@@ -950,8 +993,11 @@ constexpr KindInfo kKinds[] = {
          return {float(mask & 1), float(mask >> 1 & 1), float(mask >> 2 & 1), v[1]};
      },
      [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
+         // The child is taken at sqrt(p^2 + smooth^2) (|p| when sharp), which reaches its hi
+         // at |p| = sqrt(hi^2 - smooth^2).
          for (int a = 0; a < 3; ++a) {
-             const float e = std::max(hi[a], 0.0f);
+             const float h = std::max(hi[a], 0.0f);
+             const float e = k[3] > 0.0f ? std::sqrt(std::max(h * h - k[3] * k[3], 0.0f)) : h;
              outLo[a] = k[a] != 0.0f ? -e : lo[a];
              outHi[a] = k[a] != 0.0f ? e : hi[a];
          }
@@ -987,9 +1033,12 @@ constexpr KindInfo kKinds[] = {
      nullptr,
      Role::Domain,
      [](const Params& v, vec3, vec3) -> Params { return {radians(v[0])}; },
-     [](const Params&, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
-         const float r = reach(lo, hi);
-         outLo = vec3(-r, lo.y, -r), outHi = vec3(r, hi.y, r);
+     [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
+         // The child's xz rectangle turned by the angle times every height it spans.
+         const double a0 = double(k[0]) * lo.y, a1 = double(k[0]) * hi.y;
+         glm::vec2 l, h;
+         sweptRectangle({lo.x, lo.z}, {hi.x, hi.z}, std::min(a0, a1), std::max(a0, a1), l, h);
+         outLo = vec3(l.x, lo.y, l.y), outHi = vec3(h.x, hi.y, h.y);
      },
      [](const Params& k, vec3 lo, vec3 hi) { return stretch(std::abs(k[0]) * reach(lo, hi)); }},
     {NodeKind::Bend,
@@ -1010,9 +1059,20 @@ constexpr KindInfo kKinds[] = {
      nullptr,
      Role::Domain,
      [](const Params& v, vec3, vec3) -> Params { return {radians(v[0])}; },
-     [](const Params&, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
+     [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
+         // A point at p is the child's turned by the angle times p.x, so within the circle of
+         // the child's reach; and if p.x lies in [x0, x1], within the child's xy rectangle turned
+         // by every angle between the angle times x0 and x1. Each round takes the last box's x
+         // range, and the solid stays within every box.
          const float r = reachXY(lo, hi);
-         outLo = vec3(-r, -r, lo.z), outHi = vec3(r, r, hi.z);
+         glm::vec2 l(-r), h(r);
+         for (int round = 0; round < 4; ++round) {
+             const double a0 = double(k[0]) * l.x, a1 = double(k[0]) * h.x;
+             glm::vec2 sl, sh;
+             sweptRectangle({lo.x, lo.y}, {hi.x, hi.y}, std::min(a0, a1), std::max(a0, a1), sl, sh);
+             l = glm::max(l, sl), h = glm::min(h, sh);
+         }
+         outLo = vec3(l, lo.z), outHi = vec3(h, hi.z);
      },
      [](const Params& k, vec3 lo, vec3 hi) { return stretch(std::abs(k[0]) * reachXY(lo, hi)); }},
     {NodeKind::Taper,
@@ -1032,9 +1092,15 @@ constexpr KindInfo kKinds[] = {
          return {0.5f * v[0], v[1]};
      },
      [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
-         const float top = k[1];
-         outLo = vec3(std::min(lo.x, lo.x * top), lo.y, std::min(lo.z, lo.z * top));
-         outHi = vec3(std::max(hi.x, hi.x * top), hi.y, std::max(hi.z, hi.z * top));
+         // x and z times the scale, which is monotonic in y: its extremes over the child's
+         // heights are at their ends.
+         auto scale = [&](float y) {
+             return 1.0f + (k[1] - 1.0f) * std::clamp((y + k[0]) / (2.0f * k[0]), 0.0f, 1.0f);
+         };
+         const float s0 = std::min(scale(lo.y), scale(hi.y));
+         const float s1 = std::max(scale(lo.y), scale(hi.y));
+         outLo = vec3(std::min(lo.x * s0, lo.x * s1), lo.y, std::min(lo.z * s0, lo.z * s1));
+         outHi = vec3(std::max(hi.x * s0, hi.x * s1), hi.y, std::max(hi.z * s0, hi.z * s1));
      },
      [](const Params& k, vec3 lo, vec3 hi) {
          // q = (x / s, y, z / s): diag(1/s, 1, 1/s) plus the column of d/dy, of length
