@@ -598,15 +598,6 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
                 n.params[6] = reach;
                 n.params[7] = 1.0f / (1.0f + reach * slope);
             }
-        } else if (isTransition(n.kind)) {
-            // A morph's surface lies where one of its children's does, or between them, and its
-            // value is floored at the distance to the box around both (its bounds).
-            r.box = n.bounds;
-            radial[i] = 0.0;
-            for (uint32_t c : n.children) {
-                solid[i] = hull(solid[i], solid[c]);
-                radial[i] = std::max(radial[i], radial[c]);
-            }
         } else if (n.kind == NodeKind::Intersection) {
             // A smooth maximum is never below the sharp one, so any operand's box bounds it.
             const Aabb* best = &nodes_[n.children[0]].bounds;
@@ -687,6 +678,15 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
             }
             r.box.min -= g, r.box.max += g;
             if (n.children.size() == 1) addSpaces(r, reach[first].spaces);
+        } else if (isTransition(n.kind)) {
+            // A morph's surface lies where one of its children's does, or between them, and its
+            // value is floored at the distance to the box around both (its bounds).
+            r.box = n.bounds;
+            radial[i] = 0.0;
+            for (uint32_t c : n.children) {
+                solid[i] = hull(solid[i], solid[c]);
+                radial[i] = std::max(radial[i], radial[c]);
+            }
         } else if (n.kind == NodeKind::Intersection) {
             // A smooth maximum is never below the sharp one (every blend profile of sdf.glsl
             // adds to the larger operand, never takes from it), so a smooth intersection lies
