@@ -547,6 +547,30 @@ SDF_FN float bendLinearStretch(vec4 a, vec4 b) {
     return 1.0f + length(vec3(b)) * length(vec3(a)) * easeSlope(b.w);
 }
 
+// Transition_linear and transition_radial, at the node's local point p: the weight of the second
+// child, the ease (b.y) of t clamped to 0..1, t the position of p along the axis (a.xyz: p1 - p0
+// over its squared length, a.w: p0's position along it) or, radial, its distance from the centre
+// a.xyz less r0 (a.w), times b.x = 1 / (r1 - r0). transitionSlope is the weight's steepest slope.
+SDF_FN float transitionWeight(uint kind, vec3 p, vec4 a, vec4 b) {
+    float t = kind == kKindTransitionRadial ? (length(p - vec3(a)) - a.w) * b.x
+                                            : dot(p, vec3(a)) - a.w;
+    return ease(clamp(t, 0.0f, 1.0f), b.y);
+}
+SDF_FN float transitionSlope(uint kind, vec4 a, vec4 b) {
+    return easeSlope(b.y) * (kind == kKindTransitionRadial ? abs(b.x) : length(vec3(a)));
+}
+
+// The morph of values da and db by the weight w: their mix, with db - da clamped to +-b.z (twice
+// the diagonal of the children's bounds, which no difference reaches within them) and divided by
+// the mix's Lipschitz bound 1 + b.z W (its reciprocal in b.w; W: transitionSlope in the frame's
+// units). Colours mix by the same weight.
+SDF_FN float opTransition(float da, float db, float w, vec4 b) {
+    return (da + w * clamp(db - da, -b.z, b.z)) * b.w;
+}
+SDF_FN vec4 opTransition(vec4 a, vec4 b, float w, vec4 k) {
+    return vec4(mix(vec3(a), vec3(b), w), opTransition(a.w, b.w, w, k));
+}
+
 SDF_FN uint polarCount(vec4 a, vec4 b) {
     return a.x <= 1.0f ? 1u : (b.x >= a.x ? uint(a.x) : uint(2.0f * b.x + 2.0f));
 }

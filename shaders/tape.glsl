@@ -9,7 +9,8 @@
 // for every instruction): SDFCSG_TAPE_STACK (the most values a tape holds at once, rounded up;
 // 0 where no instruction reads the stack, when every operation folds in a primitive's value),
 // SDFCSG_TAPE_KINDS (a bit for each kind of primitive), SDFCSG_TAPE_OPERATIONS (a bit for each
-// kind of operation, less Union: union 1, intersection 2, difference 4, shell 8, offset 16),
+// kind of operation, less Union: union 1, intersection 2, difference 4, transition_linear 8,
+// transition_radial 16, shell 32, offset 64),
 // SDFCSG_TAPE_BALLS (1 where every sphere is a ball, detail::isBall, in kernels that may follow
 // values, CodegenOptions::inlineParams; KINDS then lacks the sphere's bit) and
 // SDFCSG_TAPE_DOMAINS (the most domain operations nested in one another, 0 for none). Only BALLS
@@ -44,20 +45,22 @@ float tapePrimitive(uint kind, uint i, vec3 p) {
 }
 
 const uint kTapeUnion = kKindUnion, kTapeIntersection = kKindIntersection;
+// The operations that tapeOp folds (transitions fold in tape_run.glsl).
+const uint kTapeBlendBits = SDFCSG_BOOLEAN_OPERATION_BITS & ~SDFCSG_TRANSITION_OPERATION_BITS;
 
 // One blend for the three operations, which the compiler would otherwise all evaluate and
 // select from: intersection(a, b) is -union(-a, -b) and difference(a, b) intersection(a, -b),
 // bit for bit as sdf.glsl computes them (negation rounds symmetrically). Kinds that the scene
 // lacks fold away (a scene whose only boolean is union has none of the others' bits).
 float tapeOp(uint kind, float a, float b, float k, uint blend) {
-    if ((SDFCSG_TAPE_OPERATIONS & SDFCSG_BOOLEAN_OPERATION_BITS) <= 1u) kind = kTapeUnion;
+    if ((SDFCSG_TAPE_OPERATIONS & kTapeBlendBits) <= 1u) kind = kTapeUnion;
     float s = kind == kTapeUnion ? 1.0 : -1.0;
     float c = kind == kTapeIntersection || kind == kTapeUnion ? b : -b;
     return s * opUnion(s * a, s * c, k, blend);
 }
 
 vec4 tapeOp(uint kind, vec4 a, vec4 b, float k, uint blend) {
-    if ((SDFCSG_TAPE_OPERATIONS & SDFCSG_BOOLEAN_OPERATION_BITS) <= 1u) kind = kTapeUnion;
+    if ((SDFCSG_TAPE_OPERATIONS & kTapeBlendBits) <= 1u) kind = kTapeUnion;
     float s = kind == kTapeUnion ? 1.0 : -1.0;
     float c = kind == kTapeIntersection || kind == kTapeUnion ? b.w : -b.w;
     vec4 u = opUnion(vec4(a.rgb, s * a.w), vec4(b.rgb, s * c), k, blend);

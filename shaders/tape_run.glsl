@@ -55,7 +55,15 @@ TAPE_VALUE TAPE_RUN(uint begin, uint end, vec3 p) {
         }
 #if SDFCSG_TAPE_STACK > 0
         else if (kind < kKindFirstValueOperation) {
-            acc = tapeOp(kind, stack[top--], acc, nodeSmooth(i), nodeBlend(i));
+#if (SDFCSG_TAPE_OPERATIONS & SDFCSG_TRANSITION_OPERATION_BITS) != 0
+            if (kind >= kKindTransitionLinear) {
+                // A transition (never folded into a primitive): eval.cpp's morph and floor.
+                float w = transitionWeight(kind, toLocal(i, p), TAPE_A(i), TAPE_B(i));
+                TAPE_VALUE t = opTransition(stack[top--], acc, w, TAPE_B(i));
+                acc = TAPE_WITH(t, max(TAPE_DIST(t), nodeBoundsDistance(i, p)));
+            } else
+#endif
+                acc = tapeOp(kind, stack[top--], acc, nodeSmooth(i), nodeBlend(i));
         }
 #endif
 #if (SDFCSG_TAPE_OPERATIONS & SDFCSG_VALUE_OPERATION_BITS) != 0

@@ -353,12 +353,16 @@ Result<Scene> addChild(const Scene& scene, uint32_t parent, NodeKind kind, uint3
     defaultParams(child);
     edited.nodes.push_back(child);
     edited.nodes[parent].children.push_back(uint32_t(edited.nodes.size() - 1));
-    if (kindInfo(kind).operation) { // an operation needs an operand
-        Node leaf;
-        leaf.kind = NodeKind::Sphere;
-        defaultParams(leaf);
-        edited.nodes.push_back(leaf);
-        edited.nodes[edited.nodes.size() - 2].children.push_back(uint32_t(edited.nodes.size() - 1));
+    if (kindInfo(kind).operation) { // an operation needs an operand, a transition two
+        const uint32_t op = uint32_t(edited.nodes.size() - 1);
+        for (NodeKind operand : {NodeKind::Sphere, NodeKind::Box}) {
+            if (operand == NodeKind::Box && !isTransition(kind)) break;
+            Node leaf;
+            leaf.kind = operand;
+            defaultParams(leaf);
+            edited.nodes.push_back(leaf);
+            edited.nodes[op].children.push_back(uint32_t(edited.nodes.size() - 1));
+        }
     }
     if (newIndex) *newIndex = loadedIndex(edited, edited.nodes[parent].children.back());
     return revalidate(edited);

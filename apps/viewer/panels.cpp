@@ -38,8 +38,9 @@ void nodeTree(Viewer& v, uint32_t node, std::optional<std::pair<uint32_t, uint32
     if (!operation) flags |= ImGuiTreeNodeFlags_Leaf | ImGuiTreeNodeFlags_NoTreePushOnOpen;
     if (int(node) == v.selected) flags |= ImGuiTreeNodeFlags_Selected;
     std::string label = nodeLabel(s, node);
-    if (operation && s.nodes[node].params[0] > 0.0f)
-        label += " smooth " + std::to_string(s.nodes[node].params[0]).substr(0, 5);
+    for (const ParamInfo& p : kindInfo(n.kind).params) // other operations keep other values there
+        if (p.name == "smooth" && n.params[p.slot] > 0.0f)
+            label += " smooth " + std::to_string(n.params[p.slot]).substr(0, 5);
     bool open = ImGui::TreeNodeEx((void*)(uintptr_t)node, flags, "%s", label.c_str());
     if (ImGui::IsItemClicked() && !ImGui::IsItemToggledOpen()) v.selected = int(node);
     if (node != 0 && ImGui::BeginDragDropSource()) { // the root has nowhere to go

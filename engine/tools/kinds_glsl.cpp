@@ -48,8 +48,11 @@ int main(int argc, char** argv) {
 #define SDFCSG_KIND_BIT(name) values |= 1u << bit++;
     SDFCSG_VALUE_KINDS(SDFCSG_KIND_BIT)
 #undef SDFCSG_KIND_BIT
+    // The transitions, the Boolean kinds after union, intersection and difference.
+    const unsigned transitions = booleans & ~7u;
     out << "#define SDFCSG_BOOLEAN_OPERATION_BITS " << booleans
-        << "\n#define SDFCSG_VALUE_OPERATION_BITS " << values << "\n";
+        << "\n#define SDFCSG_VALUE_OPERATION_BITS " << values
+        << "\n#define SDFCSG_TRANSITION_OPERATION_BITS " << transitions << "\n";
 
     const std::string text = out.str();
     std::ifstream old(argv[1], std::ios::binary);

@@ -294,10 +294,10 @@ inline std::string randomTreeJson(std::mt19937& rng, int depth, const TreeOption
     std::string members(op.example);
     if (op.role == Role::Boolean) {
         children += ", " + randomTreeJson(rng, depth - 1, options);
-        if (rng() % 2) members.clear(); // sharp
+        if (rng() % 2 && !isTransition(op.kind)) members.clear(); // sharp
         // A plane where it clips (it would leave a union, and the domain operations over it,
-        // unbounded).
-        if (options.planes && op.kind != NodeKind::Union && rng() % 2) {
+        // unbounded; a transition has two children, both bounded).
+        if (options.planes && op.kind != NodeKind::Union && !isTransition(op.kind) && rng() % 2) {
             const KindInfo& plane = kindInfo(NodeKind::Plane);
             children += ", " + node(plane, std::string(plane.example), "");
         }

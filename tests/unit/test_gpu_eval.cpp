@@ -132,6 +132,35 @@ TEST_F(GpuEval, EveryValueAndDomainOperationMatchesTheCpu) {
     }
 }
 
+// Each transition from its table example, transformed, its children coloured and one of them an
+// operation, inside a smooth union and nested in a repeat (on tapes, which take it from the
+// stack).
+TEST_F(GpuEval, TransitionsMatchTheCpu) {
+    for (const auto& [type, params] :
+         examples([](const KindInfo& k) { return isTransition(k.kind); })) {
+        SCOPED_TRACE(type);
+        const std::string op =
+            R"({"type": ")" + type + R"(", )" + params +
+            R"(, "rotate": [10, 25, -5], "scale": [0.9, 1.1, 1], "translate": [0.1, -0.2, 0.1],
+              "children": [{"type": "round_box", "size": [0.5, 0.8, 0.3], "radius": 0.05,
+                 "translate": [0.2, 0.1, -0.1], "rotate": [0, 30, 10], "color": [0.9, 0.3, 0.1]},
+                {"type": "union", "smooth": 0.1, "color": [0.1, 0.8, 0.3], "children": [
+                    {"type": "sphere", "radius": 0.4},
+                    {"type": "torus", "major_radius": 0.5, "minor_radius": 0.1}]}]})";
+        Scene scene = parseOrDie(R"({"version": 1, "root": {"type": "union", "smooth": 0.2,
+            "children": [)" + op +
+                                 R"(,
+            {"type": "sphere", "radius": 0.4, "translate": [1.1, 0.6, 0.2], "color": [0.1, 0.4, 0.9]}]}})");
+        ASSERT_FALSE(scene.nodes.empty());
+        expectGpuMatchesCpu(context(), scene, 4096);
+        Scene nested = parseOrDie(R"({"version": 1, "root": {"type": "repeat", "count": [2, 1, 2],
+            "spacing": [4, 1, 4], "children": [)" +
+                                  op + "]}}");
+        ASSERT_FALSE(nested.nodes.empty());
+        expectGpuMatchesCpu(context(), nested, 2048);
+    }
+}
+
 // Each blend profile on each operation, in the inlined, buffer and tape kernels alike (and a
 // scale per axis).
 TEST_F(GpuEval, BlendProfilesMatchTheCpu) {

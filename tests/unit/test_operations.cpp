@@ -162,6 +162,101 @@ TEST(Operations, BendLinearIsItsFormula) {
     }
 }
 
+// Transition_linear and transition_radial against their formula: the mix of a sphere's value a and
+// a box's b by the eased weight w, b - a clamped to +-D (D twice the diagonal of the children's
+// bounds U), divided by 1 + D W (W the weight's steepest slope) and floored at U's distance; of
+// the mix's sign wherever the mix is not near 0, so that the surface is the mix's.
+TEST(Operations, TransitionsAreTheirFormula) {
+    const std::string children = R"("children": [
+        {"type": "sphere", "radius": 0.5, "translate": [-0.3, 0, 0]},
+        {"type": "box", "size": [0.8, 0.6, 0.7], "translate": [0.3, 0.1, 0]}]})";
+    const Aabb u{glm::vec3(-0.8f, -0.5f, -0.5f), glm::vec3(0.7f, 0.5f, 0.5f)};
+    const float reach = 2.0f * glm::length(u.max - u.min);
+    const glm::vec3 p0(-0.4f, -0.1f, 0.0f), p1(0.5f, 0.2f, 0.1f), centre(0.1f, 0.0f, 0.05f);
+    const float r0 = 0.15f, r1 = 0.6f;
+    const std::string eases[] = {"linear", "smoothstep", "smootherstep"};
+    auto ease = [](int style, float t) {
+        return style == 0   ? t
+               : style == 1 ? t * t * (3 - 2 * t)
+                            : t * t * t * (t * (6 * t - 15) + 10);
+    };
+    const float slopes[] = {1.0f, 1.5f, 1.875f};
+    for (bool radial : {false, true})
+        for (int style = 0; style < 3; ++style) {
+            const std::string json =
+                radial ? R"({"type": "transition_radial", "center": [0.1, 0, 0.05], "r0": 0.15,
+                    "r1": 0.6, "ease": ")" +
+                             eases[style] + "\", " + children
+                       : R"({"type": "transition_linear", "p0": [-0.4, -0.1, 0],
+                    "p1": [0.5, 0.2, 0.1], "ease": ")" +
+                             eases[style] + "\", " + children;
+            SCOPED_TRACE(json);
+            const Evaluator e(parseRoot(json));
+            for (int k = 0; k < 3; ++k) { // the children's boxes, rounded outwards
+                EXPECT_NEAR(e.bounds().min[k], u.min[k], 1e-4f);
+                EXPECT_NEAR(e.bounds().max[k], u.max[k], 1e-4f);
+            }
+            const glm::vec3 axis = p1 - p0;
+            const float slope = slopes[style] / (radial ? r1 - r0 : glm::length(axis)); // W
+            int inside = 0, between = 0;
+            for (glm::vec3 p : randomPoints(23, 4000, 1.0f)) {
+                const float t = radial ? (glm::length(p - centre) - r0) / (r1 - r0)
+                                       : glm::dot(p - p0, axis) / glm::dot(axis, axis);
+                const float w = ease(style, glm::clamp(t, 0.0f, 1.0f));
+                const float a = glm::length(p - glm::vec3(-0.3f, 0, 0)) - 0.5f;
+                const float b = Aabb{glm::vec3(-0.1f, -0.2f, -0.35f), glm::vec3(0.7f, 0.4f, 0.35f)}
+                                    .signedDistance(p);
+                const float mix = (1 - w) * a + w * b;
+                const float want =
+                    std::max((a + w * glm::clamp(b - a, -reach, reach)) / (1.0f + reach * slope),
+                             e.nodes()[0].bounds.signedDistance(p)); // U rounded outwards
+                const float got = e.distance(p);
+                ASSERT_NEAR(got, want, 2e-5f) << p.x << " " << p.y << " " << p.z;
+                if (std::abs(mix) > 1e-4f) {
+                    ASSERT_EQ(got < 0, mix < 0) << p.x << " " << p.y << " " << p.z;
+                }
+                inside += got < 0;
+                between += got < 0 && w > 0.05f && w < 0.95f;
+            }
+            EXPECT_GT(inside, 60);
+            EXPECT_GT(between, 20);
+        }
+}
+
+// Transitions, turned, scaled per axis and holding other operations: 1-Lipschitz (sampled), their
+// colour the children's mixed by the weight.
+TEST(Operations, TransitionsStayOneLipschitz) {
+    for (const char* op :
+         {R"("type": "transition_linear", "p0": [0, -0.4, 0], "p1": [0, 0.4, 0], "ease": "linear")",
+          R"("type": "transition_linear", "p0": [-0.1, -0.2, 0], "p1": [0.1, 0.1, 0.05])",
+          R"("type": "transition_radial", "r0": 0.1, "r1": 0.5, "ease": "smootherstep")",
+          R"("type": "transition_radial", "center": [0.2, 0, 0], "r0": 0.6, "r1": 0.2)"}) {
+        SCOPED_TRACE(op);
+        Evaluator e(parseRoot(std::string("{") + op +
+                              R"(, "rotate": [5, 10, 0], "scale": [1, 1.4, 0.8], "children": [
+            {"type": "torus", "major_radius": 0.4, "minor_radius": 0.1, "color": [1, 0, 0]},
+            {"type": "union", "smooth": 0.1, "children": [
+                {"type": "box", "size": [0.4, 1.2, 0.3], "translate": [0.1, 0, 0]},
+                {"type": "sphere", "radius": 0.3, "translate": [0, 0.5, 0]}],
+             "color": [0, 0, 1]}]})"));
+        std::mt19937 rng(3);
+        std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+        int inside = 0, mixed = 0;
+        for (glm::vec3 p : randomPoints(11, 4000, 1.2f)) {
+            const glm::vec3 step = 1e-3f * glm::normalize(glm::vec3(u(rng), u(rng), u(rng)));
+            const float slope = std::abs(e.distance(p + step) - e.distance(p)) / 1e-3f;
+            ASSERT_LE(slope, 1.0f + 2e-2f) << p.x << " " << p.y << " " << p.z;
+            inside += e.distance(p) < 0;
+            const Sample s = e.sample(p);
+            ASSERT_NEAR(s.color.r + s.color.b, 1.0f, 1e-5f);
+            ASSERT_EQ(s.color.g, 0.0f);
+            mixed += s.color.r > 0.01f && s.color.b > 0.01f;
+        }
+        EXPECT_GT(inside, 20);
+        EXPECT_GT(mixed, 100);
+    }
+}
+
 // Spacing means nothing along an axis of one copy, so 0 is accepted there: the same field.
 TEST(Operations, RepeatTakesSpacingZeroAlongAnAxisOfOneCopy) {
     const Evaluator zero(parseRoot(R"({"type": "repeat", "count": [4, 1, 1],
@@ -263,6 +358,19 @@ TEST(Operations, PrunedTapesAgreeWithTheTree) {
         {"type": "bend_linear", "p0": [0, 0, -0.8], "p1": [0, 0, 0.8], "offset": [0.4, 0.3, 0],
          "translate": [0, 1.6, 0], "children": [
             {"type": "cylinder", "radius": 0.1, "height": 2.4, "rotate": [90, 0, 0]}]},
+        {"type": "transition_linear", "p0": [-0.3, 0, 0], "p1": [0.3, 0, 0],
+         "translate": [-1.8, 1.4, 0], "children": [
+            {"type": "union", "smooth": 0.05, "children": [
+                {"type": "sphere", "radius": 0.2, "translate": [-0.4, 0, 0]},
+                {"type": "sphere", "radius": 0.2, "translate": [0.4, 0, 0]},
+                {"type": "box", "size": [0.1, 0.6, 0.1]}]},
+            {"type": "torus", "major_radius": 0.4, "minor_radius": 0.1, "rotate": [90, 0, 0]}]},
+        {"type": "transition_radial", "r0": 0.1, "r1": 0.4, "ease": "linear",
+         "translate": [1.8, 1.4, 0], "children": [
+            {"type": "box", "size": [0.6, 0.6, 0.6]},
+            {"type": "difference", "children": [
+                {"type": "sphere", "radius": 0.45},
+                {"type": "cylinder", "radius": 0.15, "height": 1}]}]},
         {"type": "bend", "angle": 20, "translate": [0, -1, 0], "children": [
             {"type": "taper", "height": 0.4, "top_scale": 0.5, "children": [
                 {"type": "elongate", "length": [3, 0, 0], "children": [

@@ -250,6 +250,34 @@ std::vector<BadInput> badInputs() {
          scene(R"({"type": "bend_linear", "p0": [1, 2, 3], "p1": [1, 2, 3], "offset": [0, 1, 0],
              "children": [{"type": "sphere", "radius": 0.2}]})"),
          "scene.json: root.p1: expected a point apart from p0, got [1, 2, 3]"},
+        {"transition_linear of one child",
+         scene(R"({"type": "transition_linear", "p1": [1, 0, 0], "children": [
+             {"type": "sphere", "radius": 0.2}]})"),
+         "scene.json: root.children: expected exactly two child nodes (the shapes it morphs "
+         "between), got 1"},
+        {"transition_radial of three children",
+         scene(R"({"type": "transition_radial", "r0": 0.1, "r1": 0.5, "children": [
+             {"type": "sphere", "radius": 0.2}, {"type": "sphere", "radius": 0.3},
+             {"type": "sphere", "radius": 0.4}]})"),
+         "scene.json: root.children: expected exactly two child nodes (the shapes it morphs "
+         "between), got 3"},
+        {"transition_linear p1 at p0",
+         scene(R"({"type": "transition_linear", "p0": [1, 2, 3], "p1": [1, 2, 3], "children": [
+             {"type": "sphere", "radius": 0.2}, {"type": "sphere", "radius": 0.3}]})"),
+         "scene.json: root.p1: expected a point apart from p0, got [1, 2, 3]"},
+        {"transition_radial r1 at r0",
+         scene(R"({"type": "transition_radial", "r0": 0.5, "r1": 0.5, "children": [
+             {"type": "sphere", "radius": 0.2}, {"type": "sphere", "radius": 0.3}]})"),
+         "scene.json: root.r1: expected a radius other than r0, got 0.5"},
+        {"transition_radial r1 missing",
+         scene(R"({"type": "transition_radial", "r0": 0.5, "children": [
+             {"type": "sphere", "radius": 0.2}, {"type": "sphere", "radius": 0.3}]})"),
+         R"(scene.json: root: missing required key "r1" (a positive number))"},
+        {"transition_linear of a plane",
+         scene(R"({"type": "transition_linear", "p1": [1, 0, 0], "children": [
+             {"type": "sphere", "radius": 0.2}, {"type": "plane", "normal": [0, 1, 0]}]})"),
+         "scene.json: root: a transition_linear needs bounded children, and one of its children "
+         "reaches infinity (a plane does)"},
         {"bend_linear unknown ease",
          scene(R"({"type": "bend_linear", "p0": [0, 0, 0], "p1": [1, 0, 0], "offset": [0, 1, 0],
              "ease": "smooth", "children": [{"type": "sphere", "radius": 0.2}]})"),
@@ -299,7 +327,8 @@ std::vector<BadInput> badInputs() {
          R"(scene.json: root.blend: expected one of "smooth", "round" or "chamfer", got 2)"},
         {"primitive with children", scene(R"({"type": "sphere", "radius": 1, "children": []})"),
          "scene.json: root: a sphere takes no \"children\"; only operations (union, intersection, "
-         "difference, shell, offset, repeat, polar_repeat, mirror, elongate, twist, bend, "
+         "difference, transition_linear, transition_radial, shell, offset, repeat, polar_repeat, "
+         "mirror, elongate, twist, bend, "
          "taper, bend_linear, extrude and revolve) do"},
         {"operation without children", scene(R"({"type": "intersection"})"),
          R"(scene.json: root: missing required key "children" (a non-empty array of nodes))"},

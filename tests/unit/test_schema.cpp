@@ -58,7 +58,11 @@ std::string validValue(simdjson::dom::element property) {
 std::string node(const KindInfo& kind, const std::string& extra) {
     std::string out = R"({"type": ")" + std::string(kind.name) + "\"";
     out += extra;
-    if (kind.operation) out += R"(, "children": [{"type": "sphere", "radius": 1}])";
+    if (kind.operation)
+        out +=
+            isTransition(kind.kind) // two, as the schema says
+                ? R"(, "children": [{"type": "sphere", "radius": 1}, {"type": "sphere", "radius": 2}])"
+                : R"(, "children": [{"type": "sphere", "radius": 1}])";
     // A 2D profile goes inside an extrude, which the schema cannot require.
     if (isProfile(kind.kind))
         out = R"({"type": "extrude", "height": 1, "children": [)" + out + "}]";

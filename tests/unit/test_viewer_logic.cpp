@@ -884,7 +884,8 @@ TEST(ViewerScript, RefusesNumbersThatAreNotFinite) {
               "s.txt:4:1: pick: expected a finite number, got \"1e99\"\n"
               "s.txt:5:1: zoom: expected a positive factor, got \"0\"\n"
               "s.txt:6:1: op: expected one of union, intersection, "
-              "difference, shell, offset, repeat, polar_repeat, mirror, "
+              "difference, transition_linear, transition_radial, shell, offset, repeat, "
+              "polar_repeat, mirror, "
               "elongate, twist, bend, taper, bend_linear, extrude, revolve, got "
               "\"sphere\"");
 }

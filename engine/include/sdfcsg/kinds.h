@@ -37,11 +37,13 @@
     X(Polygon)                                                                                     \
     X(Text)
 
-// Operations of any number of children.
+// Operations of any number of children; the transitions take exactly two and come last.
 #define SDFCSG_BOOLEAN_KINDS(X)                                                                    \
     X(Union)                                                                                       \
     X(Intersection)                                                                                \
-    X(Difference)
+    X(Difference)                                                                                  \
+    X(TransitionLinear)                                                                            \
+    X(TransitionRadial)
 
 // Operations that change their one child's value.
 #define SDFCSG_VALUE_KINDS(X)                                                                      \

@@ -83,6 +83,11 @@ enum class Role : uint8_t { Primitive, Boolean, Value, Domain };
 inline constexpr bool isProfile(NodeKind kind) {
     return kind >= kFirstProfile && kind < kFirstOperation;
 }
+// Transition_linear and transition_radial: the Boolean kinds of exactly two children, a morph
+// from the first to the second by a weight that follows the point.
+inline constexpr bool isTransition(NodeKind kind) {
+    return kind == NodeKind::TransitionLinear || kind == NodeKind::TransitionRadial;
+}
 // Polygon and text: their outlines' segments live beside the node (Node::outline).
 inline constexpr bool hasOutline(NodeKind kind) {
     return kind == NodeKind::Polygon || kind == NodeKind::Text;

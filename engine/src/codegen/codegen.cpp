@@ -163,7 +163,8 @@ class Emitter {
                 if (f.next < operands.size()) {
                     current = operands[f.next++];
                     depth = f.depth + 1;
-                    if (op.kind != NodeKind::Intersection) guard(f.node, current, f.depth);
+                    if (op.kind != NodeKind::Intersection && !isTransition(op.kind))
+                        guard(f.node, current, f.depth);
                     break;
                 }
                 stack.pop_back();
@@ -484,8 +485,31 @@ class Emitter {
         out_ += ")) {\n";
     }
 
+    // A transition's second child into its first (eval.cpp: the morph at the node's local point,
+    // floored at its bounds).
+    void transition(uint32_t op, uint32_t child, uint32_t depth) {
+        const std::string a = param(op, 0), b = param(op, 1), w = "w" + std::to_string(op);
+        indent(depth);
+        out_ += "float " + w + " = transitionWeight(" + kindConst(op) + ", ";
+        localPoint(op, point());
+        out_ += ", " + a + ", " + b + ");\n";
+        indent(depth);
+        var(op);
+        out_ += " = opTransition(";
+        var(op);
+        out_ += ", ";
+        var(child);
+        out_ += ", " + w + ", " + b + ");\n";
+        indent(depth);
+        var(op);
+        out_ += " = ";
+        withDistance(op, "max(" + distance(op) + ", " + boundsDistanceOf(op, point()) + ")");
+        out_ += ";\n";
+    }
+
     void fold(uint32_t op, uint32_t child, uint32_t depth) {
         const NodeKind kind = scene_.nodes[op].kind;
+        if (isTransition(kind)) return transition(op, child, depth);
         const bool guarded = kind != NodeKind::Intersection;
         // A literal blend radius of 0 takes the sharp form: the same bits, much less code.
         const bool sharp = lit_ && (*lit_)[op].bmin.w == 0.0f;
@@ -583,6 +607,7 @@ std::string generateSceneGlsl(const Scene& scene, const CodegenOptions& options)
             if (role == Role::Boolean || role == Role::Value)
                 operations |= 1u << (uint32_t(n.kind) - uint32_t(NodeKind::Union));
             if (role != Role::Boolean) continue;
+            stackRead |= isTransition(n.kind); // never folded into a primitive's instruction
             for (size_t c = 1; c < n.children.size(); ++c)
                 stackRead |= kindInfo(nodes[n.children[c]].kind).role != Role::Primitive;
         }

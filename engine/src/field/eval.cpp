@@ -314,6 +314,16 @@ template <class V> V withDistance(V v, float d) {
         return glm::vec4(glm::vec3(v), d);
 }
 
+// A transition's value from its children's a and b at p (sdf.glsl, opTransition), floored at its
+// bounds' signed distance: the mix divided by its Lipschitz bound grows more slowly than that
+// distance outside the bounds (where it is positive, as both children are).
+template <class V> V transition(const FlatNode& op, glm::vec3 p, V a, V b) {
+    const float w =
+        sdf::transitionWeight(uint32_t(op.kind), localPoint(op, p), kernelA(op), kernelB(op));
+    const V v = sdf::opTransition(a, b, w, kernelB(op));
+    return withDistance(v, std::max(dist(v), op.bounds.signedDistance(p)));
+}
+
 // The generated code's walk, iteratively: a frame per open operation holds the running fold
 // and the next child to visit. Operand i > 0 of a union is skipped when its bounds lie at least
 // k beyond the running value, a subtrahend when they lie at least k beyond its negation; with
@@ -392,6 +402,8 @@ V evaluate(const std::vector<FlatNode>& nodes, uint32_t root, glm::vec3 p, bool 
             }
             if (f.next == 1) {
                 f.acc = value;
+            } else if (isTransition(op.kind)) {
+                f.acc = transition(op, p, f.acc, value);
             } else if (op.kind == NodeKind::Union) {
                 f.acc = sdf::opUnion(f.acc, value, op.smooth, op.blend);
             } else if (op.kind == NodeKind::Intersection) {
@@ -399,7 +411,9 @@ V evaluate(const std::vector<FlatNode>& nodes, uint32_t root, glm::vec3 p, bool 
             } else {
                 f.acc = sdf::opDifference(f.acc, value, op.smooth, op.blend);
             }
-            while (f.next < op.children.size() && skipping && op.kind != NodeKind::Intersection) {
+            // A transition needs both of its children everywhere.
+            while (f.next < op.children.size() && skipping && op.kind != NodeKind::Intersection &&
+                   !isTransition(op.kind)) {
                 float bd = nodes[op.children[f.next]].bounds.signedDistance(p);
                 float d = dist(f.acc);
                 bool skip = op.kind == NodeKind::Union ? bd - d >= op.smooth : bd + d >= op.smooth;
@@ -422,6 +436,10 @@ namespace detail {
 
 float primitiveValue(const FlatNode& node, glm::vec3 p) {
     return leaf<float>(node, p);
+}
+
+float transitionValue(const FlatNode& op, glm::vec3 p, float a, float b) {
+    return transition(op, p, a, b);
 }
 
 void primitiveValues(const FlatNode& node, const glm::vec3* p, uint32_t count, float* values) {
@@ -500,7 +518,8 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
             n.outline = src.outline;
             n.params = outlineParams(src.outline.get());
         }
-        const bool boolean = roleOf(src.kind) == Role::Boolean;
+        // Transitions keep other values in those slots.
+        const bool boolean = roleOf(src.kind) == Role::Boolean && !isTransition(src.kind);
         n.smooth = boolean ? float(double(src.params[0]) * a.scale) : 0.0f;
         n.blend = boolean ? uint32_t(src.params[1]) : 0u;
         n.children = src.children;
@@ -557,7 +576,7 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
                 }
                 n.params[7] = 1.0f / info.lipschitz(n.params, llo, lhi);
             }
-        } else if (n.kind == NodeKind::Union) {
+        } else if (n.kind == NodeKind::Union || isTransition(n.kind)) {
             Aabb box;
             for (uint32_t c : n.children) {
                 box.min = glm::min(box.min, nodes_[c].bounds.min);
@@ -566,6 +585,19 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
             box.min -= smoothGrowth(n);
             box.max += smoothGrowth(n);
             n.bounds = box;
+            if (isTransition(n.kind)) {
+                // Both children's surfaces lie in the box U, so within it neither value is
+                // farther from 0 than its diagonal, nor their difference from 2 diag(U) = D: the
+                // clamp of opTransition leaves the mix whole there. The mix grows at most
+                // 1 + D W fast (W: the weight's slope in the frame's units, the node's scale
+                // shrinking its local units), the clamped difference's term included.
+                n.params = info.kernelAround(scene.nodes[i].params, box.min, box.max);
+                const float reach = 2.0f * glm::length(box.max - box.min);
+                const float slope =
+                    sdf::transitionSlope(uint32_t(n.kind), kernelA(n), kernelB(n)) / n.scale;
+                n.params[6] = reach;
+                n.params[7] = 1.0f / (1.0f + reach * slope);
+            }
         } else if (n.kind == NodeKind::Intersection) {
             // A smooth maximum is never below the sharp one, so any operand's box bounds it.
             const Aabb* best = &nodes_[n.children[0]].bounds;
@@ -646,6 +678,15 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
             }
             r.box.min -= g, r.box.max += g;
             if (n.children.size() == 1) addSpaces(r, reach[first].spaces);
+        } else if (isTransition(n.kind)) {
+            // A morph's surface lies where one of its children's does, or between them, and its
+            // value is floored at the distance to the box around both (its bounds).
+            r.box = n.bounds;
+            radial[i] = 0.0;
+            for (uint32_t c : n.children) {
+                solid[i] = hull(solid[i], solid[c]);
+                radial[i] = std::max(radial[i], radial[c]);
+            }
         } else if (n.kind == NodeKind::Intersection) {
             // A smooth maximum is never below the sharp one (every blend profile of sdf.glsl
             // adds to the larger operand, never takes from it), so a smooth intersection lies

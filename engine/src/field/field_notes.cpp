@@ -47,6 +47,9 @@ Loss ownLoss(const Node& n, const FlatNode& flat) {
         const auto& k = flat.params;
         factor = sdf::bendLinearStretch({k[0], k[1], k[2], k[3]}, {k[4], k[5], k[6], k[7]});
         how = " divides its field by ";
+    } else if (isTransition(n.kind)) {
+        factor = flat.params[7] > 0.0f ? 1.0f / flat.params[7] : 1.0f;
+        how = " divides its field by ";
     } else if (n.kind == NodeKind::Ellipsoid) {
         const float lo = std::min({n.params[0], n.params[1], n.params[2]});
         const float hi = std::max({n.params[0], n.params[1], n.params[2]});

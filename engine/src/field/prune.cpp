@@ -262,6 +262,12 @@ struct Pruner {
             const uint32_t a = ends.back();
             const float* va = &value[size_t(a) * kLanes];
             const float* vb = &value[size_t(b) * kLanes];
+            if (isTransition(kind)) {
+                for (uint32_t l = 0; l < lanes; ++l)
+                    v[l] = transitionValue(n, c[l], va[l], vb[l]);
+                ends.back() = i;
+                continue;
+            }
             if (kind != NodeKind::Difference) {
                 float* e = &extreme[size_t(node) * kLanes];
                 if (std::isnan(e[0])) {
@@ -312,7 +318,9 @@ struct Pruner {
             const float va = valueAt(a.end), vb = valueAt(b.end);
             const float gap = 2.0f * r + slack + 1e-5f * (std::abs(va) + std::abs(vb));
             bool dropA = false, dropB = false;
-            if (kind == NodeKind::Difference) {
+            if (isTransition(kind)) {
+                // Both children count everywhere: neither is dropped.
+            } else if (kind == NodeKind::Difference) {
                 dropB = va + vb >= gap + k;
             } else {
                 const float sign = kind == NodeKind::Union ? 1.0f : -1.0f;
@@ -730,7 +738,8 @@ std::vector<uint32_t> packField(const PrunedField& f, const std::vector<FlatNode
         for (uint32_t t = begin; t + 1 < begin + length; ++t)
             if (!isDomainEnd(f.tape[t]) && !isDomainEnd(f.tape[t + 1]) &&
                 roleOf(opcode(f.tape[t])) == Role::Primitive &&
-                roleOf(opcode(f.tape[t + 1])) == Role::Boolean) {
+                roleOf(opcode(f.tape[t + 1])) == Role::Boolean &&
+                !isTransition(opcode(f.tape[t + 1]))) { // the fold's 2 bits: the first three
                 const FlatNode& op = nodes[f.tape[t + 1] & kTapeNodeMask];
                 tape[t] |= (uint32_t(op.kind) - uint32_t(NodeKind::Union) + 1u) << kTapeFoldShift |
                            op.blend << SDFCSG_TAPE_BLEND_SHIFT;

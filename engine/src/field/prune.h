@@ -112,6 +112,8 @@ std::vector<uint32_t> packField(const PrunedField& field, const std::vector<Flat
 float primitiveValue(const FlatNode& node, glm::vec3 p);
 // The same at `count` points.
 void primitiveValues(const FlatNode& node, const glm::vec3* p, uint32_t count, float* values);
+// Value of a transition at p from its children's values a and b, floored at its bounds (eval.cpp).
+float transitionValue(const FlatNode& op, glm::vec3 p, float a, float b);
 // p in the node's local space, as nodes.glsl's toLocal computes it (eval.cpp).
 glm::vec3 nodeLocalPoint(const FlatNode& node, glm::vec3 p);
 

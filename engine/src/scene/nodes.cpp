@@ -465,6 +465,53 @@ constexpr ParamInfo kBendLinear[] = {
      kEases},
 };
 
+constexpr std::string_view kEaseDoc =
+    "How the weight grows from the first child to the second: \"linear\", \"smoothstep\" "
+    "(3 t^2 - 2 t^3: steepest, 1.5 times the linear slope, half way) or \"smootherstep\" "
+    "(6 t^5 - 15 t^4 + 10 t^3: smoother ends, 1.875 times the slope).";
+constexpr ParamInfo kTransitionLinear[] = {
+    {"p0",
+     Vec3,
+     Any,
+     0,
+     false,
+     {0, 0, 0},
+     "point",
+     "Where the morph starts: points whose projection on the line through p0 and p1 falls "
+     "before p0 are the first child's."},
+    {"p1",
+     Vec3,
+     Any,
+     3,
+     true,
+     {},
+     "point",
+     "Where the morph ends: points whose projection falls beyond p1 are the second child's. Not "
+     "p0."},
+    {"ease", Choice, Any, 6, false, {1, 0, 0}, "profile", kEaseDoc, 3.4e38f, kEases},
+};
+constexpr ParamInfo kTransitionRadial[] = {
+    {"center", Vec3, Any, 0, false, {0, 0, 0}, "point", "The centre of the morph's spheres."},
+    {"r0",
+     Number,
+     NonNegative,
+     3,
+     false,
+     {0, 0, 0},
+     "length",
+     "Within this distance of the centre, the first child."},
+    {"r1",
+     Number,
+     Positive,
+     4,
+     true,
+     {},
+     "length",
+     "From this distance of the centre on, the second child. Not r0; below r0 it turns the "
+     "morph inside out (the second child within r1, the first beyond r0)."},
+    {"ease", Choice, Any, 5, false, {1, 0, 0}, "profile", kEaseDoc, 3.4e38f, kEases},
+};
+
 // Kernel parameters and local bounds (see KindInfo::kernel and ::bounds).
 using glm::vec3;
 Params halve3(const Params& v) {
@@ -813,6 +860,46 @@ constexpr KindInfo kKinds[] = {
      nullptr,
      nullptr,
      Role::Boolean},
+    {NodeKind::TransitionLinear,
+     "transition_linear",
+     true,
+     kTransitionLinear,
+     "A morph between its two children along the line from p0 to p1: the first child before "
+     "p0, the second beyond p1, and between them the surface of (1 - w) a + w b, w the ease of "
+     "the clamped position t of the point's projection from p0 to p1. Exactly two children. The "
+     "field is that mix with b - a clamped to +-D and divided by 1 + D W (D twice the diagonal "
+     "of the children's bounds, W the weight's steepest slope, ease' / |p1 - p0|), which keeps "
+     "it a distance bound.",
+     R"("p0": [-0.6, 0, 0], "p1": [0.6, 0, 0], "ease": "smoothstep")",
+     {},
+     {},
+     nullptr,
+     nullptr,
+     Role::Boolean,
+     [](const Params& v, vec3, vec3) -> Params {
+         const vec3 p0(v[0], v[1], v[2]), axis = vec3(v[3], v[4], v[5]) - p0;
+         const vec3 u = axis / glm::dot(axis, axis);
+         return {u.x, u.y, u.z, glm::dot(p0, u), 0.0f, v[6]};
+     },
+     [](const Params&, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) { outLo = lo, outHi = hi; }},
+    {NodeKind::TransitionRadial,
+     "transition_radial",
+     true,
+     kTransitionRadial,
+     "A morph between its two children by the distance from a centre: the first child within "
+     "r0 of it, the second beyond r1, and between them the surface of (1 - w) a + w b, w the "
+     "ease of the clamped fraction t of the way from r0 to r1. Exactly two children. The field "
+     "is divided as transition_linear's, with W = ease' / |r1 - r0|.",
+     R"("center": [0, 0, 0], "r0": 0.2, "r1": 0.7, "ease": "smootherstep")",
+     {},
+     {},
+     nullptr,
+     nullptr,
+     Role::Boolean,
+     [](const Params& v, vec3, vec3) -> Params {
+         return {v[0], v[1], v[2], v[3], 1.0f / (v[4] - v[3]), v[5]};
+     },
+     [](const Params&, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) { outLo = lo, outHi = hi; }},
     {NodeKind::Shell,
      "shell",
      true,
@@ -1151,8 +1238,10 @@ std::string exampleNodeJson(const KindInfo& kind) {
     if (!kind.example.empty()) json += ", " + std::string(kind.example);
     if (kind.operation) {
         const bool cuts = kind.kind == NodeKind::Extrude || kind.kind == NodeKind::Revolve;
-        json += cuts ? R"(, "children": [{"type": "circle", "radius": 0.5}])"
-                     : R"(, "children": [{"type": "sphere", "radius": 0.5}])";
+        json += cuts                      ? R"(, "children": [{"type": "circle", "radius": 0.5}])"
+                : isTransition(kind.kind) ? R"(, "children": [{"type": "sphere", "radius": 0.5}, )"
+                                            R"({"type": "box", "size": [0.8, 0.8, 0.8]}])"
+                                          : R"(, "children": [{"type": "sphere", "radius": 0.5}])";
     }
     return json + "}";
 }

@@ -889,7 +889,11 @@ Next SceneReader::readNode(element value, std::string path, uint32_t depth, Scen
                 break;
             }
     }
-    if (kind->kind == NodeKind::BendLinear && paramsOk) {
+    if (kind->kind == NodeKind::TransitionRadial && paramsOk && node.params[4] == node.params[3])
+        problems_.add(member(p, "r1"),
+                      "expected a radius other than r0, got " + describe(*valueOf("r1")));
+    if ((kind->kind == NodeKind::BendLinear || kind->kind == NodeKind::TransitionLinear) &&
+        paramsOk) {
         const glm::vec3 p0(node.params[0], node.params[1], node.params[2]);
         const glm::vec3 axis = glm::vec3(node.params[3], node.params[4], node.params[5]) - p0;
         if (!(glm::dot(axis, axis) > 0.0f))
@@ -928,6 +932,12 @@ Next SceneReader::readNode(element value, std::string path, uint32_t depth, Scen
     dom::array array = asArray(*children);
     if (array.size() == 0) {
         problems_.add(member(p, "children"), "expected at least one child node, got []");
+        return {};
+    }
+    if (isTransition(kind->kind) && array.size() != 2) {
+        problems_.add(member(p, "children"),
+                      "expected exactly two child nodes (the shapes it morphs between), got " +
+                          std::to_string(array.size()));
         return {};
     }
     if (kind->role != Role::Boolean && array.size() != 1) {
@@ -1152,6 +1162,13 @@ void checkCombinedTransforms(const Scene& scene, Problems& problems) {
                                            "(a plane does)");
             return;
         }
+        if (isTransition(node.kind))
+            for (uint32_t c : node.children)
+                if (!evaluator.nodes()[c].bounds.finite()) {
+                    report(i, article(info.name) + " needs bounded children, and one of its "
+                                                   "children reaches infinity (a plane does)");
+                    return;
+                }
         if (std::isfinite(f.scale) && f.scale > 0.0f && finite(f.toLocal[0]) &&
             finite(f.toLocal[1]) && finite(f.toLocal[2]) && finite(f.offset) &&
             std::isfinite(f.smooth))

@@ -223,6 +223,16 @@ void kind(JsonWriter& w, const KindInfo& k) {
             w.key("const");
             w.string(k.name);
             w.endObject();
+        } else if (c.name == "children" && isTransition(k.kind)) {
+            w.key("children"); // the shapes it morphs between
+            w.beginObject(Layout::Inline);
+            w.key("$ref");
+            w.string("#/$defs/children");
+            w.key("minItems");
+            w.number(2.0);
+            w.key("maxItems");
+            w.number(2.0);
+            w.endObject();
         } else if (c.name != "children" || k.operation) {
             ref(w, c.name, "#/$defs/" + std::string(c.name));
         }
