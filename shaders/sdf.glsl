@@ -521,6 +521,16 @@ SDF_FN float valueNormalised(vec4 sum, vec4 a) {
     float gradient = length(vec3(sum.x, sum.y, sum.z)) / (4.0f * a.y);
     return 0.25f * sum.w / clamp(gradient, a.z, 1.0f);
 }
+// The offset's or shell's value from the taps: valueOp of the normalised value, kept within
+// |a.x| (1 - a.z) of valueOp of the plain one, which is as far as the division moves the value
+// where the surface lies (there the child's value is a.x times the gradient's length, at least
+// a.z): the surface is the same, and the value never exceeds the plain one, a bound, by more.
+SDF_FN float valueOpNormalised(uint kind, vec4 sum, vec4 a) {
+    if (a.y <= 0.0f) return valueOp(kind, sum.w, a);
+    float plain = valueOp(kind, 0.25f * sum.w, a);
+    float reach = abs(a.x) * (1.0f - a.z) + 2.0f * a.y;
+    return plain + clamp(valueOp(kind, valueNormalised(sum, a), a) - plain, -reach, reach);
+}
 
 // Domain operations evaluate their child at one or more points of the child's space (the
 // candidates) and combine the values: the least of them, for the copies of a repetition. A point

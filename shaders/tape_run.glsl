@@ -106,7 +106,7 @@ TAPE_VALUE TAPE_RUN(uint begin, uint end, vec3 p) {
                 at = body[depth] - 1u;
             } else {
                 uint k = domainKind[depth];
-                float v = valueOp(k, valueNormalised(taps[depth], TAPE_A(i)), TAPE_A(i));
+                float v = valueOpNormalised(k, taps[depth], TAPE_A(i));
                 v = max(v, nodeBoundsDistance(i, outer[depth])); // eval.cpp's floor
                 stack[++top] = acc;
                 acc = TAPE_WITH(best[depth], v);

@@ -424,8 +424,7 @@ class Emitter {
         indent(depth + 1);
         out_ += "}\n";
         const std::string a = param(i, 0);
-        std::string value =
-            "valueOp(" + kindConst(i) + ", valueNormalised(" + t + ", " + a + "), " + a + ")";
+        std::string value = "valueOpNormalised(" + kindConst(i) + ", " + t + ", " + a + ")";
         // eval.cpp's floor, where the node normalises.
         if (lit_)
             value = "max(" + value + ", " + boundsDistanceOf(i, point()) + ")";

@@ -253,12 +253,14 @@ V evaluate(const std::vector<FlatNode>& nodes, uint32_t root, glm::vec3 p, bool 
                         current = op.children[0];
                         break;
                     }
-                    d = sdf::valueNormalised(f.taps, kernelA(op));
-                    value = f.acc;
+                    d = sdf::valueOpNormalised(uint32_t(op.kind), f.taps, kernelA(op));
+                    d = std::max(d, op.bounds.signedDistance(f.outer));
+                    value = withDistance(f.acc, d);
                     p = f.outer;
+                    stack.pop_back();
+                    continue;
                 }
                 d = sdf::valueOp(uint32_t(op.kind), d, kernelA(op));
-                if (normalises(op)) d = std::max(d, op.bounds.signedDistance(p));
                 value = withDistance(value, d);
                 stack.pop_back();
                 continue;
@@ -563,6 +565,19 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
                     if (cut.max[a] >= box.max[a]) box.max[a] = std::min(box.max[a], cut.min[a]);
                 }
             }
+        } else if (normalises(n) && child && child->finite() && !child->empty()) {
+            // A normalising offset or shell floors its value at its bounds' distance, as domain
+            // operations do, with bounds from the box its child's solid lies in, not from the
+            // child's bounds, which the stretching operations below it have grown (pass 2):
+            // beyond those, its child's value is the distance to a box, a bound with a gradient
+            // of length 1, which the division would take for a distance. Its surface lies near
+            // its distance from its child's (tests/unit/test_offsets.cpp), within these bounds.
+            const float amount =
+                n.kind == NodeKind::Offset ? std::max(n.params[0], 0.0f) : n.params[0];
+            const float grow = 1.05f * amount + 4.0f * n.params[1];
+            box = Aabb{child->min - grow, child->max + grow};
+            nodes_[i].bounds =
+                Aabb{glm::max(n.bounds.min, box.min), glm::min(n.bounds.max, box.max)};
         } else if (child && child->finite() && !child->empty()) {
             glm::vec3 lo, hi;
             info.boundsAround(n.params, child->min, child->max, lo, hi);
@@ -571,22 +586,6 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
         tight[i] = Aabb{glm::max(box.min, n.bounds.min), glm::min(box.max, n.bounds.max)};
     }
     if (count) solidBounds_ = tight[0];
-
-    // A normalising offset or shell (normalises()) floors its value at its bounds' distance, as
-    // domain operations do, with bounds from the box its child's solid lies in, not from the
-    // child's bounds, which the stretching operations below it have grown (pass 2): beyond those,
-    // its child's value is the distance to a box, a bound with a gradient of length 1, which the
-    // division would take for a distance. Its surface lies within 2% of its distance from its
-    // child's (tests/unit/test_offsets.cpp), so within these bounds.
-    for (size_t i = 0; i < count; ++i) {
-        FlatNode& n = nodes_[i];
-        const Aabb& solid = tight[n.children.empty() ? 0 : n.children[0]];
-        if (!normalises(n) || !solid.finite() || solid.empty()) continue;
-        const float amount = n.kind == NodeKind::Offset ? std::max(n.params[0], 0.0f) : n.params[0];
-        const float grow = 1.05f * amount + 4.0f * n.params[1];
-        n.bounds.min = glm::max(n.bounds.min, solid.min - grow);
-        n.bounds.max = glm::min(n.bounds.max, solid.max + grow);
-    }
 }
 
 float Evaluator::distance(glm::vec3 p) const {
