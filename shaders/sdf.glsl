@@ -562,6 +562,25 @@ SDF_FN float repeatAxisIndex(float x, float s, float n, float m, uint c) {
     return (i < 0.0f || i > n - 1.0f) ? -1.0f : i;
 }
 
+// The eases of bend_linear (and its "ease" choices, in order): each rises from 0 at t = 0 to 1
+// at t = 1, linearly, as smoothstep (3 t^2 - 2 t^3) or as smootherstep (6 t^5 - 15 t^4 + 10 t^3,
+// flat to the second derivative at both ends). easeSlope is the steepest slope of each.
+SDF_FN float ease(float t, float style) {
+    if (style == 1.0f) return t * t * (3.0f - 2.0f * t);
+    if (style == 2.0f) return t * t * t * (t * (6.0f * t - 15.0f) + 10.0f);
+    return t;
+}
+SDF_FN float easeSlope(float style) {
+    return style == 1.0f ? 1.5f : (style == 2.0f ? 1.875f : 1.0f);
+}
+
+// Bend_linear moves its child by the offset b.xyz times ease(t), t the clamped position of p
+// along the axis (a.xyz: p1 - p0 over its squared length, a.w: p0's position along it). The
+// map's Jacobian is the identity less offset * ease'(t) * a.xyz, whose norm is at most this.
+SDF_FN float bendLinearStretch(vec4 a, vec4 b) {
+    return 1.0f + length(vec3(b)) * length(vec3(a)) * easeSlope(b.w);
+}
+
 SDF_FN uint polarCount(vec4 a, vec4 b) {
     return a.x <= 1.0f ? 1u : (b.x >= a.x ? uint(a.x) : uint(2.0f * b.x + 2.0f));
 }
@@ -618,6 +637,10 @@ SDF_FN vec4 domainPoint(uint kind, vec3 p, vec4 a, vec4 b, uint c) {
         float cs = cos(a.x * p.x), sn = sin(a.x * p.x);
         return vec4(cs * p.x + sn * p.y, -sn * p.x + cs * p.y, p.z, 0.0f);
     }
+    if (kind == kKindBendLinear) {
+        float t = clamp(dot(p, vec3(a)) - a.w, 0.0f, 1.0f);
+        return vec4(p - vec3(b) * ease(t, b.w), 0.0f);
+    }
     if (kind == kKindTaper) {
         float s = 1.0f + (a.y - 1.0f) * clamp((p.y + a.x) / (2.0f * a.x), 0.0f, 1.0f);
         return vec4(p.x / s, p.y, p.z / s, 0.0f);
@@ -652,5 +675,7 @@ SDF_FN float domainFinish(uint kind, vec3 p, float best, vec4 a, vec4 b) {
         vec2 w = vec2(best + a.y, abs(p.z) - a.x + a.y);
         return min(max(w.x, w.y), 0.0f) + length(max(w, 0.0f)) - a.y;
     }
+    // Bend_linear's stretch is the same everywhere: no clamping, a division.
+    if (kind == kKindBendLinear) return best / bendLinearStretch(a, b);
     return domainClamps(kind) ? best * b.w : best;
 }

@@ -9,11 +9,20 @@
 #include "raymarch.glsl"
 #include "scene.glsl"
 
-// Steps per shadow ray, each a full scene evaluation. A ray that grazes a surface crawls along
-// it in short steps; one that runs out of them before passing it ends too lit, and with 16 a
-// patch of the snowman's drift showed the edge where that began. 24 cost about 1% of a frame.
-const int kShadowSteps = 24;
+// Soft shadows after Quilez's penumbra estimate with penetration ("soft shadows with negative
+// distances", 2020): each step takes min(res, sharpness * d / t), also where d < 0 inside an
+// occluder, and the ray ends at res = -1; the result maps [-1, 1] to [0, 1] smoothly, so the
+// geometric shadow edge is mid-penumbra. A hit that zeroes the light at once, or a step as long
+// as d, made the penumbra depend on where each pixel's samples fell: on concave walls, where
+// shadow rays run along the surface, that drew streaks. So steps are half of |d| (inside, |d|
+// is still the distance to the occluder's far side), between kShadowStepMin and kShadowStepMax
+// of the shadow reach (the scene's size), and 64 of them reach past the scene. Inside an
+// occluder the estimate falls kShadowInside times faster: a plate's depth is at most half its
+// thickness, and a table top would otherwise cast a pale shadow.
+const int kShadowSteps = 64;
 const float kShadowSharpness = 10.0;
+const float kShadowInside = 4.0;
+const float kShadowStepMin = 0.002, kShadowStepMax = 0.05, kShadowStart = 0.004;
 
 // The shade pass: colour, normal, occlusion and shadows at the hit r.t. All scene evaluations
 // go through one call of sceneSample in one loop, driven by a small state machine: the colour
@@ -45,7 +54,7 @@ void surface(vec3 ro, vec3 rd, vec4 ends, inout Trace r, out vec3 albedo) {
     int tap = 0;
     float weight = 1.0;
     uint light = 0u;
-    float res = 1.0, ph = 1.0e20, shadowEnd = 0.0; // shadow ray (IQ's improved soft shadow)
+    float res = 1.0, shadowEnd = 0.0, reach = frame.distances.w; // shadow ray
 
     while (phase != kDone) {
 #ifdef SDFCSG_TAPE_STACK
@@ -107,24 +116,19 @@ void surface(vec3 ro, vec3 rd, vec4 ends, inout Trace r, out vec3 albedo) {
                 // where far cells lie near the surface.
 #ifdef SDFCSG_TAPE_STACK
                 res = min(res, kShadowSharpness * s.b / t);
-                ph = 1.0e20;
                 t += max(s.g, eps);
 #else
                 t += max(d, eps);
 #endif
                 tap -= 1;
-            } else if (d < eps * 0.5) {
-                res = 0.0;
             } else {
-                float y = d * d / (2.0 * ph);
-                float w = sqrt(max(d * d - y * y, 0.0));
-                res = min(res, kShadowSharpness * w / max(0.0, t - y));
-                ph = d;
-                t += max(d, eps);
+                res = min(res, kShadowSharpness * (d < 0.0 ? kShadowInside * d : d) / t);
+                t += clamp(0.5 * abs(d), kShadowStepMin * reach, kShadowStepMax * reach);
             }
             tap += 1;
-            if (res < 0.02 || t >= shadowEnd || tap >= kShadowSteps) {
-                r.shadow = mix(r.shadow, vec4(res < 0.02 ? 0.0 : res),
+            if (res < -1.0 || t >= shadowEnd || tap >= kShadowSteps) {
+                float c = max(res, -1.0);
+                r.shadow = mix(r.shadow, vec4(0.25 * (1.0 + c) * (1.0 + c) * (2.0 - c)),
                                equal(uvec4(0u, 1u, 2u, 3u), uvec4(light)));
                 light += 1u;
                 nextLight = true;
@@ -139,11 +143,10 @@ void surface(vec3 ro, vec3 rd, vec4 ends, inout Trace r, out vec3 albedo) {
             dir = light == 0u ? light0 : light == 1u ? light1 : light == 2u ? light2 : light3;
             shadowEnd = light == 0u ? ends.x : light == 1u ? ends.y : light == 2u ? ends.z : ends.w;
             phase = light < lightCount ? kShadow : kDone;
-            t = 2.0 * eps;
+            t = max(2.0 * eps, kShadowStart * reach);
             // A light behind the surface needs no shadow (Lambert is zero): end it at once.
             tap = dot(r.n, dir) > 0.0 ? 0 : kShadowSteps;
             res = 1.0;
-            ph = 1.0e20;
         }
     }
 }

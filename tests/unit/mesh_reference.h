@@ -381,7 +381,7 @@ ReferenceMesh referenceDualMeshOf(const Distance& distance, const Color& color,
     const size_t copiesFrom = mesh.vertexCount();
     detail::splitTouchingSheets(mesh);
     detail::separateCrossings(mesh, copiesFrom, quadEdges, edgePoints.data(), grid.origin,
-                              grid.voxelSize);
+                              grid.voxelSize, distance);
     out.surfaceCut = field.surfaceCut;
     return out;
 }

@@ -4,10 +4,12 @@
 // JSON, and seeded random points.
 #pragma once
 
+#include <sdfcsg/eval.h>
 #include <sdfcsg/scene.h>
 
 #include <gtest/gtest.h>
 
+#include <glm/common.hpp>
 #include <glm/vec3.hpp>
 
 #include <algorithm>
@@ -239,18 +241,19 @@ inline Scene randomScene(uint32_t seed, int count, int maxDepth = 6, bool planes
 // What randomTreeJson() draws besides its trees of every kind.
 struct TreeOptions {
     bool scalesPerAxis = false; // half the nodes scaled by a factor per axis
-    bool planes = false;        // planes among the primitives: unbounded solids, clipping ones
+    bool planes = false;        // planes that intersections and differences cut by
 };
 
-// A random tree of every kind of the node table but the text (slow to compile) and, unless
-// options.planes, the plane (unbounded), each from its example in the table (sdfcsg/nodes.h),
+// A random tree of every kind of the node table but the plane (unbounded; with options.planes,
+// an operand of intersections and differences) and the text (slow to compile), each from its
+// example in the table (sdfcsg/nodes.h),
 // turned, moved and scaled at random: operations over random subtrees (Booleans sharp or with
 // their example's blend), 2D profiles under extrude or revolve, primitives at the leaves.
 inline std::string randomTreeJson(std::mt19937& rng, int depth, const TreeOptions& options = {}) {
     auto uni = [&](float a, float b) { return std::uniform_real_distribution<float>(a, b)(rng); };
     std::vector<const KindInfo*> primitives, profiles, operations;
     for (const KindInfo& k : nodeKinds()) {
-        if ((k.kind == NodeKind::Plane && !options.planes) || k.kind == NodeKind::Text) continue;
+        if (k.kind == NodeKind::Plane || k.kind == NodeKind::Text) continue;
         (isProfile(k.kind) ? profiles : k.operation ? operations : primitives).push_back(&k);
     }
     auto pick = [&](const std::vector<const KindInfo*>& from) { return from[rng() % from.size()]; };
@@ -292,6 +295,12 @@ inline std::string randomTreeJson(std::mt19937& rng, int depth, const TreeOption
     if (op.role == Role::Boolean) {
         children += ", " + randomTreeJson(rng, depth - 1, options);
         if (rng() % 2) members.clear(); // sharp
+        // A plane where it clips (it would leave a union, and the domain operations over it,
+        // unbounded).
+        if (options.planes && op.kind != NodeKind::Union && rng() % 2) {
+            const KindInfo& plane = kindInfo(NodeKind::Plane);
+            children += ", " + node(plane, std::string(plane.example), "");
+        }
     }
     return node(op, members, children);
 }
@@ -307,6 +316,77 @@ inline std::string randomTreesJson(uint32_t seed, const TreeOptions& options = {
         json += (part ? ", " : "") + std::string(at) + randomTreeJson(rng, 3, options) + "]}";
     }
     return json + "]}}";
+}
+
+// The box of the points of a grid of n + 1 points a side over `within` where the field is below
+// 0 (empty where none is); `spacing` is the grid's largest step, within which of the solid's
+// true box the result lies where the solid is not thinner than that.
+inline Aabb sampledSolid(const Evaluator& eval, const Aabb& within, int n, float& spacing) {
+    Aabb solid;
+    const glm::vec3 step = (within.max - within.min) / float(n);
+    spacing = std::max(step.x, std::max(step.y, step.z));
+    for (int i = 0; i <= n; ++i)
+        for (int j = 0; j <= n; ++j)
+            for (int k = 0; k <= n; ++k) {
+                const glm::vec3 p = within.min + glm::vec3(i, j, k) * step;
+                if (eval.distance(p) >= 0.0f) continue;
+                solid.min = glm::min(solid.min, p);
+                solid.max = glm::max(solid.max, p);
+            }
+    return solid;
+}
+
+// Scenes whose solid is far smaller than their operands' boxes, as a user writes them: an
+// intersection of two boxes grown by an offset and moved apart; a woven mat of radius 12 (a
+// repeated weave cut by a tall cylinder, a rim cut from a tall tube by a slab of two planes,
+// smoothly); a storage box 2 high (a shelled rounded box opened by a plane, dividers 11 high cut
+// down by a slab of planes). Their true boxes are about [-0.2, 1.2] x [-0.7, 1.2] x [-0.5, 1.2],
+// 24 x 1 x 24 and 4.1 x 1.85 x 3.1.
+inline std::vector<Scene> clippedScenes() {
+    const char* const roots[] = {
+        R"({"type": "intersection", "children": [
+            {"type": "offset", "distance": 0.2, "children": [{"type": "box", "size": [2, 2, 2]}]},
+            {"type": "offset", "distance": 0.2, "children": [
+                {"type": "box", "size": [2, 2, 2], "translate": [1, 0.5, 0.7]}]}]})",
+        R"({"type": "union", "children": [
+            {"type": "intersection", "name": "weave", "children": [
+                {"type": "union", "children": [
+                    {"type": "repeat", "count": [8, 1, 4], "spacing": [2.7, 1, 5.4], "children": [
+                        {"type": "polar_repeat", "count": 3, "radius": 1.5, "children": [
+                            {"type": "round_box", "size": [3.2, 0.25, 1], "radius": 0.1}]}]},
+                    {"type": "repeat", "count": [8, 1, 4], "spacing": [2.7, 1, 5.4],
+                     "translate": [1.35, 0, 2.7], "children": [
+                        {"type": "polar_repeat", "count": 3, "radius": 1.5, "children": [
+                            {"type": "round_box", "size": [3.2, 0.25, 1], "radius": 0.1}]}]}]},
+                {"type": "cylinder", "radius": 10, "height": 40}]},
+            {"type": "intersection", "name": "rim", "smooth": 0.25, "children": [
+                {"type": "difference", "children": [
+                    {"type": "cylinder", "radius": 12, "height": 40},
+                    {"type": "cylinder", "radius": 10, "height": 41}]},
+                {"type": "plane", "normal": [0, 1, 0], "offset": 0.5},
+                {"type": "plane", "normal": [0, -1, 0], "offset": 0.5}]}]})",
+        R"({"type": "union", "children": [
+            {"type": "intersection", "name": "tray", "children": [
+                {"type": "shell", "thickness": 0.1, "children": [
+                    {"type": "round_box", "size": [4, 2, 3], "radius": 0.2}]},
+                {"type": "plane", "normal": [0, 1, 0], "offset": 0.8}]},
+            {"type": "intersection", "name": "dividers", "children": [
+                {"type": "union", "children": [
+                    {"type": "repeat", "count": [3, 1, 1], "spacing": [1, 1, 1], "children": [
+                        {"type": "box", "size": [0.08, 11, 2.95]}]},
+                    {"type": "box", "size": [3.95, 11, 0.08]}]},
+                {"type": "plane", "normal": [0, 1, 0], "offset": 0.7},
+                {"type": "plane", "normal": [0, -1, 0], "offset": 0.95}]}]})",
+    };
+    const char* const names[] = {"<offset boxes>", "<woven mat>", "<storage box>"};
+    std::vector<Scene> scenes;
+    for (int i = 0; i < 3; ++i) {
+        auto scene =
+            parseScene(R"({"version": 1, "root": )" + std::string(roots[i]) + "}", names[i]);
+        EXPECT_TRUE(scene) << scene.error().str();
+        if (scene) scenes.push_back(std::move(*scene));
+    }
+    return scenes;
 }
 
 // The bundled scenes, assets/scenes/*.json, sorted by name.

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <random>
 
 namespace sdfcsg {
 namespace {
@@ -279,21 +280,52 @@ TEST(Eval, PrimitiveBoundsAreTight) {
 }
 
 // The box that framing and the mesh grid take: every point inside the solid lies in it (dense
-// samples over the bounds, for every scene of the bounds tests), and where Boolean operations
-// say more than their operands' boxes, it is within 5% of the sampled solid's box.
-Aabb sampledSolid(const Evaluator& eval, const Aabb& within, int n, float& spacing) {
-    Aabb solid;
+// samples over the bounds, for every scene of the bounds tests, and over a box three times the
+// size of the scene's finite part, for random trees of every kind scaled per axis among planes
+// and for the cases a box could most easily miss), and it is within 5% of the sampled solid's
+// box where the operations' boxes say as much.
+
+// Every point of a grid of n + 1 points a side over `within` where the field is below 0 lies in
+// the solid bounds.
+void expectSolidWithin(const Evaluator& eval, const Aabb& within, int n) {
+    const Aabb& tight = eval.solidBounds();
     const glm::vec3 step = (within.max - within.min) / float(n);
-    spacing = std::max(step.x, std::max(step.y, step.z));
+    int outside = 0;
     for (int i = 0; i <= n; ++i)
         for (int j = 0; j <= n; ++j)
             for (int k = 0; k <= n; ++k) {
                 const glm::vec3 p = within.min + glm::vec3(i, j, k) * step;
                 if (eval.distance(p) >= 0.0f) continue;
-                solid.min = glm::min(solid.min, p);
-                solid.max = glm::max(solid.max, p);
+                const float slack = 1e-5f * (1.0f + glm::length(p));
+                if (glm::all(glm::greaterThanEqual(p, tight.min - slack)) &&
+                    glm::all(glm::lessThanEqual(p, tight.max + slack)))
+                    continue;
+                if (outside++ == 0)
+                    ADD_FAILURE() << "inside the solid at " << p.x << " " << p.y << " " << p.z
+                                  << ", outside its bounds [" << tight.min.x << " " << tight.min.y
+                                  << " " << tight.min.z << "] .. [" << tight.max.x << " "
+                                  << tight.max.y << " " << tight.max.z << "]";
             }
-    return solid;
+    EXPECT_EQ(outside, 0);
+}
+
+// The scene's finite part (its bounds where finite, else its finite primitives' box), grown by
+// its size on every side.
+Aabb searchBox(const Evaluator& eval) {
+    Aabb finite;
+    for (const FlatNode& n : eval.nodes())
+        if (n.frame == kWorldFrame && n.bounds.finite() && !n.bounds.empty()) {
+            finite.min = glm::min(finite.min, n.bounds.min);
+            finite.max = glm::max(finite.max, n.bounds.max);
+        }
+    for (int a = 0; a < 3; ++a) {
+        if (std::isfinite(eval.bounds().min[a])) finite.min[a] = eval.bounds().min[a];
+        if (std::isfinite(eval.bounds().max[a])) finite.max[a] = eval.bounds().max[a];
+    }
+    if (finite.empty()) finite = Aabb{glm::vec3(-1.0f), glm::vec3(1.0f)};
+    const glm::vec3 size = finite.max - finite.min;
+    const float grow = std::max({size.x, size.y, size.z, 0.1f});
+    return Aabb{finite.min - grow, finite.max + grow};
 }
 
 TEST(Eval, SolidBoundsHoldTheSolid) {
@@ -306,18 +338,82 @@ TEST(Eval, SolidBoundsHoldTheSolid) {
             EXPECT_GE(tight.min[a], loose.min[a]);
             EXPECT_LE(tight.max[a], loose.max[a]);
         }
-        if (!loose.finite()) continue;
-        float spacing = 0.0f;
-        const Aabb solid = sampledSolid(eval, loose, 48, spacing);
-        for (int a = 0; a < 3; ++a) {
-            EXPECT_LE(tight.min[a], solid.min[a] + 1e-5f) << "axis " << a;
-            EXPECT_GE(tight.max[a], solid.max[a] - 1e-5f) << "axis " << a;
-        }
+        if (loose.finite()) expectSolidWithin(eval, loose, 48);
     }
 }
 
-TEST(Eval, SolidBoundsOfBooleansAreTight) {
-    const Scene scenes[] = {
+// What a box misses first: an offset of a difference wraps round the edges of the box it
+// subtracts (a cut box grown by the offset would not hold it), smooth blends of cut solids,
+// offsets and shells of solids cut by planes that are not along an axis, planes subtracted,
+// planes scaled per axis, every domain operation turned and scaled per axis. `tight` where
+// boxes and half-spaces say all there is to say of the solid's box (not of a ball cut by a
+// plane, nor of a solid shrunk by an inward offset or a blend).
+struct EdgeCase {
+    Scene scene;
+    bool tight;
+};
+std::vector<EdgeCase> edgeScenes() {
+    const bool tight[] = {true, false, true, false, true};
+    const char* const roots[] = {
+        R"({"type": "offset", "distance": 0.3, "children": [{"type": "difference", "children": [
+            {"type": "box", "size": [2, 2, 2]},
+            {"type": "box", "size": [2, 1, 2], "translate": [0, 1, 0]}]}]})",
+        R"({"type": "union", "smooth": 0.4, "children": [
+            {"type": "intersection", "children": [{"type": "sphere", "radius": 1},
+                {"type": "plane", "normal": [1, 1, 0], "offset": -0.3}]},
+            {"type": "difference", "children": [{"type": "box", "size": [1, 1, 1]},
+                {"type": "plane", "normal": [0, -1, 0.2], "offset": 0.1}]}]})",
+        R"({"type": "shell", "thickness": 0.2, "children": [{"type": "intersection", "children": [
+            {"type": "box", "size": [2, 1, 1.5], "rotate": [10, 20, 30]},
+            {"type": "plane", "normal": [1, 2, 0.5], "offset": 0.2},
+            {"type": "plane", "normal": [-1, 0.3, -0.4], "offset": 0.1}]}]})",
+        R"({"type": "offset", "distance": -0.1, "children": [{"type": "intersection",
+            "smooth": 0.3, "blend": "chamfer", "children": [
+            {"type": "round_box", "size": [1.5, 1.5, 1.5], "radius": 0.2},
+            {"type": "plane", "normal": [1, 1, 1], "offset": 0.1, "scale": [1, 3, 0.5]}]}]})",
+        R"({"type": "union", "children": [
+            {"type": "twist", "angle": 50, "rotate": [20, 0, 10], "scale": [1, 1.5, 0.7],
+             "children": [{"type": "box", "size": [0.8, 2, 0.3], "translate": [0.2, 0, 0]}]},
+            {"type": "bend", "angle": 40, "translate": [2, 0, 0], "children": [
+                {"type": "box", "size": [2, 0.2, 0.3], "translate": [0.3, 0, 0]}]},
+            {"type": "taper", "height": 1, "top_scale": 0.3, "translate": [-2, 0, 0],
+             "children": [{"type": "box", "size": [1, 0.6, 1], "translate": [0, 0.3, 0]}]},
+            {"type": "polar_repeat", "count": 3, "radius": 0.5, "translate": [0, 0, 2],
+             "rotate": [0, 0, 30], "children": [{"type": "box", "size": [0.6, 0.3, 0.2]}]},
+            {"type": "mirror", "axes": "xz", "smooth": 0.2, "translate": [0, 0, -2],
+             "children": [{"type": "sphere", "radius": 0.4, "translate": [0.3, 0, 0.1]}]},
+            {"type": "elongate", "length": [0.5, 0, 0.2], "translate": [0, 2, 0],
+             "children": [{"type": "torus", "major_radius": 0.3, "minor_radius": 0.1}]}]})",
+    };
+    std::vector<EdgeCase> cases;
+    for (const char* root : roots) {
+        cases.push_back({parseRoot(root), tight[cases.size()]});
+        cases.back().scene.file = "<edge case " + std::to_string(cases.size()) + ">";
+    }
+    return cases;
+}
+
+TEST(Eval, SolidBoundsHoldRandomTreesAndEdgeCases) {
+    std::vector<Scene> scenes;
+    for (EdgeCase& edge : edgeScenes())
+        scenes.push_back(std::move(edge.scene));
+    for (uint32_t seed = 1; seed <= 24; ++seed) {
+        std::mt19937 rng(seed);
+        const std::string root = randomTreeJson(rng, 3, {.scalesPerAxis = true, .planes = true});
+        auto scene = parseScene(R"({"version": 1, "root": )" + root + "}", root);
+        ASSERT_TRUE(scene) << scene.error().str();
+        scenes.push_back(std::move(*scene));
+    }
+    for (const Scene& scene : scenes) {
+        SCOPED_TRACE(scene.file);
+        const Evaluator eval(scene);
+        expectSolidWithin(eval, searchBox(eval), 40);
+        if (eval.bounds().finite()) expectSolidWithin(eval, eval.bounds(), 40);
+    }
+}
+
+TEST(Eval, SolidBoundsAreTight) {
+    std::vector<Scene> scenes = {
         // Two boxes overlapping in a corner: the overlap, not the smaller box.
         makeScene(intersect({box(2, 2, 2), box(2, 2, 2).at(1, 1, 1)})),
         // The same, smooth, inside a union with a ball.
@@ -325,17 +421,23 @@ TEST(Eval, SolidBoundsOfBooleansAreTight) {
                          sphere(0.3f).at(0.5f, 0.5f, 0.5f)})),
         // A box that spans a rounded box across two axes cuts it along the third.
         makeScene(subtract({roundBox(1.6f, 0.6f, 1.0f, 0.08f), box(2, 0.4f, 2).at(0, 0.4f, 0)})),
+        // A box cut by a plane across its diagonal, and a ball less a half-space.
+        makeScene(intersect({box(2, 2, 2), plane(glm::normalize(glm::vec3(1, 1, 0)), -0.5f)})),
+        makeScene(subtract({sphere(1), plane({0, -1, 0}, -0.3f).rotated(0, 0, 20)})),
     };
+    for (Scene& scene : clippedScenes())
+        scenes.push_back(std::move(scene));
+    for (EdgeCase& edge : edgeScenes())
+        if (edge.tight) scenes.push_back(std::move(edge.scene));
     for (const Scene& scene : scenes) {
+        SCOPED_TRACE(scene.file);
         const Evaluator eval(scene);
-        float spacing = 0.0f;
-        const Aabb solid = sampledSolid(eval, eval.bounds(), 96, spacing);
         const Aabb& tight = eval.solidBounds();
+        float spacing = 0.0f;
+        const Aabb solid = sampledSolid(eval, tight, 96, spacing);
         for (int a = 0; a < 3; ++a) {
             const float size = solid.max[a] - solid.min[a];
             EXPECT_LE(tight.max[a] - tight.min[a], 1.05f * size + 2.0f * spacing) << "axis " << a;
-            EXPECT_LE(tight.min[a], solid.min[a]);
-            EXPECT_GE(tight.max[a], solid.max[a]);
         }
     }
 }
@@ -444,7 +546,11 @@ TEST(Eval, DeepTreesNeedNoRecursion) {
 }
 
 TEST(Eval, FrameCameraSeesTheWholeScene) {
-    for (const Scene& scene : {primitiveGallery(), randomScene(3, 30)}) {
+    std::vector<Scene> scenes = {primitiveGallery(), randomScene(3, 30)};
+    for (Scene& scene : clippedScenes())
+        scenes.push_back(std::move(scene));
+    for (const Scene& scene : scenes) {
+        SCOPED_TRACE(scene.file);
         Evaluator eval(scene);
         for (float aspect : {0.5f, 1.0f, 16.0f / 9.0f}) {
             Camera cam = frameCamera(eval, aspect, 40.0f);
@@ -453,34 +559,53 @@ TEST(Eval, FrameCameraSeesTheWholeScene) {
             glm::vec3 up = glm::cross(right, forward);
             EXPECT_GT(cam.eye.z - cam.target.z, 0.0f) << "looks from the front";
             EXPECT_GT(cam.eye.y - cam.target.y, 0.0f) << "looks from above";
+            EXPECT_GT(cam.eye.x - cam.target.x, 0.0f) << "looks from the right";
             float tanV = std::tan(glm::radians(20.0f)), tanH = tanV * aspect;
-            // Every corner of the scene's box is in view; with a plane making that infinite,
-            // every corner of every finite primitive's box.
-            std::vector<Aabb> boxes;
-            if (eval.bounds().finite())
-                boxes.push_back(eval.bounds());
-            else
-                for (const FlatNode& n : eval.nodes())
-                    if (!kindInfo(n.kind).operation && n.bounds.finite() && n.frame == kWorldFrame)
-                        boxes.push_back(n.bounds);
-            ASSERT_FALSE(boxes.empty());
-            for (const Aabb& b : boxes) {
-                for (int c = 0; c < 8; ++c) {
-                    glm::vec3 corner(c & 1 ? b.max.x : b.min.x, c & 2 ? b.max.y : b.min.y,
-                                     c & 4 ? b.max.z : b.min.z);
-                    glm::vec3 v = corner - cam.eye;
-                    float z = glm::dot(v, forward);
-                    ASSERT_GT(z, 0.0f);
-                    EXPECT_LE(std::abs(glm::dot(v, right)) / z, tanH);
-                    EXPECT_LE(std::abs(glm::dot(v, up)) / z, tanV);
-                }
+            // Every corner of the box the solid lies in is in view, and some corner is near
+            // the view's edge (the solid fills the picture).
+            const Aabb b = eval.finiteBounds();
+            float fill = 0.0f;
+            for (int c = 0; c < 8; ++c) {
+                glm::vec3 corner(c & 1 ? b.max.x : b.min.x, c & 2 ? b.max.y : b.min.y,
+                                 c & 4 ? b.max.z : b.min.z);
+                glm::vec3 v = corner - cam.eye;
+                float z = glm::dot(v, forward);
+                ASSERT_GT(z, 0.0f);
+                EXPECT_LE(std::abs(glm::dot(v, right)) / z, tanH);
+                EXPECT_LE(std::abs(glm::dot(v, up)) / z, tanV);
+                fill = std::max({fill, std::abs(glm::dot(v, right)) / z / tanH,
+                                 std::abs(glm::dot(v, up)) / z / tanV});
             }
+            EXPECT_GT(fill, 0.85f);
         }
     }
     // Nothing finite: a sensible default.
     Camera cam = frameCamera(Evaluator(makeScene(plane({0, 1, 0}, 0))), 1.0f);
     EXPECT_TRUE(std::isfinite(cam.eye.x + cam.eye.y + cam.eye.z));
     EXPECT_GT(glm::length(cam.eye - cam.target), 0.0f);
+}
+
+// A flat part is seen at a slant, from its broad side: a plate lying down, standing across the
+// view or standing along it, and a woven mat, are seen at least 30 degrees off their plane and
+// at least 25 degrees off their normal (a three-quarter view).
+TEST(Eval, FrameCameraSeesFlatPartsAtASlant) {
+    struct Flat {
+        Scene scene;
+        glm::vec3 normal;
+    };
+    std::vector<Flat> flats = {
+        {makeScene(box(4, 0.1f, 3)), {0, 1, 0}},
+        {makeScene(box(4, 3, 0.1f)), {0, 0, 1}},
+        {makeScene(box(0.1f, 3, 4)), {1, 0, 0}},
+        {clippedScenes()[1], {0, 1, 0}},
+    };
+    for (const Flat& flat : flats) {
+        SCOPED_TRACE(flat.scene.file);
+        const Camera cam = frameCamera(Evaluator(flat.scene), 4.0f / 3.0f);
+        const float along = std::abs(glm::dot(glm::normalize(cam.target - cam.eye), flat.normal));
+        EXPECT_GE(along, std::sin(glm::radians(30.0f)));
+        EXPECT_LE(along, std::cos(glm::radians(25.0f)));
+    }
 }
 
 TEST(Eval, PackedNodesMirrorTheEvaluator) {

@@ -138,5 +138,71 @@ INSTANTIATE_TEST_SUITE_P(Scenes, Golden, ::testing::ValuesIn(kCases),
                              return caseName(param.param);
                          });
 
+// Soft shadows on concave walls, where shadow rays run along the surface: a ball with three
+// crossed holes, from two views. What shadows take from each pixel (the luminance without them
+// less the luminance with them) must be smooth across the surface: it may depart from the mean
+// of its four neighbours by more than kRough only at a few pixels (where a penumbra is narrower
+// than a pixel). Streaks and speckle fail this; creases and highlights, in both images, cancel.
+TEST_F(GpuTest, ShadowsOnConcaveWallsAreFreeOfStreaks) {
+    constexpr const char* kPart = R"({"version": 1, "root": {"type": "difference", "children": [
+        {"type": "sphere", "radius": 1.0, "color": [0.8, 0.8, 0.8]},
+        {"type": "cylinder", "radius": 0.45, "height": 3, "rotate": [0, 0, 90]},
+        {"type": "cylinder", "radius": 0.45, "height": 3},
+        {"type": "cylinder", "radius": 0.45, "height": 3, "rotate": [90, 0, 0]}]}})";
+    auto scene = parseScene(kPart, "concave.json");
+    ASSERT_TRUE(scene) << scene.error().str();
+    auto renderer = Renderer::create(context(), *scene);
+    ASSERT_TRUE(renderer) << renderer.error().str();
+    constexpr double kRough = 4.0; // of 255
+    constexpr uint32_t kWidth = 320, kHeight = 240;
+    const Camera views[] = {{{0.9f, 0.8f, 2.4f}, {0.0f, -0.05f, 0.0f}, {0, 1, 0}, 40.0f},
+                            {{-1.6f, 1.4f, 1.9f}, {0.0f, 0.0f, 0.0f}, {0, 1, 0}, 45.0f}};
+    for (const Camera& view : views) {
+        RenderOptions options;
+        options.width = kWidth, options.height = kHeight;
+        options.camera = view;
+        options.mode = RenderMode::Normals;
+        auto normals = (*renderer)->render(options);
+        ASSERT_TRUE(normals) << normals.error().str();
+        options.mode = RenderMode::Shaded;
+        std::vector<double> taken(size_t(kWidth) * kHeight, 0.0);
+        for (bool shadows : {false, true}) {
+            options.shadows = shadows;
+            auto image = (*renderer)->render(options);
+            ASSERT_TRUE(image) << image.error().str();
+            for (size_t i = 0; i < taken.size(); ++i) {
+                const uint8_t* c = &image->rgba[4 * i];
+                taken[i] += (shadows ? -1.0 : 1.0) * (0.299 * c[0] + 0.587 * c[1] + 0.114 * c[2]);
+            }
+        }
+        // On a smooth part of the surface: the pixels two around hit, with normals (as colours)
+        // alike, which leaves out silhouettes and creases.
+        const std::vector<PixelInfo>& pixels = (*renderer)->lastPixelInfo();
+        auto alike = [&](size_t i, size_t j) {
+            for (int ch = 0; ch < 3; ++ch)
+                if (std::abs(int(normals->rgba[4 * i + ch]) - int(normals->rgba[4 * j + ch])) > 12)
+                    return false;
+            return pixels[j].depth > 0.0f;
+        };
+        size_t inside = 0, rough = 0;
+        for (uint32_t y = 2; y + 2 < kHeight; ++y)
+            for (uint32_t x = 2; x + 2 < kWidth; ++x) {
+                const size_t i = size_t(y) * kWidth + x;
+                bool smooth = pixels[i].depth > 0.0f;
+                for (int dy = -2; dy <= 2; ++dy)
+                    for (int dx = -2; dx <= 2; ++dx)
+                        smooth = smooth && alike(i, i + dy * ptrdiff_t(kWidth) + dx);
+                const double mean =
+                    (taken[i - 1] + taken[i + 1] + taken[i - kWidth] + taken[i + kWidth]) / 4.0;
+                inside += smooth;
+                rough += smooth && std::abs(taken[i] - mean) > kRough;
+            }
+        EXPECT_LE(rough, inside / 200)
+            << rough << " of " << inside << " surface pixels have shadows unlike their "
+            << "neighbours', seen from (" << view.eye.x << ", " << view.eye.y << ", " << view.eye.z
+            << ")";
+    }
+}
+
 } // namespace
 } // namespace sdfcsg::test

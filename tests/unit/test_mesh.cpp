@@ -257,6 +257,41 @@ TEST_F(MeshTest, RandomTreesOfEveryKindMeshClosedAndManifold) {
     }
 }
 
+// The grid of the default bounds hugs the solid: along every axis where the solid is bounded,
+// its size is within 5% of the solid's true size (sampled over the grid's box) plus the margin
+// of cells the mesher adds on either side and a cell of rounding; for every bundled scene, and
+// for scenes whose operands' boxes are far larger than their solid (clippedScenes: an
+// intersection of two offset boxes, a woven mat, a storage box cut by planes).
+TEST_F(MeshTest, GridHugsTheSolid) {
+    std::vector<Scene> scenes = clippedScenes();
+    for (const auto& path : bundledScenePaths())
+        scenes.push_back(loadOrDie(path));
+    for (const Scene& scene : scenes) {
+        SCOPED_TRACE(scene.file);
+        const Evaluator evaluator(scene);
+        MeshOptions options;
+        options.resolution = 64;
+        MeshStats stats;
+        extract(scene, options, &stats);
+        const Aabb& grid = stats.bounds;
+        const float margin = 2.0f * stats.voxelSize; // resolution / 32 cells (planGrid)
+        float spacing = 0.0f;
+        const Aabb solid = sampledSolid(evaluator, grid, 80, spacing);
+        ASSERT_FALSE(solid.empty());
+        for (int a = 0; a < 3; ++a) {
+            if (!std::isfinite(evaluator.solidBounds().min[a]) ||
+                !std::isfinite(evaluator.solidBounds().max[a]))
+                continue; // a ground plane: the grid frames the finite parts
+            const float size = solid.max[a] - solid.min[a];
+            EXPECT_LE(grid.max[a] - grid.min[a],
+                      1.05f * size + 2.0f * margin + stats.voxelSize + 2.0f * spacing)
+                << "axis " << a;
+            EXPECT_LE(grid.min[a], solid.min[a]) << "axis " << a;
+            EXPECT_GE(grid.max[a], solid.max[a]) << "axis " << a;
+        }
+    }
+}
+
 TEST_F(MeshTest, TorusHasEulerCharacteristicZero) {
     const Scene scene = sceneFrom(R"({"version": 1, "root": {"type": "torus",
         "major_radius": 0.7, "minor_radius": 0.25, "rotate": [30, 0, 20]}})");
@@ -406,6 +441,32 @@ TEST_P(BundledSceneMesh, IsClosedManifoldWhereTheSurfaceFitsTheBounds) {
 
 INSTANTIATE_TEST_SUITE_P(Scenes, BundledSceneMesh, ::testing::ValuesIn(bundledScenes()),
                          sceneTestName);
+
+// The gear's rims and teeth cross the grid at every angle (it is turned 70 degrees about x), and
+// a grid moved by a fraction of a cell splits different cells there into fans
+// (separateCrossings in mesh_dual.cpp), whose triangles turned over where a cell's vertex lay on
+// the far side of the rim from its loop's chords. At resolutions even and odd around the
+// default, each moving the grid against the gear, its mesh is closed and manifold, no triangles
+// cross, and none faces against the field.
+TEST_F(MeshTest, GearIsEmbeddedAtEveryResolution) {
+    const Scene scene =
+        loadOrDie(std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes/gear.json");
+    const Evaluator evaluator(scene);
+    auto mesher = Mesher::create(context(), scene);
+    ASSERT_TRUE(mesher) << mesher.error().str();
+    for (uint32_t resolution : {64u, 96u, 101u, 118u, 128u, 142u, 151u, 200u}) {
+        SCOPED_TRACE("at " + std::to_string(resolution));
+        MeshOptions options;
+        options.resolution = resolution;
+        MeshStats stats;
+        auto mesh = (*mesher)->extract(options, &stats);
+        ASSERT_TRUE(mesh) << mesh.error().str();
+        EXPECT_FALSE(stats.surfaceCut);
+        const MeshProperties m = measureMesh(*mesh);
+        EXPECT_TRUE(m.closedManifold()) << m.str();
+        expectEmbedded(*mesh, evaluator, stats.voxelSize);
+    }
+}
 
 // Dual contouring keeps sharp edges: at resolution 128, points across every triangle of reference
 // scene A (in the benchmark's bounds, kReferenceBounds in apps/bench.cpp) and of the CSG part,

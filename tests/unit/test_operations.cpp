@@ -118,6 +118,50 @@ TEST(Operations, BendCurlsABarAsDocumented) {
               0.01f);
 }
 
+// bend_linear against its formula: the child at p less offset ease(t), t the clamped position of
+// p's projection from p0 to p1, divided by 1 + |offset| ease' / |p1 - p0| and floored at the
+// distance to its bounds, the child's box swept by the offset. Its surface lies in those bounds.
+TEST(Operations, BendLinearIsItsFormula) {
+    const glm::vec3 p0(-0.5f, -0.1f, 0.0f), p1(0.7f, 0.2f, 0.1f), offset(0.1f, 0.5f, -0.2f);
+    const glm::vec3 half(0.8f, 0.15f, 0.2f); // the box's
+    const std::string eases[] = {"linear", "smoothstep", "smootherstep"};
+    auto ease = [](int style, float t) {
+        return style == 0   ? t
+               : style == 1 ? t * t * (3 - 2 * t)
+                            : t * t * t * (t * (6 * t - 15) + 10);
+    };
+    const float slopes[] = {1.0f, 1.5f, 1.875f};
+    const Aabb swept{glm::min(-half, offset - half), glm::max(half, offset + half)};
+    for (int style = 0; style < 3; ++style) {
+        SCOPED_TRACE(eases[style]);
+        const Evaluator e(parseRoot(R"({"type": "bend_linear", "p0": [-0.5, -0.1, 0],
+            "p1": [0.7, 0.2, 0.1], "offset": [0.1, 0.5, -0.2], "ease": ")" +
+                                    eases[style] + R"(", "children": [
+            {"type": "box", "size": [1.6, 0.3, 0.4]}]})"));
+        for (int k = 0; k < 3; ++k) { // rounded outwards
+            EXPECT_LE(e.bounds().min[k], swept.min[k]);
+            EXPECT_GE(e.bounds().max[k], swept.max[k]);
+            EXPECT_NEAR(e.bounds().min[k], swept.min[k], 1e-4f);
+            EXPECT_NEAR(e.bounds().max[k], swept.max[k], 1e-4f);
+        }
+        const glm::vec3 axis = p1 - p0;
+        const float lipschitz = 1.0f + glm::length(offset) * slopes[style] / glm::length(axis);
+        int inside = 0;
+        for (glm::vec3 p : randomPoints(17, 4000, 1.2f)) {
+            const float t = glm::clamp(glm::dot(p - p0, axis) / glm::dot(axis, axis), 0.0f, 1.0f);
+            const glm::vec3 q = p - offset * ease(style, t);
+            const float box = Aabb{-half, half}.signedDistance(q);
+            const float want = std::max(box / lipschitz, e.bounds().signedDistance(p));
+            ASSERT_NEAR(e.distance(p), want, 1e-5f) << p.x << " " << p.y << " " << p.z;
+            if (e.distance(p) <= 0.0f) {
+                ++inside;
+                ASSERT_LE(e.bounds().signedDistance(p), 0.0f) << p.x << " " << p.y << " " << p.z;
+            }
+        }
+        EXPECT_GT(inside, 50);
+    }
+}
+
 // Spacing means nothing along an axis of one copy, so 0 is accepted there: the same field.
 TEST(Operations, RepeatTakesSpacingZeroAlongAnAxisOfOneCopy) {
     const Evaluator zero(parseRoot(R"({"type": "repeat", "count": [4, 1, 1],
@@ -154,11 +198,18 @@ TEST(Operations, ShellAndOffsetOfASphere) {
     EXPECT_NEAR(shell.distance({0, 1.05f, 0}), -0.05f, 1e-6f);
 }
 
-// Twist, bend and taper: 1-Lipschitz (sampled), and negative exactly where the child is at the
-// warped point.
+// Twist, bend, taper and bend_linear: 1-Lipschitz (sampled), and negative exactly where the child
+// is at the warped point.
 TEST(Operations, StretchingOperationsStayOneLipschitz) {
-    for (const char* op : {R"("type": "twist", "angle": 120)", R"("type": "bend", "angle": 60)",
-                           R"("type": "taper", "height": 1, "top_scale": 0.3)"}) {
+    for (
+        const char* op :
+        {R"("type": "twist", "angle": 120)", R"("type": "bend", "angle": 60)",
+         R"("type": "taper", "height": 1, "top_scale": 0.3)",
+         R"("type": "bend_linear", "p0": [0, -0.3, 0], "p1": [0, 0.3, 0], "offset": [0.6, 0, 0.2],
+             "ease": "linear")",
+         R"("type": "bend_linear", "p0": [0, -0.3, 0], "p1": [0.1, 0.3, 0], "offset": [0.6, 0, 0.2])",
+         R"("type": "bend_linear", "p0": [0, -0.3, 0], "p1": [0, 0.3, 0.1],
+             "offset": [0.6, 0.1, 0.2], "ease": "smootherstep")"}) {
         SCOPED_TRACE(op);
         Evaluator e(parseRoot(std::string("{") + op + R"(, "rotate": [5, 10, 0], "children": [
             {"type": "box", "size": [0.4, 1.2, 0.3], "translate": [0.1, 0, 0]}]})"));
@@ -209,6 +260,9 @@ TEST(Operations, PrunedTapesAgreeWithTheTree) {
             {"type": "mirror", "axes": "z", "children": [
                 {"type": "offset", "distance": 0.02, "children": [
                     {"type": "capsule", "a": [0, 0, 0.05], "b": [0.2, 0.3, 0.1], "radius": 0.05}]}]}]},
+        {"type": "bend_linear", "p0": [0, 0, -0.8], "p1": [0, 0, 0.8], "offset": [0.4, 0.3, 0],
+         "translate": [0, 1.6, 0], "children": [
+            {"type": "cylinder", "radius": 0.1, "height": 2.4, "rotate": [90, 0, 0]}]},
         {"type": "bend", "angle": 20, "translate": [0, -1, 0], "children": [
             {"type": "taper", "height": 0.4, "top_scale": 0.5, "children": [
                 {"type": "elongate", "length": [3, 0, 0], "children": [

@@ -246,6 +246,28 @@ std::vector<BadInput> badInputs() {
              {"type": "sphere", "radius": 0.2}]})"),
          "scene.json: root.spacing: expected a spacing greater than 0 along y, which has 3 "
          "copies, got 0"},
+        {"bend_linear p1 at p0",
+         scene(R"({"type": "bend_linear", "p0": [1, 2, 3], "p1": [1, 2, 3], "offset": [0, 1, 0],
+             "children": [{"type": "sphere", "radius": 0.2}]})"),
+         "scene.json: root.p1: expected a point apart from p0, got [1, 2, 3]"},
+        {"bend_linear unknown ease",
+         scene(R"({"type": "bend_linear", "p0": [0, 0, 0], "p1": [1, 0, 0], "offset": [0, 1, 0],
+             "ease": "smooth", "children": [{"type": "sphere", "radius": 0.2}]})"),
+         R"(scene.json: root.ease: expected one of "linear", "smoothstep" or "smootherstep", got "smooth"; did you mean "smoothstep"?)"},
+        {"text width and height", scene(R"({"type": "extrude", "height": 0.2, "children": [
+             {"type": "text", "text": "A", "width": 1, "height": 1}]})"),
+         "scene.json: root.children[0].height: expected one of \"size\", \"width\" and "
+         "\"height\" (each sets the text's size), got both \"width\" and \"height\""},
+        {"text size and width", scene(R"({"type": "extrude", "height": 0.2, "children": [
+             {"type": "text", "text": "A", "size": 1, "width": 1}]})"),
+         "scene.json: root.children[0].width: expected one of \"size\", \"width\" and "
+         "\"height\" (each sets the text's size), got both \"size\" and \"width\""},
+        {"text width zero", scene(R"({"type": "extrude", "height": 0.2, "children": [
+             {"type": "text", "text": "A", "width": 0}]})"),
+         "scene.json: root.children[0].width: expected a positive number, got 0"},
+        {"text height negative", scene(R"({"type": "extrude", "height": 0.2, "children": [
+             {"type": "text", "text": "A", "height": -2}]})"),
+         "scene.json: root.children[0].height: expected a positive number, got -2"},
         {"repeat spacing negative",
          scene(R"({"type": "repeat", "count": [2, 1, 1], "spacing": [1, -1, 0], "children": [
              {"type": "sphere", "radius": 0.2}]})"),
@@ -278,7 +300,7 @@ std::vector<BadInput> badInputs() {
         {"primitive with children", scene(R"({"type": "sphere", "radius": 1, "children": []})"),
          "scene.json: root: a sphere takes no \"children\"; only operations (union, intersection, "
          "difference, shell, offset, repeat, polar_repeat, mirror, elongate, twist, bend, "
-         "taper, extrude and revolve) do"},
+         "taper, bend_linear, extrude and revolve) do"},
         {"operation without children", scene(R"({"type": "intersection"})"),
          R"(scene.json: root: missing required key "children" (a non-empty array of nodes))"},
         {"empty children", scene(R"({"type": "union", "children": []})"),

@@ -465,6 +465,29 @@ TEST(Profiles, TextIsTheExactDistanceToItsGlyphs) {
     EXPECT_GT(inside, 200);
 }
 
+// "width" and "height" set a text's size by its ink: its outlines' extents are that wide or that
+// tall, and the field is the text's at the font size that makes them so.
+TEST(Profiles, TextFitsAWidthOrAHeight) {
+    auto unit = detail::textOutline("Fit me", detail::defaultFontFile(), 1.0f);
+    ASSERT_TRUE(unit);
+    const glm::vec2 ink = unit->max - unit->min;
+    for (int axis = 0; axis < 2; ++axis) {
+        const std::string key = axis == 0 ? "width" : "height";
+        const float want = axis == 0 ? 2.5f : 0.4f;
+        const std::string fit = R"({"type": "extrude", "height": 0.3, "children": [
+            {"type": "text", "text": "Fit me", ")" +
+                                key + R"(": )" + std::to_string(want) + "}]}";
+        Evaluator e(parseRoot(fit));
+        const Aabb& box = e.nodes()[1].bounds; // the extents, rounded outwards
+        EXPECT_NEAR(box.max[axis] - box.min[axis], want, 1e-4f) << key;
+        expectSameField(fit,
+                        R"({"type": "extrude", "height": 0.3, "children": [
+            {"type": "text", "text": "Fit me", "size": )" +
+                            std::to_string(want / ink[axis]) + "}]}",
+                        1.5f, 1e-4f);
+    }
+}
+
 // Outlines too large to loop over carry a grid of cells, each listing the segments
 // that can be nearest in it.
 TEST(Profiles, GriddedTextIsExactOnItsGrid) {

@@ -877,15 +877,16 @@ TEST(ViewerScript, RefusesNumbersThatAreNotFinite) {
                               "op sphere\nkind union\nadd torus\nmove up\n",
                               "s.txt");
     ASSERT_FALSE(script);
-    EXPECT_EQ(script.error().str(), "s.txt:1:1: orbit: expected a finite number, got \"nan\"\n"
-                                    "s.txt:2:1: zoom: expected a finite number, got \"inf\"\n"
-                                    "s.txt:3:1: set: expected a finite number, got \"-inf\"\n"
-                                    "s.txt:4:1: pick: expected a finite number, got \"1e99\"\n"
-                                    "s.txt:5:1: zoom: expected a positive factor, got \"0\"\n"
-                                    "s.txt:6:1: op: expected one of union, intersection, "
-                                    "difference, shell, offset, repeat, polar_repeat, mirror, "
-                                    "elongate, twist, bend, taper, extrude, revolve, got "
-                                    "\"sphere\"");
+    EXPECT_EQ(script.error().str(),
+              "s.txt:1:1: orbit: expected a finite number, got \"nan\"\n"
+              "s.txt:2:1: zoom: expected a finite number, got \"inf\"\n"
+              "s.txt:3:1: set: expected a finite number, got \"-inf\"\n"
+              "s.txt:4:1: pick: expected a finite number, got \"1e99\"\n"
+              "s.txt:5:1: zoom: expected a positive factor, got \"0\"\n"
+              "s.txt:6:1: op: expected one of union, intersection, "
+              "difference, shell, offset, repeat, polar_repeat, mirror, "
+              "elongate, twist, bend, taper, bend_linear, extrude, revolve, got "
+              "\"sphere\"");
 }
 
 TEST(ViewerScript, ParentTakesANodeAndAPosition) {

@@ -92,10 +92,12 @@ class Evaluator {
     // Bounds of the whole solid; infinite along axes where a plane reaches. The evaluation
     // skips by them: the field is at least their box's signed distance.
     const Aabb& bounds() const { return nodes_[0].bounds; }
-    // The box the solid lies in, within bounds() and tighter where a Boolean operation allows:
-    // an intersection within the overlap of its operands' boxes, a difference within its first
-    // operand's. The field may be below its signed distance, so nothing skips by it; framing
-    // and the mesh grid take it.
+    // The box the solid lies in, within bounds() and tighter where the operations allow: an
+    // intersection within the overlap of its operands' boxes, clipped by the half-spaces of its
+    // planes; a difference within its first operand's, less what a subtracted box or plane
+    // removes from it; a twist or polar repetition within its child's radius about the y axis.
+    // The field may be below its signed distance, so nothing skips by it; framing and the mesh
+    // grid take it.
     const Aabb& solidBounds() const { return solidBounds_; }
     // The finite box the solid lies in, as tight as the bounds know it: bounds() on every side
     // where they are finite (a difference lies within its first operand, whatever it subtracts),
@@ -136,7 +138,11 @@ std::vector<FieldNote> fieldNotes(const Scene& scene, const Evaluator& evaluator
 // settle it.
 bool provablyEmpty(const Evaluator& evaluator);
 
-// A camera looking at the finite part of the scene's bounds from the front and slightly above.
+// A camera looking at the box the solid lies in (Evaluator::finiteBounds()) from a three-quarter
+// view of that box's largest face (the front unless the top or the side is a quarter larger),
+// from the right, above and in front, as near as it can be with every corner of the box within
+// the view, a tenth inside its edges. `aspect` is the image's width over its height, `fov` the
+// vertical field of view in degrees.
 Camera frameCamera(const Evaluator& evaluator, float aspect, float fov = 45.0f);
 
 } // namespace sdfcsg

@@ -57,6 +57,7 @@
     X(Twist)                                                                                       \
     X(Bend)                                                                                        \
     X(Taper)                                                                                       \
+    X(BendLinear)                                                                                  \
     X(Extrude)                                                                                     \
     X(Revolve)
 

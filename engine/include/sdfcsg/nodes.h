@@ -38,8 +38,9 @@ inline constexpr NodeKind kFirstDomainOperation =
     NodeKind(int(kFirstValueOperation) SDFCSG_VALUE_KINDS(SDFCSG_KIND_COUNT));
 #undef SDFCSG_KIND_COUNT
 
-// Every node stores its numeric parameters in this many float slots (see ParamInfo::slot).
-inline constexpr int kMaxParams = 8;
+// Every node stores its numeric parameters in this many float slots (see ParamInfo::slot). A
+// kind's kernel parameters, which the shaders take as two vec4s, use the first eight.
+inline constexpr int kMaxParams = 12;
 using Params = std::array<float, kMaxParams>;
 
 // Choice: one of ParamInfo::choices by name, stored as its index.

@@ -133,6 +133,148 @@ float volume(const Aabb& b) {
     return e.x * e.y * e.z;
 }
 
+// The half-space dot(normal, p) <= offset of a frame, normal of unit length, and a node's value
+// is at least slope times p's signed distance from it (an exact distance's slope is 1).
+struct HalfSpace {
+    glm::dvec3 normal;
+    double offset;
+    double slope;
+};
+
+// The most half-spaces a node's boxes are clipped by; more are left out (the box then holds
+// more than the solid, never less), so that a long chain of intersections stays linear.
+constexpr size_t kMaxClipSpaces = 16;
+
+// The half-space dot(local, axis) < k of node n, local = toLocal p + offset: its value there is
+// the local one times its scale, and the local value dot(local, axis) - k is the frame's
+// distance times the length of toLocal's transpose times the axis.
+HalfSpace localSpace(const FlatNode& n, glm::dvec3 axis, double k) {
+    const glm::dvec3 across = glm::transpose(glm::dmat3(n.toLocal)) * axis;
+    const double length = glm::length(across);
+    return {across / length, (k - glm::dot(glm::dvec3(n.offset), axis)) / length,
+            length * double(n.scale)};
+}
+
+// The half-spaces a primitive's value is at least its slope times the distance from: a plane's
+// own, and a box's (rounded or not) faces where it is turned off the axes (else its bounds are
+// its faces).
+void primitiveSpaces(const FlatNode& n, std::vector<HalfSpace>& out) {
+    if (n.kind == NodeKind::Plane) {
+        out.push_back(localSpace(n, {n.params[0], n.params[1], n.params[2]}, n.params[3]));
+    } else if ((n.kind == NodeKind::Box || n.kind == NodeKind::RoundBox) &&
+               !axisAligned(glm::dmat3(n.toLocal))) {
+        for (int a = 0; a < 3; ++a) {
+            glm::dvec3 axis(0.0);
+            axis[a] = 1.0;
+            out.push_back(localSpace(n, axis, n.params[a]));
+            out.push_back(localSpace(n, -axis, n.params[a]));
+        }
+    }
+}
+
+// How far from its local y axis a primitive reaches, for the kinds that reach less far than
+// their box's corners (round about the axis, or nearly), from their kernel parameters; else
+// infinity.
+double axisRadius(NodeKind kind, const Params& k) {
+    switch (kind) {
+    case NodeKind::Sphere:
+    case NodeKind::Cylinder:
+    case NodeKind::Octahedron:
+        return k[0];
+    case NodeKind::Cone:
+    case NodeKind::RoundCone:
+        return std::max(k[0], k[kind == NodeKind::Cone ? 2 : 1]);
+    case NodeKind::RoundedCylinder:
+    case NodeKind::Torus:
+    case NodeKind::CappedTorus:
+        return double(k[0]) + k[kind == NodeKind::RoundedCylinder ? 2 : 1];
+    case NodeKind::HexPrism:
+        return k[0] / 0.8660254; // the apothem's corner
+    case NodeKind::Ellipsoid:
+        return 1.0 / std::min(k[0], k[2]);
+    case NodeKind::Pyramid:
+        return 0.5 * std::sqrt(2.0) * k[0];
+    default:
+        return INFINITY;
+    }
+}
+
+// How far from the y axis the points of a box reach.
+double boxRadius(const Aabb& b) {
+    const double x = std::max(std::abs(double(b.min.x)), std::abs(double(b.max.x)));
+    const double z = std::max(std::abs(double(b.min.z)), std::abs(double(b.max.z)));
+    return std::sqrt(x * x + z * z);
+}
+
+// A box and half-spaces: the solid below value r lies in the box grown by r along each axis and
+// in each half-space moved out by r over its slope, when the value is at least the largest of
+// the Chebyshev distance to the box (the largest of the distances along each axis, which the
+// signed distance of bounds is never below) and the half-spaces' slopes times their distances.
+struct Region {
+    Aabb box;
+    std::vector<HalfSpace> spaces;
+};
+
+void addSpaces(Region& to, const std::vector<HalfSpace>& spaces) {
+    for (const HalfSpace& h : spaces)
+        if (to.spaces.size() < kMaxClipSpaces) to.spaces.push_back(h);
+}
+
+Region grown(Region region, float r) {
+    region.box.min -= r, region.box.max += r;
+    for (HalfSpace& h : region.spaces)
+        h.offset += double(r) / h.slope;
+    return region;
+}
+
+// The box of the part of `box` in every half-space: the box of that polytope's corners, the
+// points where three of its planes (the box's faces and the half-spaces' boundaries) meet and
+// that lie in all the others (a few thousand small solves for 16 half-spaces). Where the box is
+// unbounded, only half-spaces across an axis clip it, until it is bounded. Rounded outwards.
+Aabb clipBox(const Aabb& box, const std::vector<HalfSpace>& spaces) {
+    Aabb out = box;
+    for (const HalfSpace& h : spaces)
+        for (int a = 0; a < 3; ++a) {
+            if (h.normal[(a + 1) % 3] != 0.0 || h.normal[(a + 2) % 3] != 0.0) continue;
+            const float at = float(h.offset / h.normal[a]);
+            if (h.normal[a] > 0.0)
+                out.max[a] = std::min(out.max[a], std::nextafter(at, INFINITY));
+            else
+                out.min[a] = std::max(out.min[a], std::nextafter(at, -INFINITY));
+        }
+    if (out.empty() || !out.finite()) return out;
+    std::vector<HalfSpace> planes = spaces;
+    double size = 0.0;
+    for (int a = 0; a < 3; ++a) {
+        glm::dvec3 axis(0.0);
+        axis[a] = 1.0;
+        planes.push_back({axis, double(out.max[a]), 1.0});
+        planes.push_back({-axis, -double(out.min[a]), 1.0});
+        size = std::max({size, std::abs(double(out.min[a])), std::abs(double(out.max[a]))});
+    }
+    const double slack = 1e-9 * (size + 1.0);
+    glm::dvec3 lo(INFINITY), hi(-INFINITY);
+    const size_t m = planes.size();
+    for (size_t i = 0; i < m; ++i)
+        for (size_t j = i + 1; j < m; ++j)
+            for (size_t k = j + 1; k < m; ++k) {
+                const HalfSpace &a = planes[i], &b = planes[j], &c = planes[k];
+                const glm::dvec3 bc = glm::cross(b.normal, c.normal);
+                const double det = glm::dot(a.normal, bc);
+                if (std::abs(det) < 1e-12) continue; // two of them parallel, or all three
+                const glm::dvec3 corner =
+                    (a.offset * bc + b.offset * glm::cross(c.normal, a.normal) +
+                     c.offset * glm::cross(a.normal, b.normal)) /
+                    det;
+                bool inside = true;
+                for (size_t l = 0; l < m && inside; ++l)
+                    inside = glm::dot(planes[l].normal, corner) <= planes[l].offset + slack;
+                if (inside) lo = glm::min(lo, corner), hi = glm::max(hi, corner);
+            }
+    if (lo.x > hi.x) return Aabb{}; // nothing of the box is in every half-space
+    return outwardBox(lo, hi);
+}
+
 // local = toLocal * p + offset, associated as dot(row, vec4(p, 1)) in nodes.glsl.
 glm::vec3 localPoint(const FlatNode& n, glm::vec3 p) {
     const glm::mat3& m = n.toLocal;
@@ -525,37 +667,105 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
         n.loss = lossOf(i);
     }
 
-    // Pass 3, children first: the box the solid lies in, as tight as the Boolean operations
-    // allow (solidBounds()). The bounds above stand in for a node's value wherever the
-    // evaluation skips it, so they must stay below that value; this box need not. An
-    // intersection lies within the overlap of its operands' boxes, yet its value may be below
-    // that overlap's distance (near a corner of it), so only here does it take the overlap, and
-    // the operations above follow from there.
-    std::vector<Aabb> tight(count);
+    // Pass 3, children first: the box the solid lies in, as tight as the operations allow
+    // (solidBounds()). The bounds above stand in for a node's value wherever the evaluation
+    // skips it, so they must stay below that value; this box need not. An intersection lies
+    // within the overlap of its operands' boxes, yet its value may be below that overlap's
+    // distance (near a corner of it), so only here does it take the overlap, and half-spaces
+    // clip it. Each node has
+    //  - a reach, a Region its value bounds (see Region): the bounds; a plane's half-space and
+    //    a turned box's faces; for an intersection the overlap of its operands' boxes and all
+    //    their half-spaces (the largest of the operands' values is at least the largest of
+    //    their distances, and the Chebyshev distance to an overlap is the largest of those to
+    //    the boxes); for a difference its first operand's and the half-spaces its planes leave;
+    //    for a union the box around its operands' grown by what its blend adds; an offset or a
+    //    shell grows it by its distance. What a blend or an offset grows by needs it: an offset
+    //    of a difference wraps round the edges of the box it subtracts, beyond the cut box;
+    //  - a solid box, within the reach's: its operands' solid boxes cut by its half-spaces and
+    //    by subtracted boxes, and carried through domain operations.
+    //  - a radius about its frame's y axis that the solid lies within, for twist and
+    //    polar_repeat, which turn about that axis: a cylinder twisted stays within its radius,
+    //    whose box's corners reach further.
+    std::vector<Region> reach(count);
+    std::vector<Aabb> solid(count);
+    std::vector<double> radial(count, INFINITY);
+    // A radius about node i's local y axis, about its frame's: where its transform keeps the y
+    // axis upright and scales x and z alike, the radius scaled, and the distance of its axis.
+    auto frameRadius = [&](size_t i, double local) {
+        const glm::dmat3& m = acc[i].toWorld;
+        const double sx = glm::length(m[0]), sz = glm::length(m[2]);
+        const bool upright = m[1].x == 0.0 && m[1].z == 0.0 && m[0].y == 0.0 && m[2].y == 0.0 &&
+                             std::abs(glm::dot(m[0], m[2])) <= 1e-12 * sx * sz &&
+                             std::abs(sx - sz) <= 1e-12 * sx;
+        if (!upright || !std::isfinite(local)) return double(INFINITY);
+        const glm::dvec3 o = acc[i].origin;
+        return (std::sqrt(o.x * o.x + o.z * o.z) + local * sx) * (1.0 + 1e-6);
+    };
+    const Aabb everywhere{glm::vec3(-INFINITY), glm::vec3(INFINITY)};
+    auto hull = [](Aabb a, const Aabb& b) {
+        return Aabb{glm::min(a.min, b.min), glm::max(a.max, b.max)};
+    };
+    auto overlap = [](Aabb a, const Aabb& b) {
+        return Aabb{glm::max(a.min, b.min), glm::min(a.max, b.max)};
+    };
+    auto clipped = [&](const Aabb& box, const std::vector<HalfSpace>& spaces) {
+        return spaces.empty() || box.empty() ? box : overlap(box, clipBox(box, spaces));
+    };
     for (size_t i = count; i-- > 0;) {
         const FlatNode& n = nodes_[i];
         const KindInfo& info = kindInfo(n.kind);
-        Aabb box = n.bounds;
-        const Aabb* child = n.children.empty() ? nullptr : &tight[n.children[0]];
-        if (n.kind == NodeKind::Union) {
-            box = Aabb{};
+        const uint32_t first = n.children.empty() ? 0 : n.children[0];
+        Region& r = reach[i];
+        if (!isOperation(n.kind)) {
+            r.box = solid[i] = n.bounds;
+            primitiveSpaces(n, r.spaces);
+            radial[i] = frameRadius(i, axisRadius(n.kind, n.params));
+        } else if (n.kind == NodeKind::Union) {
+            // A smooth union lies where some operand's value is below the blend's growth.
+            const float g = smoothGrowth(n);
+            radial[i] = 0.0;
             for (uint32_t c : n.children) {
-                box.min = glm::min(box.min, tight[c].min - smoothGrowth(n));
-                box.max = glm::max(box.max, tight[c].max + smoothGrowth(n));
+                r.box = hull(r.box, reach[c].box);
+                radial[i] = std::max(radial[i], radial[c] + g);
+                if (g > 0.0f) {
+                    const Region blend = grown(reach[c], g);
+                    solid[i] = hull(solid[i], clipped(blend.box, blend.spaces));
+                } else {
+                    solid[i] = hull(solid[i], solid[c]);
+                }
             }
+            r.box.min -= g, r.box.max += g;
+            if (n.children.size() == 1) addSpaces(r, reach[first].spaces);
         } else if (n.kind == NodeKind::Intersection) {
+            // A smooth maximum is never below the sharp one (every blend profile of sdf.glsl
+            // adds to the larger operand, never takes from it), so a smooth intersection lies
+            // within the sharp one: its blend grows nothing.
+            r.box = solid[i] = everywhere;
             for (uint32_t c : n.children) {
-                box.min = glm::max(box.min, tight[c].min);
-                box.max = glm::min(box.max, tight[c].max);
+                r.box = overlap(r.box, reach[c].box);
+                solid[i] = overlap(solid[i], solid[c]);
+                radial[i] = std::min(radial[i], radial[c]);
+                addSpaces(r, reach[c].spaces);
             }
         } else if (n.kind == NodeKind::Difference) {
-            box = *child;
-            // A box turned by right angles at most fills its bounds: where it spans the first
-            // operand's box across two axes, it cuts that box along the third.
+            // Within the first operand (a smooth maximum is never below the sharp one), outside
+            // every subtracted plane's half-space: minus its value is its slope times the
+            // distance from the other side.
+            r.box = reach[first].box;
+            solid[i] = solid[first];
+            radial[i] = radial[first];
+            addSpaces(r, reach[first].spaces);
             for (size_t k = 1; k < n.children.size(); ++k) {
                 const uint32_t c = n.children[k];
+                if (nodes_[c].kind == NodeKind::Plane) {
+                    const HalfSpace h = reach[c].spaces[0];
+                    addSpaces(r, {{-h.normal, -h.offset, h.slope}});
+                }
+                // A box turned by right angles at most fills its bounds: where it spans the
+                // first operand's box across two axes, it cuts that box along the third.
                 if (nodes_[c].kind != NodeKind::Box || !axisAligned(acc[c].toWorld)) continue;
                 const Aabb& cut = nodes_[c].bounds;
+                Aabb& box = solid[i];
                 for (int a = 0; a < 3; ++a) {
                     const int b = (a + 1) % 3, d = (a + 2) % 3;
                     if (!(cut.min[b] <= box.min[b] && cut.max[b] >= box.max[b] &&
@@ -565,27 +775,73 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
                     if (cut.max[a] >= box.max[a]) box.max[a] = std::min(box.max[a], cut.min[a]);
                 }
             }
-        } else if (normalises(n) && child && child->finite() && !child->empty()) {
-            // A normalising offset or shell floors its value at its bounds' distance, as domain
-            // operations do, with bounds from the box its child's solid lies in, not from the
-            // child's bounds, which the stretching operations below it have grown (pass 2):
-            // beyond those, its child's value is the distance to a box, a bound with a gradient
-            // of length 1, which the division would take for a distance. Its surface lies near
-            // its distance from its child's (tests/unit/test_offsets.cpp), within these bounds.
-            const float amount =
-                n.kind == NodeKind::Offset ? std::max(n.params[0], 0.0f) : n.params[0];
-            const float grow = 1.05f * amount + 4.0f * n.params[1];
-            box = Aabb{child->min - grow, child->max + grow};
-            nodes_[i].bounds =
-                Aabb{glm::max(n.bounds.min, box.min), glm::min(n.bounds.max, box.max)};
-        } else if (child && child->finite() && !child->empty()) {
-            glm::vec3 lo, hi;
-            info.boundsAround(n.params, child->min, child->max, lo, hi);
-            box = info.role == Role::Domain ? toFrame(i, lo, hi) : Aabb{lo, hi};
+        } else if (info.role == Role::Value) {
+            // An offset's or a shell's value is its child's less a distance; an offset inwards
+            // lies within its child.
+            const float by = n.params[0];
+            const Aabb& child = solid[first];
+            if (normalises(n) && child.finite() && !child.empty()) {
+                // A normalising offset or shell floors its value at its bounds' distance, as
+                // domain operations do, with bounds from the box its child's solid lies in, not
+                // from the child's bounds, which the stretching operations below it have grown
+                // (pass 2): beyond those, its child's value is the distance to a box, a bound
+                // with a gradient of length 1, which the division would take for a distance.
+                // Its surface lies near its distance from its child's
+                // (tests/unit/test_offsets.cpp), within these bounds.
+                const float amount = n.kind == NodeKind::Offset ? std::max(by, 0.0f) : by;
+                const float grow = 1.05f * amount + 4.0f * n.params[1];
+                nodes_[i].bounds = overlap(n.bounds, Aabb{child.min - grow, child.max + grow});
+            }
+            if (n.kind == NodeKind::Offset && by <= 0.0f) {
+                r = reach[first];
+                solid[i] = solid[first];
+                radial[i] = radial[first];
+            } else {
+                r = grown(reach[first], by);
+                solid[i] = r.box;
+                radial[i] = radial[first] + by;
+            }
+        } else {
+            // A domain operation's value is floored at its bounds' distance; its solid is its
+            // child's carried through it.
+            r.box = solid[i] = n.bounds;
+            const Aabb& child = solid[first];
+            if (child.empty()) {
+                solid[i] = Aabb{};
+            } else if (child.finite()) {
+                glm::vec3 lo, hi;
+                info.boundsAround(n.params, child.min, child.max, lo, hi);
+                // Turning about the y axis keeps the distance from it; a polar repetition moves
+                // its child out by its radius first.
+                double turned = INFINITY;
+                if (n.kind == NodeKind::Twist) turned = radial[first];
+                if (n.kind == NodeKind::PolarRepeat)
+                    turned = std::abs(double(n.params[1])) + radial[first];
+                if (std::isfinite(turned)) {
+                    const float t = std::nextafter(float(turned), INFINITY);
+                    lo.x = std::max(lo.x, -t), lo.z = std::max(lo.z, -t);
+                    hi.x = std::min(hi.x, t), hi.z = std::min(hi.z, t);
+                    radial[i] = frameRadius(i, turned);
+                }
+                solid[i] = toFrame(i, lo, hi);
+            }
         }
-        tight[i] = Aabb{glm::max(box.min, n.bounds.min), glm::min(box.max, n.bounds.max)};
+        r.box = overlap(r.box, n.bounds);
+        solid[i] = overlap(solid[i], r.box);
+        radial[i] = std::min(radial[i], boxRadius(solid[i]));
+        // The half-spaces that an enclosing intersection, difference, one-operand union or
+        // inward offset takes on clip there, with the rest of its own.
+        const uint32_t up = parent[i];
+        const bool carried =
+            up != UINT32_MAX &&
+            (nodes_[up].kind == NodeKind::Intersection ||
+             (nodes_[up].kind == NodeKind::Difference && nodes_[up].children[0] == i) ||
+             (nodes_[up].kind == NodeKind::Union && nodes_[up].children.size() == 1) ||
+             (nodes_[up].kind == NodeKind::Offset && nodes_[up].params[0] <= 0.0f));
+        if (!carried) solid[i] = clipped(solid[i], r.spaces);
+        if (solid[i].empty()) solid[i] = Aabb{};
     }
-    if (count) solidBounds_ = tight[0];
+    if (count) solidBounds_ = solid[0];
 }
 
 float Evaluator::distance(glm::vec3 p) const {
@@ -645,26 +901,53 @@ bool provablyEmpty(const Evaluator& evaluator) {
     return true;
 }
 
+namespace {
+
+// Where the eye lies from a box's centre: a three-quarter view of its largest face, that face's
+// normal turned some 35 to 40 degrees off towards the right, the top and the front, so that the
+// face is seen open and its two neighbours at a slant; a flat part is never seen edge-on. The
+// front (xy) is the largest unless another is a quarter larger; the top (xz) before the side.
+glm::vec3 threeQuarter(glm::vec3 size) {
+    const float front = size.x * size.y, top = size.x * size.z, side = size.y * size.z;
+    glm::vec3 w(0.45f, 0.55f, 0.6f);
+    if (top > 1.25f * front && top >= side)
+        w.y = 1.0f;
+    else if (side > 1.25f * front)
+        w.x = 1.0f;
+    else
+        w.z = 1.0f;
+    return glm::normalize(w);
+}
+
+} // namespace
+
 Camera frameCamera(const Evaluator& evaluator, float aspect, float fov) {
     Camera camera;
     camera.fov = fov;
-    Aabb box = evaluator.bounds();
-    if (!box.finite()) {
-        box = Aabb{};
-        for (const FlatNode& n : evaluator.nodes()) {
-            if (isOperation(n.kind) || !n.bounds.finite() || n.frame != kWorldFrame) continue;
-            box.min = glm::min(box.min, n.bounds.min);
-            box.max = glm::max(box.max, n.bounds.max);
-        }
+    const Aabb box = evaluator.nodes().empty() ? Aabb{glm::vec3(-1.0f), glm::vec3(1.0f)}
+                                               : evaluator.finiteBounds();
+    const glm::vec3 centre = 0.5f * (box.max + box.min), half = 0.5f * (box.max - box.min);
+    const glm::vec3 direction = threeQuarter(glm::max(box.max - box.min, glm::vec3(1e-6f)));
+    // The camera's axes as makeRayCamera (sdfcsg/camera.h) makes them.
+    const glm::vec3 right = glm::normalize(glm::cross(-direction, camera.up));
+    const glm::vec3 up = glm::cross(right, -direction);
+    // The nearest eye from which every corner lies within the view, a tenth inside its edges: a
+    // corner at v from the centre lies at depth D - v.direction, and needs |v.right| and |v.up|
+    // within that depth times the half-angles' tangents.
+    const float tanV = 0.9f * std::tan(0.5f * glm::radians(fov));
+    const float tanH = tanV * std::max(aspect, 1e-3f);
+    // At least as far as frames a ball of radius 1e-3: a solid smaller than that is framed as
+    // one, not from a hair's breadth.
+    const float halfH = std::atan(std::tan(0.5f * glm::radians(fov)) * std::max(aspect, 1e-3f));
+    float distance = 1.1e-3f / std::sin(std::min(0.5f * glm::radians(fov), halfH));
+    for (int c = 0; c < 8; ++c) {
+        const glm::vec3 v((c & 1 ? 1.0f : -1.0f) * half.x, (c & 2 ? 1.0f : -1.0f) * half.y,
+                          (c & 4 ? 1.0f : -1.0f) * half.z);
+        const float depth = glm::dot(v, direction);
+        distance =
+            std::max({distance, depth + std::abs(glm::dot(v, right)) / tanH,
+                      depth + std::abs(glm::dot(v, up)) / tanV, depth + 1e-3f * glm::length(half)});
     }
-    if (box.empty()) box = Aabb{glm::vec3(-1.0f), glm::vec3(1.0f)};
-
-    glm::vec3 centre = 0.5f * (box.min + box.max);
-    float radius = std::max(0.5f * glm::length(box.max - box.min), 1e-3f);
-    float halfV = 0.5f * glm::radians(fov);
-    float halfH = std::atan(std::tan(halfV) * std::max(aspect, 1e-3f));
-    float distance = 1.1f * radius / std::sin(std::min(halfV, halfH));
-    glm::vec3 direction = glm::normalize(glm::vec3(0.0f, 0.35f, 1.0f)); // front, ~20 deg up
     camera.eye = centre + direction * distance;
     camera.target = centre;
     return camera;

@@ -7,6 +7,8 @@
 #include "sdfcsg/eval.h"
 #include "sdfcsg/nodes.h"
 
+#include "field/sdf.h"
+
 #include <algorithm>
 #include <cstdio>
 #include <string>
@@ -42,6 +44,10 @@ Loss ownLoss(const Node& n, const FlatNode& flat) {
     if (n.kind == NodeKind::Twist || n.kind == NodeKind::Bend || n.kind == NodeKind::Taper) {
         factor = flat.params[7] > 0.0f ? 1.0f / flat.params[7] : 1.0f;
         how = " divides its field by up to ";
+    } else if (n.kind == NodeKind::BendLinear) {
+        const auto& k = flat.params;
+        factor = sdf::bendLinearStretch({k[0], k[1], k[2], k[3]}, {k[4], k[5], k[6], k[7]});
+        how = " divides its field by ";
     } else if (n.kind == NodeKind::Ellipsoid) {
         const float lo = std::min({n.params[0], n.params[1], n.params[2]});
         const float hi = std::max({n.params[0], n.params[1], n.params[2]});

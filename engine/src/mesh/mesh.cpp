@@ -887,7 +887,7 @@ void Extraction::finish() {
         // The edge data, which the vertices pass wrote, lies where the dual pass read it.
         detail::separateCrossings(mesh, copiesFrom, quadEdges,
                                   m.mapped<detail::EdgePoint>(SDFCSG_BINDING_MESH_HERMITE),
-                                  g.origin, g.h);
+                                  g.origin, g.h, distance);
         stage("crossings", t2);
     }
     // Colour borders, where asked for and where there can be any: the CPU's whole tree is too

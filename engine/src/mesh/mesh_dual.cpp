@@ -475,7 +475,8 @@ template <class F> void inHalves(size_t n, F&& f) {
 } // namespace
 
 Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<uint32_t>& quadEdges,
-                             const EdgePoint* points, glm::vec3 origin, float h) {
+                             const EdgePoint* points, glm::vec3 origin, float h,
+                             const Distance& distance) {
     Separation result;
     const size_t quads = mesh.indices.size() / 6;
     if (quads == 0 || quadEdges.size() != quads) return result;
@@ -666,6 +667,7 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
     // the positions (`probe`); the whole mesh takes the split quads at the end. After the
     // first, a round checks only the quads that share a cell with a split one (`split`, their
     // corners `reach`): the others are as the first round found them, apart.
+    std::vector<uint8_t> toMean(dualVertices, 0); // lone vertices moved for their fans
     std::vector<uint32_t> probe, split;
     std::vector<uint8_t> reach;
     std::vector<std::pair<uint32_t, uint32_t>> pairs;
@@ -685,8 +687,34 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
             std::swap(mesh.indices, probe);
         }
         result.remaining = pairs.size();
-        if (pairs.empty() || round == kRounds) break;
-        size_t newly = 0;
+        // Fan triangles (those with an edge or face point) that fold (see facing()): a marked
+        // cell's lone vertex there lies across a sharp edge from a chord of its loop, or on the
+        // face that holds the chord, clamped into its cell. It goes, once, to the mean of its
+        // quads' edge points, inside the hull of its loop, where its fan faces like the loop (any
+        // point inside the cell keeps the fan embedded), and the next round checks it. Cells are
+        // not marked for folding: a decision by a threshold would change the mesh's counts where
+        // rounding moves a triangle across it.
+        size_t newly = 0, moved = 0;
+        for (size_t t = 0; t < probe.size(); t += 3) {
+            const uint32_t* f = &probe[t];
+            if (std::max({f[0], f[1], f[2]}) < dualVertices ||
+                facing(mesh, distance, h, f[0], f[1], f[2]) >= 0.0f)
+                continue;
+            for (size_t k = 0; k < 3; ++k) {
+                const uint32_t v = f[k];
+                if (v >= dualVertices || !isMarked(v) || shared[v] || toMean[v]) continue;
+                glm::vec3 sum(0.0f);
+                int count = 0;
+                for (auto it = std::lower_bound(around.begin(), around.end(), std::pair{v, 0u});
+                     it != around.end() && it->first == v; ++it, ++count)
+                    sum += edgePosition(it->second);
+                if (count == 0) continue;
+                mesh.positions[v] = sum / float(count);
+                toMean[v] = 1;
+                ++moved;
+            }
+        }
+        if ((pairs.empty() && newly + moved == 0) || round == kRounds) break;
         for (const auto& [a, b] : pairs)
             for (uint32_t t : {a, b})
                 for (int k = 0; k < 3; ++k)
@@ -695,7 +723,7 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
                         marked[cellOf[v]] = 1;
                         ++newly;
                     }
-        if (newly == 0) break; // what crosses lies in cells already split
+        if (newly + moved == 0) break; // what crosses lies in cells already split
         result.cells += newly;
         result.rounds = round + 1;
         // A marked cell with several vertices (pieces of surface, or copies of one vertex for

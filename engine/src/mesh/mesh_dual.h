@@ -75,8 +75,12 @@ struct Separation {
 // their two triangles, sharp features included. Rounds repeat, marking the cells of the vertices
 // of triangles that still cross, until none do or a few rounds have passed. Only the quads around
 // cells of several vertices and around vertices whose quads may cross (starWedges() in
-// mesh_dual.cpp) are checked, so that meshes with nothing to fix pay little.
+// mesh_dual.cpp) are checked, so that meshes with nothing to fix pay little. Where a fan triangle
+// folds (by its vertices' normals, and where `distance` is set by the field, as in foldQuads()),
+// a marked cell's lone vertex in it moves once to the mean of its quads' edge points, and the
+// next round checks it.
 Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<uint32_t>& quadEdges,
-                             const EdgePoint* points, glm::vec3 origin, float h);
+                             const EdgePoint* points, glm::vec3 origin, float h,
+                             const Distance& distance);
 
 } // namespace sdfcsg::detail

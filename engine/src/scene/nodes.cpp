@@ -1,5 +1,9 @@
 #include "sdfcsg/nodes.h"
 
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
+
 #include <algorithm>
 #include <cmath>
 
@@ -233,7 +237,26 @@ constexpr ParamInfo kText[] = {
      false,
      {1, 0, 0},
      "length",
-     "Font size: the height of the font's em square (capitals are about 0.7 of it)."},
+     "Font size: the height of the font's em square (capitals are about 0.7 of it). Give "
+     "size, width or height, not two of them."},
+    {"width",
+     Number,
+     Positive,
+     1,
+     false,
+     {0, 0, 0},
+     "length",
+     "The width of the text's ink (its outlines' extents, spaces at the ends left out): the "
+     "font size that makes it so, instead of size."},
+    {"height",
+     Number,
+     Positive,
+     2,
+     false,
+     {0, 0, 0},
+     "length",
+     "The height of the text's ink, from the lowest descender to the highest glyph top of this "
+     "text: the font size that makes it so, instead of size."},
     {"font",
      Text,
      Any,
@@ -407,6 +430,40 @@ constexpr ParamInfo kTaper[] = {
      "factor",
      "Scale of x and z at y = +height/2 (1 at y = -height/2)."},
 };
+constexpr std::string_view kEases[] = {"linear", "smoothstep", "smootherstep"};
+constexpr ParamInfo kBendLinear[] = {
+    {"p0",
+     Vec3,
+     Any,
+     0,
+     false,
+     {0, 0, 0},
+     "point",
+     "Where the offset starts: points whose projection on the line through p0 and p1 falls "
+     "before p0 are not moved."},
+    {"p1",
+     Vec3,
+     Any,
+     3,
+     true,
+     {},
+     "point",
+     "Where the offset is complete: points whose projection falls beyond p1 move by all of it. "
+     "Not p0."},
+    {"offset", Vec3, Any, 6, true, {}, "length", "How far the child moves at p1 and beyond."},
+    {"ease",
+     Choice,
+     Any,
+     9,
+     false,
+     {1, 0, 0},
+     "profile",
+     "How the offset grows from p0 to p1: \"linear\" (kinks at both ends), \"smoothstep\" "
+     "(an S, 3 t^2 - 2 t^3: steepest, 1.5 times the linear slope, half way) or "
+     "\"smootherstep\" (6 t^5 - 15 t^4 + 10 t^3: smoother ends, 1.875 times the slope).",
+     3.4e38f,
+     kEases},
+};
 
 // Kernel parameters and local bounds (see KindInfo::kernel and ::bounds).
 using glm::vec3;
@@ -428,6 +485,37 @@ float reach(vec3 lo, vec3 hi) {
 float reachXY(vec3 lo, vec3 hi) {
     const float x = std::max(-lo.x, hi.x), y = std::max(-lo.y, hi.y);
     return std::sqrt(x * x + y * y);
+}
+
+// The box of the rectangle [lo, hi] of a plane turned by every angle from a0 to a1 (radians,
+// a0 <= a1, from the first axis towards the second: (u cos t - v sin t, u sin t + v cos t)):
+// the box of its corners' arcs, each reaching its ends and the axis directions it passes. Exact,
+// since the turned rectangle lies within the hull of its turned corners at every angle.
+void sweptRectangle(glm::vec2 lo, glm::vec2 hi, double a0, double a1, glm::vec2& outLo,
+                    glm::vec2& outHi) {
+    constexpr double kTurn = 2.0 * 3.14159265358979323846;
+    glm::dvec2 l(INFINITY), h(-INFINITY);
+    for (int c = 0; c < 4; ++c) {
+        const glm::dvec2 corner(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y);
+        const double r = std::sqrt(corner.x * corner.x + corner.y * corner.y);
+        const double phi = std::atan2(corner.y, corner.x);
+        auto reach = [&](double t) {
+            const glm::dvec2 q(r * std::cos(t), r * std::sin(t));
+            l = glm::min(l, q), h = glm::max(h, q);
+        };
+        if (a1 - a0 >= kTurn) {
+            l = glm::min(l, glm::dvec2(-r)), h = glm::max(h, glm::dvec2(r));
+            continue;
+        }
+        reach(phi + a0);
+        reach(phi + a1);
+        for (int quarter = 0; quarter < 4; ++quarter) {
+            const double t = quarter * 0.25 * kTurn;
+            const double first = t + std::ceil((phi + a0 - t) / kTurn) * kTurn;
+            if (first <= phi + a1) reach(first);
+        }
+    }
+    outLo = glm::vec2(l), outHi = glm::vec2(h);
 }
 
 // The largest singular value of the identity plus a column of length a, a bound of the twist's
@@ -787,8 +875,19 @@ constexpr KindInfo kKinds[] = {
      Role::Domain,
      polarKernel,
      [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
-         const float r = reach(lo + vec3(k[1], 0, 0), hi + vec3(k[1], 0, 0));
+         // The box of the copies' turned boxes; past 64 copies, close to the circle they reach.
+         const vec3 from = lo + vec3(k[1], 0, 0), to = hi + vec3(k[1], 0, 0);
+         const float r = reach(from, to);
          outLo = vec3(-r, lo.y, -r), outHi = vec3(r, hi.y, r);
+         if (k[0] > 64.0f) return;
+         glm::vec2 l(INFINITY), h(-INFINITY);
+         for (int i = 0; i < int(k[0]); ++i) {
+             glm::vec2 cl, ch;
+             const double a = double(i) * double(k[2]);
+             sweptRectangle({from.x, from.z}, {to.x, to.z}, a, a, cl, ch);
+             l = glm::min(l, cl), h = glm::max(h, ch);
+         }
+         outLo = vec3(l.x, lo.y, l.y), outHi = vec3(h.x, hi.y, h.y);
      }},
     {NodeKind::Mirror,
      "mirror",
@@ -807,8 +906,11 @@ constexpr KindInfo kKinds[] = {
          return {float(mask & 1), float(mask >> 1 & 1), float(mask >> 2 & 1), v[1]};
      },
      [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
+         // The child is taken at sqrt(p^2 + smooth^2) (|p| when sharp), which reaches its hi
+         // at |p| = sqrt(hi^2 - smooth^2).
          for (int a = 0; a < 3; ++a) {
-             const float e = std::max(hi[a], 0.0f);
+             const float h = std::max(hi[a], 0.0f);
+             const float e = k[3] > 0.0f ? std::sqrt(std::max(h * h - k[3] * k[3], 0.0f)) : h;
              outLo[a] = k[a] != 0.0f ? -e : lo[a];
              outHi[a] = k[a] != 0.0f ? e : hi[a];
          }
@@ -844,9 +946,12 @@ constexpr KindInfo kKinds[] = {
      nullptr,
      Role::Domain,
      [](const Params& v, vec3, vec3) -> Params { return {radians(v[0])}; },
-     [](const Params&, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
-         const float r = reach(lo, hi);
-         outLo = vec3(-r, lo.y, -r), outHi = vec3(r, hi.y, r);
+     [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
+         // The child's xz rectangle turned by the angle times every height it spans.
+         const double a0 = double(k[0]) * lo.y, a1 = double(k[0]) * hi.y;
+         glm::vec2 l, h;
+         sweptRectangle({lo.x, lo.z}, {hi.x, hi.z}, std::min(a0, a1), std::max(a0, a1), l, h);
+         outLo = vec3(l.x, lo.y, l.y), outHi = vec3(h.x, hi.y, h.y);
      },
      [](const Params& k, vec3 lo, vec3 hi) { return stretch(std::abs(k[0]) * reach(lo, hi)); }},
     {NodeKind::Bend,
@@ -867,9 +972,20 @@ constexpr KindInfo kKinds[] = {
      nullptr,
      Role::Domain,
      [](const Params& v, vec3, vec3) -> Params { return {radians(v[0])}; },
-     [](const Params&, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
+     [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
+         // A point at p is the child's turned by the angle times p.x, so within the circle of
+         // the child's reach; and if p.x lies in [x0, x1], within the child's xy rectangle turned
+         // by every angle between the angle times x0 and x1. Each round takes the last box's x
+         // range, and the solid stays within every box.
          const float r = reachXY(lo, hi);
-         outLo = vec3(-r, -r, lo.z), outHi = vec3(r, r, hi.z);
+         glm::vec2 l(-r), h(r);
+         for (int round = 0; round < 4; ++round) {
+             const double a0 = double(k[0]) * l.x, a1 = double(k[0]) * h.x;
+             glm::vec2 sl, sh;
+             sweptRectangle({lo.x, lo.y}, {hi.x, hi.y}, std::min(a0, a1), std::max(a0, a1), sl, sh);
+             l = glm::max(l, sl), h = glm::min(h, sh);
+         }
+         outLo = vec3(l, lo.z), outHi = vec3(h, hi.z);
      },
      [](const Params& k, vec3 lo, vec3 hi) { return stretch(std::abs(k[0]) * reachXY(lo, hi)); }},
     {NodeKind::Taper,
@@ -889,9 +1005,15 @@ constexpr KindInfo kKinds[] = {
          return {0.5f * v[0], v[1]};
      },
      [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
-         const float top = k[1];
-         outLo = vec3(std::min(lo.x, lo.x * top), lo.y, std::min(lo.z, lo.z * top));
-         outHi = vec3(std::max(hi.x, hi.x * top), hi.y, std::max(hi.z, hi.z * top));
+         // x and z times the scale, which is monotonic in y: its extremes over the child's
+         // heights are at their ends.
+         auto scale = [&](float y) {
+             return 1.0f + (k[1] - 1.0f) * std::clamp((y + k[0]) / (2.0f * k[0]), 0.0f, 1.0f);
+         };
+         const float s0 = std::min(scale(lo.y), scale(hi.y));
+         const float s1 = std::max(scale(lo.y), scale(hi.y));
+         outLo = vec3(std::min(lo.x * s0, lo.x * s1), lo.y, std::min(lo.z * s0, lo.z * s1));
+         outHi = vec3(std::max(hi.x * s0, hi.x * s1), hi.y, std::max(hi.z * s0, hi.z * s1));
      },
      [](const Params& k, vec3 lo, vec3 hi) {
          // q = (x / s, y, z / s): diag(1/s, 1, 1/s) plus the column of d/dy, of length
@@ -903,6 +1025,31 @@ constexpr KindInfo kKinds[] = {
          const float least = std::min({scale(lo.y), scale(hi.y), 1.0f, top});
          const float slope = std::abs(top - 1.0f) / (2.0f * hh);
          return std::max(1.0f / least, 1.0f) + reach(lo, hi) * slope / (least * least);
+     }},
+    {NodeKind::BendLinear,
+     "bend_linear",
+     true,
+     kBendLinear,
+     "Its child moved by part of the offset that grows, along the line from p0 to p1, from none "
+     "to all of it: an S-shaped jog in a bar, a kink in a pipe. A point whose projection on "
+     "that line lies the fraction t of the way from p0 to p1 (clamped to 0..1) sees the child "
+     "at itself less offset times ease(t). The field is divided by the map's Lipschitz bound, "
+     "1 + |offset| ease' / |p1 - p0| (ease' the ease's steepest slope).",
+     R"("p0": [-0.5, 0, 0], "p1": [0.5, 0, 0], "offset": [0, 0.4, 0], "ease": "smoothstep")",
+     {},
+     {},
+     nullptr,
+     nullptr,
+     Role::Domain,
+     [](const Params& v, vec3, vec3) -> Params {
+         const vec3 p0(v[0], v[1], v[2]), axis = vec3(v[3], v[4], v[5]) - p0;
+         const vec3 u = axis / glm::dot(axis, axis);
+         return {u.x, u.y, u.z, glm::dot(p0, u), v[6], v[7], v[8], v[9]};
+     },
+     [](const Params& k, vec3 lo, vec3 hi, vec3& outLo, vec3& outHi) {
+         // The child's points move by the offset times ease(t), which lies in 0..1.
+         const vec3 offset(k[4], k[5], k[6]);
+         outLo = glm::min(lo, lo + offset), outHi = glm::max(hi, hi + offset);
      }},
     {NodeKind::Extrude,
      "extrude",

@@ -413,8 +413,17 @@ Result<std::shared_ptr<const std::vector<glm::vec4>>> buildOutline(const Node& n
                     message.replace(at, font->file.size(), name);
             return Error::message(ErrorKind::Validation, {}, message);
         }
+        // "width" or "height" (slots 1 and 2, 0 when absent) scales the text to that ink
+        // extent; its outlines are linear in the size.
+        const glm::vec2 ink = text->max - text->min;
+        const float fit = node.params[1] > 0.0f && ink.x > 0.0f   ? node.params[1] / ink.x
+                          : node.params[2] > 0.0f && ink.y > 0.0f ? node.params[2] / ink.y
+                                                                  : 1.0f;
         segments = std::move(text->segments);
-        shift = -0.5f * (text->min + text->max);
+        if (fit != 1.0f)
+            for (GlyphSegment& s : segments)
+                s.a *= fit, s.b *= fit, s.c *= fit;
+        shift = -0.5f * fit * (text->min + text->max);
     }
     return std::make_shared<const std::vector<glm::vec4>>(packOutline(segments, shift));
 }

@@ -847,6 +847,19 @@ Next SceneReader::readNode(element value, std::string path, uint32_t depth, Scen
             problems_.add(member(p, "points"), why);
         paramsOk = paramsOk && polygonProblem(node.points).empty();
     }
+    if (kind->kind == NodeKind::Text) {
+        // Each of the three sets the text's size: one at most.
+        std::vector<std::string> given;
+        for (std::string_view key : {"size", "width", "height"})
+            if (valueOf(key)) given.push_back(std::string(key));
+        if (given.size() > 1) {
+            problems_.add(member(p, given[1]),
+                          "expected one of \"size\", \"width\" and \"height\" (each sets the "
+                          "text's size), got both " +
+                              quote(given[0]) + " and " + quote(given[1]));
+            paramsOk = false;
+        }
+    }
     // Past the limit, the outline that passed it has said so: no more are built.
     if (hasOutline(kind->kind) && paramsOk && outlineWords_ <= kMaxOutlineWords) {
         auto outline = buildOutline(node, files_);
@@ -875,6 +888,13 @@ Next SceneReader::readNode(element value, std::string path, uint32_t depth, Scen
                                   formatFloat(node.params[3 + a]));
                 break;
             }
+    }
+    if (kind->kind == NodeKind::BendLinear && paramsOk) {
+        const glm::vec3 p0(node.params[0], node.params[1], node.params[2]);
+        const glm::vec3 axis = glm::vec3(node.params[3], node.params[4], node.params[5]) - p0;
+        if (!(glm::dot(axis, axis) > 0.0f))
+            problems_.add(member(p, "p1"),
+                          "expected a point apart from p0, got " + describe(*valueOf("p1")));
     }
     if (kind->kind == NodeKind::RoundBox && paramsOk) {
         const float* size = node.params.data();
