@@ -498,6 +498,40 @@ SDF_FN float valueOp(uint kind, float d, vec4 a) {
     return kind == kKindShell ? abs(d) - a.x : d - a.x;
 }
 
+// Over a child whose field is not a distance (FlatNode::loss), an offset or shell measures from
+// the child's value divided by its gradient's length, which is a distance to first order near
+// the surface (a.y: the tap step h, a.z: the least length the gradient is given, 1/loss, so that
+// the value grows by at most the loss; eval.cpp, normalisedStep). The child runs at four taps
+// around p, the corners of a tetrahedron (p + h k_c, k_c = (1,-1,-1), (-1,-1,1), (-1,1,-1),
+// (1,1,1)); since the k_c sum to zero and k_c k_c^T to 4 I, sum(k_c f_c) / 4h is the gradient
+// and sum(f_c) / 4 the value at p, both to second order.
+SDF_FN vec3 valueTap(vec3 p, float h, uint c) {
+    return p + h * vec3(c == 0u || c == 3u ? 1.0f : -1.0f, c >= 2u ? 1.0f : -1.0f,
+                        c == 1u || c == 3u ? 1.0f : -1.0f);
+}
+// The running sum of the taps: xyz sum(k_c f_c), w sum(f_c).
+SDF_FN vec4 valueTapSum(vec4 sum, float d, uint c) {
+    return sum + d * vec4(c == 0u || c == 3u ? 1.0f : -1.0f, c >= 2u ? 1.0f : -1.0f,
+                          c == 1u || c == 3u ? 1.0f : -1.0f, 1.0f);
+}
+// The child's value at p over its gradient's length, from the taps' sum; with a.y 0 (a child
+// whose field is a distance, at one tap where the code does not know which), the value.
+SDF_FN float valueNormalised(vec4 sum, vec4 a) {
+    if (a.y <= 0.0f) return sum.w;
+    float gradient = length(vec3(sum.x, sum.y, sum.z)) / (4.0f * a.y);
+    return 0.25f * sum.w / clamp(gradient, a.z, 1.0f);
+}
+// The offset's or shell's value from the taps: valueOp of the normalised value, kept within
+// |a.x| (1 - a.z) of valueOp of the plain one, which is as far as the division moves the value
+// where the surface lies (there the child's value is a.x times the gradient's length, at least
+// a.z): the surface is the same, and the value never exceeds the plain one, a bound, by more.
+SDF_FN float valueOpNormalised(uint kind, vec4 sum, vec4 a) {
+    if (a.y <= 0.0f) return valueOp(kind, sum.w, a);
+    float plain = valueOp(kind, 0.25f * sum.w, a);
+    float reach = abs(a.x) * (1.0f - a.z) + 2.0f * a.y;
+    return plain + clamp(valueOp(kind, valueNormalised(sum, a), a) - plain, -reach, reach);
+}
+
 // Domain operations evaluate their child at one or more points of the child's space (the
 // candidates) and combine the values: the least of them, for the copies of a repetition. A point
 // p here is in the node's local space. Repeat: a: spacing, G; b: count, M packed a byte per

@@ -25,8 +25,9 @@ TAPE_VALUE TAPE_RUN(uint begin, uint end, vec3 p) {
 #endif
     TAPE_VALUE acc = TAPE_VALUE(0.0f);
 #if SDFCSG_TAPE_DOMAINS > 0
-    // Open domain operations: the point outside, the local point, the least candidate value,
-    // the candidate, their count, the child's first instruction and the operation's kind.
+    // Open domain operations (and normalising offsets and shells): the point outside, the local
+    // point, the least candidate value, the candidate, their count, the child's first
+    // instruction and the operation's kind.
     TAPE_ARRAY(vec3, outer, SDFCSG_TAPE_DOMAINS);
     TAPE_ARRAY(vec3, local, SDFCSG_TAPE_DOMAINS);
     TAPE_ARRAY(TAPE_VALUE, best, SDFCSG_TAPE_DOMAINS);
@@ -34,6 +35,8 @@ TAPE_VALUE TAPE_RUN(uint begin, uint end, vec3 p) {
     TAPE_ARRAY(uint, count, SDFCSG_TAPE_DOMAINS);
     TAPE_ARRAY(uint, body, SDFCSG_TAPE_DOMAINS);
     TAPE_ARRAY(uint, domainKind, SDFCSG_TAPE_DOMAINS);
+    TAPE_ARRAY(vec4, taps, SDFCSG_TAPE_DOMAINS); // offsets' and shells' tap sums
+
     int depth = -1;
 #endif
     for (uint at = begin; at < end; ++at) {
@@ -68,7 +71,23 @@ TAPE_VALUE TAPE_RUN(uint begin, uint end, vec3 p) {
 #endif
 #if (SDFCSG_TAPE_OPERATIONS & SDFCSG_VALUE_OPERATION_BITS) != 0
         else if (kind < kKindFirstDomainOperation) {
-            acc = TAPE_WITH(acc, valueOp(kind, TAPE_DIST(acc), TAPE_A(i)));
+#if SDFCSG_TAPE_DOMAINS > 0
+            if (((ins >> SDFCSG_TAPE_FOLD_SHIFT) & 3u) == 3u) {
+                // An offset or shell over a field that is not a distance (sdf.glsl,
+                // valueNormalised): its child runs next at the four taps, as a domain
+                // operation's at its candidates, up to the end that names it.
+                ++depth;
+                outer[depth] = p;
+                best[depth] = acc;
+                taps[depth] = vec4(0.0f);
+                candidate[depth] = 0u;
+                count[depth] = 4u;
+                body[depth] = at + 1u;
+                domainKind[depth] = kind;
+                p = valueTap(p, TAPE_A(i).y, 0u);
+            } else
+#endif
+                acc = TAPE_WITH(acc, valueOp(kind, TAPE_DIST(acc), TAPE_A(i)));
         }
 #endif
 #if SDFCSG_TAPE_DOMAINS > 0
@@ -84,6 +103,24 @@ TAPE_VALUE TAPE_RUN(uint begin, uint end, vec3 p) {
             body[depth] = at + 1u;
             domainKind[depth] = kind;
             p = TAPE_XYZ(domainPoint(kind, local[depth], TAPE_A(i), TAPE_B(i), 0u));
+        } else if (domainKind[depth] < kKindFirstDomainOperation) {
+            // An offset's or shell's tap: summed; the child again at the next tap, or its value.
+            uint c = candidate[depth];
+            taps[depth] = valueTapSum(taps[depth], TAPE_DIST(acc), c);
+            if (c == 0u) best[depth] = acc; // the colour
+            acc = stack[top--];
+            if (++candidate[depth] < count[depth]) {
+                p = valueTap(outer[depth], TAPE_A(i).y, candidate[depth]);
+                at = body[depth] - 1u;
+            } else {
+                uint k = domainKind[depth];
+                float v = valueOpNormalised(k, taps[depth], TAPE_A(i));
+                v = max(v, nodeBoundsDistance(i, outer[depth])); // eval.cpp's floor
+                stack[++top] = acc;
+                acc = TAPE_WITH(best[depth], v);
+                p = outer[depth];
+                --depth;
+            }
         } else {
             // The child's value: the least so far; the child again at the next candidate whose
             // bounds could lower it, or the operation's value.

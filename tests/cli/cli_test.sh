@@ -52,7 +52,7 @@ case_validate() {
     printf '{"version": 1, "root": {"type": "offset", "distance": 0.3, "children": [%s]}}' \
         '{"type": "twist", "angle": 90, "children": [{"type": "box", "size": [1, 2, 1]}]}' >twisted.json
     check "validate notes" 0 "$bin" validate twisted.json
-    expect_text "validate note" out.txt "twisted.json: root: note: offset over a field that is not a distance (twist at root.children[0] divides its field by up to 2.06): the surface lies 0.3 to 0.617 from the child's instead of 0.3"
+    expect_text "validate note" out.txt "twisted.json: root: note: offset over a field that is not a distance (twist at root.children[0] divides its field by up to 2.65): the surface lies about 0.3 from the child's (divided by the field's gradient, to first order; 0.3 to 0.794 without)"
 
     printf '{"version": 1, "root": {"type": "sphere", "radius": -1}}' >bad.json
     check "validate bad" 1 "$bin" validate bad.json

@@ -463,12 +463,12 @@ TEST(Eval, FieldNotesNameWhatDependsOnDistancesThatAreNot) {
     EXPECT_EQ(notes[0].path, "root.children[0]");
     EXPECT_EQ(notes[0].message,
               "offset over a field that is not a distance (twist at root.children[0].children[0] "
-              "divides its field by up to 2.06): the surface lies 0.3 to 0.617 from the child's "
-              "instead of 0.3");
+              "divides its field by up to 2.65): the surface lies about 0.3 from the child's "
+              "(divided by the field's gradient, to first order; 0.3 to 0.794 without)");
     EXPECT_EQ(notes[1].message,
               "shell over a field that is not a distance (sphere at root.children[1].children[0], "
-              "scaled unevenly: its field below the distance by up to 2): the skin is 0.1 to 0.2 "
-              "thick instead of 0.1");
+              "scaled unevenly: its field below the distance by up to 2): the skin is about 0.1 "
+              "thick (divided by the field's gradient, to first order; 0.1 to 0.2 without)");
     EXPECT_EQ(notes[2].message,
               "smooth union over a field that is not a distance (ellipsoid at "
               "root.children[2].children[0]: a bound, below the distance by up to 1.67): the "
@@ -476,8 +476,9 @@ TEST(Eval, FieldNotesNameWhatDependsOnDistancesThatAreNot) {
     EXPECT_EQ(notes[3].path, "root.children[3]");
     EXPECT_EQ(notes[3].message,
               "offset over a field that is not a distance (smooth blend at "
-              "root.children[3].children[0]: no distance within 0.1 of its seam): the offset "
-              "there is not 0.05");
+              "root.children[3].children[0]: no distance within 0.1 of its seam): the surface "
+              "lies about 0.05 from the child's (divided by the field's gradient, to first "
+              "order; not 0.05 within the blend)");
     for (const Scene& bundled : bundledScenes())
         EXPECT_TRUE(fieldNotes(bundled, Evaluator(bundled)).empty()) << bundled.file;
 }

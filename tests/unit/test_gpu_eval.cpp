@@ -200,6 +200,25 @@ TEST_F(GpuEval, ScalesPerAxisAndRepetitionsMatchTheCpu) {
     expectGpuMatchesCpu(context(), scene, 4096);
 }
 
+// Offsets and shells over twist, bend, taper and a smooth union divide by their child's gradient
+// from four taps (sdf.glsl, valueNormalised): the child's code in a loop in the inlined kernels,
+// and opened as a domain operation on tapes.
+TEST_F(GpuEval, NormalisingOffsetsMatchTheCpu) {
+    Scene scene = parseOrDie(R"({"version": 1, "root": {"type": "union", "children": [
+        {"type": "offset", "distance": 0.3, "children": [
+            {"type": "twist", "angle": 90, "children": [
+                {"type": "box", "size": [1, 2, 1], "color": [0.9, 0.3, 0.1]}]}]},
+        {"type": "shell", "thickness": 0.1, "translate": [2, 0, 0], "children": [
+            {"type": "bend", "angle": 40, "children": [{"type": "box", "size": [1.5, 0.4, 0.6]}]}]},
+        {"type": "offset", "distance": -0.05, "translate": [-2, 0, 0], "children": [
+            {"type": "taper", "height": 1.5, "top_scale": 0.4, "children": [
+                {"type": "union", "smooth": 0.2, "children": [
+                    {"type": "box", "size": [1, 1.5, 1], "color": [0.1, 0.4, 0.9]},
+                    {"type": "sphere", "radius": 0.5, "translate": [0.5, 0, 0]}]}]}]}]}})");
+    ASSERT_FALSE(scene.nodes.empty());
+    expectGpuMatchesCpu(context(), scene, 4096);
+}
+
 class BundledEval : public GpuTest, public ::testing::WithParamInterface<fs::path> {};
 
 TEST_P(BundledEval, MatchesTheCpu) {

@@ -53,6 +53,13 @@ struct FlatNode {
     // the formula alone would fall below (a scale that differs per axis). Domain operations'
     // values always are.
     bool boundsFloor = false;
+    // How far the node's value may fall below the distance: it lies between distance / loss and
+    // the distance (1: a distance, as far as the field knows). Twist, bend and taper divide by
+    // their Lipschitz bound, a scale that differs per axis multiplies by its smallest factor, an
+    // ellipsoid is a bound, a smooth blend counts as 2; a node's is the worst of its own and its
+    // children's. An offset or shell over a child with loss above 1 measures from the child's
+    // value over its gradient's length (sdf.glsl, valueNormalised) and is a distance again.
+    float loss = 1.0f;
     std::vector<uint32_t> children;
     // Polygon and text: Node::outline; the parameters then hold the glyph count (slot 1) and
     // the outline's extents (slots 2-5).

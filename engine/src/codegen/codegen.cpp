@@ -121,6 +121,7 @@ class Emitter {
                 if (!operands.empty()) {
                     stack.push_back({current, 1, depth});
                     if (kindInfo(n.kind).role == Role::Domain) depth += openDomain(current, depth);
+                    if (taps(current)) depth += openTaps(current, depth);
                     current = operands[0];
                     ++depth;
                     continue;
@@ -146,6 +147,8 @@ class Emitter {
                 const Role role = kindInfo(op.kind).role;
                 if (role == Role::Domain) {
                     closeDomain(f.node, child, f.depth);
+                } else if (taps(f.node)) {
+                    closeTaps(f.node, child, f.depth);
                 } else if (role == Role::Value) {
                     indent(f.depth);
                     declare(f.node);
@@ -367,6 +370,77 @@ class Emitter {
         out_ += "}\n";
     }
 
+    // Whether offset or shell i runs its child at four taps (sdf.glsl, valueNormalised): with
+    // values inlined, where its child's field is not a distance (FlatNode::loss); read from the
+    // node buffer, always, at one tap where it is one (a value edit may change which).
+    bool taps(uint32_t i) const {
+        if (kindInfo(scene_.nodes[i].kind).role != Role::Value) return false;
+        return !lit_ || (*lit_)[i].p0.y > 0.0f;
+    }
+
+    // Offset or shell i over its child at the taps: the child's code in a loop, at p<level>.
+    // Returns the child's code's extra indentation.
+    uint32_t openTaps(uint32_t i, uint32_t depth) {
+        const std::string level = std::to_string(points_.size());
+        const std::string c = "c" + level;
+        indent(depth);
+        out_ += sample_ ? "vec4 " : "float ";
+        var(i);
+        comment(i);
+        indent(depth);
+        out_ += "{\n";
+        indent(depth + 1);
+        out_ += "vec4 t" + level + " = vec4(0.0);\n";
+        if (sample_) {
+            indent(depth + 1);
+            out_ += "vec4 f" + level + " = vec4(0.0);\n";
+        }
+        std::string step = "nodes[" + indexExpr(i) + "].p0.y", count = "4u";
+        if (lit_) {
+            step.clear();
+            appendFloat(step, (*lit_)[i].p0.y);
+        } else {
+            count = "(" + step + " > 0.0 ? 4u : 1u)";
+        }
+        indent(depth + 1);
+        out_ += "for (uint " + c + " = 0u; " + c + " < " + count + "; ++" + c + ") {\n";
+        indent(depth + 2);
+        out_ += "vec3 p" + level + " = valueTap(" + point() + ", " + step + ", " + c + ");\n";
+        points_.push_back("p" + level);
+        return 1;
+    }
+
+    void closeTaps(uint32_t i, uint32_t child, uint32_t depth) {
+        points_.pop_back();
+        const std::string level = std::to_string(points_.size());
+        const std::string t = "t" + level, c = "c" + level;
+        indent(depth + 2);
+        out_ += t + " = valueTapSum(" + t + ", " + distance(child) + ", " + c + ");\n";
+        if (sample_) {
+            indent(depth + 2);
+            out_ += "if (" + c + " == 0u) f" + level + " = ";
+            var(child);
+            out_ += ";\n";
+        }
+        indent(depth + 1);
+        out_ += "}\n";
+        const std::string a = param(i, 0);
+        std::string value = "valueOpNormalised(" + kindConst(i) + ", " + t + ", " + a + ")";
+        // eval.cpp's floor, where the node normalises.
+        if (lit_)
+            value = "max(" + value + ", " + boundsDistanceOf(i, point()) + ")";
+        else
+            value = "(" + a + ".y > 0.0 ? max(" + value + ", " + boundsDistanceOf(i, point()) +
+                    ") : " + value + ")";
+        indent(depth + 1);
+        var(i);
+        out_ += " = ";
+        out_ += sample_ ? "vec4(f" + level + ".rgb, " + value + ")" : value;
+        out_ += ";\n";
+        indent(depth);
+        out_ += "}\n";
+    }
+
     void var(uint32_t i) {
         out_ += sample_ ? 's' : 'd';
         out_ += std::to_string(i);
@@ -574,7 +648,10 @@ uint32_t domainNesting(const Scene& scene) {
     uint32_t most = 0;
     for (size_t i = 0; i < scene.nodes.size(); ++i) { // parents come first
         const Node& n = scene.nodes[i];
-        const uint32_t own = depth[i] + (kindInfo(n.kind).role == Role::Domain ? 1 : 0);
+        // Offsets and shells may normalise their child's field (eval.cpp), which the tape
+        // machine runs as it runs a domain operation's child.
+        const Role role = kindInfo(n.kind).role;
+        const uint32_t own = depth[i] + (role == Role::Domain || role == Role::Value ? 1 : 0);
         most = std::max(most, own);
         for (uint32_t c : n.children)
             depth[c] = own;

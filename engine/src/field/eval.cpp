@@ -102,6 +102,20 @@ float smoothGrowth(const FlatNode& n) {
     return n.smooth * std::min(1.0f, dip * folds) * (1.0f + 1e-5f);
 }
 
+// A loss (FlatNode::loss) above this is not a distance; and what a smooth blend counts as: the
+// field of a polynomial smooth minimum of two distances whose gradients meet at up to 120
+// degrees has a gradient of length at least 1/2.
+constexpr float kExactLoss = 1.001f;
+constexpr float kBlendLoss = 2.0f;
+
+// The tap step of an offset or shell over a field that is not a distance (sdf.glsl,
+// valueNormalised): a thousandth of its child's box, far below the detail the offset moves by,
+// and far enough above single precision's rounding of the child's values (about 1e-7 of the
+// box) to leave the gradient good to about 1e-4.
+float normalisedStep(const Aabb& child) {
+    return child.finite() ? 1e-3f * std::max(glm::length(child.max - child.min), 1e-6f) : 1e-3f;
+}
+
 // Whether a linear map takes each axis onto an axis (turns by right angles, mirrors, scales).
 bool axisAligned(const glm::dmat3& m) {
     for (int c = 0; c < 3; ++c) {
@@ -300,6 +314,12 @@ Role roleOf(NodeKind kind) {
     return kindInfo(kind).role;
 }
 
+// Whether an offset or shell measures from its child's value over its gradient's length
+// (FlatNode::loss).
+bool normalises(const FlatNode& n) {
+    return roleOf(n.kind) == Role::Value && n.params[1] > 0.0f;
+}
+
 glm::vec4 kernelA(const FlatNode& n) {
     return {n.params[0], n.params[1], n.params[2], n.params[3]};
 }
@@ -341,7 +361,8 @@ V evaluate(const std::vector<FlatNode>& nodes, uint32_t root, glm::vec3 p, bool 
         uint32_t node, next;
         V acc;
         glm::vec3 outer{0.0f}, local{0.0f}; // domain operations: the point outside, and local
-        uint32_t candidate = 0, count = 0;
+        uint32_t candidate = 0, count = 0;  // domain operations and normalising value ones
+        glm::vec4 taps{0.0f};               // normalising value operations: valueTapSum's
     };
     thread_local std::vector<Frame> stack;
     stack.clear();
@@ -358,6 +379,10 @@ V evaluate(const std::vector<FlatNode>& nodes, uint32_t root, glm::vec3 p, bool 
                 f.count = sdf::domainCount(kind, kernelA(n), kernelB(n));
                 f.acc = withDistance(V{}, INFINITY);
                 p = glm::vec3(sdf::domainPoint(kind, f.local, kernelA(n), kernelB(n), 0));
+            } else if (normalises(n)) {
+                f.outer = p;
+                f.count = 4;
+                p = sdf::valueTap(p, n.params[1], 0);
             }
             stack.push_back(f);
             current = n.children[0];
@@ -371,8 +396,24 @@ V evaluate(const std::vector<FlatNode>& nodes, uint32_t root, glm::vec3 p, bool 
             const FlatNode& op = nodes[f.node];
             const Role role = roleOf(op.kind);
             if (role == Role::Value) {
-                value =
-                    withDistance(value, sdf::valueOp(uint32_t(op.kind), dist(value), kernelA(op)));
+                float d = dist(value);
+                if (normalises(op)) {
+                    f.taps = sdf::valueTapSum(f.taps, d, f.candidate);
+                    if (f.candidate == 0) f.acc = value; // the colour
+                    if (++f.candidate < f.count) {
+                        p = sdf::valueTap(f.outer, op.params[1], f.candidate);
+                        current = op.children[0];
+                        break;
+                    }
+                    d = sdf::valueOpNormalised(uint32_t(op.kind), f.taps, kernelA(op));
+                    d = std::max(d, op.bounds.signedDistance(f.outer));
+                    value = withDistance(f.acc, d);
+                    p = f.outer;
+                    stack.pop_back();
+                    continue;
+                }
+                d = sdf::valueOp(uint32_t(op.kind), d, kernelA(op));
+                value = withDistance(value, d);
                 stack.pop_back();
                 continue;
             }
@@ -469,11 +510,13 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
         glm::dvec3 offset{0.0},
             origin{0.0}; // local = toLocal*p + offset; world = toWorld*l + origin
         double scale = 1.0;
-        bool uneven = false; // some scale on the way differs per axis
+        bool uneven = false;  // some scale on the way differs per axis
+        double stretch = 1.0; // the product of largest over smallest factor on the way
     };
     const Acc identity;
     std::vector<Acc> acc(count);
     std::vector<uint32_t> parent(count, UINT32_MAX);
+    std::vector<float> reach(count, 0.0f);
     for (size_t i = 0; i < count; ++i) {
         const Node& src = scene.nodes[i];
         for (uint32_t c : src.children)
@@ -502,6 +545,7 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
         a.origin = up.toWorld * t + up.origin;
         a.scale = up.scale * std::min({s.x, s.y, s.z});
         a.uneven = up.uneven || s.x != s.y || s.y != s.z;
+        a.stretch = up.stretch * std::max({s.x, s.y, s.z}) / std::min({s.x, s.y, s.z});
 
         FlatNode& n = nodes_[i];
         n.kind = src.kind;
@@ -523,6 +567,15 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
         n.smooth = boolean ? float(double(src.params[0]) * a.scale) : 0.0f;
         n.blend = boolean ? uint32_t(src.params[1]) : 0u;
         n.children = src.children;
+        // How far out an offset or shell above reads its child (see pass 2), in this frame.
+        if (hasParent) {
+            const Node& above = scene.nodes[parent[i]];
+            const float units = float(acc[parent[i]].scale);
+            float read = reach[parent[i]];
+            if (above.kind == NodeKind::Offset) read += std::max(above.params[0], 0.0f) * units;
+            if (above.kind == NodeKind::Shell) read += 0.5f * above.params[0] * units;
+            reach[i] = opensFrame ? read / units : read;
+        }
     }
 
     // Pass 2, children first: bounds, and the kernel parameters of the operations that take
@@ -537,6 +590,28 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
         }
         return outwardBox(wlo, whi);
     };
+    // How far node i's value may fall below the distance (FlatNode::loss), once its children's
+    // and its own parameters are known.
+    auto lossOf = [&](size_t i) {
+        const FlatNode& n = nodes_[i];
+        const Node& src = scene.nodes[i];
+        if (roleOf(n.kind) == Role::Value) return 1.0f;
+        float loss = float(acc[i].stretch);
+        for (uint32_t c : n.children)
+            loss = std::max(loss, nodes_[c].loss);
+        if (n.kind == NodeKind::Ellipsoid) {
+            const float lo = std::min({src.params[0], src.params[1], src.params[2]});
+            const float hi = std::max({src.params[0], src.params[1], src.params[2]});
+            loss = std::max(loss, hi / lo);
+        }
+        if (roleOf(n.kind) == Role::Domain) {
+            // The child's frame starts afresh: the node's own stretch is not in its leaves'.
+            loss *= float(acc[i].stretch);
+            if (kindInfo(n.kind).lipschitz && n.params[7] > 0.0f) loss /= n.params[7];
+        }
+        if (n.smooth > 0.0f) loss = std::max(loss, kBlendLoss);
+        return loss;
+    };
     for (size_t i = count; i-- > 0;) {
         FlatNode& n = nodes_[i];
         const KindInfo& info = kindInfo(n.kind);
@@ -550,6 +625,10 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
             values[0] = float(double(values[0]) * acc[i].scale);
             const Aabb& child = nodes_[n.children[0]].bounds;
             n.params = info.kernelAround(values, child.min, child.max);
+            if (nodes_[n.children[0]].loss > kExactLoss) {
+                n.params[1] = normalisedStep(child);
+                n.params[2] = 1.0f / nodes_[n.children[0]].loss;
+            }
             n.bounds = child;
             if (child.finite())
                 info.boundsAround(n.params, child.min, child.max, n.bounds.min, n.bounds.max);
@@ -558,6 +637,7 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
             if (!child.finite()) { // refused by the parser, but for mirror and elongate
                 n.params = info.kernelAround(scene.nodes[i].params, glm::vec3(0), glm::vec3(0));
                 n.bounds = infiniteBox();
+                n.loss = lossOf(i);
                 continue;
             }
             n.params = info.kernelAround(scene.nodes[i].params, child.min, child.max);
@@ -565,6 +645,15 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
             info.boundsAround(n.params, child.min, child.max, lo, hi);
             n.bounds = toFrame(i, lo, hi);
             if (info.lipschitz) {
+                // Twist, bend and taper evaluate their child at points clamped to their bounds,
+                // below which their value is the bounds' distance: a bound, far below the
+                // distance at the box's corners. Under an offset or shell the box reaches as far
+                // as the offset reads (and the taps a little more), so the field is the child's
+                // wherever the offset's surface may lie.
+                if (reach[i] > 0.0f) {
+                    const float grow = 1.01f * reach[i] + 4.0f * normalisedStep(n.bounds);
+                    n.bounds.min -= grow, n.bounds.max += grow;
+                }
                 // Over the node's bounds (which the child's points are clamped to) in local space.
                 glm::vec3 llo(INFINITY), lhi(-INFINITY);
                 for (int c = 0; c < 8; ++c) {
@@ -607,6 +696,7 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
         } else {
             n.bounds = nodes_[n.children[0]].bounds;
         }
+        n.loss = lossOf(i);
     }
 
     // Pass 3, children first: the box the solid lies in, as tight as the operations allow
@@ -730,6 +820,19 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
             // An offset's or a shell's value is its child's less a distance; an offset inwards
             // lies within its child.
             const float by = n.params[0];
+            const Aabb& child = solid[first];
+            if (normalises(n) && child.finite() && !child.empty()) {
+                // A normalising offset or shell floors its value at its bounds' distance, as
+                // domain operations do, with bounds from the box its child's solid lies in, not
+                // from the child's bounds, which the stretching operations below it have grown
+                // (pass 2): beyond those, its child's value is the distance to a box, a bound
+                // with a gradient of length 1, which the division would take for a distance.
+                // Its surface lies near its distance from its child's
+                // (tests/unit/test_offsets.cpp), within these bounds.
+                const float amount = n.kind == NodeKind::Offset ? std::max(by, 0.0f) : by;
+                const float grow = 1.05f * amount + 4.0f * n.params[1];
+                nodes_[i].bounds = overlap(n.bounds, Aabb{child.min - grow, child.max + grow});
+            }
             if (n.kind == NodeKind::Offset && by <= 0.0f) {
                 r = reach[first];
                 solid[i] = solid[first];

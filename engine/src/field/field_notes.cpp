@@ -1,8 +1,9 @@
 // Where a scene's field stops being a distance, and which operations depend on it being one
 // (sdfcsg/eval.h, fieldNotes). Offsets, shells and smooth blends act on the field's values: over
-// a field whose values lie below the distance by up to a factor L, an offset r lands between r
-// and L r from the child's surface, a shell of thickness t is t to L t thick, and a blend of
-// radius k reaches up to L k.
+// a field whose values lie below the distance by up to a factor L, an offset r would land between
+// r and L r from the child's surface and a shell of thickness t be t to L t thick, but for their
+// division by the field's gradient (FlatNode::loss), which brings them near r and t to first
+// order; a blend of radius k reaches up to L k.
 #include "sdfcsg/eval.h"
 #include "sdfcsg/nodes.h"
 
@@ -80,16 +81,19 @@ std::string noteOf(const Node& n, const Loss& loss) {
         (smoothOf(n) > 0.0f ? "smooth " : "") + std::string(kindInfo(n.kind).name);
     const float factor = loss.factor;
     std::string effect;
+    // Offsets and shells divide by the field's gradient (FlatNode::loss): a first-order
+    // distance, which strays where the stretch changes within their reach.
+    const std::string divides = "divided by the field's gradient, to first order; ";
     if (n.kind == NodeKind::Offset) {
         const float r = std::abs(n.params[0]);
-        effect = factor > 0.0f ? "the surface lies " + number(r) + " to " + number(r * factor) +
-                                     " from the child's instead of " + number(r)
-                               : "the offset there is not " + number(r);
+        effect = "the surface lies about " + number(r) + " from the child's (" + divides +
+                 (factor > 0.0f ? number(r) + " to " + number(r * factor) + " without)"
+                                : "not " + number(r) + " within the blend)");
     } else if (n.kind == NodeKind::Shell) {
         const float t = n.params[0];
-        effect = factor > 0.0f ? "the skin is " + number(t) + " to " + number(t * factor) +
-                                     " thick instead of " + number(t)
-                               : "the skin there is not " + number(t) + " thick";
+        effect = "the skin is about " + number(t) + " thick (" + divides +
+                 (factor > 0.0f ? number(t) + " to " + number(t * factor) + " without)"
+                                : "not " + number(t) + " within the blend)");
     } else {
         const float k = smoothOf(n);
         effect = factor > 0.0f

@@ -28,13 +28,25 @@ uint32_t instruction(uint32_t node, NodeKind kind) {
 }
 
 NodeKind opcode(uint32_t instruction) {
-    return NodeKind(instruction >> kTapeKindShift);
+    return NodeKind((instruction >> kTapeKindShift) & 0x3fu);
+}
+
+// An offset or shell that normalises its child's field (eval.cpp) opens like a domain operation:
+// its instruction before its child's, marked by both fold bits, and an end after.
+constexpr uint32_t kTapeOpens = 3u << kTapeFoldShift;
+bool opens(uint32_t ins) {
+    return (ins & kTapeOpens) == kTapeOpens && (ins >> kTapeKindShift) != kTapeDomainEnd;
 }
 
 template <class V> V opValue(const FlatNode& op, V a, V b) {
     return op.kind == NodeKind::Union          ? sdf::opUnion(a, b, op.smooth, op.blend)
            : op.kind == NodeKind::Intersection ? sdf::opIntersection(a, b, op.smooth, op.blend)
                                                : sdf::opDifference(a, b, op.smooth, op.blend);
+}
+
+// Whether an offset or shell normalises its child's field (eval.cpp, FlatNode::loss).
+bool normalises(const FlatNode& n) {
+    return kindInfo(n.kind).role == Role::Value && n.params[1] > 0.0f;
 }
 
 // Looked up for every instruction of every cell's pass: a table of their own.
@@ -96,6 +108,7 @@ template <class V> class Machine {
             local_.resize(domains);
             best_.resize(domains);
             candidate_.resize(domains);
+            taps_.resize(domains);
             count_.resize(domains);
             body_.resize(domains);
             domainKind_.resize(domains);
@@ -110,6 +123,7 @@ template <class V> class Machine {
     const uint32_t* field = nullptr;
     std::vector<V> stack_, best_;
     std::vector<vec3> outer_, local_;
+    std::vector<vec4> taps_;
     std::vector<uint> candidate_, count_, body_, domainKind_;
 
     float tapePrimitive(uint, uint i, vec3 p) const { return primitiveValue(nodes_[i], p); }
@@ -194,7 +208,8 @@ V run(const std::vector<FlatNode>& nodes, const uint32_t* tape, uint32_t length,
 //  - a subtrahend b of a difference where a + b >= k over the cell (max(a, -b) is a), and the
 //    running union a or operand b where they lie k apart (opUnion returns the other).
 // A domain operation's instructions (its own, its child's and the end) stay whole: the pruner
-// takes its value at c like a primitive's and keeps or drops it as one.
+// takes its value at c like a primitive's and keeps or drops it as one; so do those of an offset
+// or shell that normalises its child's field (opens()).
 struct Pruner {
     // The cells pruned together: the children of one parent, which share its tape. The first
     // pass reads each node once for all of them.
@@ -241,7 +256,7 @@ struct Pruner {
                 ends.push_back(i);
                 continue;
             }
-            if (role == Role::Domain) {
+            if (role == Role::Domain || opens(in[i])) {
                 const uint32_t end = i + spans[node] - 1;
                 for (uint32_t l = 0; l < lanes; ++l)
                     value[size_t(end) * kLanes + l] =
@@ -298,8 +313,8 @@ struct Pruner {
             const uint32_t ins = in[i];
             const NodeKind kind = opcode(ins);
             const Role role = roleOf(kind);
-            if (role == Role::Primitive || role == Role::Domain) {
-                const uint32_t span = role == Role::Domain ? spans[ins & kTapeNodeMask] : 1;
+            if (role == Role::Primitive || role == Role::Domain || opens(ins)) {
+                const uint32_t span = role == Role::Primitive ? 1 : spans[ins & kTapeNodeMask];
                 stack.push_back({uint32_t(out.size()), i + span - 1, false});
                 out.insert(out.end(), in + i, in + i + span);
                 i += span - 1;
@@ -427,12 +442,15 @@ std::vector<uint32_t> fullTape(const std::vector<FlatNode>& nodes, uint32_t& sta
             frames.pop_back();
         } else if (f.next < n.children.size()) {
             if (role == Role::Domain) tape.push_back(instruction(f.node, n.kind));
+            if (normalises(n)) tape.push_back(instruction(f.node, n.kind) | kTapeOpens);
             if (f.next >= 2) tape.push_back(instruction(f.node, n.kind)), --depth;
             const uint32_t child = n.children[f.next++];
             frames.push_back({child, 0});
         } else {
-            if (role == Role::Domain) tape.push_back(f.node | kTapeDomainEnd << kTapeKindShift);
-            if (role == Role::Value) tape.push_back(instruction(f.node, n.kind));
+            if (role == Role::Domain || normalises(n))
+                tape.push_back(f.node | kTapeDomainEnd << kTapeKindShift);
+            else if (role == Role::Value)
+                tape.push_back(instruction(f.node, n.kind));
             if (n.children.size() >= 2) tape.push_back(instruction(f.node, n.kind)), --depth;
             frames.pop_back();
         }
@@ -451,7 +469,7 @@ std::vector<uint32_t> domainSpans(PrunedField& field, size_t nodeCount) {
         if (isDomainEnd(ins)) {
             spans[ins & kTapeNodeMask] = i + 1 - begins.back();
             begins.pop_back();
-        } else if (roleOf(opcode(ins)) == Role::Domain) {
+        } else if (roleOf(opcode(ins)) == Role::Domain || opens(ins)) {
             begins.push_back(i);
             field.domainDepth = std::max(field.domainDepth, uint32_t(begins.size()));
         }
