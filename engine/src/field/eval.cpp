@@ -516,7 +516,7 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
     const Acc identity;
     std::vector<Acc> acc(count);
     std::vector<uint32_t> parent(count, UINT32_MAX);
-    std::vector<float> reach(count, 0.0f);
+    std::vector<float> offsetReach(count, 0.0f);
     for (size_t i = 0; i < count; ++i) {
         const Node& src = scene.nodes[i];
         for (uint32_t c : src.children)
@@ -571,10 +571,10 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
         if (hasParent) {
             const Node& above = scene.nodes[parent[i]];
             const float units = float(acc[parent[i]].scale);
-            float read = reach[parent[i]];
+            float read = offsetReach[parent[i]];
             if (above.kind == NodeKind::Offset) read += std::max(above.params[0], 0.0f) * units;
             if (above.kind == NodeKind::Shell) read += 0.5f * above.params[0] * units;
-            reach[i] = opensFrame ? read / units : read;
+            offsetReach[i] = opensFrame ? read / units : read;
         }
     }
 
@@ -650,8 +650,8 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
                 // distance at the box's corners. Under an offset or shell the box reaches as far
                 // as the offset reads (and the taps a little more), so the field is the child's
                 // wherever the offset's surface may lie.
-                if (reach[i] > 0.0f) {
-                    const float grow = 1.01f * reach[i] + 4.0f * normalisedStep(n.bounds);
+                if (offsetReach[i] > 0.0f) {
+                    const float grow = 1.01f * offsetReach[i] + 4.0f * normalisedStep(n.bounds);
                     n.bounds.min -= grow, n.bounds.max += grow;
                 }
                 // Over the node's bounds (which the child's points are clamped to) in local space.
