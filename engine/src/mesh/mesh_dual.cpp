@@ -714,7 +714,7 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
                 ++moved;
             }
         }
-        if ((pairs.empty() && newly + moved == 0) || round == kRounds) break;
+        if ((pairs.empty() && moved == 0) || round == kRounds) break;
         for (const auto& [a, b] : pairs)
             for (uint32_t t : {a, b})
                 for (int k = 0; k < 3; ++k)
