@@ -106,6 +106,21 @@ TEST_F(GpuEval, OperationsMatchTheCpu) {
     expectGpuMatchesCpu(context(), scene, 4096);
 }
 
+// Node `op` (JSON) in a smooth union beside a sphere, and nested in a repeat: GPU against CPU.
+void expectInUnionAndRepeatMatchesCpu(Context& context, const std::string& op) {
+    Scene scene = parseOrDie(R"({"version": 1, "root": {"type": "union", "smooth": 0.2,
+        "children": [)" + op +
+                             R"(,
+        {"type": "sphere", "radius": 0.4, "translate": [1.1, 0.6, 0.2], "color": [0.1, 0.4, 0.9]}]}})");
+    ASSERT_FALSE(scene.nodes.empty());
+    expectGpuMatchesCpu(context, scene, 4096);
+    Scene nested = parseOrDie(R"({"version": 1, "root": {"type": "repeat", "count": [2, 1, 2],
+        "spacing": [4, 1, 4], "children": [)" +
+                              op + "]}}");
+    ASSERT_FALSE(nested.nodes.empty());
+    expectGpuMatchesCpu(context, nested, 2048);
+}
+
 // Every value and domain operation, around a child that shows what they do.
 TEST_F(GpuEval, EveryValueAndDomainOperationMatchesTheCpu) {
     for (const auto& [type, params] : examples(isValueOrDomain)) {
@@ -118,17 +133,7 @@ TEST_F(GpuEval, EveryValueAndDomainOperationMatchesTheCpu) {
               "children": [{"type": "round_box", "size": [0.5, 0.8, 0.3], "radius": 0.05,
                  "translate": [0.2, 0.1, -0.1], "rotate": [0, 30, 10], "scale": [1, 1.2, 0.9],
                  "color": [0.9, 0.3, 0.1]}]})";
-        Scene scene = parseOrDie(R"({"version": 1, "root": {"type": "union", "smooth": 0.2,
-            "children": [)" + op +
-                                 R"(,
-            {"type": "sphere", "radius": 0.4, "translate": [1.1, 0.6, 0.2], "color": [0.1, 0.4, 0.9]}]}})");
-        ASSERT_FALSE(scene.nodes.empty());
-        expectGpuMatchesCpu(context(), scene, 4096);
-        Scene nested = parseOrDie(R"({"version": 1, "root": {"type": "repeat", "count": [2, 1, 2],
-            "spacing": [4, 1, 4], "children": [)" +
-                                  op + "]}}");
-        ASSERT_FALSE(nested.nodes.empty());
-        expectGpuMatchesCpu(context(), nested, 2048);
+        expectInUnionAndRepeatMatchesCpu(context(), op);
     }
 }
 
@@ -147,17 +152,7 @@ TEST_F(GpuEval, TransitionsMatchTheCpu) {
                 {"type": "union", "smooth": 0.1, "color": [0.1, 0.8, 0.3], "children": [
                     {"type": "sphere", "radius": 0.4},
                     {"type": "torus", "major_radius": 0.5, "minor_radius": 0.1}]}]})";
-        Scene scene = parseOrDie(R"({"version": 1, "root": {"type": "union", "smooth": 0.2,
-            "children": [)" + op +
-                                 R"(,
-            {"type": "sphere", "radius": 0.4, "translate": [1.1, 0.6, 0.2], "color": [0.1, 0.4, 0.9]}]}})");
-        ASSERT_FALSE(scene.nodes.empty());
-        expectGpuMatchesCpu(context(), scene, 4096);
-        Scene nested = parseOrDie(R"({"version": 1, "root": {"type": "repeat", "count": [2, 1, 2],
-            "spacing": [4, 1, 4], "children": [)" +
-                                  op + "]}}");
-        ASSERT_FALSE(nested.nodes.empty());
-        expectGpuMatchesCpu(context(), nested, 2048);
+        expectInUnionAndRepeatMatchesCpu(context(), op);
     }
 }
 

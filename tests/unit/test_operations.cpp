@@ -118,19 +118,19 @@ TEST(Operations, BendCurlsABarAsDocumented) {
               0.01f);
 }
 
+// The eases of bend_linear and the transitions, their formulas and steepest slopes.
+const std::string eases[] = {"linear", "smoothstep", "smootherstep"};
+float ease(int style, float t) {
+    return style == 0 ? t : style == 1 ? t * t * (3 - 2 * t) : t * t * t * (t * (6 * t - 15) + 10);
+}
+const float slopes[] = {1.0f, 1.5f, 1.875f};
+
 // bend_linear against its formula: the child at p less offset ease(t), t the clamped position of
 // p's projection from p0 to p1, divided by 1 + |offset| ease' / |p1 - p0| and floored at the
 // distance to its bounds, the child's box swept by the offset. Its surface lies in those bounds.
 TEST(Operations, BendLinearIsItsFormula) {
     const glm::vec3 p0(-0.5f, -0.1f, 0.0f), p1(0.7f, 0.2f, 0.1f), offset(0.1f, 0.5f, -0.2f);
     const glm::vec3 half(0.8f, 0.15f, 0.2f); // the box's
-    const std::string eases[] = {"linear", "smoothstep", "smootherstep"};
-    auto ease = [](int style, float t) {
-        return style == 0   ? t
-               : style == 1 ? t * t * (3 - 2 * t)
-                            : t * t * t * (t * (6 * t - 15) + 10);
-    };
-    const float slopes[] = {1.0f, 1.5f, 1.875f};
     const Aabb swept{glm::min(-half, offset - half), glm::max(half, offset + half)};
     for (int style = 0; style < 3; ++style) {
         SCOPED_TRACE(eases[style]);
@@ -174,13 +174,6 @@ TEST(Operations, TransitionsAreTheirFormula) {
     const float reach = 2.0f * glm::length(u.max - u.min);
     const glm::vec3 p0(-0.4f, -0.1f, 0.0f), p1(0.5f, 0.2f, 0.1f), centre(0.1f, 0.0f, 0.05f);
     const float r0 = 0.15f, r1 = 0.6f;
-    const std::string eases[] = {"linear", "smoothstep", "smootherstep"};
-    auto ease = [](int style, float t) {
-        return style == 0   ? t
-               : style == 1 ? t * t * (3 - 2 * t)
-                            : t * t * t * (t * (6 * t - 15) + 10);
-    };
-    const float slopes[] = {1.0f, 1.5f, 1.875f};
     for (bool radial : {false, true})
         for (int style = 0; style < 3; ++style) {
             const std::string json =

@@ -287,12 +287,7 @@ class Emitter {
         const uint32_t kind = uint32_t(n.kind);
         const std::string level = std::to_string(points_.size());
         const std::string local = "l" + level, best = "b" + level, c = "c" + level, q = "q" + level;
-        indent(depth);
-        out_ += sample_ ? "vec4 " : "float ";
-        var(i);
-        comment(i);
-        indent(depth);
-        out_ += "{\n";
+        openBlock(i, depth);
         indent(depth + 1);
         out_ += "vec3 " + local + " = ";
         std::string at = point();
@@ -383,12 +378,7 @@ class Emitter {
     uint32_t openTaps(uint32_t i, uint32_t depth) {
         const std::string level = std::to_string(points_.size());
         const std::string c = "c" + level;
-        indent(depth);
-        out_ += sample_ ? "vec4 " : "float ";
-        var(i);
-        comment(i);
-        indent(depth);
-        out_ += "{\n";
+        openBlock(i, depth);
         indent(depth + 1);
         out_ += "vec4 t" + level + " = vec4(0.0);\n";
         if (sample_) {
@@ -444,6 +434,16 @@ class Emitter {
     void var(uint32_t i) {
         out_ += sample_ ? 's' : 'd';
         out_ += std::to_string(i);
+    }
+
+    // Node i's variable, declared with its comment, and the block that computes it.
+    void openBlock(uint32_t i, uint32_t depth) {
+        indent(depth);
+        out_ += sample_ ? "vec4 " : "float ";
+        var(i);
+        comment(i);
+        indent(depth);
+        out_ += "{\n";
     }
 
     void declare(uint32_t i) {
