@@ -120,6 +120,14 @@ Failure printBounds(Viewer& v, const Step& s) {
     return std::nullopt;
 }
 
+// The field notes the Scene panel lists, a line each.
+Failure printNotes(Viewer& v, const Step&) {
+    for (const FieldNote& note : v.fieldNotes)
+        std::printf("note %s: %s\n", note.path.c_str(), note.message.c_str());
+    std::fflush(stdout);
+    return std::nullopt;
+}
+
 Failure expectError(Viewer& v, const Step& s) {
     const std::string& want = s.c.text;
     std::string shown = v.doc.error() ? v.doc.error()->str() : "";
@@ -273,6 +281,7 @@ const Action kActions[] = {
     {"pick", pickPixel, Wait::Image},
     {"ui", toggle<&Viewer::showUi>},
     {"print-bounds", printBounds, Wait::Image},
+    {"print-notes", printNotes, Wait::Image},
     {"expect-error", expectError, Wait::Image},
     {"expect-selected", expectSelected},
     {"screenshot", takeScreenshot},

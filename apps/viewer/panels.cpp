@@ -93,6 +93,13 @@ template <class Edit> void useArguments(Viewer& v, uint32_t id, Edit&& edited) {
     }
 }
 
+// A note on the scene's field (fieldNotes), in the warnings' colour.
+void fieldNote(const FieldNote& note) {
+    ImGui::PushStyleColor(ImGuiCol_Text, IM_COL32(255, 200, 90, 255));
+    ImGui::TextWrapped("note: %s", note.message.c_str());
+    ImGui::PopStyleColor();
+}
+
 void valueEditor(Viewer& v) {
     if (v.selected < 0 || v.selected >= int(v.scene->nodes.size())) {
         ImGui::TextDisabled("Click a node in the tree or the image to select it.");
@@ -103,6 +110,8 @@ void valueEditor(Viewer& v) {
     const KindInfo& info = kindInfo(n.kind);
     ImGui::Text("%s", nodeLabel(*v.scene, id).c_str());
     ImGui::TextDisabled("%s", n.path.c_str());
+    for (const FieldNote& note : v.fieldNotes)
+        if (note.path == n.path) fieldNote(note);
     if (const int use = copyingUse(*v.scene, id); use >= 0) {
         // The loader makes the copy from the definition: nothing here is the file's to change.
         const Node& u = v.scene->nodes[use];
@@ -429,6 +438,15 @@ void panels(Viewer& v) {
         uint32_t moved = 0;
         if (drop && commit(v, dropNode(*v.scene, drop->first, drop->second, &moved)))
             v.selected = int(moved);
+        if (!v.fieldNotes.empty() &&
+            ImGui::TreeNode("fieldnotes", "%zu field note%s", v.fieldNotes.size(),
+                            v.fieldNotes.size() == 1 ? "" : "s")) {
+            for (const FieldNote& note : v.fieldNotes) {
+                ImGui::TextDisabled("%s", note.path.c_str());
+                fieldNote(note);
+            }
+            ImGui::TreePop();
+        }
     }
     if (v.scene && ImGui::CollapsingHeader("Node", ImGuiTreeNodeFlags_DefaultOpen)) valueEditor(v);
     if (v.scene && ImGui::CollapsingHeader("Mesh")) meshPanel(v);

@@ -116,6 +116,7 @@ const std::vector<Verb>& verbs() {
         {"expect-error", 1, -1, false, {}, "the error"},
         {"expect-selected", 1, 1, false, {}},
         {"print-bounds", 1, 1, false, {}},
+        {"print-notes", 0, 0, false, {}},
         {"mesh", 2, 4, false, {"extract", "export"}, {}, checkMesh},
         {"view", 1, 1, false, {"mesh", "march"}},
         {"wireframe", 1, 1, false, {"on", "off"}},

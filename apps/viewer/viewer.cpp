@@ -85,6 +85,7 @@ void syncScene(Viewer& v) {
     v.scene = std::make_shared<const Scene>(v.doc.scene());
     v.sceneVersion = v.doc.version();
     v.evaluator = std::make_unique<Evaluator>(*v.scene);
+    v.fieldNotes = fieldNotes(*v.scene, *v.evaluator);
     if (v.selected >= int(v.scene->nodes.size())) v.selected = -1;
     if (first) resetCamera(v);
 }

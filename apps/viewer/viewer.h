@@ -69,6 +69,7 @@ struct Viewer {
     std::shared_ptr<const Scene> scene; // doc.scene() as handed to the workers
     uint64_t sceneVersion = ~0ull;
     std::unique_ptr<Evaluator> evaluator; // of `scene`, for picking and framing
+    std::vector<FieldNote> fieldNotes;    // of `scene`: where its field stops being a distance
 
     OrbitCamera camera;
     RenderMode mode = RenderMode::Shaded;

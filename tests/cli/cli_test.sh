@@ -53,6 +53,7 @@ case_validate() {
         '{"type": "twist", "angle": 90, "children": [{"type": "box", "size": [1, 2, 1]}]}' >twisted.json
     check "validate notes" 0 "$bin" validate twisted.json
     expect_text "validate note" out.txt "twisted.json: root: note: offset over a field that is not a distance (twist at root.children[0] divides its field by up to 2.65): the surface lies about 0.3 from the child's (divided by the field's gradient, to first order; 0.3 to 0.794 without)"
+    expect_text "validate shading note" out.txt "twisted.json: root: note: ambient occlusion and soft shadows over a field that is not a distance (twist at root.children[0] divides its field by up to 2.65): the shading can be darker where its values lie below the distance (down to 1/2.65 of it); --no-ao and --no-shadows leave them out"
 
     printf '{"version": 1, "root": {"type": "sphere", "radius": -1}}' >bad.json
     check "validate bad" 1 "$bin" validate bad.json

@@ -459,7 +459,7 @@ TEST(Eval, FieldNotesNameWhatDependsOnDistancesThatAreNot) {
             {"type": "difference", "children": [
                 {"type": "box", "size": [1, 1, 1]}, {"type": "sphere", "radius": 0.6}]}]}]})");
     const std::vector<FieldNote> notes = fieldNotes(scene, Evaluator(scene));
-    ASSERT_EQ(notes.size(), 4u);
+    ASSERT_EQ(notes.size(), 5u);
     EXPECT_EQ(notes[0].path, "root.children[0]");
     EXPECT_EQ(notes[0].message,
               "offset over a field that is not a distance (twist at root.children[0].children[0] "
@@ -479,6 +479,16 @@ TEST(Eval, FieldNotesNameWhatDependsOnDistancesThatAreNot) {
               "root.children[3].children[0]: no distance within 0.1 of its seam): the surface "
               "lies about 0.05 from the child's (divided by the field's gradient, to first "
               "order; not 0.05 within the blend)");
+    EXPECT_EQ(notes[4].path, "root");
+    EXPECT_EQ(notes[4].message,
+              "ambient occlusion and soft shadows over a field that is not a distance (twist at "
+              "root.children[0].children[0] divides its field by up to 2.65): the shading can be "
+              "darker where its values lie below the distance (down to 1/2.65 of it); --no-ao "
+              "and --no-shadows leave them out");
+    // Below a loss of 2 the shading shows nothing worth a note.
+    const Scene gentle = parseRoot(
+        R"({"type": "twist", "angle": 40, "children": [{"type": "box", "size": [1, 2, 1]}]})");
+    EXPECT_TRUE(fieldNotes(gentle, Evaluator(gentle)).empty());
     for (const Scene& bundled : bundledScenes())
         EXPECT_TRUE(fieldNotes(bundled, Evaluator(bundled)).empty()) << bundled.file;
 }

@@ -192,6 +192,19 @@ SCRIPT
     "$diff" p1-highlight.png p3-box.png differ 0.001 || fail "selecting showed no bounding box"
 }
 
+# The field notes that the Scene and Node panels show: those of `sdfcsg validate`, and none once
+# an edit makes the field a distance again.
+case_notes() {
+    printf '{"version": 1, "root": {"type": "offset", "distance": 0.3, "children": [%s]}}' \
+        '{"type": "twist", "name": "twist", "angle": 90, "children": [{"type": "box", "size": [1, 2, 1]}]}' >twisted.json
+    printf 'print-notes\nselect twist\nset angle 0\nprint-notes\n' >notes.txt
+    run twisted.json --script notes.txt --size 320x240 --no-ui >notes.out || fail "notes script: $(cat notes.out)"
+    "$cli" validate twisted.json | sed -n 's/^twisted.json: \(.*\): note: /note \1: /p' >want.txt
+    [ "$(wc -l <want.txt)" -eq 2 ] || fail "validate gave $(cat want.txt)"
+    grep '^note ' notes.out >got.txt || true
+    cmp -s want.txt got.txt || fail "the viewer's notes $(cat got.txt) are not validate's $(cat want.txt)"
+}
+
 # An invalid file on disk shows its error and keeps the last image; fixing it reloads. Opening
 # an invalid file keeps the scene, and Save still writes the scene's own file.
 case_reload() {

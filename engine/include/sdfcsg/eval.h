@@ -125,7 +125,9 @@ class Evaluator {
 // union, intersection, difference or mirror (whose blend width is measured in values). A field
 // stops being a distance under twist, bend and taper (divided by their Lipschitz bound), a
 // scale that differs between axes (the smallest factor), an ellipsoid, and within a smooth
-// blend's radius. One note per dependent node, naming it by its JSON path.
+// blend's radius. One note per dependent node, naming it by its JSON path, in the file's order;
+// then one at the root where the renderer's ambient occlusion and soft shadows, which read the
+// field as a distance, show the loss (a factor of 2 or more).
 struct FieldNote {
     std::string path;    // the dependent node, e.g. "root.children[1]"
     std::string message; // what it depends on, where that stops being a distance, and how much
