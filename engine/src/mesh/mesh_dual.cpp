@@ -532,7 +532,7 @@ size_t pullToSurface(std::vector<glm::vec3>& positions, const std::vector<uint32
             const glm::vec3 lo = origin + glm::floor((p - origin) / h) * h, in = (p - lo) / h;
             const bool clamped = glm::any(glm::lessThan(in, glm::vec3(2 * kInset))) ||
                                  glm::any(glm::greaterThan(in, glm::vec3(1 - 2 * kInset)));
-            if ((!clamped && (clampedOnly || off[v] <= 0.1f * h)) ||
+            if ((!clamped && (clampedOnly || off[v] <= 0.2f * h)) ||
                 std::abs(distance(p)) <= 0.45f * h)
                 continue;
             const glm::vec3 to =

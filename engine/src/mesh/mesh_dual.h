@@ -56,7 +56,7 @@ static_assert(sizeof(EdgePoint) == 48);
 // field's gradient (two Newton steps), inside their cells: those with no edge point within half a
 // cell (nearer, the field is within half a cell there) and with the field `distance` 0.45 of a
 // cell or more, that were clamped to their cell's side (as where the QEF's point lay outside the
-// cell: a corner of a feature thinner than a cell), or, unless `clampedOnly`, that lie a tenth of
+// cell: a corner of a feature thinner than a cell), or, unless `clampedOnly`, that lie a fifth of
 // a cell or more off one of their edge points' tangent planes (as the mean of the edge points of
 // a piece curved within its cell). `positions` are the QEF's points (clampedOnly: those inside
 // their cells lie on their planes) or the means that foldQuads() moves folding vertices to;
