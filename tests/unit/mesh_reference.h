@@ -377,6 +377,9 @@ ReferenceMesh referenceDualMeshOf(const Distance& distance, const Color& color,
                                           c.g, field.others[k], c.b});
                 }
     // The host steps of Extraction::finish() in engine/src/mesh/mesh.cpp.
+    for (std::vector<glm::vec3>* positions : {&mesh.positions, &smooth})
+        detail::pullToSurface(*positions, mesh.indices, quadEdges, edgePoints.data(), grid.origin,
+                              grid.voxelSize, distance, positions != &smooth);
     detail::foldQuads(mesh, smooth, distance, grid.voxelSize);
     const size_t copiesFrom = mesh.vertexCount();
     detail::splitTouchingSheets(mesh);

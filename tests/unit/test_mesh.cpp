@@ -5,12 +5,14 @@
 #include "driver_cache.h"
 #include "gpu_test.h"
 #include "mesh_checks.h"
+#include "mesh_readers.h"
 #include "mesh_reference.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <numbers>
 #include <random>
 
@@ -254,6 +256,41 @@ TEST_F(MeshTest, RandomTreesOfEveryKindMeshClosedAndManifold) {
         auto mesher = Mesher::create(context(), scene);
         ASSERT_TRUE(mesher) << mesher.error().str();
         expectClosedAtEach(**mesher, {37u, 64u, 96u, 131u});
+    }
+}
+
+std::vector<std::pair<std::string, std::string>> qualityScenes(uint32_t seeds);
+
+// Seeded random trees of every kind and random Booleans of turned primitives (qualityScenes(),
+// as scripts/mesh-quality.sh measures them), meshed at odd resolutions: every vertex lies within
+// 0.6 of a cell of the surface (vertices the QEF clamped to their cell's side, and means of
+// pieces curved within their cells, are pulled onto the surface by the field: before, up to 0.73
+// of a cell), and at most 4% of a mesh's triangles face against the field. Not yet the issue's
+// 0.5 of a cell and no flipped triangle: most flipped triangles left are the fans of
+// separateCrossings() in features about a cell thin, their centres a quarter of a cell deep,
+// where the field's gradient points to another part of the surface (marching cubes, all of
+// whose vertices lie on the surface, flips 60 to 134 triangles on the first three trees at 64
+// cells; dual contouring 48 to 128).
+TEST_F(MeshTest, RandomScenesHaveVerticesNearTheSurfaceAndFewFlippedTriangles) {
+    const char* seeds = std::getenv("SDFCSG_MESH_SEEDS");
+    const uint32_t count = seeds ? uint32_t(std::strtoul(seeds, nullptr, 10)) : 3u;
+    for (const auto& [name, json] : qualityScenes(count)) {
+        SCOPED_TRACE(name + ": " + json);
+        const Scene scene = sceneFrom(json);
+        const Evaluator evaluator(scene);
+        auto mesher = Mesher::create(context(), scene);
+        ASSERT_TRUE(mesher) << mesher.error().str();
+        for (uint32_t resolution : {37u, 64u, 96u, 131u}) {
+            SCOPED_TRACE("at " + std::to_string(resolution));
+            MeshOptions options;
+            options.resolution = resolution;
+            MeshStats stats;
+            auto mesh = (*mesher)->extract(options, &stats);
+            ASSERT_TRUE(mesh) << mesh.error().str();
+            EXPECT_LE(maxSurfaceDistance(*mesh, evaluator), 0.6f * stats.voxelSize);
+            const TriangleFacing facing = checkTriangleFacing(*mesh, evaluator, stats.voxelSize);
+            EXPECT_LE(double(facing.flipped), 0.04 * double(mesh->triangleCount())) << facing.str();
+        }
     }
 }
 
@@ -975,6 +1012,116 @@ TEST_F(MeshTest, BadOptionsAreUsageErrors) {
     ASSERT_FALSE(mesh);
     EXPECT_EQ(mesh.error().kind, ErrorKind::Usage);
     EXPECT_EQ(mesh.error().diagnostics.at(0).message, "the voxel size must be a positive number");
+}
+
+// Dual contouring's quality figures over many meshes: flipped triangles (checkTriangleFacing),
+// self-intersecting pairs, and the vertices' largest distance from the surface in cells.
+struct QualityTotals {
+    size_t meshes = 0, flipped = 0, folding = 0, pairs = 0, crossing = 0;
+    double worstShare = 0; // the largest share of a mesh's triangles flipped
+    float worst = 0;
+    std::string worstAt;
+
+    void add(const Mesh& mesh, const Evaluator& evaluator, float h, const std::string& name) {
+        const TriangleFacing facing = checkTriangleFacing(mesh, evaluator, h);
+        const SelfIntersections crossings = findSelfIntersections(mesh);
+        const float distance = maxSurfaceDistance(mesh, evaluator) / h;
+        std::printf("%s: %zu flipped, %zu crossing pairs, vertices within %.3f cells\n",
+                    name.c_str(), facing.flipped, crossings.total(), double(distance));
+        ++meshes;
+        if (mesh.triangleCount() > 0)
+            worstShare =
+                std::max(worstShare, double(facing.flipped) / double(mesh.triangleCount()));
+        flipped += facing.flipped;
+        folding += facing.flipped > 0;
+        pairs += crossings.total();
+        crossing += crossings.total() > 0;
+        if (distance > worst) {
+            worst = distance;
+            worstAt = name;
+        }
+    }
+    void print(const char* what) const {
+        std::printf("%s: %zu meshes, %zu flipped in %zu (at most %.3f%% of a mesh), %zu crossing "
+                    "pairs in %zu, vertices within %.3f cells (%s)\n",
+                    what, meshes, flipped, folding, 100 * worstShare, pairs, crossing,
+                    double(worst), worstAt.c_str());
+    }
+};
+
+// The scenes of the figures: the random trees of every kind (randomTreesJson, as
+// RandomTreesOfEveryKindMeshClosedAndManifold draws them) and random Booleans of turned
+// primitives, sharp and smooth (randomScene), as JSON.
+std::vector<std::pair<std::string, std::string>> qualityScenes(uint32_t seeds) {
+    std::vector<std::pair<std::string, std::string>> scenes;
+    for (uint32_t seed = 0; seed < seeds; ++seed)
+        scenes.push_back({"trees_" + std::to_string(seed), randomTreesJson(1000 + seed)});
+    for (uint32_t seed = 0; seed < seeds; ++seed)
+        scenes.push_back({"booleans_" + std::to_string(seed), toJson(randomScene(seed, 40, 5))});
+    return scenes;
+}
+
+// For scripts/mesh-quality.sh, which compares two builds of sdfcsg on the same scenes: with
+// SDFCSG_MESH_QUALITY_SCENES=DIR, writes qualityScenes() into DIR; with SDFCSG_MESH_QUALITY=LIST,
+// prints the figures of each line "SCENE MESH.ply H" of LIST (H: the cell edge) and their totals.
+// Skipped without either.
+TEST(MeshQuality, FiguresOfWrittenMeshes) {
+    const char* scenes = std::getenv("SDFCSG_MESH_QUALITY_SCENES");
+    const char* list = std::getenv("SDFCSG_MESH_QUALITY");
+    if (!scenes && !list) GTEST_SKIP() << "set SDFCSG_MESH_QUALITY(_SCENES); see the comment";
+    if (scenes)
+        for (const auto& [name, json] : qualityScenes(12))
+            std::ofstream(std::filesystem::path(scenes) / (name + ".json")) << json;
+    if (!list) return;
+    std::ifstream in(list);
+    std::string scenePath, meshPath;
+    float h = 0;
+    QualityTotals totals;
+    while (in >> scenePath >> meshPath >> h) {
+        std::ifstream file(meshPath, std::ios::binary);
+        const std::string bytes((std::istreambuf_iterator<char>(file)), {});
+        const PlyData ply = readPly(bytes);
+        ASSERT_TRUE(ply.error.empty()) << meshPath << ": " << ply.error;
+        Mesh mesh;
+        mesh.positions = ply.positions;
+        mesh.indices = ply.indices;
+        totals.add(mesh, Evaluator(loadOrDie(scenePath)), h, meshPath);
+    }
+    totals.print("total");
+}
+
+// The same figures of this build, meshed here: with SDFCSG_MESH_QUALITY_SEEDS=N, over
+// qualityScenes(N) at 37, 64, 96 and 131 cells and table_and_chairs at 64, 97, 101, 128 and 143.
+TEST_F(MeshTest, QualityFigures) {
+    const char* seeds = std::getenv("SDFCSG_MESH_QUALITY_SEEDS");
+    if (!seeds) GTEST_SKIP() << "set SDFCSG_MESH_QUALITY_SEEDS; see the comment";
+    std::vector<std::pair<std::string, std::string>> scenes =
+        qualityScenes(uint32_t(std::strtoul(seeds, nullptr, 10)));
+    std::ifstream tableFile(std::filesystem::path(SDFCSG_SOURCE_DIR) /
+                            "assets/scenes/table_and_chairs.json");
+    scenes.push_back({"table", std::string((std::istreambuf_iterator<char>(tableFile)), {})});
+    QualityTotals trees, booleans, tables;
+    for (const auto& [name, json] : scenes) {
+        const Scene scene = sceneFrom(json);
+        const Evaluator evaluator(scene);
+        auto mesher = Mesher::create(context(), scene);
+        ASSERT_TRUE(mesher) << mesher.error().str();
+        const bool table = name == "table";
+        QualityTotals& totals = table ? tables : name[0] == 't' ? trees : booleans;
+        for (uint32_t resolution : table ? std::vector<uint32_t>{64, 97, 101, 128, 143}
+                                         : std::vector<uint32_t>{37, 64, 96, 131}) {
+            MeshOptions options;
+            options.resolution = resolution;
+            MeshStats stats;
+            auto mesh = (*mesher)->extract(options, &stats);
+            ASSERT_TRUE(mesh) << mesh.error().str();
+            totals.add(*mesh, evaluator, stats.voxelSize,
+                       name + " at " + std::to_string(resolution));
+        }
+    }
+    trees.print("trees");
+    booleans.print("booleans");
+    tables.print("table");
 }
 
 } // namespace

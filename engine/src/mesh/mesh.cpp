@@ -877,6 +877,11 @@ void Extraction::finish() {
         const Evaluator& evaluator = *m.evaluator;
         if (evaluator.nodes().size() < kTapeMinNodes)
             distance = [&](glm::vec3 p) { return evaluator.distance(p); };
+        // The edge data, which the vertices pass wrote, lies where the dual pass read it.
+        const auto* edges = m.mapped<detail::EdgePoint>(SDFCSG_BINDING_MESH_HERMITE);
+        for (std::vector<glm::vec3>* positions : {&mesh.positions, &smooth})
+            detail::pullToSurface(*positions, mesh.indices, quadEdges, edges, g.origin, g.h,
+                                  distance, positions != &smooth);
         detail::foldQuads(mesh, smooth, distance, g.h);
         stage("quads", t0);
         const auto t1 = Clock::now();
@@ -884,10 +889,7 @@ void Extraction::finish() {
         detail::splitTouchingSheets(mesh);
         stage("sheets", t1);
         const auto t2 = Clock::now();
-        // The edge data, which the vertices pass wrote, lies where the dual pass read it.
-        detail::separateCrossings(mesh, copiesFrom, quadEdges,
-                                  m.mapped<detail::EdgePoint>(SDFCSG_BINDING_MESH_HERMITE),
-                                  g.origin, g.h, distance);
+        detail::separateCrossings(mesh, copiesFrom, quadEdges, edges, g.origin, g.h, distance);
         stage("crossings", t2);
     }
     // Colour borders, where asked for and where there can be any: the CPU's whole tree is too

@@ -5,6 +5,7 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
+#include <glm/vector_relational.hpp>
 
 #include <algorithm>
 #include <array>
@@ -460,6 +461,36 @@ void starWedges(const Mesh& mesh, const uint32_t* t, const std::vector<glm::vec3
     }
 }
 
+// The field's gradient at p, by tetrahedral differences a hundredth of a cell `h` wide.
+glm::vec3 gradientAt(const Distance& distance, glm::vec3 p, float h) {
+    const glm::vec3 taps[4] = {{1, -1, -1}, {-1, -1, 1}, {-1, 1, -1}, {1, 1, 1}};
+    glm::vec3 g(0.0f);
+    for (const glm::vec3& tap : taps)
+        g += tap * distance(p + tap * (0.01f * h));
+    return g / (0.04f * h);
+}
+
+// Point p moved toward the surface along the field's gradient, kept in the box [lo, hi] (a cell,
+// or a face of one: lo and hi agree on its axis): two Newton steps, each kept only where it
+// brings p nearer to the surface.
+glm::vec3 towardSurface(const Distance& distance, glm::vec3 p, glm::vec3 lo, glm::vec3 hi,
+                        float h) {
+    float d = distance(p);
+    for (int step = 0; step < 2; ++step) {
+        glm::vec3 g = gradientAt(distance, p, h);
+        for (int k = 0; k < 3; ++k)
+            if (lo[k] == hi[k]) g[k] = 0.0f;
+        const float gg = glm::dot(g, g);
+        if (!(gg > 1e-6f)) break;
+        const glm::vec3 next = glm::clamp(p - d * g / gg, lo, hi);
+        const float e = distance(next);
+        if (!(std::abs(e) < std::abs(d))) break;
+        p = next;
+        d = e;
+    }
+    return p;
+}
+
 // Runs f(begin, end, half) over [0, n), in two halves on two threads where n is large enough to
 // pay for the second.
 template <class F> void inHalves(size_t n, F&& f) {
@@ -473,6 +504,45 @@ template <class F> void inHalves(size_t n, F&& f) {
 }
 
 } // namespace
+
+size_t pullToSurface(std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices,
+                     const std::vector<uint32_t>& quadEdges, const EdgePoint* points,
+                     glm::vec3 origin, float h, const Distance& distance, bool clampedOnly) {
+    const size_t quads = indices.size() / 6;
+    if (!distance || quadEdges.size() != quads) return 0;
+    // Per vertex: the squared distance to its nearest edge point, and the largest distance from
+    // the tangent planes of its edge points.
+    std::vector<float> nearest(positions.size(), INFINITY), off(positions.size(), 0.0f);
+    for (size_t q = 0; q < quads; ++q) {
+        const EdgePoint& e = points[quadEdges[q]];
+        if (!finite(e.position) || !finite(e.normal) || !finite(e.other)) continue;
+        const uint32_t* t = &indices[6 * q];
+        for (int k = 0; k < 6; ++k) {
+            const glm::vec3 d = positions[t[k]] - e.position;
+            nearest[t[k]] = std::min(nearest[t[k]], glm::dot(d, d));
+            off[t[k]] = std::max(
+                {off[t[k]], std::abs(glm::dot(d, e.normal)), std::abs(glm::dot(d, e.other))});
+        }
+    }
+    size_t moved[2] = {0, 0};
+    inHalves(positions.size(), [&](size_t begin, size_t end, int half) {
+        for (size_t v = begin; v < end; ++v) {
+            if (nearest[v] <= 0.25f * h * h) continue; // then the field is within half a cell
+            glm::vec3& p = positions[v];
+            const glm::vec3 lo = origin + glm::floor((p - origin) / h) * h, in = (p - lo) / h;
+            const bool clamped = glm::any(glm::lessThan(in, glm::vec3(2 * kInset))) ||
+                                 glm::any(glm::greaterThan(in, glm::vec3(1 - 2 * kInset)));
+            if ((!clamped && (clampedOnly || off[v] <= 0.2f * h)) ||
+                std::abs(distance(p)) <= 0.45f * h)
+                continue;
+            const glm::vec3 to =
+                towardSurface(distance, p, lo + kInset * h, lo + (1 - kInset) * h, h);
+            moved[half] += to != p;
+            p = to;
+        }
+    });
+    return moved[0] + moved[1];
+}
 
 Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<uint32_t>& quadEdges,
                              const EdgePoint* points, glm::vec3 origin, float h,
@@ -499,6 +569,11 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
             view[2 * v + 1] = glm::vec3(b, sign + n.y * n.y * a, -n.y);
         }
     });
+    auto cellLo = [&](uint32_t v) {
+        return origin + glm::vec3(uint32_t(key[v] & 0x1fffff), uint32_t((key[v] >> 21) & 0x1fffff),
+                                  uint32_t(key[v] >> 42)) *
+                            h;
+    };
     // cellOf[v]: v, or for a vertex that shares its cell (`shared`: several pieces of surface,
     // or copies for sheets that touch), the first vertex of the cell, which names it. The pieces
     // of a cell come one after another (the dual pass writes them so), the copies after all.
@@ -689,12 +764,17 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
         result.remaining = pairs.size();
         // Fan triangles (those with an edge or face point) that fold (see facing()): a marked
         // cell's lone vertex there lies across a sharp edge from a chord of its loop, or on the
-        // face that holds the chord, clamped into its cell. It goes, once, to the mean of its
-        // quads' edge points, inside the hull of its loop, where its fan faces like the loop (any
-        // point inside the cell keeps the fan embedded), and the next round checks it. Cells are
-        // not marked for folding: a decision by a threshold would change the mesh's counts where
-        // rounding moves a triangle across it.
+        // face that holds the chord, clamped into its cell, or deep inside a feature thinner than
+        // a cell. It moves, once, to whichever of a few points of its cell its fan faces best
+        // from (fewest folding triangles, by the field where it is known): where it is, the mean
+        // of its quads' edge points (inside the hull of its loop, where its fan faces like the
+        // loop), each of these two moved onto the surface, and the cell's centre; any point
+        // inside the cell keeps the fan embedded. The next round checks it. Cells are not marked
+        // for folding: a decision by a threshold would change the mesh's counts where rounding
+        // moves a triangle across it (marking them was tried: fans there fold more often than
+        // the quads did).
         size_t newly = 0, moved = 0;
+        std::vector<uint32_t> toPlace;
         for (size_t t = 0; t < probe.size(); t += 3) {
             const uint32_t* f = &probe[t];
             if (std::max({f[0], f[1], f[2]}) < dualVertices ||
@@ -703,15 +783,61 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
             for (size_t k = 0; k < 3; ++k) {
                 const uint32_t v = f[k];
                 if (v >= dualVertices || !isMarked(v) || shared[v] || toMean[v]) continue;
+                toMean[v] = 1;
+                toPlace.push_back(v);
+            }
+        }
+        if (!toPlace.empty()) {
+            // Each such vertex's triangles in the probe, (vertex, first index) sorted.
+            std::vector<std::pair<uint32_t, uint32_t>> fan;
+            for (size_t t = 0; t < probe.size(); t += 3)
+                for (size_t k = 0; k < 3; ++k)
+                    if (const uint32_t v = probe[t + k]; v < dualVertices && toMean[v] == 1)
+                        fan.push_back({v, uint32_t(t)});
+            std::sort(fan.begin(), fan.end());
+            for (uint32_t v : toPlace) {
+                toMean[v] = 2;
+                const auto [b, e] = std::equal_range(
+                    fan.begin(), fan.end(), std::pair{v, 0u},
+                    [](const auto& x, const auto& y) { return x.first < y.first; });
+                // How the fan faces with v at p: its folding triangles, then their sum.
+                auto score = [&](glm::vec3 p) {
+                    mesh.positions[v] = p;
+                    float folds = 0.0f, sum = 0.0f;
+                    for (auto it = b; it != e; ++it) {
+                        const uint32_t* f = &probe[it->second];
+                        const float c = facing(mesh, distance, h, f[0], f[1], f[2], true);
+                        if (c < 0.0f) {
+                            folds += 1.0f;
+                            sum += c;
+                        }
+                    }
+                    return std::pair{folds, -sum};
+                };
+                const glm::vec3 lo = cellLo(v) + kInset * h, hi = cellLo(v) + (1 - kInset) * h;
+                auto onSurface = [&](glm::vec3 p) {
+                    return distance ? towardSurface(distance, p, lo, hi, h) : p;
+                };
                 glm::vec3 sum(0.0f);
                 int count = 0;
                 for (auto it = std::lower_bound(around.begin(), around.end(), std::pair{v, 0u});
                      it != around.end() && it->first == v; ++it, ++count)
                     sum += edgePosition(it->second);
-                if (count == 0) continue;
-                mesh.positions[v] = sum / float(count);
-                toMean[v] = 1;
-                ++moved;
+                const glm::vec3 placed = mesh.positions[v];
+                glm::vec3 best = placed;
+                auto bestScore = score(placed);
+                if (count > 0) {
+                    const glm::vec3 mean = sum / float(count);
+                    for (const glm::vec3& p :
+                         {mean, onSurface(mean), onSurface(placed), cellLo(v) + 0.5f * h}) {
+                        if (const auto c = score(p); c < bestScore) {
+                            bestScore = c;
+                            best = p;
+                        }
+                    }
+                }
+                mesh.positions[v] = best;
+                moved += best != placed;
             }
         }
         if ((pairs.empty() && moved == 0) || round == kRounds) break;

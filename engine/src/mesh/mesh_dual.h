@@ -52,6 +52,21 @@ struct EdgePoint {
 };
 static_assert(sizeof(EdgePoint) == 48);
 
+// Vertices that may lie farther than half a cell `h` from the surface move toward it along the
+// field's gradient (two Newton steps), inside their cells: those with no edge point within half a
+// cell (nearer, the field is within half a cell there) and with the field `distance` 0.45 of a
+// cell or more, that were clamped to their cell's side (as where the QEF's point lay outside the
+// cell: a corner of a feature thinner than a cell), or, unless `clampedOnly`, that lie a fifth of
+// a cell or more off one of their edge points' tangent planes (as the mean of the edge points of
+// a piece curved within its cell). `positions` are the QEF's points (clampedOnly: those inside
+// their cells lie on their planes) or the means that foldQuads() moves folding vertices to;
+// `indices` holds the quads as the quads pass wrote them, `quadEdges` their edge points in
+// `points`, and `origin` is the grid's corner. Does nothing without a field. Returns how many
+// vertices moved.
+size_t pullToSurface(std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices,
+                     const std::vector<uint32_t>& quadEdges, const EdgePoint* points,
+                     glm::vec3 origin, float h, const Distance& distance, bool clampedOnly);
+
 // What separateCrossings() did: its rounds, the cells it split, and the pairs of triangles that
 // still cross (in cells it could not make embedded, as one vertex serving two sheets).
 struct Separation {
@@ -77,8 +92,8 @@ struct Separation {
 // cells of several vertices and around vertices whose quads may cross (starWedges() in
 // mesh_dual.cpp) are checked, so that meshes with nothing to fix pay little. Where a fan triangle
 // folds (by its vertices' normals, and where `distance` is set by the field, as in foldQuads()),
-// a marked cell's lone vertex in it moves once to the mean of its quads' edge points, and the
-// next round checks it.
+// a marked cell's lone vertex in it moves once to the point of its cell, of a few, that its fan
+// faces best from, and the next round checks it.
 Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<uint32_t>& quadEdges,
                              const EdgePoint* points, glm::vec3 origin, float h,
                              const Distance& distance);
