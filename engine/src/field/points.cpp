@@ -14,7 +14,6 @@ namespace sdfcsg {
 
 struct PointSampler::Impl {
     Context::Impl& ctx;
-    bool skipping = false;
     detail::SceneBuffers scene;
     detail::Buffer in, out, staging;
     VkShaderModule module = VK_NULL_HANDLE;
@@ -55,12 +54,12 @@ Result<std::unique_ptr<PointSampler>> PointSampler::create(Context& context, con
     if (auto ok = checkEvaluation(scene, evaluation); !ok) return ok.error();
     Context::Impl& ctx = detail::contextImpl(context);
     auto impl = std::make_unique<Impl>(ctx);
-    // Bounds tests pay on GPUs only (RenderOptions::boundsSkipping).
-    impl->skipping = !context.cpuDevice();
     CodegenOptions codegen;
     codegen.evaluation = usesTapes(scene, evaluation) ? Evaluation::Tapes : Evaluation::Inlined;
     codegen.inlineParams = true;
-    codegen.boundsTests = impl->skipping;
+    // Bounds skipping on, whatever the device: without it the values away from the surface are
+    // other bounds than the CPU evaluator's (the same surface, not the same numbers).
+    codegen.boundsTests = true;
     auto spirv = compileKernel("probe.comp", generateSceneGlsl(scene, codegen));
     if (!spirv) return spirv.error();
 
@@ -90,7 +89,7 @@ Result<std::unique_ptr<PointSampler>> PointSampler::create(Context& context, con
     impl->module = detail::createShaderModule(ctx, *spirv);
     impl->setLayout = detail::createDescriptorSetLayout(ctx, kBindings);
     impl->layout = detail::createPipelineLayout(ctx, impl->setLayout, sizeof(uint32_t));
-    const detail::SpecConstant spec[] = {{SDFCSG_SPEC_BOUNDS_SKIPPING, impl->skipping ? 1u : 0u}};
+    const detail::SpecConstant spec[] = {{SDFCSG_SPEC_BOUNDS_SKIPPING, 1u}};
     impl->pipeline = detail::createComputePipeline(ctx, impl->module, impl->layout, spec);
     impl->pool = detail::createDescriptorPool(ctx, kBindings);
     impl->set = detail::allocateDescriptorSet(ctx, impl->pool, impl->setLayout);
