@@ -367,19 +367,6 @@ PYBIND11_MODULE(sdfcsg, module) {
                    (d.children.empty() ? "" : " of " + std::to_string(d.children.size())) + ">";
         });
 
-    // A function for every kind, and a method for every operation of one child, from the table.
-    for (const KindInfo& kind : nodeKinds()) {
-        const KindInfo* k = &kind;
-        module.def(
-            std::string(kind.name).c_str(),
-            [k](py::args args, const py::kwargs& kwargs) { return build(*k, args, kwargs); },
-            docstring(kind).c_str());
-        if (kind.role == Role::Value || kind.role == Role::Domain)
-            shapeClass.def(
-                std::string(kind.name).c_str(),
-                [k](py::args args, const py::kwargs& kwargs) { return build(*k, args, kwargs); },
-                docstring(kind).c_str());
-    }
     module.def(
         "shape",
         [](std::string type, const py::kwargs& kwargs) {
@@ -533,4 +520,23 @@ PYBIND11_MODULE(sdfcsg, module) {
     py::module_::import("atexit").attr("register")(module.attr("_release_device"));
     module.def("device_name", [] { return context().deviceName(); });
     module.def("_validation_messages", [] { return context().validationMessageCount(); });
+    // A function for every kind, and a method for every operation of one child, from the table;
+    // last, so that a kind named as one of the functions above (mesh, say) takes a trailing
+    // underscore (mesh_) rather than hiding it.
+    for (const KindInfo& kind : nodeKinds()) {
+        const KindInfo* k = &kind;
+        auto named = [&](py::handle scope) {
+            const std::string name(kind.name);
+            return py::hasattr(scope, name.c_str()) ? name + "_" : name;
+        };
+        module.def(
+            named(module).c_str(),
+            [k](py::args args, const py::kwargs& kwargs) { return build(*k, args, kwargs); },
+            docstring(kind).c_str());
+        if (kind.role == Role::Value || kind.role == Role::Domain)
+            shapeClass.def(
+                named(shapeClass).c_str(),
+                [k](py::args args, const py::kwargs& kwargs) { return build(*k, args, kwargs); },
+                docstring(kind).c_str());
+    }
 }
