@@ -199,9 +199,21 @@ Scene sceneOf(py::handle object) {
     throw py::type_error("sdfcsg: expected a Shape or a Scene");
 }
 
-// A progress callback that stops long work on Ctrl-C (the signal is seen between bands).
-std::function<bool(float)> interruptible() {
-    return [](float) { return PyErr_CheckSignals() == 0; };
+// A progress callback for long work: Ctrl-C stops it (the signal is seen between bands), and so
+// does `progress(fraction)` returning False or raising; the error then raised is that exception
+// or KeyboardInterrupt, left set for raise().
+std::function<bool(float)> interruptible(py::object progress = py::none()) {
+    return [progress](float done) {
+        if (PyErr_CheckSignals() != 0) return false;
+        if (progress.is_none()) return true;
+        try {
+            const py::object answer = progress(done);
+            return answer.is_none() || answer.cast<bool>();
+        } catch (py::error_already_set& e) {
+            e.restore();
+            return false;
+        }
+    };
 }
 
 std::optional<Camera> cameraOf(const py::object& camera) {
@@ -225,7 +237,8 @@ std::optional<Camera> cameraOf(const py::object& camera) {
 }
 
 Image renderImage(py::handle object, uint32_t width, uint32_t height, const py::object& camera,
-                  const std::string& mode, uint32_t aa, bool shadows, bool grid) {
+                  const std::string& mode, uint32_t aa, bool shadows, bool grid,
+                  const py::object& progress = py::none()) {
     const Scene scene = sceneOf(object);
     RenderOptions options;
     options.width = width;
@@ -237,9 +250,11 @@ Image renderImage(py::handle object, uint32_t width, uint32_t height, const py::
     options.aa = aa;
     options.shadows = shadows;
     options.grid = grid;
-    options.progress = interruptible();
+    options.progress = interruptible(progress);
     auto renderer = unwrap(Renderer::create(context(), scene));
-    return unwrap(renderer->render(options));
+    Image image = unwrap(renderer->render(options));
+    if (PyErr_Occurred()) throw py::error_already_set(); // raised by progress after the last band
+    return image;
 }
 
 py::array_t<uint8_t> imageArray(const Image& image) {
@@ -437,14 +452,18 @@ PYBIND11_MODULE(sdfcsg, module) {
     module.def(
         "render",
         [](py::handle object, uint32_t width, uint32_t height, py::object camera, std::string mode,
-           uint32_t aa, bool shadows, bool grid) {
-            return imageArray(renderImage(object, width, height, camera, mode, aa, shadows, grid));
+           uint32_t aa, bool shadows, bool grid, py::object progress) {
+            return imageArray(
+                renderImage(object, width, height, camera, mode, aa, shadows, grid, progress));
         },
         py::arg("shape"), py::arg("width") = 800, py::arg("height") = 600,
         py::arg("camera") = py::none(), py::arg("mode") = "shaded", py::arg("aa") = 1,
-        py::arg("shadows") = true, py::arg("grid") = false,
-        "render(shape_or_scene, width, height, camera={'eye':..., 'target':...}, mode='shaded') "
-        "-> uint8 array (height, width, 4), RGBA.");
+        py::arg("shadows") = true, py::arg("grid") = false, py::arg("progress") = py::none(),
+        "render(shape_or_scene, width=800, height=600, camera=None, mode='shaded', aa=1, "
+        "shadows=True, grid=False, progress=None) -> uint8 array (height, width, 4), RGBA.\n\n"
+        "camera: {'eye': [x, y, z], 'target': ..., 'up': ..., 'fov': degrees}. progress: called "
+        "with the fraction done; returning False stops the render (sdfcsg.Error, kind "
+        "'cancelled').");
 
     py::class_<Mesh>(module, "Mesh", "A triangle mesh: vertices, faces, normals, colors.")
         .def_property_readonly("vertices",
@@ -482,7 +501,7 @@ PYBIND11_MODULE(sdfcsg, module) {
     module.def(
         "mesh",
         [](py::handle object, uint32_t resolution, std::optional<float> voxelSize,
-           std::string method, std::optional<float> simplify) {
+           std::string method, std::optional<float> simplify, py::object progress) {
             const Scene scene = sceneOf(object);
             MeshOptions options;
             options.resolution = resolution;
@@ -491,20 +510,23 @@ PYBIND11_MODULE(sdfcsg, module) {
                 options.method = MeshMethod::MarchingCubes;
             else if (method != "dual_contouring")
                 throw py::value_error("sdfcsg.mesh: method is dual_contouring or marching_cubes");
-            options.progress = interruptible();
+            options.progress = interruptible(progress);
             Mesh mesh = unwrap(extractMesh(context(), scene, options));
             if (simplify) {
                 SimplifyOptions s;
                 s.maxError = *simplify;
-                s.progress = interruptible();
+                s.progress = interruptible(progress);
                 mesh = unwrap(simplifyMesh(mesh, Evaluator(scene), s));
             }
+            if (PyErr_Occurred()) throw py::error_already_set(); // from progress at the end
             return mesh;
         },
         py::arg("shape"), py::arg("resolution") = 128, py::arg("voxel_size") = py::none(),
         py::arg("method") = "dual_contouring", py::arg("simplify") = py::none(),
+        py::arg("progress") = py::none(),
         "mesh(shape_or_scene, resolution=128, voxel_size=None, method='dual_contouring', "
-        "simplify=max_error) -> Mesh.");
+        "simplify=None, progress=None) -> Mesh.\n\nsimplify: the largest distance from the "
+        "surface the simplified mesh may stray. progress: as render's.");
 
     module.def("evaluate", &evaluate, py::arg("shape"), py::arg("points"),
                py::arg("colors") = false, py::arg("device") = py::none(),

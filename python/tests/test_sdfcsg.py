@@ -147,3 +147,18 @@ def test_evaluate_on_the_cpu_and_the_device():
     np.testing.assert_allclose(sphere, np.linalg.norm(points, axis=1) - 1, atol=1e-6)
     with pytest.raises(ValueError):
         sdfcsg.evaluate(shape, np.zeros((4, 2), np.float32))
+
+
+def test_progress_reports_and_stops():
+    seen = []
+    sdfcsg.render(sdfcsg.sphere(1), 64, 48, progress=seen.append)
+    assert seen and seen[-1] == pytest.approx(1.0) and seen == sorted(seen)
+    with pytest.raises(sdfcsg.Error) as stopped:
+        sdfcsg.mesh(sdfcsg.sphere(1), resolution=32, progress=lambda done: False)
+    assert stopped.value.kind == "cancelled"
+
+    def fails(done):
+        raise RuntimeError("from the callback")
+
+    with pytest.raises(RuntimeError, match="from the callback"):
+        sdfcsg.render(sdfcsg.sphere(1), 64, 48, progress=fails)
