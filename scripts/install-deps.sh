@@ -8,7 +8,8 @@ PACKAGES="build-essential cmake ninja-build pkg-config git
   libcurl4-openssl-dev libcpp-httplib-dev
   libglfw3-dev libimgui-dev xvfb xauth gdb
   libfreetype-dev libfontconfig-dev fonts-dejavu-core zlib1g-dev libmeshoptimizer-dev
-  clang-14 libclang-rt-14-dev clang-format"
+  clang-14 libclang-rt-14-dev clang-format
+  pybind11-dev python3-dev python3-numpy python3-pytest"
 missing=""
 for p in $PACKAGES; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"

@@ -15,6 +15,7 @@
 #include "sdfcsg/io.h"
 #include "sdfcsg/mesh.h"
 #include "sdfcsg/mesh_report.h"
+#include "sdfcsg/model.h"
 #include "sdfcsg/nodes.h"
 #include "sdfcsg/render.h"
 #include "sdfcsg/scene.h"

@@ -1,0 +1,21 @@
+# Runs the C++ examples, and the Python ones where PYTHON is set, and checks that both wrote the
+# same scene files. Inputs: CPP, PYTHON, SCRIPT, WORK_DIR.
+file(REMOVE_RECURSE ${WORK_DIR})
+execute_process(COMMAND ${CPP} ${WORK_DIR}/cpp RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "the C++ examples failed (${rc})")
+endif()
+if(NOT PYTHON)
+    return()
+endif()
+execute_process(COMMAND ${PYTHON} ${SCRIPT} ${WORK_DIR}/python RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "the Python examples failed (${rc})")
+endif()
+foreach(name IN ITEMS bracket gear vase lattice)
+    execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORK_DIR}/cpp/${name}.json
+        ${WORK_DIR}/python/${name}.json RESULT_VARIABLE differ)
+    if(differ)
+        message(FATAL_ERROR "${name}.json differs between C++ and Python (${WORK_DIR})")
+    endif()
+endforeach()
