@@ -866,7 +866,8 @@ TEST(ViewerScript, ReportsEveryProblem) {
               "s.txt:2:1: unknown command \"fly\" (known: select, set, mode, shadows, ao, grid, "
               "boxes, orbit, drag, zoom, frame, reset, undo, redo, save, screenshot, generate, "
               "edit-scene, add, remove, kind, op, move, parent, open, pick, wait-reload, ui, "
-              "expect-error, expect-selected, print-bounds, mesh, view, wireframe, thin-walls)\n"
+              "expect-error, expect-selected, print-bounds, print-notes, mesh, view, wireframe, "
+              "thin-walls)\n"
               "s.txt:3:1: set: expected a finite number, got \"big\"\n"
               "s.txt:4:1: zoom: expected 1 arguments, got 0\n"
               "s.txt:5:1: undo: expected 0 arguments, got 1");
