@@ -10,6 +10,7 @@
 #include <glm/vec2.hpp>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstring>
@@ -61,6 +62,38 @@ std::optional<uint64_t> zipUnpackedSize(const std::string& s) {
     return std::nullopt;
 }
 
+// The squared distance from p to the triangle abc, and which feature of it is nearest: 0, 1, 2
+// its corners, 3, 4, 5 its edges ab, bc, ca, 6 its face (Ericson, Real-Time Collision Detection,
+// 5.1.5).
+struct Nearest {
+    float distance2;
+    int feature;
+    vec3 point;
+};
+Nearest nearestOnTriangle(vec3 p, vec3 a, vec3 b, vec3 c) {
+    const auto at = [&](vec3 q, int feature) {
+        return Nearest{glm::dot(p - q, p - q), feature, q};
+    };
+    const vec3 ab = b - a, ac = c - a, ap = p - a;
+    const float d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
+    if (d1 <= 0.0f && d2 <= 0.0f) return at(a, 0);
+    const vec3 bp = p - b;
+    const float d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
+    if (d3 >= 0.0f && d4 <= d3) return at(b, 1);
+    const float vc = d1 * d4 - d3 * d2;
+    if (vc <= 0.0f && d1 >= 0.0f && d3 <= 0.0f) return at(a + ab * (d1 / (d1 - d3)), 3);
+    const vec3 cp = p - c;
+    const float d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
+    if (d6 >= 0.0f && d5 <= d6) return at(c, 2);
+    const float vb = d5 * d2 - d1 * d6;
+    if (vb <= 0.0f && d2 >= 0.0f && d6 <= 0.0f) return at(a + ac * (d2 / (d2 - d6)), 5);
+    const float va = d3 * d6 - d5 * d4;
+    if (va <= 0.0f && d4 - d3 >= 0.0f && d5 - d6 >= 0.0f)
+        return at(b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))), 4);
+    const float sum = va + vb + vc;
+    return sum > 0.0f ? at(a + ab * (vb / sum) + ac * (vc / sum), 6) : at(a, 0);
+}
+
 // ---- A hierarchy of triangles: boxes for the nearest triangle, dipoles for the winding ----
 
 struct Box {
@@ -84,29 +117,6 @@ class Hierarchy {
         }
         nodes_.reserve(2 * n / kLeaf + 2);
         build(0, uint32_t(n));
-    }
-
-    // The distance from p to the nearest triangle, if nearer than `limit`; else `limit`.
-    float nearest(vec3 p, float limit) const {
-        float best2 = limit * limit;
-        uint32_t stack[64];
-        int top = 0;
-        stack[top++] = 0;
-        while (top > 0) {
-            const Node& n = nodes_[stack[--top]];
-            if (n.box.distance2(p) >= best2) continue;
-            if (n.count > 0) {
-                for (uint32_t k = n.first; k < n.first + n.count; ++k)
-                    best2 = std::min(best2, triangleDistance2(p, order_[k]));
-                continue;
-            }
-            const float da = nodes_[n.left].box.distance2(p);
-            const float db = nodes_[n.right].box.distance2(p);
-            // The nearer child is searched first: pushed last.
-            stack[top++] = da < db ? n.right : n.left;
-            stack[top++] = da < db ? n.left : n.right;
-        }
-        return std::sqrt(best2);
     }
 
     // The generalised winding number at p.
@@ -192,39 +202,6 @@ class Hierarchy {
         return index;
     }
 
-    // Ericson's closest point on a triangle, as a squared distance.
-    float triangleDistance2(vec3 p, size_t t) const {
-        const vec3 a = corner(t, 0), b = corner(t, 1), c = corner(t, 2);
-        const vec3 ab = b - a, ac = c - a, ap = p - a;
-        const float d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
-        vec3 q;
-        if (d1 <= 0.0f && d2 <= 0.0f) {
-            q = a;
-        } else {
-            const vec3 bp = p - b;
-            const float d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
-            const vec3 cp = p - c;
-            const float d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
-            const float vc = d1 * d4 - d3 * d2, vb = d5 * d2 - d1 * d6, va = d3 * d6 - d5 * d4;
-            if (d3 >= 0.0f && d4 <= d3)
-                q = b;
-            else if (d6 >= 0.0f && d5 <= d6)
-                q = c;
-            else if (vc <= 0.0f && d1 >= 0.0f && d3 <= 0.0f)
-                q = a + ab * (d1 / (d1 - d3));
-            else if (vb <= 0.0f && d2 >= 0.0f && d6 <= 0.0f)
-                q = a + ac * (d2 / (d2 - d6));
-            else if (va <= 0.0f && d4 - d3 >= 0.0f && d5 - d6 >= 0.0f)
-                q = b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-            else {
-                const float sum = va + vb + vc;
-                q = sum > 0.0f ? a + ab * (vb / sum) + ac * (vc / sum) : a;
-            }
-        }
-        const vec3 d = p - q;
-        return glm::dot(d, d);
-    }
-
     // The solid angle the triangle subtends at p, signed (Van Oosterom and Strackee 1983).
     double solidAngle(vec3 p, size_t t) const {
         const glm::dvec3 a = glm::dvec3(corner(t, 0) - p), b = glm::dvec3(corner(t, 1) - p),
@@ -240,6 +217,49 @@ class Hierarchy {
     std::vector<uint32_t> order_;
     std::vector<vec3> centres_;
     std::vector<Node> nodes_;
+};
+
+// The angle-weighted pseudonormals of a closed, consistently oriented mesh (Baerentzen and Aanaes
+// 2005): at the feature of the mesh nearest to p (a face, an edge or a corner), p lies outside
+// exactly where it is on the side its pseudonormal points to.
+struct Pseudonormals {
+    std::vector<vec3> corners;              // per vertex: angle-weighted sum of face normals
+    std::vector<std::array<vec3, 3>> edges; // per triangle, edges ab, bc, ca: the two faces' sum
+    std::vector<vec3> faces;
+
+    explicit Pseudonormals(const TriangleMesh& mesh)
+        : corners(mesh.positions.size(), vec3(0.0f)), edges(mesh.triangles.size()),
+          faces(mesh.triangles.size()) {
+        std::unordered_map<uint64_t, vec3> edgeSums;
+        const auto key = [](uint32_t u, uint32_t v) {
+            return (uint64_t(std::min(u, v)) << 32) | std::max(u, v);
+        };
+        for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+            const glm::uvec3 i = mesh.triangles[t];
+            const vec3 p[3] = {mesh.positions[i.x], mesh.positions[i.y], mesh.positions[i.z]};
+            const vec3 n = glm::cross(p[1] - p[0], p[2] - p[0]);
+            faces[t] = glm::length(n) > 0.0f ? glm::normalize(n) : vec3(0.0f);
+            for (int c = 0; c < 3; ++c) {
+                const vec3 e1 = p[(c + 1) % 3] - p[c], e2 = p[(c + 2) % 3] - p[c];
+                const float l = glm::length(e1) * glm::length(e2);
+                const float angle =
+                    l > 0.0f ? std::acos(glm::clamp(glm::dot(e1, e2) / l, -1.0f, 1.0f)) : 0.0f;
+                corners[i[c]] += angle * faces[t];
+                edgeSums[key(i[c], i[(c + 1) % 3])] += faces[t];
+            }
+        }
+        for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+            const glm::uvec3 i = mesh.triangles[t];
+            for (int e = 0; e < 3; ++e)
+                edges[t][e] = edgeSums[key(i[e], i[(e + 1) % 3])];
+        }
+    }
+
+    vec3 at(const TriangleMesh& mesh, uint32_t t, int feature) const {
+        return feature < 3   ? corners[mesh.triangles[t][feature]]
+               : feature < 6 ? edges[t][feature - 3]
+                             : faces[t];
+    }
 };
 
 // Runs body(i) for i in [0, count) on every core.
@@ -274,8 +294,7 @@ Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::strin
     }
     Assimp::Importer importer;
     const aiScene* scene = importer.ReadFileFromMemory(
-        bytes.data(), bytes.size(),
-        aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices,
+        bytes.data(), bytes.size(), aiProcess_Triangulate | aiProcess_PreTransformVertices,
         hint.c_str());
     if (!scene)
         return reason("not a mesh file that can be read: " +
@@ -286,36 +305,36 @@ Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::strin
     if (faces > kMaxMeshTriangles)
         return reason("more than " + std::to_string(kMaxMeshTriangles) + " triangles (" +
                       std::to_string(faces) + ")");
-    // One vertex per position across the file's meshes, so that edges between them are shared.
-    TriangleMesh mesh;
-    std::unordered_map<uint64_t, std::vector<uint32_t>> seen;
-    auto vertex = [&](const aiVector3D& v) -> uint32_t {
-        const vec3 p(v.x, v.y, v.z);
-        uint32_t bits[3];
-        std::memcpy(bits, &p, sizeof bits);
-        const uint64_t key = (uint64_t(bits[0]) * 0x9E3779B97F4A7C15ull) ^
-                             (uint64_t(bits[1]) * 0xC2B2AE3D27D4EB4Full) ^ bits[2];
-        std::vector<uint32_t>& same = seen[key];
-        for (uint32_t i : same)
-            if (mesh.positions[i] == p) return i;
-        same.push_back(uint32_t(mesh.positions.size()));
-        mesh.positions.push_back(p);
-        return same.back();
+    // One vertex per position across the file's meshes, so that edges between them are shared:
+    // the corners sorted by position, each run of equal ones made one vertex.
+    struct Corner {
+        vec3 p;
+        uint32_t at; // triangle * 3 + corner
     };
+    std::vector<Corner> corners;
+    corners.reserve(3 * faces);
     for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
         const aiMesh& part = *scene->mMeshes[m];
         for (unsigned f = 0; f < part.mNumFaces; ++f) {
             const aiFace& face = part.mFaces[f];
             if (face.mNumIndices != 3) continue;
-            glm::uvec3 t;
             for (int c = 0; c < 3; ++c) {
                 const aiVector3D& v = part.mVertices[face.mIndices[c]];
                 if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
                     return reason("a NaN or infinite vertex");
-                t[c] = vertex(v);
+                corners.push_back({vec3(v.x, v.y, v.z), uint32_t(corners.size())});
             }
-            mesh.triangles.push_back(t);
         }
+    }
+    const auto before = [](const Corner& a, const Corner& b) {
+        return a.p.x != b.p.x ? a.p.x < b.p.x : a.p.y != b.p.y ? a.p.y < b.p.y : a.p.z < b.p.z;
+    };
+    std::sort(corners.begin(), corners.end(), before);
+    TriangleMesh mesh;
+    mesh.triangles.resize(corners.size() / 3);
+    for (size_t k = 0; k < corners.size(); ++k) {
+        if (k == 0 || corners[k].p != corners[k - 1].p) mesh.positions.push_back(corners[k].p);
+        mesh.triangles[corners[k].at / 3][corners[k].at % 3] = uint32_t(mesh.positions.size() - 1);
     }
     if (mesh.triangles.empty()) return reason("no triangles");
     return mesh;
@@ -385,54 +404,128 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
         return (size_t(b.z) * size_t(f.bricks_.y) + size_t(b.y)) * size_t(f.bricks_.x) +
                size_t(b.x);
     };
-    // Bricks within the band of a triangle's box hold samples.
+    // The bricks within reach of each triangle's box hold samples; each lists those triangles.
+    std::vector<std::pair<uint32_t, uint32_t>> touches; // (slot, triangle)
     size_t stored = 0;
-    for (const glm::uvec3& t : mesh.triangles) {
+    for (uint32_t t = 0; t < mesh.triangles.size(); ++t) {
         Box tb;
         for (int c = 0; c < 3; ++c)
-            tb.add(mesh.positions[t[c]]);
+            tb.add(mesh.positions[mesh.triangles[t][c]]);
         const glm::ivec3 lo = brickOf(tb.lo - margin), hi = brickOf(tb.hi + margin);
         for (int z = lo.z; z <= hi.z; ++z)
             for (int y = lo.y; y <= hi.y; ++y)
                 for (int x = lo.x; x <= hi.x; ++x) {
-                    int32_t& s = f.slots_[slotOf({x, y, z})];
-                    if (s == kOutside) s = 0, ++stored;
+                    const size_t s = slotOf({x, y, z});
+                    if (f.slots_[s] == kOutside) f.slots_[s] = 0, ++stored;
+                    touches.emplace_back(uint32_t(s), t);
                 }
-        if (stored * kBrickSamples * sizeof(float) + slots * sizeof(int32_t) > kMaxMeshFieldBytes)
-            return tooLarge(stored * kBrickSamples * sizeof(float) + slots * sizeof(int32_t));
+        const size_t bytes = stored * kBrickSamples * sizeof(float) + slots * sizeof(int32_t) +
+                             touches.size() * sizeof(touches[0]);
+        if (bytes > kMaxMeshFieldBytes) return tooLarge(bytes);
     }
-    std::vector<uint32_t> storedSlots;
-    storedSlots.reserve(stored);
-    for (size_t s = 0; s < slots; ++s)
-        if (f.slots_[s] == 0) {
-            f.slots_[s] = int32_t(storedSlots.size() * kBrickSamples);
-            storedSlots.push_back(uint32_t(s));
+    std::sort(touches.begin(), touches.end());
+    // Stored bricks in slot order, each with its range of `touches`.
+    std::vector<std::pair<uint32_t, size_t>> bricks; // (slot, first touch)
+    for (size_t k = 0; k < touches.size(); ++k)
+        if (k == 0 || touches[k].first != touches[k - 1].first) {
+            f.slots_[touches[k].first] = int32_t(bricks.size() * kBrickSamples);
+            bricks.emplace_back(touches[k].first, k);
         }
-    f.samples_.resize(storedSlots.size() * kBrickSamples);
-    const Hierarchy h(mesh);
+    bricks.emplace_back(0, touches.size());
+    f.samples_.resize((bricks.size() - 1) * kBrickSamples);
     const auto brickCorner = [&](size_t s) {
         const size_t x = s % size_t(f.bricks_.x),
                      y = (s / size_t(f.bricks_.x)) % size_t(f.bricks_.y),
                      z = s / (size_t(f.bricks_.x) * size_t(f.bricks_.y));
         return f.origin_ + brickSize * vec3(float(x), float(y), float(z));
     };
-    // Samples: the distance to the nearest triangle, negative where the winding number says
-    // inside. Bricks without samples: their centre's inside.
-    const float far = 2.0f * brickSize + margin;
-    parallelFor(storedSlots.size(), [&](size_t i) {
-        const vec3 corner = brickCorner(storedSlots[i]);
-        float* out = &f.samples_[i * kBrickSamples];
-        for (int z = 0; z < kBrickSide; ++z)
-            for (int y = 0; y < kBrickSide; ++y)
-                for (int x = 0; x < kBrickSide; ++x) {
-                    const vec3 p = corner + f.cell_ * vec3(float(x), float(y), float(z));
-                    const float d = h.nearest(p, far);
-                    *out++ = h.winding(p) >= 0.5f ? -d : d;
-                }
+    // The sign: from the pseudonormals where the mesh is closed and consistently oriented, else
+    // from the winding number. Samples beyond every triangle's reach are at least `margin` from
+    // the surface, as are their neighbours at least margin - cell: no surface lies between
+    // them, and they take a neighbour's sign.
+    const bool clean = !meshDefects(mesh).any();
+    const Pseudonormals normals(clean ? mesh : TriangleMesh{});
+    const Hierarchy h(mesh);
+    parallelFor(bricks.size() - 1, [&](size_t b) {
+        const vec3 corner = brickCorner(bricks[b].first);
+        float* out = &f.samples_[b * kBrickSamples];
+        float best[kBrickSamples];
+        uint32_t nearest[kBrickSamples];
+        std::fill(best, best + kBrickSamples, margin * margin);
+        std::fill(nearest, nearest + kBrickSamples, ~0u);
+        for (size_t k = bricks[b].second; k < bricks[b + 1].second; ++k) {
+            const uint32_t t = touches[k].second;
+            const glm::uvec3 i = mesh.triangles[t];
+            const vec3 a = mesh.positions[i.x], bb = mesh.positions[i.y], c = mesh.positions[i.z];
+            const vec3 lo = (glm::min(a, glm::min(bb, c)) - margin - corner) / f.cell_;
+            const vec3 hi = (glm::max(a, glm::max(bb, c)) + margin - corner) / f.cell_;
+            const glm::ivec3 from = glm::max(glm::ivec3(glm::ceil(lo)), glm::ivec3(0));
+            const glm::ivec3 to = glm::min(glm::ivec3(glm::floor(hi)), glm::ivec3(kBrick));
+            const vec3 normal = glm::cross(bb - a, c - a);
+            const float area2 = glm::dot(normal, normal);
+            for (int z = from.z; z <= to.z; ++z)
+                for (int y = from.y; y <= to.y; ++y)
+                    for (int x = from.x; x <= to.x; ++x) {
+                        const size_t s =
+                            (size_t(z) * kBrickSide + size_t(y)) * kBrickSide + size_t(x);
+                        const vec3 p = corner + f.cell_ * vec3(float(x), float(y), float(z));
+                        // The plane's distance is at most the triangle's: most samples are
+                        // already nearer another.
+                        const float plane = glm::dot(p - a, normal);
+                        if (plane * plane >= best[s] * area2) continue;
+                        const float d2 = nearestOnTriangle(p, a, bb, c).distance2;
+                        if (d2 < best[s]) best[s] = d2, nearest[s] = t;
+                    }
+        }
+        // Signs of the samples a triangle reached, then passed on to the rest.
+        int8_t sign[kBrickSamples] = {};
+        const auto point = [&](int s) {
+            return corner + f.cell_ * vec3(float(s % kBrickSide),
+                                           float(s / kBrickSide % kBrickSide),
+                                           float(s / (kBrickSide * kBrickSide)));
+        };
+        bool any = false;
+        for (int s = 0; s < kBrickSamples; ++s) {
+            if (nearest[s] == ~0u) continue;
+            const vec3 p = point(s);
+            bool inside;
+            if (clean) {
+                const glm::uvec3 i = mesh.triangles[nearest[s]];
+                const Nearest n = nearestOnTriangle(p, mesh.positions[i.x], mesh.positions[i.y],
+                                                    mesh.positions[i.z]);
+                inside = glm::dot(p - n.point, normals.at(mesh, nearest[s], n.feature)) < 0.0f;
+            } else {
+                inside = h.winding(p) >= 0.5f;
+            }
+            sign[s] = inside ? -1 : 1;
+            any = true;
+        }
+        if (!any) sign[0] = h.winding(point(0)) >= 0.5f ? -1 : 1;
+        for (bool changed = true; changed;) {
+            changed = false;
+            for (int s = 0; s < kBrickSamples; ++s) {
+                if (sign[s] != 0) continue;
+                const int x = s % kBrickSide, y = s / kBrickSide % kBrickSide,
+                          z = s / (kBrickSide * kBrickSide);
+                const int8_t next = x > 0 && sign[s - 1]                 ? sign[s - 1]
+                                    : x < kBrick && sign[s + 1]          ? sign[s + 1]
+                                    : y > 0 && sign[s - kBrickSide]      ? sign[s - kBrickSide]
+                                    : y < kBrick && sign[s + kBrickSide] ? sign[s + kBrickSide]
+                                    : z > 0 && sign[s - kBrickSide * kBrickSide]
+                                        ? sign[s - kBrickSide * kBrickSide]
+                                    : z < kBrick && sign[s + kBrickSide * kBrickSide]
+                                        ? sign[s + kBrickSide * kBrickSide]
+                                        : int8_t(0);
+                if (next != 0) sign[s] = next, changed = true;
+            }
+        }
+        for (int s = 0; s < kBrickSamples; ++s)
+            out[s] = float(sign[s]) * std::sqrt(best[s]);
     });
+    // Bricks without samples: their centre's inside.
     parallelFor(slots, [&](size_t s) {
-        if (f.slots_[s] != kOutside) return;
-        if (h.winding(brickCorner(s) + 0.5f * brickSize) >= 0.5f) f.slots_[s] = kInside;
+        if (f.slots_[s] == kOutside && h.winding(brickCorner(s) + 0.5f * brickSize) >= 0.5f)
+            f.slots_[s] = kInside;
     });
     return f;
 }
