@@ -357,6 +357,40 @@ SDF_FN float sdOutline(vec3 p3, float firstAt, float nx, vec2 lo, vec2 hi, float
     return max(winding != 0.0f ? -d : d, boxDistance);
 }
 
+// The image profile's sample at grid point g of a grid of nx per row (engine/src/scene/image.h:
+// four samples to a word, from word 2).
+SDF_FN float imageSample(uint first, float nx, vec2 g SDF_DATA_PARAM) {
+    uint k = uint(g.x + nx * g.y);
+    return SDF_DATA(first + 2u + k / 4u)[int(k % 4u)];
+}
+
+// Image: the signed distance to a mask's edges (engine/src/scene/image.h, from `first`), sampled
+// at the centres of the pixels of the image (lo to hi) and of a ring of outside pixels around
+// it, nx by ny samples `side` apart, and interpolated bilinearly: exact at the samples, and
+// within a small part of a pixel of the distance between them (bilinear interpolation of a
+// distance has a slope of up to sqrt(2) within a pixel or two of a corner of the mask). Beyond
+// the samples, at q the nearest point of their rectangle, sqrt(|p - q|^2 + d(q)^2): the edges
+// lie inside the image, on the far side of q from p, so this is a lower bound, 1-Lipschitz and
+// the interpolation itself on the rectangle. Never below the distance to the image's box.
+SDF_FN float sdImage(vec3 p3, float firstAt, float nx, vec2 lo, vec2 hi, float ny, float side
+                     SDF_DATA_PARAM) {
+    vec2 p = vec2(p3.x, p3.y);
+    uint first = uint(firstAt);
+    vec2 corner = lo - 0.5f * side, last = vec2(nx, ny) - 1.0f;
+    vec2 q = clamp(p, corner, corner + last * side);
+    vec2 t = (q - corner) / side;
+    vec2 g = clamp(floor(t), vec2(0.0f), last - 1.0f);
+    vec2 f = t - g;
+    float d00 = imageSample(first, nx, g SDF_DATA_ARG);
+    float d10 = imageSample(first, nx, g + vec2(1.0f, 0.0f) SDF_DATA_ARG);
+    float d01 = imageSample(first, nx, g + vec2(0.0f, 1.0f) SDF_DATA_ARG);
+    float d11 = imageSample(first, nx, g + vec2(1.0f) SDF_DATA_ARG);
+    float d = mix(mix(d00, d10, f.x), mix(d01, d11, f.x), f.y);
+    float v = d < 0.0f ? d : sqrt(dot2(p - q) + d * d);
+    vec2 e = max(lo - p, p - hi);
+    return max(v, length(max(e, 0.0f)) + min(max(e.x, e.y), 0.0f));
+}
+
 // CSG operators: IQ's polynomial smooth minimum with blend radius k, and smooth max(a, b) =
 // -smin(-a, -b). Once the operands differ by k or more the blend factor is exactly 0 or 1, so
 // those cases return an operand unchanged: this makes bounds skipping and pruning exact in
@@ -487,6 +521,8 @@ SDF_FN float sdPrimitive(uint kind, vec3 q, vec4 a, vec4 b, uint kinds SDF_DATA_
     if (SDF_IS(kKindRegularPolygon)) return sdRegularPolygon(q, a.x, a.y, a.z, a.w);
     if (SDF_IS(kKindPolygon) || SDF_IS(kKindText))
         return sdOutline(q, a.x, a.y, vec2(a.z, a.w), vec2(b.x, b.y), b.z, b.w SDF_DATA_ARG);
+    if (SDF_IS(kKindImage))
+        return sdImage(q, a.x, a.y, vec2(a.z, a.w), vec2(b.x, b.y), b.z, b.w SDF_DATA_ARG);
     return 1e30f;
 }
 #undef SDF_IS

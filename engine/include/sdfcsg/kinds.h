@@ -35,7 +35,8 @@
     X(Rectangle)                                                                                   \
     X(RegularPolygon)                                                                              \
     X(Polygon)                                                                                     \
-    X(Text)
+    X(Text)                                                                                        \
+    X(Image)
 
 // Operations of any number of children; the transitions take exactly two and come last.
 #define SDFCSG_BOOLEAN_KINDS(X)                                                                    \
