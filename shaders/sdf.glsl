@@ -391,6 +391,27 @@ SDF_FN float sdImage(vec3 p3, float firstAt, float nx, vec2 lo, vec2 hi, float n
     return max(v, length(max(e, 0.0f)) + min(max(e.x, e.y), 0.0f));
 }
 
+// Heightmap: the solid under heights over x in [-hx, hx], z in [-hz, hz] (engine/src/scene/image.h,
+// from `first`: nx by ny heights at the centres of the image's pixels, interpolated bilinearly
+// and held at the border's beyond them), within the box up to `height`. y - height(x, z) changes
+// by at most sqrt(1 + sx^2 + sz^2) per unit, sx and sz the steepest slopes of the interpolation,
+// so times its inverse `invL` it is a bound, and so is its maximum with the box's distance.
+SDF_FN float sdHeightmap(vec3 p, float firstAt, float nx, float hx, float hz, float height,
+                         float ny, float invL SDF_DATA_PARAM) {
+    uint first = uint(firstAt);
+    vec2 n = vec2(nx, ny), extent = vec2(hx, hz);
+    vec2 t = clamp((vec2(p.x, p.z) + extent) * n / (2.0f * extent) - 0.5f, vec2(0.0f), n - 1.0f);
+    vec2 g = min(floor(t), max(n - 2.0f, 0.0f)), g1 = min(g + 1.0f, n - 1.0f);
+    vec2 f = t - g;
+    float h00 = imageSample(first, nx, g SDF_DATA_ARG);
+    float h10 = imageSample(first, nx, vec2(g1.x, g.y) SDF_DATA_ARG);
+    float h01 = imageSample(first, nx, vec2(g.x, g1.y) SDF_DATA_ARG);
+    float h11 = imageSample(first, nx, g1 SDF_DATA_ARG);
+    float h = mix(mix(h00, h10, f.x), mix(h01, h11, f.x), f.y);
+    float box = sdBox(p - vec3(0.0f, 0.5f * height, 0.0f), vec3(hx, 0.5f * height, hz));
+    return max((p.y - h) * invL, box);
+}
+
 // CSG operators: IQ's polynomial smooth minimum with blend radius k, and smooth max(a, b) =
 // -smin(-a, -b). Once the operands differ by k or more the blend factor is exactly 0 or 1, so
 // those cases return an operand unchanged: this makes bounds skipping and pruning exact in
@@ -516,6 +537,8 @@ SDF_FN float sdPrimitive(uint kind, vec3 q, vec4 a, vec4 b, uint kinds SDF_DATA_
     if (SDF_IS(kKindRoundCone)) return sdRoundCone(q, a.x, a.y, a.z, a.w, b.x);
     if (SDF_IS(kKindLink)) return sdLink(q, a.x, a.y, a.z);
     if (SDF_IS(kKindCappedTorus)) return sdCappedTorus(q, a.x, a.y, a.z, a.w);
+    if (SDF_IS(kKindHeightmap))
+        return sdHeightmap(q, a.x, a.y, a.z, a.w, b.x, b.z, b.w SDF_DATA_ARG);
     if (SDF_IS(kKindCircle)) return sdCircle(q, a.x);
     if (SDF_IS(kKindRectangle)) return sdRectangle(q, a.x, a.y, a.z);
     if (SDF_IS(kKindRegularPolygon)) return sdRegularPolygon(q, a.x, a.y, a.z, a.w);

@@ -1,5 +1,6 @@
-// The image profile on the CPU: masks drawn into PNGs here against the analytic distances of
-// what was drawn, its field's slope, its parameters' and hostile files' messages.
+// The image profile and the heightmap on the CPU: masks and heights drawn into PNGs here against
+// the analytic distances of what was drawn, their fields' slopes, their parameters' and hostile
+// files' messages.
 #include "scene/image.h"
 
 #include "scene_build_util.h"
@@ -213,6 +214,88 @@ TEST(ImageProfile, ItsParametersAreChecked) {
               "\"white\"");
     EXPECT_EQ(errorOf(R"("size": 1)"),
               "test.json: root.children[0]: missing required key \"file\" (a string)");
+}
+
+// A w by h PNG of grey levels grey(column, row) in 0..255.
+fs::path greyPng(const std::string& name, uint32_t w, uint32_t h,
+                 const std::function<uint8_t(uint32_t, uint32_t)>& grey) {
+    Image image{w, h, std::vector<uint8_t>(size_t(w) * h * 4, 255)};
+    for (uint32_t r = 0; r < h; ++r)
+        for (uint32_t c = 0; c < w; ++c)
+            for (size_t k = 0; k < 3; ++k)
+                image.rgba[4 * (c + size_t(w) * r) + k] = grey(c, r);
+    const fs::path file = outputDir() / name;
+    EXPECT_TRUE(writePng(image, file));
+    return file;
+}
+
+Evaluator heightmapField(const fs::path& file, const std::string& size) {
+    return Evaluator(test::parseRoot(R"({"type": "heightmap", "file": ")" + file.string() +
+                                     R"(", "size": )" + size + "}"));
+}
+
+// Grey levels rising by 5 a column (exactly linear in 8 bits) make a ramp: above it, away from
+// its edges, the field is the distance to its plane (its slope is the bound it divides by).
+TEST(Heightmap, RampIsTheDistanceToItsPlane) {
+    const fs::path file = greyPng("ramp.png", 52, 8, [](uint32_t c, uint32_t) { return c * 5; });
+    const Evaluator field = heightmapField(file, "[2.6, 0.5, 1]"); // a pixel is 0.05 along x
+    const double slope = 0.5 / 2.55;                               // 0.5 over 51 pixels
+    auto height = [&](double x) { return (x + 1.3 - 0.025) * slope; };
+    std::mt19937 rng(4);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f), up(0.0f, 0.15f);
+    for (int i = 0; i < 5000; ++i) {
+        const float x = u(rng), z = 0.3f * u(rng);
+        const float y = float(height(x)) + up(rng);
+        const double truth = (y - height(x)) / std::sqrt(1.0 + slope * slope);
+        ASSERT_NEAR(field.distance({x, y, z}), truth, 2e-5) << x << " " << y << " " << z;
+    }
+    // Below the ramp, inside its box: inside.
+    EXPECT_LT(field.distance({0.5f, float(height(0.5)) - 0.01f, 0.0f}), 0.0f);
+    EXPECT_GT(field.distance({0.5f, float(height(0.5)) + 0.01f, 0.0f}), 0.0f);
+}
+
+// Over the bundled terrain the field changes by at most the distance between two points, is
+// negative exactly below the interpolated heights within the box, and bounds the distance.
+TEST(Heightmap, TerrainFieldIsABound) {
+    const Evaluator field =
+        heightmapField(fs::path(SDFCSG_SOURCE_DIR) / "assets/scenes/terrain.png", "[2, 0.6, 2]");
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(-1.3f, 1.3f), step(-0.2f, 0.2f);
+    for (int i = 0; i < 20000; ++i) {
+        const glm::vec3 a(u(rng), 0.5f * u(rng) + 0.3f, u(rng));
+        const glm::vec3 b = a + glm::vec3(step(rng), step(rng), step(rng));
+        ASSERT_LE(std::abs(field.distance(a) - field.distance(b)),
+                  glm::length(b - a) * (1.0f + 1e-5f) + 1e-6f)
+            << a.x << " " << a.y << " " << a.z;
+    }
+    // A column through the terrain changes sign once, where the heights are; the value above is
+    // at most the height above the surface.
+    for (int i = 0; i < 200; ++i) {
+        const float x = 0.95f * u(rng) / 1.3f, z = 0.95f * u(rng) / 1.3f;
+        float surface = -1.0f;
+        for (float y = 0.0005f; y < 0.6f; y += 0.001f)
+            if (field.distance({x, y, z}) >= 0.0f) {
+                surface = y;
+                break;
+            }
+        ASSERT_GE(surface, 0.0f) << x << " " << z;
+        for (float y : {surface + 0.05f, surface + 0.3f})
+            EXPECT_LE(field.distance({x, y, z}), y - surface + 1e-3f);
+        for (float y = surface + 0.002f; y < 0.7f; y += 0.01f)
+            ASSERT_GT(field.distance({x, y, z}), 0.0f) << x << " " << y << " " << z;
+    }
+}
+
+TEST(Heightmap, ItsProblemsAreNamed) {
+    auto error = [](const std::string& members) {
+        auto scene = parseScene(R"({"version": 1, "root": {"type": "heightmap", )" + members + "}}",
+                                "test.json");
+        return scene ? "accepted" : scene.error().str();
+    };
+    EXPECT_EQ(error(R"("file": "emblem.png")"),
+              "test.json: root: missing required key \"size\" (an array of 3 positive numbers)");
+    EXPECT_EQ(error(R"("file": "nothing.png", "size": [1, 1, 1])"),
+              "test.json: root.file: cannot load image \"nothing.png\": no such file");
 }
 
 } // namespace

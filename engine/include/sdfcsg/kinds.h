@@ -27,7 +27,8 @@
     X(RoundedCylinder)                                                                             \
     X(RoundCone)                                                                                   \
     X(Link)                                                                                        \
-    X(CappedTorus)
+    X(CappedTorus)                                                                                 \
+    X(Heightmap)
 
 // Shapes in the xy plane, for extrude and revolve.
 #define SDFCSG_PROFILE_KINDS(X)                                                                    \

@@ -305,7 +305,8 @@ template <class V> float dist(const V& v) {
 // the first word's index (0 here; the node buffer rebases it), then word 0's x, word 1, word 0's
 // y and z. Polygon and text, sdOutline's (outline.h): its grid's cells per row (0 for an outline
 // listed by contour), its box, and the grid's rows and cell side (or the number of contours);
-// image, sdImage's (image.h): the same of its grid of distances.
+// image, sdImage's (image.h): the same of its grid of distances; heightmap, sdHeightmap's: its
+// samples per row, half extents along x and z, height, 0, rows and 1 / its Lipschitz bound.
 Params wordsParams(const std::vector<glm::vec4>* words) {
     if (!words || words->size() < 2) return Params{};
     const glm::vec4 layout = (*words)[0], box = (*words)[1];
@@ -601,6 +602,9 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
         float loss = float(acc[i].stretch);
         for (uint32_t c : n.children)
             loss = std::max(loss, nodes_[c].loss);
+        // A heightmap's value is the height difference over its Lipschitz bound (slot 7: 1 / it).
+        if (n.kind == NodeKind::Heightmap && n.params[7] > 0.0f)
+            loss = std::max(loss, 1.0f / n.params[7]);
         if (n.kind == NodeKind::Ellipsoid) {
             const float lo = std::min({src.params[0], src.params[1], src.params[2]});
             const float hi = std::max({src.params[0], src.params[1], src.params[2]});

@@ -140,8 +140,10 @@ std::vector<float> signedDistances(const std::vector<bool>& inside, uint32_t w, 
     return d;
 }
 
-Result<std::shared_ptr<const std::vector<glm::vec4>>> buildImage(const Node& node,
-                                                                 const SceneFiles& files) {
+namespace {
+
+// The image that the node's "file" names, found under `files` and read.
+Result<GreyImage> nodeImage(const Node& node, const SceneFiles& files) {
     const std::string& name = node.strings[0];
     auto fail = [&](const std::string& why) {
         if (!files.trusted)
@@ -156,6 +158,16 @@ Result<std::shared_ptr<const std::vector<glm::vec4>>> buildImage(const Node& nod
     if (!file) return fail(file.error().diagnostics[0].message);
     auto image = readPng(*file);
     if (!image) return fail(image.error().diagnostics[0].message);
+    return image;
+}
+
+} // namespace
+
+Result<std::shared_ptr<const std::vector<glm::vec4>>> buildImage(const Node& node,
+                                                                 const SceneFiles& files) {
+    const std::string& name = node.strings[0];
+    auto image = nodeImage(node, files);
+    if (!image) return image.error();
 
     // Inside: ink (dark and opaque) at least the threshold, or with "inside": "light", light and
     // opaque; the ring around the image is outside.
@@ -189,6 +201,32 @@ Result<std::shared_ptr<const std::vector<glm::vec4>>> buildImage(const Node& nod
     (*words)[1] = glm::vec4(-half.x, -half.y, half.x, half.y);
     for (size_t i = 0; i < d.size(); ++i)
         (*words)[2 + i / 4][int(i % 4)] = d[i] * side;
+    return std::shared_ptr<const std::vector<glm::vec4>>(std::move(words));
+}
+
+Result<std::shared_ptr<const std::vector<glm::vec4>>> buildHeightmap(const Node& node,
+                                                                     const SceneFiles& files) {
+    auto image = nodeImage(node, files);
+    if (!image) return image.error();
+    const uint32_t w = image->width, h = image->height;
+    const glm::vec3 size(node.params[0], node.params[1], node.params[2]);
+    const glm::vec2 cell(size.x / float(w), size.z / float(h));
+    // The interpolation's steepest slope along x and along z bounds its gradient's length.
+    double sx = 0.0, sz = 0.0;
+    for (uint32_t r = 0; r < h; ++r)
+        for (uint32_t c = 0; c < w; ++c) {
+            const size_t i = c + size_t(w) * r;
+            if (c + 1 < w) sx = std::max(sx, double(std::abs(image->grey[i + 1] - image->grey[i])));
+            if (r + 1 < h) sz = std::max(sz, double(std::abs(image->grey[i + w] - image->grey[i])));
+        }
+    sx *= double(size.y) / double(cell.x), sz *= double(size.y) / double(cell.y);
+    auto words =
+        std::make_shared<std::vector<glm::vec4>>(2 + (image->grey.size() + 3) / 4, glm::vec4(0.0f));
+    (*words)[0] =
+        glm::vec4(float(w), float(h), float(1.0 / std::sqrt(1.0 + sx * sx + sz * sz)), 0.0f);
+    (*words)[1] = glm::vec4(0.5f * size.x, 0.5f * size.z, size.y, 0.0f);
+    for (size_t i = 0; i < image->grey.size(); ++i)
+        (*words)[2 + i / 4][int(i % 4)] = image->grey[i] * size.y;
     return std::shared_ptr<const std::vector<glm::vec4>>(std::move(words));
 }
 

@@ -1,11 +1,15 @@
 // PNG images that a scene names: the image profile's mask, made into a grid of signed distances
-// as shaders/sdf.glsl's sdImage reads it.
+// as shaders/sdf.glsl's sdImage reads it, and the heightmap's heights, as sdHeightmap reads them.
 //
 // The words (Node::words): word 0 is (samples per row nx, rows ny, sample spacing, 0), word 1
 // the image's rectangle (lo xy, hi xy), centred on the origin; from word 2 the nx * ny signed
 // distances, four to a word, row by row from the bottom (the image's last row) up. The samples
 // sit at the centres of the image's pixels and of a ring of pixels around it that count as
 // outside, so every edge of the mask lies inside the rectangle of samples.
+//
+// A heightmap's words: word 0 is (samples per row nx, rows ny, 1 / its Lipschitz bound, 0), word 1
+// (half its size along x, along z, its height, 0); from word 2 the heights at the pixels' centres,
+// four to a word, row by row from the image's top (-z) to its bottom (+z).
 #pragma once
 
 #include "sdfcsg/error.h"
@@ -51,5 +55,11 @@ std::vector<float> signedDistances(const std::vector<bool>& inside, uint32_t w, 
 // "unknown image" and nothing of the file system.
 Result<std::shared_ptr<const std::vector<glm::vec4>>> buildImage(const Node& node,
                                                                  const SceneFiles& files);
+
+// The heightmap node's words (above): grey levels 0 to 1 as heights 0 to size.y over size.x by
+// size.z, and the Lipschitz bound of y - height(x, z), sqrt(1 + sx^2 + sz^2) with sx and sz the
+// steepest slopes between neighbouring pixels along x and z. Errors as buildImage's.
+Result<std::shared_ptr<const std::vector<glm::vec4>>> buildHeightmap(const Node& node,
+                                                                     const SceneFiles& files);
 
 } // namespace sdfcsg::detail

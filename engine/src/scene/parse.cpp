@@ -864,9 +864,11 @@ Next SceneReader::readNode(element value, std::string path, uint32_t depth, Scen
     }
     // Past the limit, the words that passed it have said so: no more are built.
     if (hasWords(kind->kind) && paramsOk && outlineWords_ <= kMaxOutlineWords) {
-        auto outline =
-            kind->kind == NodeKind::Image ? buildImage(node, files_) : buildOutline(node, files_);
-        if (!outline && kind->kind == NodeKind::Image) {
+        const bool image = kind->kind == NodeKind::Image || kind->kind == NodeKind::Heightmap;
+        auto outline = kind->kind == NodeKind::Image       ? buildImage(node, files_)
+                       : kind->kind == NodeKind::Heightmap ? buildHeightmap(node, files_)
+                                                           : buildOutline(node, files_);
+        if (!outline && image) {
             problems_.add(member(p, "file"), outline.error().diagnostics[0].message);
         } else if (!outline) {
             const bool fontProblem = outline.error().diagnostics[0].path == "font";
