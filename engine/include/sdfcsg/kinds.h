@@ -27,7 +27,8 @@
     X(RoundedCylinder)                                                                             \
     X(RoundCone)                                                                                   \
     X(Link)                                                                                        \
-    X(CappedTorus)
+    X(CappedTorus)                                                                                 \
+    X(Heightmap)
 
 // Shapes in the xy plane, for extrude and revolve.
 #define SDFCSG_PROFILE_KINDS(X)                                                                    \
@@ -35,7 +36,8 @@
     X(Rectangle)                                                                                   \
     X(RegularPolygon)                                                                              \
     X(Polygon)                                                                                     \
-    X(Text)
+    X(Text)                                                                                        \
+    X(Image)
 
 // Operations of any number of children; the transitions take exactly two and come last.
 #define SDFCSG_BOOLEAN_KINDS(X)                                                                    \
