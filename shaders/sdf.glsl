@@ -412,6 +412,41 @@ SDF_FN float sdHeightmap(vec3 p, float firstAt, float nx, float hx, float hz, fl
     return max((p.y - h) * invL, box);
 }
 
+// Mesh: the field of a triangle mesh (engine/src/field/mesh_field.h, from `first`): word 0 holds
+// the grid's bricks along x, y, z and the band, word 1 its corner and cell; from word 2 a slot
+// per brick (its samples' first index over 729, or -1 outside, -2 inside), four to a word, then
+// the bricks' 9^3 samples each, four to a word. Trilinear within a brick with samples; the band,
+// a bound of the right sign, in one without; beyond the grid, the distance to it plus the band.
+SDF_FN float meshWord(uint at, uint k SDF_DATA_PARAM) {
+    return SDF_DATA(at + k / 4u)[int(k % 4u)];
+}
+SDF_FN float sdMesh(vec3 p, float firstAt, float bx, vec3 origin, float cell, float by, float bz
+                    SDF_DATA_PARAM) {
+    uint first = uint(firstAt);
+    float band = SDF_DATA(first).w;
+    vec3 bricks = vec3(bx, by, bz);
+    vec3 g = (p - origin) / cell;
+    vec3 outside = max(max(-g, g - 8.0f * bricks), vec3(0.0f));
+    if (outside.x + outside.y + outside.z > 0.0f) return length(outside) * cell + band;
+    vec3 b = min(floor(g / 8.0f), bricks - 1.0f);
+    float slot = meshWord(first + 2u, uint(b.x + bx * (b.y + by * b.z)) SDF_DATA_ARG);
+    if (slot < 0.0f) return slot < -1.5f ? -band : band;
+    uint samples = first + 2u + (uint(bx * by * bz) + 3u) / 4u;
+    vec3 local = min(g - 8.0f * b, vec3(8.0f));
+    vec3 i = min(floor(local), vec3(7.0f));
+    vec3 t = local - i;
+    uint k = uint(slot) * 729u + uint(i.x + 9.0f * (i.y + 9.0f * i.z));
+    float c000 = meshWord(samples, k SDF_DATA_ARG), c100 = meshWord(samples, k + 1u SDF_DATA_ARG);
+    float c010 = meshWord(samples, k + 9u SDF_DATA_ARG);
+    float c110 = meshWord(samples, k + 10u SDF_DATA_ARG);
+    float c001 = meshWord(samples, k + 81u SDF_DATA_ARG);
+    float c101 = meshWord(samples, k + 82u SDF_DATA_ARG);
+    float c011 = meshWord(samples, k + 90u SDF_DATA_ARG);
+    float c111 = meshWord(samples, k + 91u SDF_DATA_ARG);
+    return mix(mix(mix(c000, c100, t.x), mix(c010, c110, t.x), t.y),
+               mix(mix(c001, c101, t.x), mix(c011, c111, t.x), t.y), t.z);
+}
+
 // CSG operators: IQ's polynomial smooth minimum with blend radius k, and smooth max(a, b) =
 // -smin(-a, -b). Once the operands differ by k or more the blend factor is exactly 0 or 1, so
 // those cases return an operand unchanged: this makes bounds skipping and pruning exact in
@@ -539,6 +574,8 @@ SDF_FN float sdPrimitive(uint kind, vec3 q, vec4 a, vec4 b, uint kinds SDF_DATA_
     if (SDF_IS(kKindCappedTorus)) return sdCappedTorus(q, a.x, a.y, a.z, a.w);
     if (SDF_IS(kKindHeightmap))
         return sdHeightmap(q, a.x, a.y, a.z, a.w, b.x, b.z, b.w SDF_DATA_ARG);
+    if (SDF_IS(kKindMesh))
+        return sdMesh(q, a.x, a.y, vec3(a.z, a.w, b.x), b.y, b.z, b.w SDF_DATA_ARG);
     if (SDF_IS(kKindCircle)) return sdCircle(q, a.x);
     if (SDF_IS(kKindRectangle)) return sdRectangle(q, a.x, a.y, a.z);
     if (SDF_IS(kKindRegularPolygon)) return sdRegularPolygon(q, a.x, a.y, a.z, a.w);

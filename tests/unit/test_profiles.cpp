@@ -333,7 +333,7 @@ TEST(Profiles, OutlinesOfAllNodesAreBounded) {
     const std::string error =
         errorOf(R"({"type": "extrude", "height": 1, "children": [{"type": "union", "children": [)" +
                 kids + "]}]}");
-    EXPECT_NE(error.find("the scene's outlines and images exceed 64 MiB in all, the limit"),
+    EXPECT_NE(error.find("the scene's outlines, images and meshes exceed 64 MiB in all, the limit"),
               std::string::npos)
         << error.substr(0, 300);
 }

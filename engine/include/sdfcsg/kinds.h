@@ -28,7 +28,8 @@
     X(RoundCone)                                                                                   \
     X(Link)                                                                                        \
     X(CappedTorus)                                                                                 \
-    X(Heightmap)
+    X(Heightmap)                                                                                   \
+    X(Mesh)
 
 // Shapes in the xy plane, for extrude and revolve.
 #define SDFCSG_PROFILE_KINDS(X)                                                                    \

@@ -94,7 +94,8 @@ inline constexpr bool hasOutline(NodeKind kind) {
 }
 // The kinds whose data follows them in the node buffer (Node::words): outlines and images.
 inline constexpr bool hasWords(NodeKind kind) {
-    return hasOutline(kind) || kind == NodeKind::Image || kind == NodeKind::Heightmap;
+    return hasOutline(kind) || kind == NodeKind::Image || kind == NodeKind::Heightmap ||
+           kind == NodeKind::Mesh;
 }
 // A polygon's points, at most; and the vec4s of every node's words in a scene (outlines, a large
 // one listing its segments per cell of a grid, and images), so that they stay within 64 MiB of

@@ -1,6 +1,9 @@
 // A mesh's signed distance field (mesh_field.h).
 #include "field/mesh_field.h"
 
+#include "scene/files.h"
+#include "scene/parse_util.h"
+
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -14,6 +17,8 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <fstream>
+#include <iterator>
 #include <numbers>
 #include <optional>
 #include <thread>
@@ -313,6 +318,7 @@ Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::strin
     };
     std::vector<Corner> corners;
     corners.reserve(3 * faces);
+    const bool zUp = hint == "stl" || hint == "3mf";
     for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
         const aiMesh& part = *scene->mMeshes[m];
         for (unsigned f = 0; f < part.mNumFaces; ++f) {
@@ -322,7 +328,9 @@ Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::strin
                 const aiVector3D& v = part.mVertices[face.mIndices[c]];
                 if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
                     return reason("a NaN or infinite vertex");
-                corners.push_back({vec3(v.x, v.y, v.z), uint32_t(corners.size())});
+                // The printing formats build along z: their z is the scene's y.
+                const vec3 p = zUp ? vec3(v.x, v.z, -v.y) : vec3(v.x, v.y, v.z);
+                corners.push_back({p, uint32_t(corners.size())});
             }
         }
     }
@@ -528,6 +536,44 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
             f.slots_[s] = kInside;
     });
     return f;
+}
+
+std::vector<glm::vec4> MeshField::words() const {
+    std::vector<glm::vec4> w(2 + (slots_.size() + 3) / 4 + (samples_.size() + 3) / 4,
+                             glm::vec4(0.0f));
+    w[0] = glm::vec4(float(bricks_.x), float(bricks_.y), float(bricks_.z), band_);
+    w[1] = glm::vec4(origin_, cell_);
+    for (size_t s = 0; s < slots_.size(); ++s)
+        w[2 + s / 4][int(s % 4)] =
+            slots_[s] < 0 ? float(slots_[s]) : float(slots_[s] / kBrickSamples);
+    const size_t at = 2 + (slots_.size() + 3) / 4;
+    for (size_t k = 0; k < samples_.size(); ++k)
+        w[at + k / 4][int(k % 4)] = samples_[k];
+    return w;
+}
+
+Result<std::shared_ptr<const std::vector<glm::vec4>>> buildMesh(const Node& node,
+                                                                const SceneFiles& files) {
+    const std::string& name = node.strings[0];
+    auto fail = [&](const std::string& why) {
+        if (!files.trusted)
+            return reason(
+                untrustedFileProblem("mesh", name, ": name a mesh file in the scene's folder"));
+        const std::filesystem::path named(name);
+        const bool joined = !named.is_absolute() && !files.folder.empty();
+        return reason("cannot load mesh " + quote(joined ? (files.folder / named).string() : name) +
+                      ": " + why);
+    };
+    auto file = sceneFile(name, files, kMaxMeshFileBytes);
+    if (!file) return fail(file.error().diagnostics[0].message);
+    std::ifstream in(*file, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (!in && !in.eof()) return fail("cannot be read");
+    auto mesh = readTriangleMesh(bytes, file->extension().string());
+    if (!mesh) return fail(mesh.error().diagnostics[0].message);
+    auto field = MeshField::make(*mesh, int(node.params[0]));
+    if (!field) return fail(field.error().diagnostics[0].message);
+    return std::make_shared<const std::vector<glm::vec4>>(field->words());
 }
 
 float MeshField::distance(glm::vec3 p) const {

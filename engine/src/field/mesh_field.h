@@ -7,11 +7,14 @@
 #pragma once
 
 #include "sdfcsg/error.h"
+#include "sdfcsg/scene.h"
 
 #include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -21,8 +24,9 @@ namespace sdfcsg::detail {
 // is refused before the field is made.
 inline constexpr uintmax_t kMaxMeshFileBytes = uintmax_t(256) << 20;
 inline constexpr size_t kMaxMeshTriangles = size_t(8) << 20;
-// The field's memory: its bricks' samples and the grid of brick slots.
-inline constexpr size_t kMaxMeshFieldBytes = size_t(1) << 30;
+// The field's memory: its bricks' samples and the grid of brick slots, as much as a scene's words
+// may hold in all (kMaxOutlineWords).
+inline constexpr size_t kMaxMeshFieldBytes = size_t(64) << 20;
 
 struct TriangleMesh {
     std::vector<glm::vec3> positions;
@@ -30,9 +34,10 @@ struct TriangleMesh {
 };
 
 // The triangles of an STL (binary or ASCII), OBJ, PLY, glTF binary (.glb) or 3MF file, read
-// through Assimp with every node's transform applied, points and lines left out. `bytes` is the
-// file's contents and `extension` its name's (".stl", ...), which tells the format. Errors are
-// the reason alone, for the caller to place ("not a mesh file Assimp reads: ...", "no
+// through Assimp with every node's transform applied, points and lines left out. STL and 3MF,
+// made for printing, are z up (as sdfcsg writes them): they are turned so that their z is +y.
+// `bytes` is the file's contents and `extension` its name's (".stl", ...), which tells the format.
+// Errors are the reason alone, for the caller to place ("not a mesh file Assimp reads: ...", "no
 // triangles", "more than N triangles", "a NaN or infinite vertex", "a 3MF whose parts unpack to
 // more than N MiB").
 Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::string& extension);
@@ -74,6 +79,8 @@ class MeshField {
     size_t bytes() const {
         return samples_.size() * sizeof(float) + slots_.size() * sizeof(int32_t);
     }
+    // sdMesh's words (shaders/sdf.glsl).
+    std::vector<glm::vec4> words() const;
 
   private:
     static constexpr int kBrickSide = kBrick + 1,
@@ -86,6 +93,13 @@ class MeshField {
     std::vector<int32_t> slots_; // per brick: its samples' index, or kOutside / kInside
     std::vector<float> samples_; // kBrickSamples per stored brick, x fastest
 };
+
+// The mesh node's words (Node::words, sdMesh's layout in shaders/sdf.glsl): its "file" found
+// under `files` (sceneFile()) and read, its field made at its "resolution". Errors are for the
+// caller to place at the node's "file"; an untrusted scene's problems with the file say
+// "unknown mesh" and nothing of the file system.
+Result<std::shared_ptr<const std::vector<glm::vec4>>> buildMesh(const Node& node,
+                                                                const SceneFiles& files);
 
 // The generalised winding number of the mesh at each of `points`: near 1 inside a closed
 // surface, near 0 outside, in between near a hole. Exposed for tests.

@@ -5,6 +5,7 @@
 
 #include "sdfcsg/eval.h"
 
+#include "field/mesh_field.h"
 #include "scene/image.h"
 #include "scene/json_syntax.h"
 #include "scene/json_writer.h"
@@ -864,9 +865,11 @@ Next SceneReader::readNode(element value, std::string path, uint32_t depth, Scen
     }
     // Past the limit, the words that passed it have said so: no more are built.
     if (hasWords(kind->kind) && paramsOk && outlineWords_ <= kMaxOutlineWords) {
-        const bool image = kind->kind == NodeKind::Image || kind->kind == NodeKind::Heightmap;
+        const bool image = kind->kind == NodeKind::Image || kind->kind == NodeKind::Heightmap ||
+                           kind->kind == NodeKind::Mesh;
         auto outline = kind->kind == NodeKind::Image       ? buildImage(node, files_)
                        : kind->kind == NodeKind::Heightmap ? buildHeightmap(node, files_)
+                       : kind->kind == NodeKind::Mesh      ? buildMesh(node, files_)
                                                            : buildOutline(node, files_);
         if (!outline && image) {
             problems_.add(member(p, "file"), outline.error().diagnostics[0].message);
@@ -879,7 +882,7 @@ Next SceneReader::readNode(element value, std::string path, uint32_t depth, Scen
                                              "spaces");
         } else if ((outlineWords_ += (*outline)->size()) > kMaxOutlineWords) {
             if (outlineWords_ - (*outline)->size() <= kMaxOutlineWords) // once, where it passes
-                problems_.add(p, "the scene's outlines and images exceed " +
+                problems_.add(p, "the scene's outlines, images and meshes exceed " +
                                      std::to_string(kMaxOutlineWords * 16 >> 20) +
                                      " MiB in all, the limit");
         } else {
