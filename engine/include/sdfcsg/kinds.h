@@ -27,8 +27,8 @@
     X(RoundedCylinder)                                                                             \
     X(RoundCone)                                                                                   \
     X(Link)                                                                                        \
-    X(CappedTorus)                                                                                 \
-    X(Heightmap)
+    X(Heightmap)                                                                                   \
+    X(CappedTorus)
 
 // Shapes in the xy plane, for extrude and revolve.
 #define SDFCSG_PROFILE_KINDS(X)                                                                    \

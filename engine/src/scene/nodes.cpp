@@ -866,6 +866,15 @@ constexpr KindInfo kKinds[] = {
      [](const Params& k, vec3& lo, vec3& hi) {
          return symmetric({k[1] + k[2], k[0] + k[1] + k[2], k[2]}, lo, hi);
      }},
+    {NodeKind::Heightmap, "heightmap", false, kHeightmap,
+     "A PNG image's grey levels as heights over a rectangle in the xz plane, centred on the origin "
+     "(only where the user names a file); the solid below them. Its field is a bound: the height "
+     "difference over the Lipschitz bound of the heights' bilinear interpolation.",
+     R"("file": "terrain.png", "size": [1.6, 0.4, 1.6])", "sdHeightmap", kHeightmapArgs, nullptr,
+     [](const Params& k, vec3& lo, vec3& hi) {
+         lo = vec3(-k[2], 0.0f, -k[3]), hi = vec3(k[2], k[4], k[3]);
+         return true;
+     }},
     {NodeKind::CappedTorus, "capped_torus", false, kCappedTorus,
      "Arc of a ring around the y axis (a horseshoe, a handle), centred on +z.",
      R"("major_radius": 0.8, "minor_radius": 0.2, "angle": 250)", "sdCappedTorus", kA0A1A2A3,
@@ -876,15 +885,6 @@ constexpr KindInfo kKinds[] = {
      [](const Params& k, vec3& lo, vec3& hi) {
          float r = k[0] + k[1];
          return symmetric({r, k[1], r}, lo, hi);
-     }},
-    {NodeKind::Heightmap, "heightmap", false, kHeightmap,
-     "A PNG image's grey levels as heights over a rectangle in the xz plane, centred on the origin "
-     "(only where the user names a file); the solid below them. Its field is a bound: the height "
-     "difference over the Lipschitz bound of the heights' bilinear interpolation.",
-     R"("file": "terrain.png", "size": [1.6, 0.4, 1.6])", "sdHeightmap", kHeightmapArgs, nullptr,
-     [](const Params& k, vec3& lo, vec3& hi) {
-         lo = vec3(-k[2], 0.0f, -k[3]), hi = vec3(k[2], k[4], k[3]);
-         return true;
      }},
     {NodeKind::Circle, "circle", false, kCircle,
      "2D profile: a circle in the xy plane, centred at the origin.", R"("radius": 0.5)", "sdCircle",
