@@ -13,18 +13,38 @@ import zlib
 N = 256
 
 
+def segment_distance(px, py, ax, ay, bx, by):
+    dx, dy = bx - ax, by - ay
+    t = max(0.0, min(1.0, ((px - ax) * dx + (py - ay) * dy) / (dx * dx + dy * dy)))
+    return math.hypot(px - ax - t * dx, py - ay - t * dy)
+
+
+# A star of five points (radius 0.66 at the points, 0.27 at the notches), one point up.
+STAR = [((0.66 if k % 2 == 0 else 0.27) * math.sin(k * math.pi / 5),
+         (0.66 if k % 2 == 0 else 0.27) * math.cos(k * math.pi / 5)) for k in range(10)]
+
+
+def in_star(x, y):
+    """Even-odd rule over the star's edges."""
+    inside = False
+    for (ax, ay), (bx, by) in zip(STAR, STAR[1:] + STAR[:1]):
+        if (ay > y) != (by > y) and x < ax + (y - ay) * (bx - ax) / (by - ay):
+            inside = not inside
+    return inside
+
+
 def inside(x, y):
-    """Whether (x, y), in [-1, 1] with y up, is ink: the ring, or the star within it."""
+    """Whether (x, y), in [-1, 1] with y up, is ink: the ring, or the star within it with its
+    points rounded (the star grown by 0.05), so that no corner is sharper than a few pixels."""
     r = math.hypot(x, y)
     if 0.80 <= r <= 0.95:
         return True
-    # A star of five points: the angle folded into one point's half sector, then the edge from
-    # the point (radius 0.72) to the notch (radius 0.30) between two points.
-    a = (math.atan2(x, y) + math.pi / 5) % (2 * math.pi / 5) - math.pi / 5
-    px, py = r * math.sin(abs(a)), r * math.cos(a)
-    ax, ay = 0.0, 0.72
-    bx, by = 0.30 * math.sin(math.pi / 5), 0.30 * math.cos(math.pi / 5)
-    return (bx - ax) * (py - ay) - (by - ay) * (px - ax) <= 0.0
+    if r > 0.75:
+        return False
+    if in_star(x, y):
+        return True
+    return min(segment_distance(x, y, *a, *b)
+               for a, b in zip(STAR, STAR[1:] + STAR[:1])) <= 0.05
 
 
 def chunk(kind, data):

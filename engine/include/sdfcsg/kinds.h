@@ -27,9 +27,9 @@
     X(RoundedCylinder)                                                                             \
     X(RoundCone)                                                                                   \
     X(Link)                                                                                        \
-    X(CappedTorus)                                                                                 \
     X(Heightmap)                                                                                   \
-    X(Mesh)
+    X(Mesh)                                                                                        \
+    X(CappedTorus)
 
 // Shapes in the xy plane, for extrude and revolve.
 #define SDFCSG_PROFILE_KINDS(X)                                                                    \

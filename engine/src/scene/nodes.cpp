@@ -890,17 +890,6 @@ constexpr KindInfo kKinds[] = {
      [](const Params& k, vec3& lo, vec3& hi) {
          return symmetric({k[1] + k[2], k[0] + k[1] + k[2], k[2]}, lo, hi);
      }},
-    {NodeKind::CappedTorus, "capped_torus", false, kCappedTorus,
-     "Arc of a ring around the y axis (a horseshoe, a handle), centred on +z.",
-     R"("major_radius": 0.8, "minor_radius": 0.2, "angle": 250)", "sdCappedTorus", kA0A1A2A3,
-     [](const Params& v) -> Params {
-         const double half = 0.5 * double(v[2]) * 3.14159265358979323846 / 180.0;
-         return {v[0], v[1], float(std::sin(half)), float(std::cos(half))};
-     },
-     [](const Params& k, vec3& lo, vec3& hi) {
-         float r = k[0] + k[1];
-         return symmetric({r, k[1], r}, lo, hi);
-     }},
     {NodeKind::Heightmap, "heightmap", false, kHeightmap,
      "A PNG image's grey levels as heights over a rectangle in the xz plane, centred on the origin "
      "(only where the user names a file); the solid below them. Its field is a bound: the height "
@@ -922,6 +911,17 @@ constexpr KindInfo kKinds[] = {
          lo = vec3(k[2], k[3], k[4]);
          hi = lo + 8.0f * k[5] * vec3(k[1], k[6], k[7]);
          return true;
+     }},
+    {NodeKind::CappedTorus, "capped_torus", false, kCappedTorus,
+     "Arc of a ring around the y axis (a horseshoe, a handle), centred on +z.",
+     R"("major_radius": 0.8, "minor_radius": 0.2, "angle": 250)", "sdCappedTorus", kA0A1A2A3,
+     [](const Params& v) -> Params {
+         const double half = 0.5 * double(v[2]) * 3.14159265358979323846 / 180.0;
+         return {v[0], v[1], float(std::sin(half)), float(std::cos(half))};
+     },
+     [](const Params& k, vec3& lo, vec3& hi) {
+         float r = k[0] + k[1];
+         return symmetric({r, k[1], r}, lo, hi);
      }},
     {NodeKind::Circle, "circle", false, kCircle,
      "2D profile: a circle in the xy plane, centred at the origin.", R"("radius": 0.5)", "sdCircle",
