@@ -420,9 +420,10 @@ SDF_FN float sdHeightmap(vec3 p, float firstAt, float nx, float hx, float hz, fl
 SDF_FN float meshWord(uint at, uint k SDF_DATA_PARAM) {
     return SDF_DATA(at + k / 4u)[int(k % 4u)];
 }
-SDF_FN float sdMesh(vec3 p, float firstAt, float bx, vec3 origin, float cell, float by, float bz
-                    SDF_DATA_PARAM) {
+SDF_FN float sdMesh(vec3 p, float firstAt, float bx, float ox, float oy, float oz, float cell,
+                    float by, float bz SDF_DATA_PARAM) {
     uint first = uint(firstAt);
+    vec3 origin = vec3(ox, oy, oz);
     float band = SDF_DATA(first).w;
     vec3 bricks = vec3(bx, by, bz);
     vec3 g = (p - origin) / cell;
@@ -575,7 +576,7 @@ SDF_FN float sdPrimitive(uint kind, vec3 q, vec4 a, vec4 b, uint kinds SDF_DATA_
     if (SDF_IS(kKindHeightmap))
         return sdHeightmap(q, a.x, a.y, a.z, a.w, b.x, b.z, b.w SDF_DATA_ARG);
     if (SDF_IS(kKindMesh))
-        return sdMesh(q, a.x, a.y, vec3(a.z, a.w, b.x), b.y, b.z, b.w SDF_DATA_ARG);
+        return sdMesh(q, a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w SDF_DATA_ARG);
     if (SDF_IS(kKindCircle)) return sdCircle(q, a.x);
     if (SDF_IS(kKindRectangle)) return sdRectangle(q, a.x, a.y, a.z);
     if (SDF_IS(kKindRegularPolygon)) return sdRegularPolygon(q, a.x, a.y, a.z, a.w);

@@ -44,9 +44,13 @@ std::string numberText(double v) {
 // A valid value for a parameter as the schema describes it; numbers at most half the vectors'
 // components also keep the one rule a schema cannot state (a round box's radius at most half
 // its smallest size).
-// `key`: a "file" names the bundled emblem, which the tests' folder holds (tests/CMakeLists.txt).
+// `key`: a "file" names the bundled emblem, or for a mesh the gear, which the tests' folder holds
+// (tests/CMakeLists.txt).
 std::string validValue(simdjson::dom::element property, std::string_view key = {}) {
-    if (key == "file") return "\"emblem.png\"";
+    if (key == "file")
+        return std::string_view(property["description"]).find("mesh") != std::string_view::npos
+                   ? "\"gear.stl\""
+                   : "\"emblem.png\"";
     if (simdjson::dom::array choices; property["enum"].get(choices) == simdjson::SUCCESS)
         return simdjson::to_string(choices.at(0));
     std::string_view type = property["type"];
