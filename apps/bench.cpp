@@ -130,11 +130,18 @@ bool parseCount(const char* s, uint32_t lo, uint32_t hi, uint32_t& out) {
     return true;
 }
 
+// A scene's JSON, the files it names relative to its file's folder, as loadScene() reads them.
+Result<Scene> parseAt(const std::string& json, const std::string& file) {
+    ParseOptions options;
+    options.files.folder = std::filesystem::path(file).parent_path();
+    return parseScene(json, file, options);
+}
+
 // JSON text to a renderer with its pipeline built.
 Result<std::unique_ptr<Renderer>> buildFromJson(Context& context, const std::string& json,
                                                 const std::string& file,
                                                 Evaluation evaluation = Evaluation::Auto) {
-    auto scene = parseScene(json, file);
+    auto scene = parseAt(json, file);
     if (!scene) return scene.error();
     RendererOptions options;
     options.evaluation = evaluation;
@@ -548,7 +555,7 @@ Status measureFrames(Renderer& renderer, const std::string& json, const std::str
     if (!noSkip) return noSkip.error();
     row.skip = *skip;
     row.noSkip = *noSkip;
-    if (auto scene = parseScene(json, file); scene && usesTapes(*scene, args.evaluation)) {
+    if (auto scene = parseAt(json, file); scene && usesTapes(*scene, args.evaluation)) {
         options.boundsSkipping.reset();
         auto edit = medianEditMs(renderer, *scene, options, args.frames);
         if (!edit) return edit.error();
@@ -561,7 +568,7 @@ Status measureFrames(Renderer& renderer, const std::string& json, const std::str
 // `coldContext`, and its frame.
 Status measureBuffer(Context& coldContext, const std::string& json, const std::string& file,
                      const RenderArgs& args, RenderOptions options, Row& row) {
-    auto scene = parseScene(json, file);
+    auto scene = parseAt(json, file);
     if (!scene) return scene.error();
     RendererOptions values;
     values.inlineValues = false;
@@ -737,7 +744,7 @@ int runBench(int argc, char** argv) {
         }
         if (status != 0) break;
         row.builds(cold, warm);
-        if (auto scene = parseScene(json, file)) row.nodes = scene->nodes.size();
+        if (auto scene = parseAt(json, file)) row.nodes = scene->nodes.size();
 
         RenderOptions options;
         options.width = width;

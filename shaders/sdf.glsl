@@ -357,6 +357,97 @@ SDF_FN float sdOutline(vec3 p3, float firstAt, float nx, vec2 lo, vec2 hi, float
     return max(winding != 0.0f ? -d : d, boxDistance);
 }
 
+// The image profile's sample at grid point g of a grid of nx per row (engine/src/scene/image.h:
+// four samples to a word, from word 2).
+SDF_FN float imageSample(uint first, float nx, vec2 g SDF_DATA_PARAM) {
+    uint k = uint(g.x + nx * g.y);
+    return SDF_DATA(first + 2u + k / 4u)[int(k % 4u)];
+}
+
+// Image: the signed distance to a mask's edges (engine/src/scene/image.h, from `first`), sampled
+// at the centres of the pixels of the image (lo to hi) and of a ring of outside pixels around
+// it, nx by ny samples `side` apart, and interpolated bilinearly: exact at the samples, and
+// within a small part of a pixel of the distance between them (bilinear interpolation of a
+// distance has a slope of up to sqrt(2) within a pixel or two of a corner of the mask). Beyond
+// the samples, at q the nearest point of their rectangle, sqrt(|p - q|^2 + d(q)^2): the edges
+// lie inside the image, on the far side of q from p, so this is a lower bound, 1-Lipschitz and
+// the interpolation itself on the rectangle. Never below the distance to the image's box.
+SDF_FN float sdImage(vec3 p3, float firstAt, float nx, vec2 lo, vec2 hi, float ny, float side
+                     SDF_DATA_PARAM) {
+    vec2 p = vec2(p3.x, p3.y);
+    uint first = uint(firstAt);
+    vec2 corner = lo - 0.5f * side, last = vec2(nx, ny) - 1.0f;
+    vec2 q = clamp(p, corner, corner + last * side);
+    vec2 t = (q - corner) / side;
+    vec2 g = clamp(floor(t), vec2(0.0f), last - 1.0f);
+    vec2 f = t - g;
+    float d00 = imageSample(first, nx, g SDF_DATA_ARG);
+    float d10 = imageSample(first, nx, g + vec2(1.0f, 0.0f) SDF_DATA_ARG);
+    float d01 = imageSample(first, nx, g + vec2(0.0f, 1.0f) SDF_DATA_ARG);
+    float d11 = imageSample(first, nx, g + vec2(1.0f) SDF_DATA_ARG);
+    float d = mix(mix(d00, d10, f.x), mix(d01, d11, f.x), f.y);
+    float v = d < 0.0f ? d : sqrt(dot2(p - q) + d * d);
+    vec2 e = max(lo - p, p - hi);
+    return max(v, length(max(e, 0.0f)) + min(max(e.x, e.y), 0.0f));
+}
+
+// Heightmap: the solid under heights over x in [-hx, hx], z in [-hz, hz] (engine/src/scene/image.h,
+// from `first`: nx by ny heights at the centres of the image's pixels, interpolated bilinearly
+// and held at the border's beyond them), within the box up to `height`. y - height(x, z) changes
+// by at most sqrt(1 + sx^2 + sz^2) per unit, sx and sz the steepest slopes of the interpolation,
+// so times its inverse `invL` it is a bound, and so is its maximum with the box's distance.
+SDF_FN float sdHeightmap(vec3 p, float firstAt, float nx, float hx, float hz, float height,
+                         float ny, float invL SDF_DATA_PARAM) {
+    uint first = uint(firstAt);
+    vec2 n = vec2(nx, ny), extent = vec2(hx, hz);
+    vec2 t = clamp((vec2(p.x, p.z) + extent) * n / (2.0f * extent) - 0.5f, vec2(0.0f), n - 1.0f);
+    vec2 g = min(floor(t), max(n - 2.0f, 0.0f)), g1 = min(g + 1.0f, n - 1.0f);
+    vec2 f = t - g;
+    float h00 = imageSample(first, nx, g SDF_DATA_ARG);
+    float h10 = imageSample(first, nx, vec2(g1.x, g.y) SDF_DATA_ARG);
+    float h01 = imageSample(first, nx, vec2(g.x, g1.y) SDF_DATA_ARG);
+    float h11 = imageSample(first, nx, g1 SDF_DATA_ARG);
+    float h = mix(mix(h00, h10, f.x), mix(h01, h11, f.x), f.y);
+    float box = sdBox(p - vec3(0.0f, 0.5f * height, 0.0f), vec3(hx, 0.5f * height, hz));
+    return max((p.y - h) * invL, box);
+}
+
+// Mesh: the field of a triangle mesh (engine/src/field/mesh_field.h, from `first`): word 0 holds
+// the grid's bricks along x, y, z and the band, word 1 its corner and cell; from word 2 a slot
+// per brick (its samples' first index over 729, or -1 outside, -2 inside), four to a word, then
+// the bricks' 9^3 samples each, four to a word. Trilinear within a brick with samples; the band,
+// a bound of the right sign, in one without; beyond the grid, the distance to it plus the band.
+SDF_FN float meshWord(uint at, uint k SDF_DATA_PARAM) {
+    return SDF_DATA(at + k / 4u)[int(k % 4u)];
+}
+SDF_FN float sdMesh(vec3 p, float firstAt, float bx, float ox, float oy, float oz, float cell,
+                    float by, float bz SDF_DATA_PARAM) {
+    uint first = uint(firstAt);
+    vec3 origin = vec3(ox, oy, oz);
+    float band = SDF_DATA(first).w;
+    vec3 bricks = vec3(bx, by, bz);
+    vec3 g = (p - origin) / cell;
+    vec3 outside = max(max(-g, g - 8.0f * bricks), vec3(0.0f));
+    if (outside.x + outside.y + outside.z > 0.0f) return length(outside) * cell + band;
+    vec3 b = min(floor(g / 8.0f), bricks - 1.0f);
+    float slot = meshWord(first + 2u, uint(b.x + bx * (b.y + by * b.z)) SDF_DATA_ARG);
+    if (slot < 0.0f) return slot < -1.5f ? -band : band;
+    uint samples = first + 2u + (uint(bx * by * bz) + 3u) / 4u;
+    vec3 local = min(g - 8.0f * b, vec3(8.0f));
+    vec3 i = min(floor(local), vec3(7.0f));
+    vec3 t = local - i;
+    uint k = uint(slot) * 729u + uint(i.x + 9.0f * (i.y + 9.0f * i.z));
+    float c000 = meshWord(samples, k SDF_DATA_ARG), c100 = meshWord(samples, k + 1u SDF_DATA_ARG);
+    float c010 = meshWord(samples, k + 9u SDF_DATA_ARG);
+    float c110 = meshWord(samples, k + 10u SDF_DATA_ARG);
+    float c001 = meshWord(samples, k + 81u SDF_DATA_ARG);
+    float c101 = meshWord(samples, k + 82u SDF_DATA_ARG);
+    float c011 = meshWord(samples, k + 90u SDF_DATA_ARG);
+    float c111 = meshWord(samples, k + 91u SDF_DATA_ARG);
+    return mix(mix(mix(c000, c100, t.x), mix(c010, c110, t.x), t.y),
+               mix(mix(c001, c101, t.x), mix(c011, c111, t.x), t.y), t.z);
+}
+
 // CSG operators: IQ's polynomial smooth minimum with blend radius k, and smooth max(a, b) =
 // -smin(-a, -b). Once the operands differ by k or more the blend factor is exactly 0 or 1, so
 // those cases return an operand unchanged: this makes bounds skipping and pruning exact in
@@ -482,11 +573,17 @@ SDF_FN float sdPrimitive(uint kind, vec3 q, vec4 a, vec4 b, uint kinds SDF_DATA_
     if (SDF_IS(kKindRoundCone)) return sdRoundCone(q, a.x, a.y, a.z, a.w, b.x);
     if (SDF_IS(kKindLink)) return sdLink(q, a.x, a.y, a.z);
     if (SDF_IS(kKindCappedTorus)) return sdCappedTorus(q, a.x, a.y, a.z, a.w);
+    if (SDF_IS(kKindHeightmap))
+        return sdHeightmap(q, a.x, a.y, a.z, a.w, b.x, b.z, b.w SDF_DATA_ARG);
+    if (SDF_IS(kKindMesh))
+        return sdMesh(q, a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w SDF_DATA_ARG);
     if (SDF_IS(kKindCircle)) return sdCircle(q, a.x);
     if (SDF_IS(kKindRectangle)) return sdRectangle(q, a.x, a.y, a.z);
     if (SDF_IS(kKindRegularPolygon)) return sdRegularPolygon(q, a.x, a.y, a.z, a.w);
     if (SDF_IS(kKindPolygon) || SDF_IS(kKindText))
         return sdOutline(q, a.x, a.y, vec2(a.z, a.w), vec2(b.x, b.y), b.z, b.w SDF_DATA_ARG);
+    if (SDF_IS(kKindImage))
+        return sdImage(q, a.x, a.y, vec2(a.z, a.w), vec2(b.x, b.y), b.z, b.w SDF_DATA_ARG);
     return 1e30f;
 }
 #undef SDF_IS

@@ -245,15 +245,18 @@ struct TreeOptions {
 };
 
 // A random tree of every kind of the node table but the plane (unbounded; with options.planes,
-// an operand of intersections and differences) and the text (slow to compile), each from its
-// example in the table (sdfcsg/nodes.h),
-// turned, moved and scaled at random: operations over random subtrees (Booleans sharp or with
-// their example's blend), 2D profiles under extrude or revolve, primitives at the leaves.
+// an operand of intersections and differences), the text (slow to compile), the image and the
+// heightmap (they read files; tests/unit/test_images.cpp), each from its example in the table
+// (sdfcsg/nodes.h), turned, moved and scaled at random: operations over random subtrees (Booleans
+// sharp or with their example's blend), 2D profiles under extrude or revolve, primitives at the
+// leaves.
 inline std::string randomTreeJson(std::mt19937& rng, int depth, const TreeOptions& options = {}) {
     auto uni = [&](float a, float b) { return std::uniform_real_distribution<float>(a, b)(rng); };
     std::vector<const KindInfo*> primitives, profiles, operations;
     for (const KindInfo& k : nodeKinds()) {
-        if (k.kind == NodeKind::Plane || k.kind == NodeKind::Text) continue;
+        if (k.kind == NodeKind::Plane || k.kind == NodeKind::Text || k.kind == NodeKind::Image ||
+            k.kind == NodeKind::Heightmap)
+            continue;
         (isProfile(k.kind) ? profiles : k.operation ? operations : primitives).push_back(&k);
     }
     auto pick = [&](const std::vector<const KindInfo*>& from) { return from[rng() % from.size()]; };

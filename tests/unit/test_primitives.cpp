@@ -389,6 +389,8 @@ std::vector<glm::vec3> samplePoints(double size, uint32_t seed) {
 TEST(Primitives, EveryKindHasACase) {
     std::vector<bool> seen(kNodeKindCount, false);
     seen[size_t(NodeKind::Ellipsoid)] = true; // a bound: EllipsoidIsABoundWithinItsFactor
+    seen[size_t(NodeKind::Heightmap)] = true; // a file's: test_images.cpp, Heightmap.*
+    seen[size_t(NodeKind::Mesh)] = true;      // a file's: test_mesh_field.cpp, MeshNode.*
     for (const KindInfo& k : nodeKinds()) // against 3D primitives and brute force: test_profiles
         if (isProfile(k.kind)) seen[size_t(k.kind)] = true;
     for (const Case& c : cases())

@@ -250,7 +250,7 @@ TEST(Profiles, FontBesideTheSceneLoadsFromAnotherWorkingDirectory) {
         // The same font as the default, so the same outline.
         auto reference = parseScene(textScene(""));
         ASSERT_TRUE(reference);
-        EXPECT_EQ(*scene->nodes[1].outline, *reference->nodes[1].outline);
+        EXPECT_EQ(*scene->nodes[1].words, *reference->nodes[1].words);
         // An edited copy parses under the same rule.
         ParseOptions options;
         options.files = scene->files;
@@ -265,13 +265,13 @@ TEST(Profiles, FontsByFamily) {
     ASSERT_TRUE(sans) << sans.error().str();
     auto reference = parseScene(textScene(""));
     ASSERT_TRUE(reference);
-    EXPECT_EQ(*sans->nodes[1].outline, *reference->nodes[1].outline);
+    EXPECT_EQ(*sans->nodes[1].words, *reference->nodes[1].words);
     auto lower = parseScene(textScene("dejavu sans"));
     ASSERT_TRUE(lower) << lower.error().str();
-    EXPECT_EQ(*lower->nodes[1].outline, *reference->nodes[1].outline);
+    EXPECT_EQ(*lower->nodes[1].words, *reference->nodes[1].words);
     auto serif = parseScene(textScene("DejaVu Serif"));
     ASSERT_TRUE(serif) << serif.error().str();
-    EXPECT_NE(*serif->nodes[1].outline, *reference->nodes[1].outline);
+    EXPECT_NE(*serif->nodes[1].words, *reference->nodes[1].words);
 
     for (const char* family : {"No Such Family", "DejaVu Sans:style=Bold"}) {
         auto unknown = parseScene(textScene(family), "test.json");
@@ -333,7 +333,7 @@ TEST(Profiles, OutlinesOfAllNodesAreBounded) {
     const std::string error =
         errorOf(R"({"type": "extrude", "height": 1, "children": [{"type": "union", "children": [)" +
                 kids + "]}]}");
-    EXPECT_NE(error.find("the scene's polygon and text outlines exceed 64 MiB in all, the limit"),
+    EXPECT_NE(error.find("the scene's outlines, images and meshes exceed 64 MiB in all, the limit"),
               std::string::npos)
         << error.substr(0, 300);
 }

@@ -44,7 +44,13 @@ std::string numberText(double v) {
 // A valid value for a parameter as the schema describes it; numbers at most half the vectors'
 // components also keep the one rule a schema cannot state (a round box's radius at most half
 // its smallest size).
-std::string validValue(simdjson::dom::element property) {
+// `key`: a "file" names the bundled emblem, or for a mesh the gear, which the tests' folder holds
+// (tests/CMakeLists.txt).
+std::string validValue(simdjson::dom::element property, std::string_view key = {}) {
+    if (key == "file")
+        return std::string_view(property["description"]).find("mesh") != std::string_view::npos
+                   ? "\"gear.stl\""
+                   : "\"emblem.png\"";
     if (simdjson::dom::array choices; property["enum"].get(choices) == simdjson::SUCCESS)
         return simdjson::to_string(choices.at(0));
     std::string_view type = property["type"];
@@ -202,7 +208,7 @@ TEST(Schema, AgreesWithTheParser) {
             std::string_view key = r;
             if (key == "type" || key == "children") continue;
             requiredOnly +=
-                R"(, ")" + std::string(key) + "\": " + validValue(def["properties"][key]);
+                R"(, ")" + std::string(key) + "\": " + validValue(def["properties"][key], key);
         }
         auto ok = parseScene(node(kind, requiredOnly));
         EXPECT_TRUE(ok) << (ok ? "" : ok.error().str());
@@ -213,7 +219,7 @@ TEST(Schema, AgreesWithTheParser) {
             for (const ParamInfo& q : kind.params)
                 if (q.required && q.name != p.name)
                     without += R"(, ")" + std::string(q.name) +
-                               "\": " + validValue(def["properties"][q.name]);
+                               "\": " + validValue(def["properties"][q.name], q.name);
             EXPECT_FALSE(parseScene(node(kind, without))) << "without " << p.name;
         }
         // A number at the schema's bound: refused when the bound is exclusive, accepted when not.
@@ -228,7 +234,7 @@ TEST(Schema, AgreesWithTheParser) {
             for (const ParamInfo& q : kind.params)
                 if (q.required && q.name != p.name)
                     others += R"(, ")" + std::string(q.name) +
-                              "\": " + validValue(def["properties"][q.name]);
+                              "\": " + validValue(def["properties"][q.name], q.name);
             const std::string at =
                 others + R"(, ")" + std::string(p.name) + "\": " + numberText(bound);
             const std::string below =

@@ -61,9 +61,9 @@ struct FlatNode {
     // value over its gradient's length (sdf.glsl, valueNormalised) and is a distance again.
     float loss = 1.0f;
     std::vector<uint32_t> children;
-    // Polygon and text: Node::outline; the parameters then hold the glyph count (slot 1) and
-    // the outline's extents (slots 2-5).
-    std::shared_ptr<const std::vector<glm::vec4>> outline;
+    // Polygon, text and image: Node::words; the parameters then come from its first two words
+    // (the layout and the extents in slots 2-5).
+    std::shared_ptr<const std::vector<glm::vec4>> words;
 };
 
 struct Sample {

@@ -27,6 +27,8 @@
     X(RoundedCylinder)                                                                             \
     X(RoundCone)                                                                                   \
     X(Link)                                                                                        \
+    X(Heightmap)                                                                                   \
+    X(Mesh)                                                                                        \
     X(CappedTorus)
 
 // Shapes in the xy plane, for extrude and revolve.
@@ -35,7 +37,8 @@
     X(Rectangle)                                                                                   \
     X(RegularPolygon)                                                                              \
     X(Polygon)                                                                                     \
-    X(Text)
+    X(Text)                                                                                        \
+    X(Image)
 
 // Operations of any number of children; the transitions take exactly two and come last.
 #define SDFCSG_BOOLEAN_KINDS(X)                                                                    \

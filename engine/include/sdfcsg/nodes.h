@@ -88,12 +88,18 @@ inline constexpr bool isProfile(NodeKind kind) {
 inline constexpr bool isTransition(NodeKind kind) {
     return kind == NodeKind::TransitionLinear || kind == NodeKind::TransitionRadial;
 }
-// Polygon and text: their outlines' segments live beside the node (Node::outline).
+// Polygon and text: their outlines' segments live beside the node (Node::words).
 inline constexpr bool hasOutline(NodeKind kind) {
     return kind == NodeKind::Polygon || kind == NodeKind::Text;
 }
-// A polygon's points, at most; and the vec4s of every outline of a scene (a large one lists its
-// segments per cell of a grid), so that they stay within 64 MiB of the node buffer.
+// The kinds whose data follows them in the node buffer (Node::words): outlines and images.
+inline constexpr bool hasWords(NodeKind kind) {
+    return hasOutline(kind) || kind == NodeKind::Image || kind == NodeKind::Heightmap ||
+           kind == NodeKind::Mesh;
+}
+// A polygon's points, at most; and the vec4s of every node's words in a scene (outlines, a large
+// one listing its segments per cell of a grid, and images), so that they stay within 64 MiB of
+// the node buffer.
 inline constexpr size_t kMaxPolygonPoints = 1024;
 inline constexpr size_t kMaxOutlineWords = size_t(1) << 22;
 

@@ -71,9 +71,10 @@ struct Node {
     // Polygon: its points; text: its string and font (ParamInfo::slot indexes strings).
     std::vector<glm::vec2> points;
     std::array<std::string, 2> strings;
-    // Polygon and text: the outline's glyph records and segments, made by the loader (the
-    // layout is sdOutline's in shaders/sdf.glsl); shared by copies of the scene.
-    std::shared_ptr<const std::vector<glm::vec4>> outline;
+    // The data that follows the node in the node buffer, made by the loader and shared by copies
+    // of the scene: polygon and text, the outline's records and segments (sdOutline's layout,
+    // scene/outline.h); image, its grid of distances (sdImage's, scene/image.h).
+    std::shared_ptr<const std::vector<glm::vec4>> words;
     // Set on a use of a definition: this union's one child, and everything below it, is the copy.
     std::optional<Use> use;
 };

@@ -66,11 +66,11 @@ class Emitter {
             bool boundsTests)
         : scene_(scene), out_(out), lit_(literals), tests_(boundsTests),
           gridded_(scene.nodes.size(), false) {
-        // Whether node i's subtree holds a gridded outline (outline.h): children come after
-        // their operation.
+        // Whether node i's subtree holds a grid (a gridded outline, outline.h, or an image):
+        // children come after their operation.
         for (size_t i = scene.nodes.size(); i-- > 0;) {
             const Node& n = scene.nodes[i];
-            bool gridded = n.outline && (*n.outline)[0].x != 0.0f;
+            bool gridded = n.words && (!hasOutline(n.kind) || (*n.words)[0].x != 0.0f);
             for (uint32_t child : n.children)
                 gridded = gridded || gridded_[child];
             gridded_[i] = gridded;
@@ -186,8 +186,8 @@ class Emitter {
     // (a 13-character text took 4 to 16 s and 500 MB to compile, and drew slower than the loop).
     bool inlinedOutline(uint32_t i) const {
         const Node& n = scene_.nodes[i];
-        return lit_ && n.outline && (*n.outline)[0].x == 0.0f &&
-               n.outline->size() <= detail::kInlinedOutlineWords;
+        return lit_ && hasOutline(n.kind) && n.words && (*n.words)[0].x == 0.0f &&
+               n.words->size() <= detail::kInlinedOutlineWords;
     }
 
     static std::string vec2Literal(float x, float y) {
@@ -199,7 +199,7 @@ class Emitter {
 
     // sdOutline (shaders/sdf.glsl) unrolled over node i's outline: `float outline<i>(vec3 p)`.
     void outlineFunction(uint32_t i) {
-        const glm::vec4* w = scene_.nodes[i].outline->data() + 2; // the contours
+        const glm::vec4* w = scene_.nodes[i].words->data() + 2; // the contours
         out_ += "float outline" + std::to_string(i) +
                 "(vec3 p3) {\n    vec2 p = p3.xy;\n    float best = 1e30, winding = 0.0;\n"
                 "    bool holds;\n";

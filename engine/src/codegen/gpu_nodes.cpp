@@ -39,14 +39,14 @@ std::vector<GpuNode> packNodes(const Evaluator& evaluator) {
         g.bmax = glm::vec4(clampHuge(n.bounds.max), domain ? float(n.children[0]) : float(n.blend));
         out.push_back(g);
     }
-    // Polygon and text outlines after the nodes, 8 vec4 to a node's room; their first record
+    // Node words (outlines, images) after the nodes, 8 vec4 to a node's room; their first record
     // (slot 0) becomes its index in the buffer seen as vec4s (sdf.glsl, nodeWords).
     std::vector<glm::vec4> words;
     for (size_t i = 0; i < evaluator.nodes().size(); ++i) {
         const FlatNode& n = evaluator.nodes()[i];
-        if (!n.outline) continue;
+        if (!n.words) continue;
         out[i].p0.x = float(out.size() * 8 + words.size());
-        words.insert(words.end(), n.outline->begin(), n.outline->end());
+        words.insert(words.end(), n.words->begin(), n.words->end());
     }
     words.resize((words.size() + 7) / 8 * 8, glm::vec4(0.0f));
     for (size_t k = 0; k < words.size(); k += 8) {

@@ -286,7 +286,7 @@ glm::vec3 localPoint(const FlatNode& n, glm::vec3 p) {
 // The value types of sceneDistance (float) and sceneSample (vec4: colour, distance in w).
 template <class V> V leaf(const FlatNode& n, glm::vec3 p) {
     float d = sdf::evalPrimitive(n.kind, localPoint(n, p), n.params,
-                                 n.outline ? n.outline->data() : nullptr) *
+                                 n.words ? n.words->data() : nullptr) *
               n.scale;
     if (n.boundsFloor) d = std::max(d, n.bounds.signedDistance(p));
     if constexpr (std::is_same_v<V, float>)
@@ -301,12 +301,15 @@ template <class V> float dist(const V& v) {
         return v.w;
 }
 
-// Polygon and text: sdOutline's parameters (outline.h): the outline's first word (0 here; the
-// node buffer rebases it), its grid's cells per row (0 for an outline listed by contour), its
-// box, and the grid's rows and cell side (or the number of contours).
-Params outlineParams(const std::vector<glm::vec4>* outline) {
-    if (!outline || outline->size() < 2) return Params{};
-    const glm::vec4 layout = (*outline)[0], box = (*outline)[1];
+// The kernel parameters of a kind with words (Node::words) come from its first two: slot 0 is
+// the first word's index (0 here; the node buffer rebases it), then word 0's x, word 1, word 0's
+// y and z. Polygon and text, sdOutline's (outline.h): its grid's cells per row (0 for an outline
+// listed by contour), its box, and the grid's rows and cell side (or the number of contours);
+// image, sdImage's (image.h): the same of its grid of distances; heightmap, sdHeightmap's: its
+// samples per row, half extents along x and z, height, 0, rows and 1 / its Lipschitz bound.
+Params wordsParams(const std::vector<glm::vec4>* words) {
+    if (!words || words->size() < 2) return Params{};
+    const glm::vec4 layout = (*words)[0], box = (*words)[1];
     return {0.0f, layout.x, box.x, box.y, box.z, box.w, layout.y, layout.z};
 }
 
@@ -558,9 +561,9 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
         n.boundsFloor = !isOperation(src.kind) && a.uneven;
         n.color = src.color ? *src.color : upNode ? upNode->color : kDefaultColor;
         n.params = sdf::kernelParams(src.kind, src.params);
-        if (hasOutline(src.kind)) {
-            n.outline = src.outline;
-            n.params = outlineParams(src.outline.get());
+        if (hasWords(src.kind)) {
+            n.words = src.words;
+            n.params = wordsParams(src.words.get());
         }
         // Transitions keep other values in those slots.
         const bool boolean = roleOf(src.kind) == Role::Boolean && !isTransition(src.kind);
@@ -599,6 +602,9 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
         float loss = float(acc[i].stretch);
         for (uint32_t c : n.children)
             loss = std::max(loss, nodes_[c].loss);
+        // A heightmap's value is the height difference over its Lipschitz bound (slot 7: 1 / it).
+        if (n.kind == NodeKind::Heightmap && n.params[7] > 0.0f)
+            loss = std::max(loss, 1.0f / n.params[7]);
         if (n.kind == NodeKind::Ellipsoid) {
             const float lo = std::min({src.params[0], src.params[1], src.params[2]});
             const float hi = std::max({src.params[0], src.params[1], src.params[2]});

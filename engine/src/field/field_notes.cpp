@@ -51,6 +51,9 @@ Loss ownLoss(const Node& n, const FlatNode& flat) {
     } else if (isTransition(n.kind)) {
         factor = flat.params[7] > 0.0f ? 1.0f / flat.params[7] : 1.0f;
         how = " divides its field by ";
+    } else if (n.kind == NodeKind::Heightmap) {
+        factor = flat.params[7] > 0.0f ? 1.0f / flat.params[7] : 1.0f;
+        how = ": a bound (its slopes' Lipschitz bound), below the distance by up to ";
     } else if (n.kind == NodeKind::Ellipsoid) {
         const float lo = std::min({n.params[0], n.params[1], n.params[2]});
         const float hi = std::max({n.params[0], n.params[1], n.params[2]});

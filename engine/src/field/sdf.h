@@ -55,12 +55,12 @@ inline Params kernelParams(NodeKind kind, const Params& v) {
     return info.kernel ? info.kernel(v) : Params{v[0], v[1]}; // operations: smooth, blend
 }
 
-// Local distance of a primitive, given its kernel parameters and, for polygon and text, its
-// outline (FlatNode::outline).
-inline float evalPrimitive(NodeKind kind, vec3 p, const Params& k, const vec4* outline = nullptr) {
-    if (hasOutline(kind) && !outline) return 1e30f; // built in code without its outline
+// Local distance of a primitive, given its kernel parameters and, for the kinds with words
+// (polygon, text, image), those words (FlatNode::words).
+inline float evalPrimitive(NodeKind kind, vec3 p, const Params& k, const vec4* words = nullptr) {
+    if (hasWords(kind) && !words) return 1e30f; // built in code without its words
     return sdPrimitive(uint(kind), p, vec4(k[0], k[1], k[2], k[3]), vec4(k[4], k[5], k[6], k[7]),
-                       kAllKinds, outline);
+                       kAllKinds, words);
 }
 
 // Exact local bounding box of a primitive: lo/hi corners; false for the (unbounded) plane.

@@ -51,6 +51,8 @@ constexpr std::string_view kRules = R"(## How to build a scene
   whose points [x, y] have x >= 0 (x is the distance from the axis). Flat plates and lettering
   are an "extrude" (thickness along z) of a 2D profile: "circle", "rectangle",
   "regular_polygon", "polygon" or "text". 2D profiles exist only inside extrude or revolve.
+- "image" (a 2D profile) and "heightmap" read a PNG file: use them only when the request names
+  such a file, with that name, never a name of your own.
 - "blend" chooses the profile of "smooth": "smooth", "round" (a fillet) or "chamfer" (a bevel).
 - A part that recurs in other sizes or places (the legs of a table and of its chairs, the
   windows of a house) can be written once under "definitions", with parameters and their

@@ -175,16 +175,16 @@ Result<std::shared_ptr<SharedPasses>> sharedPasses(Context::Impl& ctx) {
 
 } // namespace
 
-// Polygon and text outlines follow the nodes in their buffer: a new size is a new buffer.
-static size_t outlineSize(const Node& n) {
-    return n.outline ? n.outline->size() : 0;
+// Node words (outlines, images) follow the nodes in their buffer: a new size is a new buffer.
+static size_t wordCount(const Node& n) {
+    return n.words ? n.words->size() : 0;
 }
 
 bool sameStructure(const Scene& a, const Scene& b) {
     if (a.nodes.size() != b.nodes.size()) return false;
     for (size_t i = 0; i < a.nodes.size(); ++i)
         if (a.nodes[i].kind != b.nodes[i].kind || a.nodes[i].children != b.nodes[i].children ||
-            outlineSize(a.nodes[i]) != outlineSize(b.nodes[i]))
+            wordCount(a.nodes[i]) != wordCount(b.nodes[i]))
             return false;
     return true;
 }

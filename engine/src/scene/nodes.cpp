@@ -269,6 +269,106 @@ constexpr ParamInfo kText[] = {
      "the scene file's folder; empty or absent: DejaVu Sans (Debian's fonts-dejavu-core). "
      "Generated scenes name families only."},
 };
+constexpr ParamInfo kHeightmap[] = {
+    {"file",
+     Text,
+     Any,
+     0,
+     true,
+     {},
+     "file",
+     "A PNG file relative to the scene file's folder (at most 16 MiB, 4,194,304 pixels and 8192 "
+     "on a side), its grey levels the heights, black 0 and white the top; only a file the user "
+     "names."},
+    {"size",
+     Vec3,
+     Positive,
+     0,
+     true,
+     {},
+     "length",
+     "The box the heights fill: the image's width along x, white's height along y (black is at "
+     "y = 0) and the image's height along z (its top row at -z)."},
+};
+constexpr ParamInfo kMesh[] = {
+    {"file",
+     Text,
+     Any,
+     0,
+     true,
+     {},
+     "file",
+     "A triangle mesh file relative to the scene file's folder: STL, OBJ, PLY, glTF binary (.glb) "
+     "or 3MF (at most 256 MiB and 8,388,608 triangles); only a file the user names."},
+    {"resolution",
+     Number,
+     Count,
+     0,
+     false,
+     {128, 0, 0},
+     "cells",
+     "Cells of its field along the mesh's longest side; the field is exact to interpolation "
+     "within about two cells of the surface.",
+     1024.0f,
+     {},
+     8.0f},
+};
+constexpr std::string_view kImageInside[] = {"dark", "light"};
+constexpr ParamInfo kImage[] = {
+    {"file",
+     Text,
+     Any,
+     0,
+     true,
+     {},
+     "file",
+     "A PNG file relative to the scene file's folder (at most 16 MiB, 4,194,304 pixels and 8192 "
+     "on a side); only a file the user names."},
+    {"size",
+     Number,
+     Positive,
+     0,
+     false,
+     {1, 0, 0},
+     "length",
+     "The image's longer side. Give size, width or height, not two of them."},
+    {"width",
+     Number,
+     Positive,
+     1,
+     false,
+     {0, 0, 0},
+     "length",
+     "The image's width, instead of size."},
+    {"height",
+     Number,
+     Positive,
+     2,
+     false,
+     {0, 0, 0},
+     "length",
+     "The image's height, instead of size."},
+    {"threshold",
+     Number,
+     NonNegative,
+     3,
+     false,
+     {0.5f, 0, 0},
+     "fraction",
+     "A pixel is inside where its ink (opacity times darkness, or lightness) is at least this.",
+     1.0f},
+    {"inside",
+     Choice,
+     Any,
+     4,
+     false,
+     {0, 0, 0},
+     "mask",
+     "Which pixels are the shape: \"dark\" (dark ink on a light or transparent ground) or "
+     "\"light\" (the image inverted).",
+     3.4e38f,
+     kImageInside},
+};
 constexpr ParamInfo kExtrude[] = {
     {"height",
      Number,
@@ -624,7 +724,8 @@ constexpr float kProfileReach = 1e30f;
 bool profile(float x, float y, vec3& lo, vec3& hi) {
     return symmetric({x, y, kProfileReach}, lo, hi);
 }
-// Polygon and text: the outline's extents in slots 2-5 (Evaluator, from Node::outline).
+// Polygon, text and image: the outline's or image's extents in slots 2-5 (Evaluator, from
+// Node::words).
 bool outlineBounds(const Params& k, vec3& lo, vec3& hi) {
     lo = vec3(k[2], k[3], -kProfileReach), hi = vec3(k[4], k[5], kProfileReach);
     return true;
@@ -634,6 +735,8 @@ constexpr KernelArg kA0[] = {{0, 1}};
 constexpr KernelArg kA3[] = {{0, 3}};
 constexpr KernelArg kA3A1[] = {{0, 3}, {3, 1}};
 constexpr KernelArg kA0A1[] = {{0, 1}, {1, 1}};
+constexpr KernelArg kHeightmapArgs[] = {{0, 1}, {1, 1}, {2, 1}, {3, 1}, {4, 1}, {6, 1}, {7, 1}};
+constexpr KernelArg kMeshArgs[] = {{0, 1}, {1, 1}, {2, 1}, {3, 1}, {4, 1}, {5, 1}, {6, 1}, {7, 1}};
 constexpr KernelArg kOutlineArgs[] = {{0, 1}, {1, 1}, {2, 2}, {4, 2}, {6, 1}, {7, 1}};
 constexpr KernelArg kA0A1A2[] = {{0, 1}, {1, 1}, {2, 1}};
 constexpr KernelArg kA0A1A2A3[] = {{0, 1}, {1, 1}, {2, 1}, {3, 1}};
@@ -787,6 +890,28 @@ constexpr KindInfo kKinds[] = {
      [](const Params& k, vec3& lo, vec3& hi) {
          return symmetric({k[1] + k[2], k[0] + k[1] + k[2], k[2]}, lo, hi);
      }},
+    {NodeKind::Heightmap, "heightmap", false, kHeightmap,
+     "A PNG image's grey levels as heights over a rectangle in the xz plane, centred on the origin "
+     "(only where the user names a file); the solid below them. Its field is a bound: the height "
+     "difference over the Lipschitz bound of the heights' bilinear interpolation.",
+     R"("file": "terrain.png", "size": [1.6, 0.4, 1.6])", "sdHeightmap", kHeightmapArgs, nullptr,
+     [](const Params& k, vec3& lo, vec3& hi) {
+         lo = vec3(-k[2], 0.0f, -k[3]), hi = vec3(k[2], k[4], k[3]);
+         return true;
+     }},
+    {NodeKind::Mesh, "mesh", false, kMesh,
+     "A triangle mesh read from a file, in the file's units, STL and 3MF turned from z up to y up "
+     "(only where the user names a file). "
+     "Its field is the distance to the triangles, exact near the surface (sampled in bricks, "
+     "interpolated) and a bound beyond; the inside is what the generalised winding number "
+     "says, so meshes with holes or flipped triangles still have one.",
+     R"("file": "gear.stl", "resolution": 96)", "sdMesh", kMeshArgs, nullptr,
+     [](const Params& k, vec3& lo, vec3& hi) {
+         // The field's grid: bricks of 8 cells from its corner.
+         lo = vec3(k[2], k[3], k[4]);
+         hi = lo + 8.0f * k[5] * vec3(k[1], k[6], k[7]);
+         return true;
+     }},
     {NodeKind::CappedTorus, "capped_torus", false, kCappedTorus,
      "Arc of a ring around the y axis (a horseshoe, a handle), centred on +z.",
      R"("major_radius": 0.8, "minor_radius": 0.2, "angle": 250)", "sdCappedTorus", kA0A1A2A3,
@@ -827,6 +952,11 @@ constexpr KindInfo kKinds[] = {
      "FreeType and centred on the origin (the middle of its outlines' extents); exact distance "
      "to the glyphs' outlines.",
      R"("text": "Bo sdfg", "size": 0.5)", "sdOutline", kOutlineArgs, nullptr, outlineBounds},
+    {NodeKind::Image, "image", false, kImage,
+     "2D profile: a PNG image's mask in the xy plane, centred on the origin (only where the user "
+     "names a file); the exact distance to the mask's pixel edges at the pixels' centres, "
+     "interpolated between them.",
+     R"("file": "emblem.png", "size": 1)", "sdImage", kOutlineArgs, nullptr, outlineBounds},
     {NodeKind::Union,
      "union",
      true,

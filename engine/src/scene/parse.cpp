@@ -5,6 +5,8 @@
 
 #include "sdfcsg/eval.h"
 
+#include "field/mesh_field.h"
+#include "scene/image.h"
 #include "scene/json_syntax.h"
 #include "scene/json_writer.h"
 #include "scene/legacy.h"
@@ -847,23 +849,31 @@ Next SceneReader::readNode(element value, std::string path, uint32_t depth, Scen
             problems_.add(member(p, "points"), why);
         paramsOk = paramsOk && polygonProblem(node.points).empty();
     }
-    if (kind->kind == NodeKind::Text) {
-        // Each of the three sets the text's size: one at most.
+    if (kind->kind == NodeKind::Text || kind->kind == NodeKind::Image) {
+        // Each of the three sets the text's or image's size: one at most.
+        const std::string what = kind->kind == NodeKind::Text ? "text's" : "image's";
         std::vector<std::string> given;
         for (std::string_view key : {"size", "width", "height"})
             if (valueOf(key)) given.push_back(std::string(key));
         if (given.size() > 1) {
             problems_.add(member(p, given[1]),
-                          "expected one of \"size\", \"width\" and \"height\" (each sets the "
-                          "text's size), got both " +
-                              quote(given[0]) + " and " + quote(given[1]));
+                          "expected one of \"size\", \"width\" and \"height\" (each sets the " +
+                              what + " size), got both " + quote(given[0]) + " and " +
+                              quote(given[1]));
             paramsOk = false;
         }
     }
-    // Past the limit, the outline that passed it has said so: no more are built.
-    if (hasOutline(kind->kind) && paramsOk && outlineWords_ <= kMaxOutlineWords) {
-        auto outline = buildOutline(node, files_);
-        if (!outline) {
+    // Past the limit, the words that passed it have said so: no more are built.
+    if (hasWords(kind->kind) && paramsOk && outlineWords_ <= kMaxOutlineWords) {
+        const bool image = kind->kind == NodeKind::Image || kind->kind == NodeKind::Heightmap ||
+                           kind->kind == NodeKind::Mesh;
+        auto outline = kind->kind == NodeKind::Image       ? buildImage(node, files_)
+                       : kind->kind == NodeKind::Heightmap ? buildHeightmap(node, files_)
+                       : kind->kind == NodeKind::Mesh      ? buildMesh(node, files_)
+                                                           : buildOutline(node, files_);
+        if (!outline && image) {
+            problems_.add(member(p, "file"), outline.error().diagnostics[0].message);
+        } else if (!outline) {
             const bool fontProblem = outline.error().diagnostics[0].path == "font";
             problems_.add(member(p, fontProblem && !node.strings[1].empty() ? "font" : "text"),
                           outline.error().diagnostics[0].message);
@@ -872,11 +882,11 @@ Next SceneReader::readNode(element value, std::string path, uint32_t depth, Scen
                                              "spaces");
         } else if ((outlineWords_ += (*outline)->size()) > kMaxOutlineWords) {
             if (outlineWords_ - (*outline)->size() <= kMaxOutlineWords) // once, where it passes
-                problems_.add(p, "the scene's polygon and text outlines exceed " +
+                problems_.add(p, "the scene's outlines, images and meshes exceed " +
                                      std::to_string(kMaxOutlineWords * 16 >> 20) +
                                      " MiB in all, the limit");
         } else {
-            node.outline = *outline;
+            node.words = *outline;
         }
     }
     if (kind->kind == NodeKind::Repeat && paramsOk) {
@@ -1098,12 +1108,12 @@ void closeRevolvedProfiles(Scene& scene) {
     for (const Node& node : scene.nodes) {
         if (node.kind != NodeKind::Revolve || node.children.size() != 1) continue;
         Node& child = scene.nodes[node.children[0]];
-        if (child.kind != NodeKind::Polygon || !child.outline ||
+        if (child.kind != NodeKind::Polygon || !child.words ||
             child.transform.rotate != glm::vec3(0.0f) || child.transform.scale != glm::vec3(1.0f))
             continue;
         if (auto outline =
                 revolvedOutline(child.points, -node.params[0] - child.transform.translate.x))
-            child.outline = std::move(outline);
+            child.words = std::move(outline);
     }
 }
 

@@ -1,0 +1,108 @@
+// A triangle mesh read from a file, and the signed distance field made from it: the exact
+// distance to the triangles in a narrow band of bricks about the surface, a bound beyond it, and
+// the inside told by the generalised winding number (Jacobson, Kavan and Sorkine-Hornung 2013),
+// so that a mesh with holes, flipped or repeated triangles, as files from elsewhere often are,
+// still has a sensible inside. The winding number is summed through a hierarchy of triangles, far
+// clusters as dipoles (Barill, Dickson, Schmidt, Levin and Jacobson 2018, fast winding numbers).
+#pragma once
+
+#include "sdfcsg/error.h"
+#include "sdfcsg/scene.h"
+
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace sdfcsg::detail {
+
+// What a mesh node may read: the file's size, and its triangles once read. A file over either
+// is refused before the field is made.
+inline constexpr uintmax_t kMaxMeshFileBytes = uintmax_t(256) << 20;
+inline constexpr size_t kMaxMeshTriangles = size_t(8) << 20;
+// The field's memory: its bricks' samples and the grid of brick slots, as much as a scene's words
+// may hold in all (kMaxOutlineWords).
+inline constexpr size_t kMaxMeshFieldBytes = size_t(64) << 20;
+
+struct TriangleMesh {
+    std::vector<glm::vec3> positions;
+    std::vector<glm::uvec3> triangles; // indices into positions, counter-clockwise seen outside
+};
+
+// The triangles of an STL (binary or ASCII), OBJ, PLY, glTF binary (.glb) or 3MF file, read
+// through Assimp with every node's transform applied, points and lines left out. STL and 3MF,
+// made for printing, are z up (as sdfcsg writes them): they are turned so that their z is +y.
+// `bytes` is the file's contents and `extension` its name's (".stl", ...), which tells the format.
+// Errors are the reason alone, for the caller to place ("not a mesh file Assimp reads: ...", "no
+// triangles", "more than N triangles", "a NaN or infinite vertex", "a 3MF whose parts unpack to
+// more than N MiB").
+Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::string& extension);
+
+// What a mesh has that a closed, consistently oriented one would not: the inside it gets from
+// the winding number copes with each, and the user is told.
+struct MeshDefects {
+    size_t openEdges = 0;    // edges of one triangle
+    size_t crowdedEdges = 0; // edges of three or more triangles
+    size_t flippedEdges = 0; // edges whose two triangles run the same way along them
+    size_t degenerate = 0;   // triangles of no area
+    bool any() const { return openEdges + crowdedEdges + flippedEdges + degenerate > 0; }
+};
+MeshDefects meshDefects(const TriangleMesh& mesh);
+
+// The sampled field: a grid of bricks of kBrick cells over the mesh's box grown by the band;
+// a brick within the band of a triangle holds (kBrick + 1)^3 samples of the signed distance (its
+// corners shared with its neighbours, so that trilinear interpolation never leaves the brick),
+// any other the sign of its inside alone.
+class MeshField {
+  public:
+    static constexpr int kBrick = 8;
+
+    // `cells`: the cells along the box's longest side; the band reaches `bandCells` cells from
+    // the surface (at least the diagonal of one cell, so that every cell the surface crosses
+    // has its samples). Refused where the field would exceed kMaxMeshFieldBytes.
+    static Result<MeshField> make(const TriangleMesh& mesh, int cells, float bandCells = 2.0f);
+
+    // The signed distance at p, in the mesh's units: exact to interpolation within the band, a
+    // bound of the right sign (the band's width, or the distance to the grid's box plus it)
+    // beyond.
+    float distance(glm::vec3 p) const;
+
+    glm::vec3 origin() const { return origin_; }
+    float cell() const { return cell_; }
+    float band() const { return band_; }
+    glm::ivec3 bricks() const { return bricks_; }
+    size_t storedBricks() const { return samples_.size() / kBrickSamples; }
+    size_t bytes() const {
+        return samples_.size() * sizeof(float) + slots_.size() * sizeof(int32_t);
+    }
+    // sdMesh's words (shaders/sdf.glsl).
+    std::vector<glm::vec4> words() const;
+
+  private:
+    static constexpr int kBrickSide = kBrick + 1,
+                         kBrickSamples = kBrickSide * kBrickSide * kBrickSide;
+    static constexpr int32_t kOutside = -1, kInside = -2; // slots of bricks without samples
+
+    glm::vec3 origin_{0.0f}; // the grid's least corner
+    float cell_ = 1.0f, band_ = 1.0f;
+    glm::ivec3 bricks_{0};
+    std::vector<int32_t> slots_; // per brick: its samples' index, or kOutside / kInside
+    std::vector<float> samples_; // kBrickSamples per stored brick, x fastest
+};
+
+// The mesh node's words (Node::words, sdMesh's layout in shaders/sdf.glsl): its "file" found
+// under `files` (sceneFile()) and read, its field made at its "resolution". Errors are for the
+// caller to place at the node's "file"; an untrusted scene's problems with the file say
+// "unknown mesh" and nothing of the file system.
+Result<std::shared_ptr<const std::vector<glm::vec4>>> buildMesh(const Node& node,
+                                                                const SceneFiles& files);
+
+// The generalised winding number of the mesh at each of `points`: near 1 inside a closed
+// surface, near 0 outside, in between near a hole. Exposed for tests.
+std::vector<float> windingNumbers(const TriangleMesh& mesh, const std::vector<glm::vec3>& points);
+
+} // namespace sdfcsg::detail

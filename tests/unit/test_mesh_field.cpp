@@ -1,0 +1,273 @@
+// Mesh files read into triangles, and the signed distance field made from them
+// (engine/src/field/mesh_field.h): against an analytic sphere, with holes and flipped triangles,
+// and with hostile files.
+#include "field/mesh_field.h"
+
+#include <sdfcsg/eval.h>
+#include <sdfcsg/export.h>
+#include <sdfcsg/mesh.h>
+#include <sdfcsg/scene.h>
+
+#include <gtest/gtest.h>
+
+#include <glm/geometric.hpp>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace sdfcsg::detail {
+namespace {
+
+// A unit sphere: an icosahedron, each triangle split in four `levels` times, pushed onto it.
+Mesh icosphere(int levels) {
+    const float t = (1.0f + std::sqrt(5.0f)) / 2.0f;
+    Mesh m;
+    m.positions = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                   {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+    m.indices = {0, 11, 5,  0, 5,  1, 0, 1, 7, 0, 7,  10, 0, 10, 11, 1, 5, 9, 5, 11,
+                 4, 11, 10, 2, 10, 7, 6, 7, 1, 8, 3,  9,  4, 3,  4,  2, 3, 2, 6, 3,
+                 6, 8,  3,  8, 9,  4, 9, 5, 2, 4, 11, 6,  2, 10, 8,  6, 7, 9, 8, 1};
+    for (glm::vec3& p : m.positions)
+        p = glm::normalize(p);
+    for (int l = 0; l < levels; ++l) {
+        std::map<std::pair<uint32_t, uint32_t>, uint32_t> middles;
+        auto middle = [&](uint32_t a, uint32_t b) {
+            const auto key = std::minmax(a, b);
+            auto [it, added] = middles.try_emplace(key, uint32_t(m.positions.size()));
+            if (added) m.positions.push_back(glm::normalize(m.positions[a] + m.positions[b]));
+            return it->second;
+        };
+        std::vector<uint32_t> next;
+        for (size_t i = 0; i < m.indices.size(); i += 3) {
+            const uint32_t a = m.indices[i], b = m.indices[i + 1], c = m.indices[i + 2];
+            const uint32_t ab = middle(a, b), bc = middle(b, c), ca = middle(c, a);
+            next.insert(next.end(), {a, ab, ca, b, bc, ab, c, ca, bc, ab, bc, ca});
+        }
+        m.indices = std::move(next);
+    }
+    m.normals = m.positions;
+    return m;
+}
+
+TriangleMesh triangles(const Mesh& m) {
+    TriangleMesh t;
+    t.positions = m.positions;
+    for (size_t i = 0; i < m.indices.size(); i += 3)
+        t.triangles.push_back({m.indices[i], m.indices[i + 1], m.indices[i + 2]});
+    return t;
+}
+
+std::vector<glm::vec3> randomPoints(uint32_t seed, int count, float reach) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(-reach, reach);
+    std::vector<glm::vec3> points(count);
+    for (glm::vec3& p : points)
+        p = {u(rng), u(rng), u(rng)};
+    return points;
+}
+
+// A binary STL of `count` claimed triangles followed by `mesh`'s.
+std::string binaryStl(const TriangleMesh& mesh, uint32_t count) {
+    std::string s(80, ' ');
+    s.append(reinterpret_cast<const char*>(&count), 4);
+    for (const glm::uvec3& t : mesh.triangles) {
+        float record[12] = {};
+        for (int c = 0; c < 3; ++c)
+            std::memcpy(record + 3 + 3 * c, &mesh.positions[t[c]], 12);
+        s.append(reinterpret_cast<const char*>(record), sizeof record);
+        s.append(2, '\0');
+    }
+    return s;
+}
+
+TEST(MeshField, EveryFormatReadsTheSameTriangles) {
+    Mesh sphere = icosphere(3);
+    const glm::vec3 centre(0.3f, 0.7f, -0.2f); // read back where it was: STL and 3MF turned
+    for (glm::vec3& p : sphere.positions)
+        p += centre;
+    for (MeshFormat format : {MeshFormat::Ply, MeshFormat::Obj, MeshFormat::Stl, MeshFormat::Glb,
+                              MeshFormat::ThreeMf}) {
+        const std::string name(meshFormatName(format));
+        SCOPED_TRACE(name);
+        auto read =
+            readTriangleMesh(encodeMesh(sphere, format, LengthUnit::Millimeter), "." + name);
+        ASSERT_TRUE(read) << read.error().str();
+        EXPECT_EQ(read->triangles.size(), sphere.indices.size() / 3);
+        EXPECT_EQ(read->positions.size(), sphere.positions.size()); // STL's corners welded
+        EXPECT_FALSE(meshDefects(*read).any());
+        float farthest = 0.0f;
+        for (const glm::vec3& p : read->positions)
+            farthest = std::max(farthest, std::abs(glm::length(p - centre) - 1.0f));
+        EXPECT_LT(farthest, 1e-5f);
+    }
+}
+
+TEST(MeshField, DistanceOfASphereMesh) {
+    const TriangleMesh sphere = triangles(icosphere(5)); // 20480 triangles, sagitta about 1e-4
+    auto field = MeshField::make(sphere, 64);
+    ASSERT_TRUE(field) << field.error().str();
+    const float cell = field->cell();
+    EXPECT_NEAR(cell, 2.0f / 64.0f, 1e-3f);
+    int inBand = 0;
+    for (const glm::vec3& p : randomPoints(3, 20000, 1.6f)) {
+        const float exact = glm::length(p) - 1.0f, d = field->distance(p);
+        if (std::abs(exact) < field->band()) {
+            ++inBand;
+            ASSERT_NEAR(d, exact, 0.05f * cell) << p.x << " " << p.y << " " << p.z;
+        } else {
+            // Beyond the band: a bound of the right sign.
+            ASSERT_EQ(d < 0.0f, exact < 0.0f) << p.x << " " << p.y << " " << p.z << " " << d;
+            ASSERT_LE(std::abs(d), std::abs(exact) + 0.05f * cell);
+        }
+    }
+    EXPECT_GT(inBand, 500);
+    // Sparse: only bricks near the sphere hold samples.
+    EXPECT_LT(field->storedBricks(),
+              size_t(field->bricks().x * field->bricks().y * field->bricks().z));
+}
+
+// A sphere with a hole cut in it and some triangles turned over still has the ball as its
+// inside; the defects are counted.
+TEST(MeshField, HolesAndFlippedTrianglesKeepTheInside) {
+    TriangleMesh mesh = triangles(icosphere(4));
+    std::vector<glm::uvec3> kept;
+    size_t flipped = 0;
+    for (size_t i = 0; i < mesh.triangles.size(); ++i) {
+        glm::uvec3 t = mesh.triangles[i];
+        glm::vec3 c = (mesh.positions[t.x] + mesh.positions[t.y] + mesh.positions[t.z]) / 3.0f;
+        if (c.y > 0.93f) continue; // a hole about the top
+        if (i % 97 == 0 && c.y < 0.5f) std::swap(t.y, t.z), ++flipped;
+        kept.push_back(t);
+    }
+    mesh.triangles = kept;
+    const MeshDefects defects = meshDefects(mesh);
+    EXPECT_GT(defects.openEdges, 10u);
+    EXPECT_EQ(defects.flippedEdges, 3 * flipped);
+    EXPECT_EQ(defects.crowdedEdges, 0u);
+    const std::vector<glm::vec3> points = randomPoints(5, 4000, 1.5f);
+    const std::vector<float> w = windingNumbers(mesh, points);
+    auto field = MeshField::make(mesh, 48);
+    ASSERT_TRUE(field) << field.error().str();
+    for (size_t i = 0; i < points.size(); ++i) {
+        const float r = glm::length(points[i]);
+        if (points[i].y > 0.7f || std::abs(r - 1.0f) < 0.1f) continue; // near the hole or surface
+        ASSERT_EQ(w[i] > 0.5f, r < 1.0f) << w[i] << " at radius " << r;
+        ASSERT_EQ(field->distance(points[i]) < 0.0f, r < 1.0f) << "at radius " << r;
+    }
+}
+
+TEST(MeshField, HostileFilesAreRefused) {
+    const TriangleMesh sphere = triangles(icosphere(1));
+    auto text = [](const Result<TriangleMesh>& r) {
+        return r ? std::string("read") : r.error().diagnostics[0].message;
+    };
+    // Claims 2^31 triangles, holds 80.
+    EXPECT_NE(text(readTriangleMesh(binaryStl(sphere, 1u << 31), ".stl")).find("not a mesh file"),
+              std::string::npos);
+    TriangleMesh bad = sphere;
+    bad.positions[3].x = NAN;
+    EXPECT_EQ(text(readTriangleMesh(binaryStl(bad, uint32_t(bad.triangles.size())), ".stl")),
+              "a NaN or infinite vertex");
+    EXPECT_EQ(text(readTriangleMesh("v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\n", ".obj")), "no triangles");
+    EXPECT_NE(text(readTriangleMesh(std::string(100, 'x'), ".ply")).find("not a mesh file"),
+              std::string::npos);
+    EXPECT_NE(text(readTriangleMesh("", ".glb")).find("not a mesh file"), std::string::npos);
+    // A 3MF whose directory claims an entry of 4 GiB - 2 (a ZIP bomb's shape): refused unread.
+    std::string bomb = encodeMesh(icosphere(1), MeshFormat::ThreeMf, LengthUnit::Millimeter);
+    const size_t directory = bomb.rfind(std::string("PK\1\2", 4));
+    ASSERT_NE(directory, std::string::npos);
+    const uint32_t huge = 0xfffffffeu;
+    std::memcpy(&bomb[directory + 24], &huge, 4);
+    EXPECT_EQ(text(readTriangleMesh(bomb, ".3mf")),
+              "a 3MF whose parts unpack to more than 1024 MiB");
+    EXPECT_EQ(text(readTriangleMesh("PK", ".3mf")),
+              "not a 3MF file: no ZIP directory that can be read");
+    // A field too large for memory is refused before it is made.
+    auto huge_field = MeshField::make(triangles(icosphere(2)), 100000);
+    ASSERT_FALSE(huge_field);
+    EXPECT_NE(huge_field.error().str().find("over the limit of 64 MiB"), std::string::npos)
+        << huge_field.error().str();
+}
+
+const std::filesystem::path kGearStl =
+    std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes/gear.stl";
+
+Scene meshScene(const std::string& file, int resolution) {
+    auto scene = parseScene(R"({"version": 1, "root": {"type": "mesh", "file": ")" + file +
+                                R"(", "resolution": )" + std::to_string(resolution) + "}}",
+                            "test.json");
+    if (!scene) ADD_FAILURE() << scene.error().str();
+    return scene ? *scene : Scene{};
+}
+
+// The node's field, through the kernels' formula (sdMesh), is the mesh field's.
+TEST(MeshNode, FieldIsTheMeshFields) {
+    std::ifstream in(kGearStl, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    auto mesh = readTriangleMesh(bytes, ".stl");
+    ASSERT_TRUE(mesh) << mesh.error().str();
+    auto field = MeshField::make(*mesh, 96);
+    ASSERT_TRUE(field) << field.error().str();
+    const Evaluator node(meshScene(kGearStl.string(), 96));
+    const glm::vec3 lo = node.bounds().min, hi = node.bounds().max;
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    for (int i = 0; i < 20000; ++i) {
+        // Inside the grid and a little beyond it.
+        const glm::vec3 t(u(rng), u(rng), u(rng));
+        const glm::vec3 p = lo - 0.2f * (hi - lo) + 1.4f * t * (hi - lo);
+        ASSERT_NEAR(node.distance(p), field->distance(p), 1e-5f);
+    }
+}
+
+// Scene -> mesh -> mesh node: the scene's surface is the node's, within the mesh's own error (its
+// cells at 56) and the field's interpolation; and both agree on the inside away from it. (The
+// gear's field is a bound, not a distance, so values away from the surface differ.)
+TEST(MeshNode, RoundTripKeepsTheSurface) {
+    auto gear = loadScene(std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes/gear.json");
+    ASSERT_TRUE(gear) << gear.error().str();
+    const Evaluator scene(*gear), node(meshScene(kGearStl.string(), 128));
+    const glm::vec3 size = scene.bounds().max - scene.bounds().min;
+    const float cell = std::max({size.x, size.y, size.z}) / 56.0f;
+    std::mt19937 rng(4);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    int near = 0;
+    for (int i = 0; i < 40000; ++i) {
+        const glm::vec3 p = scene.bounds().min + glm::vec3(u(rng), u(rng), u(rng)) * size;
+        const float d = scene.distance(p), v = node.distance(p);
+        if (std::abs(d) < 0.1f * cell) {
+            ++near;
+            ASSERT_LT(std::abs(v), 0.6f * cell) << p.x << " " << p.y << " " << p.z;
+        } else if (std::abs(d) > cell) {
+            ASSERT_EQ(v < 0.0f, d < 0.0f) << p.x << " " << p.y << " " << p.z;
+        }
+    }
+    EXPECT_GT(near, 200);
+}
+
+TEST(MeshNode, ItsProblemsAreNamed) {
+    auto error = [](const std::string& root, bool trusted = true) {
+        ParseOptions options;
+        options.files.trusted = trusted;
+        options.files.folder = trusted ? "" : SDFCSG_SOURCE_DIR;
+        auto scene = parseScene(R"({"version": 1, "root": )" + root + "}", "test.json", options);
+        return scene ? "accepted" : scene.error().str();
+    };
+    EXPECT_EQ(error(R"({"type": "mesh", "file": "nothing.stl"})"),
+              "test.json: root.file: cannot load mesh \"nothing.stl\": no such file");
+    EXPECT_EQ(error(R"({"type": "mesh", "file": "/etc/passwd"})", false),
+              "test.json: root.file: unknown mesh \"/etc/passwd\": name a mesh file in the "
+              "scene's folder");
+    EXPECT_EQ(error(R"({"type": "mesh", "file": ")" + kGearStl.string() + R"(", "resolution": 4})"),
+              "test.json: root.resolution: expected at least 8, got 4");
+}
+
+} // namespace
+} // namespace sdfcsg::detail
