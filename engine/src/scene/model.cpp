@@ -517,7 +517,7 @@ Status setValue(Scene& scene, uint32_t index, std::string_view key, const Value&
         node.params = edited.params;
         node.points = edited.points;
         node.strings = edited.strings;
-        node.outline = edited.outline;
+        node.words = edited.words;
     }
     return Ok{};
 }
