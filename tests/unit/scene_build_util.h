@@ -245,8 +245,9 @@ struct TreeOptions {
 };
 
 // A random tree of every kind of the node table but the plane (unbounded; with options.planes,
-// an operand of intersections and differences), the text (slow to compile), the image and the
-// heightmap (they read files; tests/unit/test_images.cpp), each from its example in the table
+// an operand of intersections and differences), the text (slow to compile), the image, the
+// heightmap and the mesh (they read files; tests/unit/test_images.cpp, test_mesh_field.cpp), each
+// from its example in the table
 // (sdfcsg/nodes.h), turned, moved and scaled at random: operations over random subtrees (Booleans
 // sharp or with their example's blend), 2D profiles under extrude or revolve, primitives at the
 // leaves.
@@ -255,7 +256,7 @@ inline std::string randomTreeJson(std::mt19937& rng, int depth, const TreeOption
     std::vector<const KindInfo*> primitives, profiles, operations;
     for (const KindInfo& k : nodeKinds()) {
         if (k.kind == NodeKind::Plane || k.kind == NodeKind::Text || k.kind == NodeKind::Image ||
-            k.kind == NodeKind::Heightmap)
+            k.kind == NodeKind::Heightmap || k.kind == NodeKind::Mesh)
             continue;
         (isProfile(k.kind) ? profiles : k.operation ? operations : primitives).push_back(&k);
     }
