@@ -556,13 +556,8 @@ Result<std::shared_ptr<const std::vector<glm::vec4>>> buildMesh(const Node& node
                                                                 const SceneFiles& files) {
     const std::string& name = node.strings[0];
     auto fail = [&](const std::string& why) {
-        if (!files.trusted)
-            return reason(
-                untrustedFileProblem("mesh", name, ": name a mesh file in the scene's folder"));
-        const std::filesystem::path named(name);
-        const bool joined = !named.is_absolute() && !files.folder.empty();
-        return reason("cannot load mesh " + quote(joined ? (files.folder / named).string() : name) +
-                      ": " + why);
+        return reason(
+            nodeFileProblem("mesh", name, files, why, ": name a mesh file in the scene's folder"));
     };
     auto file = sceneFile(name, files, kMaxMeshFileBytes);
     if (!file) return fail(file.error().diagnostics[0].message);

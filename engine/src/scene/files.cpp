@@ -60,4 +60,14 @@ std::string untrustedFileProblem(std::string_view what, std::string_view name,
     return "unknown " + std::string(what) + " " + quote(name) + std::string(hint);
 }
 
+std::string nodeFileProblem(std::string_view what, std::string_view name, const SceneFiles& files,
+                            std::string_view why, std::string_view hint) {
+    if (!files.trusted) return untrustedFileProblem(what, name, hint);
+    const fs::path named(name);
+    const bool joined = !named.is_absolute() && !files.folder.empty();
+    return "cannot load " + std::string(what) + " " +
+           quote(joined ? (files.folder / named).string() : std::string(name)) + ": " +
+           std::string(why);
+}
+
 } // namespace sdfcsg::detail

@@ -26,4 +26,10 @@ Result<std::filesystem::path> sceneFile(std::string_view name, const SceneFiles&
 std::string untrustedFileProblem(std::string_view what, std::string_view name,
                                  std::string_view hint);
 
+// What a problem `why` with the file `name` that a node reads (`what`: "image", "mesh") says:
+// "cannot load WHAT \"PATH\": WHY", PATH the name joined to the scene's folder; in an untrusted
+// scene, untrustedFileProblem()'s text with `hint`.
+std::string nodeFileProblem(std::string_view what, std::string_view name, const SceneFiles& files,
+                            std::string_view why, std::string_view hint);
+
 } // namespace sdfcsg::detail

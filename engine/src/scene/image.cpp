@@ -146,13 +146,8 @@ namespace {
 Result<GreyImage> nodeImage(const Node& node, const SceneFiles& files) {
     const std::string& name = node.strings[0];
     auto fail = [&](const std::string& why) {
-        if (!files.trusted)
-            return problem(
-                untrustedFileProblem("image", name, ": name a PNG file in the scene's folder"));
-        const std::filesystem::path named(name);
-        const bool joined = !named.is_absolute() && !files.folder.empty();
-        return problem("cannot load image " +
-                       quote(joined ? (files.folder / named).string() : name) + ": " + why);
+        return problem(
+            nodeFileProblem("image", name, files, why, ": name a PNG file in the scene's folder"));
     };
     auto file = sceneFile(name, files, kMaxImageBytes);
     if (!file) return fail(file.error().diagnostics[0].message);
