@@ -109,22 +109,13 @@ glm::vec3 vec3Args(const py::args& args, bool uniformAllowed) {
     throw py::type_error("sdfcsg: expected x, y, z or [x, y, z]");
 }
 
-// Required parameters first, then optional ones, each in the table's order: positional order.
-std::vector<const ParamInfo*> ordered(const KindInfo& kind) {
-    std::vector<const ParamInfo*> out;
-    for (int pass = 0; pass < 2; ++pass)
-        for (const ParamInfo& p : kind.params)
-            if (p.required == (pass == 0)) out.push_back(&p);
-    return out;
-}
-
 std::string signature(const KindInfo& kind) {
     std::string s = std::string(kind.name) + "(";
     if (kind.operation)
         s += isTransition(kind.kind)      ? "first, second, "
              : kind.role == Role::Boolean ? "*children, "
                                           : "child, ";
-    for (const ParamInfo* p : ordered(kind))
+    for (const ParamInfo* p : positionalParams(kind))
         s += std::string(p->name) + (p->required ? "" : "=None") + ", ";
     s.resize(s.size() - 2);
     return s + ")";
@@ -132,7 +123,7 @@ std::string signature(const KindInfo& kind) {
 
 std::string docstring(const KindInfo& kind) {
     std::string doc = signature(kind) + "\n\n" + std::string(kind.doc) + "\n";
-    for (const ParamInfo* p : ordered(kind))
+    for (const ParamInfo* p : positionalParams(kind))
         doc += "\n" + std::string(p->name) + " (" + std::string(p->unit) +
                (p->required ? "" : ", optional") + "): " + std::string(p->doc);
     return doc;
@@ -159,7 +150,7 @@ m::Shape build(const KindInfo& kind, py::args args, const py::kwargs& kwargs) {
             children.push_back(args[next].cast<m::Shape>());
         }
     }
-    const std::vector<const ParamInfo*> params = ordered(kind);
+    const std::vector<const ParamInfo*> params = positionalParams(kind);
     if (args.size() - next > params.size())
         throw py::type_error("sdfcsg." + signature(kind) + ": too many arguments");
     std::vector<m::Arg> values;

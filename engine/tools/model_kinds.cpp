@@ -44,15 +44,6 @@ std::string argumentName(std::string_view json) {
     return std::string(json);
 }
 
-// Required parameters first, then the optional ones, each group in the table's order.
-std::vector<const ParamInfo*> ordered(const KindInfo& kind) {
-    std::vector<const ParamInfo*> out;
-    for (int pass = 0; pass < 2; ++pass)
-        for (const ParamInfo& p : kind.params)
-            if (p.required == (pass == 0)) out.push_back(&p);
-    return out;
-}
-
 // The first sentence of a documentation text.
 std::string_view sentence(std::string_view doc) {
     const size_t end = doc.find(". ");
@@ -62,14 +53,14 @@ std::string_view sentence(std::string_view doc) {
 // The documentation comment: the kind's and each parameter's.
 void comment(std::ostream& out, const KindInfo& kind, const char* indent) {
     out << indent << "// " << kind.name << ": " << sentence(kind.doc) << "\n";
-    for (const ParamInfo* p : ordered(kind))
+    for (const ParamInfo* p : positionalParams(kind))
         out << indent << "//   " << p->name << (p->required ? "" : " (optional)") << ", " << p->unit
             << ": " << sentence(p->doc) << "\n";
 }
 
 // "Value radius, Value top_radius = {}" and the matching {{"radius", radius}, ...}.
 void parameters(const KindInfo& kind, std::string& declared, std::string& passed) {
-    for (const ParamInfo* p : ordered(kind)) {
+    for (const ParamInfo* p : positionalParams(kind)) {
         const std::string name = argumentName(p->name);
         declared += ", Value " + name + (p->required ? "" : " = {}");
         passed += std::string(passed.empty() ? "" : ", ") + "{\"" + std::string(p->name) +
@@ -131,13 +122,13 @@ int main(int argc, char** argv) {
                    << ") {\n    return shape(" << type << ", {" << passed
                    << "}, {std::move(child)}, where);\n}\n";
             std::string args;
-            for (const ParamInfo* p : ordered(kind))
+            for (const ParamInfo* p : positionalParams(kind))
                 args += "std::move(" + argumentName(p->name) + "), ";
             methods << "\n";
             comment(methods, kind, "");
             methods << "Shape " << name << "(" << list(declared + where) << ") const;\n";
             std::string defined;
-            for (const ParamInfo* p : ordered(kind))
+            for (const ParamInfo* p : positionalParams(kind))
                 defined += ", Value " + argumentName(p->name);
             header << "inline Shape Shape::" << name << "(" << list(defined + ", Where where")
                    << ") const {\n    return model::" << name << "(*this, " << args
@@ -159,7 +150,7 @@ int main(int argc, char** argv) {
               "Shape(); };\n";
     for (const KindInfo& kind : nodeKinds()) {
         std::string call;
-        for (const ParamInfo* p : ordered(kind))
+        for (const ParamInfo* p : positionalParams(kind))
             call += "arg(\"" + std::string(p->name) + "\"), ";
         const std::string operands = !kind.operation              ? ""
                                      : isTransition(kind.kind)    ? "child(0), child(1), "

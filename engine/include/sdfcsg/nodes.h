@@ -16,6 +16,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace sdfcsg {
 
@@ -146,6 +147,16 @@ std::span<const KindInfo> nodeKinds();
 // "children" with one operand (a sphere; a circle under extrude and revolve).
 std::string exampleNodeJson(const KindInfo& kind);
 const KindInfo& kindInfo(NodeKind kind);
+
+// A kind's parameters in the order the modelling API (sdfcsg/model.h) and the Python module take
+// them by position: the required ones first, then the optional ones, each in the table's order.
+inline std::vector<const ParamInfo*> positionalParams(const KindInfo& kind) {
+    std::vector<const ParamInfo*> out;
+    for (int pass = 0; pass < 2; ++pass)
+        for (const ParamInfo& p : kind.params)
+            if (p.required == (pass == 0)) out.push_back(&p);
+    return out;
+}
 const KindInfo* findKind(std::string_view name); // nullptr when unknown
 // type, name, translate, rotate, scale, color and (operations only) children.
 std::span<const CommonKey> commonNodeKeys();
