@@ -27,15 +27,26 @@
 #include <initializer_list>
 #include <memory>
 #include <optional>
-#include <source_location>
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace sdfcsg::model {
 
-// Where a call that made a node stands in the caller's source, for errors.
-using Where = std::source_location;
+// Where a call that made a node stands in the caller's source, for errors. As a default argument,
+// Where::current() is the caller's line. (The compilers' builtins rather than std::source_location,
+// which clang before 15 cannot compile with GCC's standard library.)
+struct Where {
+    static constexpr Where current(const char* file = __builtin_FILE(),
+                                   unsigned line = __builtin_LINE()) {
+        return {file, line};
+    }
+    const char* file_name() const { return file_; }
+    unsigned line() const { return line_; }
+
+    const char* file_ = "";
+    unsigned line_ = 0;
+};
 
 // A value of the scene format, kept as its JSON text: a number, a vector ({1, 2, 3} or a
 // glm::vec3), a string (a choice such as "round", a text, a colour "#rrggbb", or "$name", a

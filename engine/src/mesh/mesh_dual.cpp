@@ -797,14 +797,14 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
             std::sort(fan.begin(), fan.end());
             for (uint32_t v : toPlace) {
                 toMean[v] = 2;
-                const auto [b, e] = std::equal_range(
+                const auto mine = std::equal_range(
                     fan.begin(), fan.end(), std::pair{v, 0u},
                     [](const auto& x, const auto& y) { return x.first < y.first; });
                 // How the fan faces with v at p: its folding triangles, then their sum.
                 auto score = [&](glm::vec3 p) {
                     mesh.positions[v] = p;
                     float folds = 0.0f, sum = 0.0f;
-                    for (auto it = b; it != e; ++it) {
+                    for (auto it = mine.first; it != mine.second; ++it) {
                         const uint32_t* f = &probe[it->second];
                         const float c = facing(mesh, distance, h, f[0], f[1], f[2], true);
                         if (c < 0.0f) {
