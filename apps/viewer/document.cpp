@@ -2,6 +2,7 @@
 
 #include <sdfcsg/io.h>
 
+#include <algorithm>
 #include <fstream>
 #include <system_error>
 
@@ -77,7 +78,7 @@ Status Document::open(const std::filesystem::path& path) {
 }
 
 bool Document::pollReload() {
-    if (!watcher_.poll()) return false;
+    if (!watcher_.poll()) return pollReads();
     auto scene = loadScene(path_);
     ++version_;
     if (!scene) {
@@ -89,6 +90,37 @@ bool Document::pollReload() {
     history_.endMerge();
     history_.push(std::move(*scene));
     loaded_ = true;
+    return true;
+}
+
+// The files are those of the scene on screen, whichever step of its history: a set that
+// differs from the last poll's is watched from now on, a change of one of them parses the scene
+// again (its JSON names the files; the parse reads them).
+bool Document::pollReads() {
+    if (!loaded_) return false;
+    const std::vector<std::filesystem::path> files = filesRead(scene());
+    if (!std::equal(files.begin(), files.end(), reads_.begin(), reads_.end(),
+                    [](const auto& file, const FileWatcher& w) { return file == w.path(); })) {
+        reads_.clear();
+        for (const std::filesystem::path& file : files)
+            reads_.emplace_back(file);
+        return false;
+    }
+    bool changed = false;
+    for (FileWatcher& read : reads_)
+        changed = read.poll() || changed;
+    if (!changed) return false;
+    ParseOptions options;
+    options.files = scene().files;
+    auto again = parseScene(toJson(scene()), scene().file, options);
+    ++version_;
+    if (!again) {
+        error_ = again.error();
+        return true;
+    }
+    error_.reset();
+    history_.endMerge();
+    history_.push(std::move(*again));
     return true;
 }
 

@@ -56,7 +56,9 @@ class Document {
     // Loads a file; on failure the current scene stays, with its path and watcher (a document
     // without a scene watches the broken file instead), and error() holds the problems.
     Status open(const std::filesystem::path& path);
-    // Reloads if the file changed on disk; true when something changed (scene or error).
+    // Reloads if the file changed on disk, or parses the scene on screen again if a file that
+    // its nodes read (filesRead()) did, as one more step; true when something changed (scene or
+    // error).
     bool pollReload();
     // Writes the current scene as JSON, atomically, and takes that version as seen.
     Status save(const std::filesystem::path& path);
@@ -78,8 +80,11 @@ class Document {
     void touch() { ++version_; }
 
   private:
+    bool pollReads();
+
     std::filesystem::path path_;
     FileWatcher watcher_;
+    std::vector<FileWatcher> reads_; // the files that the scene's nodes read
     History history_;
     std::optional<Error> error_;
     bool loaded_ = false;

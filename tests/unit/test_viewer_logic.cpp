@@ -23,6 +23,7 @@
 #include <glm/trigonometric.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -766,6 +767,52 @@ TEST(ViewerFiles, ReloadKeepsTheLastGoodScene) {
     EXPECT_EQ(doc.scene().nodes.size(), 1u);
     ASSERT_TRUE(doc.history().undo());
     EXPECT_EQ(doc.scene().nodes.size(), 5u);
+}
+
+// An ASCII STL of the tetrahedron of the origin and the three axes' points at `size`.
+std::string tetrahedronStl(float size) {
+    const std::string a = "0 0 0", b = std::to_string(size) + " 0 0",
+                      c = "0 " + std::to_string(size) + " 0", d = "0 0 " + std::to_string(size);
+    std::string stl = "solid t\n";
+    for (const auto& [p, q, r] : {std::array{a, c, b}, {a, b, d}, {a, d, c}, {b, c, d}})
+        stl += "facet normal 0 0 0\nouter loop\nvertex " + p + "\nvertex " + q + "\nvertex " + r +
+               "\nendloop\nendfacet\n";
+    return stl + "endsolid t\n";
+}
+
+TEST(ViewerFiles, AChangedMeshFileParsesTheSceneAgain) {
+    fs::path dir = tempDir("viewer_reads");
+    writeText(dir / "part.stl", tetrahedronStl(1));
+    writeText(dir / "scene.json", R"({"version": 1, "root": {"type": "union", "children": [
+        {"type": "sphere", "radius": 0.2},
+        {"type": "mesh", "file": "part.stl", "resolution": 16}]}})");
+    Document doc;
+    ASSERT_TRUE(doc.open(dir / "scene.json"));
+    EXPECT_EQ(filesRead(doc.scene()), std::vector<fs::path>{dir / "part.stl"});
+    const auto before = doc.scene().nodes[2].words;
+    ASSERT_TRUE(before);
+    EXPECT_FALSE(doc.pollReload()); // the first poll starts watching the mesh
+    EXPECT_FALSE(doc.pollReload());
+
+    // Another mesh in the file: the node's field is made again, as one more step.
+    writeText(dir / "part.stl", tetrahedronStl(2));
+    fs::last_write_time(dir / "part.stl",
+                        fs::last_write_time(dir / "part.stl") + std::chrono::seconds(5));
+    EXPECT_TRUE(doc.pollReload());
+    EXPECT_FALSE(doc.error());
+    ASSERT_TRUE(doc.scene().nodes[2].words);
+    EXPECT_NE(*doc.scene().nodes[2].words, *before);
+    EXPECT_FALSE(doc.pollReload());
+    ASSERT_TRUE(doc.history().undo());
+    EXPECT_EQ(doc.scene().nodes[2].words, before);
+
+    // A broken mesh keeps the scene, and says why.
+    writeText(dir / "part.stl", "solid t\nendsolid t\n");
+    EXPECT_TRUE(doc.pollReload());
+    ASSERT_TRUE(doc.error());
+    EXPECT_NE(doc.error()->str().find("root.children[1].file: cannot load mesh"), std::string::npos)
+        << doc.error()->str();
+    EXPECT_EQ(doc.scene().nodes[2].words, before);
 }
 
 TEST(ViewerFiles, SaveIsAtomicAndNotReloaded) {

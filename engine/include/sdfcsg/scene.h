@@ -146,6 +146,11 @@ Result<Scene> parseScene(std::string_view json, std::string_view file = "<input>
 // and oversize files are reported like any other.
 Result<Scene> loadScene(const std::filesystem::path& path, const Limits& limits = {});
 
+// The files that the scene's nodes read (an image's, a heightmap's or a mesh's "file"), each
+// once, in the order of the nodes, joined to scene.files' folder as the loader joins them: what a
+// viewer watches to load them again when they change.
+std::vector<std::filesystem::path> filesRead(const Scene& scene);
+
 // Serialises to the current format (2-space indent, stable key order). parseScene(toJson(s))
 // gives back an equal scene.
 std::string toJson(const Scene& scene);

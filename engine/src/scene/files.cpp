@@ -5,6 +5,9 @@
 #include "scene/files.h"
 
 #include "scene/parse_util.h"
+#include "sdfcsg/nodes.h"
+
+#include <algorithm>
 
 namespace sdfcsg::detail {
 
@@ -71,3 +74,22 @@ std::string nodeFileProblem(std::string_view what, std::string_view name, const 
 }
 
 } // namespace sdfcsg::detail
+
+namespace sdfcsg {
+
+std::vector<std::filesystem::path> filesRead(const Scene& scene) {
+    std::vector<std::filesystem::path> read;
+    for (const Node& node : scene.nodes)
+        for (const ParamInfo& param : kindInfo(node.kind).params)
+            if (param.type == ValueType::Text && param.unit == "file") {
+                const std::filesystem::path named(node.strings[param.slot]);
+                std::filesystem::path file = named.is_absolute() || scene.files.folder.empty()
+                                                 ? named
+                                                 : scene.files.folder / named;
+                if (std::find(read.begin(), read.end(), file) == read.end())
+                    read.push_back(std::move(file));
+            }
+    return read;
+}
+
+} // namespace sdfcsg
