@@ -196,6 +196,53 @@ TEST(MeshField, HostileFilesAreRefused) {
         << huge_field.error().str();
 }
 
+// A glTF whose buffer is a file beside it reads as its binary form does. The files that a mesh
+// file names are read from its folder alone: one that names a file outside it, or a device, reads
+// nothing from there.
+TEST(MeshField, FilesAMeshNamesAreReadFromItsFolderAlone) {
+    const std::filesystem::path dir =
+        std::filesystem::path(SDFCSG_TEST_OUTPUT_DIR) / "mesh_named_files";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir / "part");
+    const Mesh sphere = icosphere(2);
+    // The binary form's two chunks: its JSON (the buffer named by the JSON's first "byteLength"),
+    // then the buffer.
+    const std::string glb = encodeMesh(sphere, MeshFormat::Glb, LengthUnit::Millimeter);
+    uint32_t jsonLength = 0;
+    std::memcpy(&jsonLength, &glb[12], 4);
+    std::string json = glb.substr(20, jsonLength);
+    const std::string buffer = glb.substr(20 + jsonLength + 8);
+    const size_t byteLength = json.find("\"byteLength\"");
+    ASSERT_NE(byteLength, std::string::npos) << json;
+    auto write = [](const std::filesystem::path& file, const std::string& bytes) {
+        std::ofstream(file, std::ios::binary) << bytes;
+    };
+    write(dir / "part" / "sphere.bin", buffer);
+    write(dir / "outside.bin", buffer);
+    auto gltf = [&](const std::string& uri) {
+        std::string named = json;
+        named.insert(byteLength, "\"uri\": \"" + uri + "\", ");
+        return named;
+    };
+    auto besides = readTriangleMesh(gltf("sphere.bin"), ".gltf", dir / "part");
+    ASSERT_TRUE(besides) << besides.error().str();
+    auto binary = readTriangleMesh(glb, ".glb");
+    ASSERT_TRUE(binary) << binary.error().str();
+    EXPECT_EQ(besides->positions, binary->positions);
+    EXPECT_EQ(besides->triangles, binary->triangles);
+    for (const std::string& uri : {std::string("../outside.bin"), (dir / "outside.bin").string(),
+                                   std::string("/dev/zero")}) {
+        SCOPED_TRACE(uri);
+        EXPECT_FALSE(readTriangleMesh(gltf(uri), ".gltf", dir / "part"));
+    }
+    EXPECT_FALSE(readTriangleMesh(gltf("sphere.bin"), ".gltf")); // no folder: no files
+    // An OBJ's material library on a device that never ends: not read, and the triangles are.
+    auto obj = readTriangleMesh("mtllib /dev/zero\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", ".obj",
+                                dir / "part");
+    ASSERT_TRUE(obj) << obj.error().str();
+    EXPECT_EQ(obj->triangles.size(), 1u);
+}
+
 const std::filesystem::path kGearStl =
     std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes/gear.stl";
 

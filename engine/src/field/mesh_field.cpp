@@ -4,7 +4,9 @@
 #include "scene/files.h"
 #include "scene/parse_util.h"
 
+#include <assimp/IOSystem.hpp>
 #include <assimp/Importer.hpp>
+#include <assimp/MemoryIOWrapper.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
@@ -283,9 +285,40 @@ template <class Body> void parallelFor(size_t count, Body&& body) {
         t.join();
 }
 
+// The files that a mesh file names (a glTF's buffers, an OBJ's materials), read under the rule
+// of an untrusted scene in the mesh file's folder whatever the scene's own rule: a file from
+// elsewhere must not reach the rest of the file system by the names it holds, nor block on a
+// device. At most kMaxMeshFileBytes in all; a file refused is one that does not exist.
+class FolderFiles : public Assimp::IOSystem {
+  public:
+    explicit FolderFiles(std::filesystem::path folder) : files_{std::move(folder), false} {}
+    bool Exists(const char* name) const override {
+        return bool(sceneFile(name, files_, kMaxMeshFileBytes));
+    }
+    char getOsSeparator() const override { return '/'; }
+    Assimp::IOStream* Open(const char* name, const char* mode) override {
+        if (std::strpbrk(mode, "wa+")) return nullptr;
+        const auto file = sceneFile(name, files_, kMaxMeshFileBytes - read_);
+        if (!file) return nullptr;
+        std::ifstream in(*file, std::ios::binary);
+        std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        if (bytes.size() > kMaxMeshFileBytes - read_) return nullptr;
+        read_ += bytes.size();
+        auto* copy = new uint8_t[bytes.size()];
+        std::memcpy(copy, bytes.data(), bytes.size());
+        return new Assimp::MemoryIOStream(copy, bytes.size(), true);
+    }
+    void Close(Assimp::IOStream* stream) override { delete stream; }
+
+  private:
+    SceneFiles files_;
+    uintmax_t read_ = 0;
+};
+
 } // namespace
 
-Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::string& extension) {
+Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::string& extension,
+                                      const std::filesystem::path& folder) {
     std::string hint =
         extension.size() > 1 && extension[0] == '.' ? extension.substr(1) : extension;
     std::transform(hint.begin(), hint.end(), hint.begin(),
@@ -298,6 +331,7 @@ Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::strin
                           std::to_string((4 * kMaxMeshFileBytes) >> 20) + " MiB");
     }
     Assimp::Importer importer;
+    importer.SetIOHandler(new FolderFiles(folder)); // the importer's to delete
     const aiScene* scene = importer.ReadFileFromMemory(
         bytes.data(), bytes.size(), aiProcess_Triangulate | aiProcess_PreTransformVertices,
         hint.c_str());
@@ -564,7 +598,7 @@ Result<std::shared_ptr<const std::vector<glm::vec4>>> buildMesh(const Node& node
     std::ifstream in(*file, std::ios::binary);
     std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     if (!in && !in.eof()) return fail("cannot be read");
-    auto mesh = readTriangleMesh(bytes, file->extension().string());
+    auto mesh = readTriangleMesh(bytes, file->extension().string(), file->parent_path());
     if (!mesh) return fail(mesh.error().diagnostics[0].message);
     auto field = MeshField::make(*mesh, int(node.params[0]));
     if (!field) return fail(field.error().diagnostics[0].message);

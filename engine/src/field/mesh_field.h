@@ -33,14 +33,18 @@ struct TriangleMesh {
     std::vector<glm::uvec3> triangles; // indices into positions, counter-clockwise seen outside
 };
 
-// The triangles of an STL (binary or ASCII), OBJ, PLY, glTF binary (.glb) or 3MF file, read
-// through Assimp with every node's transform applied, points and lines left out. STL and 3MF,
-// made for printing, are z up (as sdfcsg writes them): they are turned so that their z is +y.
-// `bytes` is the file's contents and `extension` its name's (".stl", ...), which tells the format.
+// The triangles of an STL (binary or ASCII), OBJ, PLY, glTF (.gltf or binary .glb) or 3MF file,
+// read through Assimp with every node's transform applied, points and lines left out. STL and
+// 3MF, made for printing, are z up (as sdfcsg writes them): they are turned so that their z is
+// +y. `bytes` is the file's contents and `extension` its name's (".stl", ...), which tells the
+// format. The files it names (a glTF's buffers, an OBJ's materials) are read from `folder` alone,
+// as an untrusted scene's are (SceneFiles): no absolute path, no "..", nothing outside it; none
+// where `folder` is empty.
 // Errors are the reason alone, for the caller to place ("not a mesh file Assimp reads: ...", "no
 // triangles", "more than N triangles", "a NaN or infinite vertex", "a 3MF whose parts unpack to
 // more than N MiB").
-Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::string& extension);
+Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::string& extension,
+                                      const std::filesystem::path& folder = {});
 
 // What a mesh has that a closed, consistently oriented one would not: the inside it gets from
 // the winding number copes with each, and the user is told.

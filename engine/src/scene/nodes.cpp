@@ -298,8 +298,9 @@ constexpr ParamInfo kMesh[] = {
      true,
      {},
      "file",
-     "A triangle mesh file relative to the scene file's folder: STL, OBJ, PLY, glTF binary (.glb) "
-     "or 3MF (at most 256 MiB and 8,388,608 triangles); only a file the user names."},
+     "A triangle mesh file relative to the scene file's folder: STL, OBJ, PLY, glTF (.glb, or "
+     ".gltf with the files it names in its own folder) or 3MF (at most 256 MiB and 8,388,608 "
+     "triangles); only a file the user names."},
     {"resolution",
      Number,
      Count,
