@@ -71,7 +71,7 @@ m::Shape here(const m::Shape& shape) {
 }
 
 // A Python value as a value of the scene format: numbers, strings, sequences (lists, tuples,
-// NumPy arrays) of them; None is absent.
+// NumPy arrays) and dicts of them; None is absent.
 m::Value value(py::handle v) {
     if (v.is_none()) return {};
     if (py::isinstance<py::bool_>(v)) return m::Value::json(v.cast<bool>() ? "true" : "false");
@@ -79,6 +79,16 @@ m::Value value(py::handle v) {
         py::isinstance(v, py::module_::import("numpy").attr("number")))
         return m::Value(v.cast<double>());
     if (py::isinstance<py::str>(v)) return m::Value(v.cast<std::string>());
+    if (py::isinstance<py::dict>(v)) { // a camera, a light
+        std::string json = "{";
+        for (auto [key, item] : v.cast<py::dict>()) {
+            const m::Value member = value(item);
+            json += (json.size() > 1 ? ", " : "") +
+                    m::Value(py::str(key).cast<std::string>()).json() + ": " +
+                    (member.absent() ? std::string("null") : member.json());
+        }
+        return m::Value::json(json + "}");
+    }
     if (py::hasattr(v, "__len__") && py::hasattr(v, "__getitem__")) {
         std::string json = "[";
         for (size_t i = 0; i < py::len(v); ++i) {
@@ -406,6 +416,12 @@ PYBIND11_MODULE(sdfcsg, module) {
         });
 
     sceneClass.def("json", [](const Scene& s) { return toJson(s); })
+        .def(
+            "python",
+            [](const Scene& s, std::string_view output) { return m::toPython(s, output); },
+            py::arg("output") = "scene.json",
+            "python(output='scene.json'): the scene as a Python program that builds it with this "
+            "module and saves it to its first argument, else to output.")
         .def("shape", [](const Scene& s) { return m::fromScene(s); })
         .def(
             "find", [](const Scene& s, std::string_view n) { return unwrap(m::findNode(s, n)); },
@@ -426,6 +442,27 @@ PYBIND11_MODULE(sdfcsg, module) {
                    std::to_string(s.nodes.size()) + " nodes>";
         });
 
+    module.def(
+        "scene",
+        [](const m::Shape& root, const py::kwargs& kwargs) {
+            m::ShapeData d = root.data();
+            std::vector<m::Arg> settings;
+            for (auto [key, v] : kwargs) {
+                const std::string name = key.cast<std::string>();
+                if (name != "parts") {
+                    settings.push_back({name, value(v)});
+                    continue;
+                }
+                for (py::handle part : v)
+                    d.parts.push_back(std::make_shared<const m::Part>(part.cast<m::Part>()));
+            }
+            return unwrap(
+                m::toScene(m::Shape(std::make_shared<const m::ShapeData>(std::move(d))), settings));
+        },
+        "scene(root, name=None, description=None, camera=None, lights=None, background=None, "
+        "parts=None) -> Scene: a shape's scene with the settings of the file's top level "
+        "(camera and each light a dict; background a colour) and parts its uses need not "
+        "reach, in this order.");
     module.def(
         "load", [](std::string path) { return unwrap(loadScene(path)); },
         "load(path): a scene file (raises sdfcsg.Error with the file and JSON path).");
@@ -534,21 +571,24 @@ PYBIND11_MODULE(sdfcsg, module) {
     module.def("device_name", [] { return context().deviceName(); });
     module.def("_validation_messages", [] { return context().validationMessageCount(); });
     // A function for every kind, and a method for every operation of one child, from the table;
-    // last, so that a kind named as one of the functions above (mesh, say) takes a trailing
-    // underscore (mesh_) rather than hiding it.
+    // last, so that a kind's name taken by one of the functions above is seen.
     for (const KindInfo& kind : nodeKinds()) {
         const KindInfo* k = &kind;
-        auto named = [&](py::handle scope) {
-            const std::string name(kind.name);
-            return py::hasattr(scope, name.c_str()) ? name + "_" : name;
-        };
+        // The name that toPython writes: a kind named as one of the functions above takes a
+        // trailing underscore, and a name it does not know to be taken stops the import.
+        const std::string name = m::pythonName(kind);
+        const bool method = kind.role == Role::Value || kind.role == Role::Domain;
+        if (py::hasattr(module, name.c_str()) || (method && py::hasattr(shapeClass, name.c_str())))
+            throw std::logic_error("sdfcsg: the kind " + std::string(kind.name) +
+                                   " would be named " + name +
+                                   ", which is taken: name it in pythonName (python_writer.cpp)");
         module.def(
-            named(module).c_str(),
+            name.c_str(),
             [k](py::args args, const py::kwargs& kwargs) { return build(*k, args, kwargs); },
             docstring(kind).c_str());
-        if (kind.role == Role::Value || kind.role == Role::Domain)
+        if (method)
             shapeClass.def(
-                named(shapeClass).c_str(),
+                name.c_str(),
                 [k](py::args args, const py::kwargs& kwargs) { return build(*k, args, kwargs); },
                 docstring(kind).c_str());
     }
