@@ -15,8 +15,10 @@
 #include <algorithm>
 #include <cstring>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace py = pybind11;
@@ -70,13 +72,38 @@ m::Shape here(const m::Shape& shape) {
     return m::Shape(std::make_shared<const m::ShapeData>(std::move(d)));
 }
 
+// Whether NumPy is imported: the module imports it only to make an array, and a value cannot be
+// one of its scalars before something has imported it.
+bool numpyImported() {
+    return py::module_::import("sys").attr("modules").contains("numpy");
+}
+
+bool isNumpyScalar(py::handle v) {
+    return numpyImported() && py::isinstance(v, py::module_::import("numpy").attr("number"));
+}
+
+// Starts importing NumPy on a thread of its own, where nothing has imported it yet, for the
+// device's work to hide: a first render's array then finds it imported, or nearly. Once.
+void importNumpyMeanwhile() {
+    static bool started = false;
+    if (std::exchange(started, true) || numpyImported()) return;
+    const py::cpp_function import([] {
+        try {
+            py::module_::import("numpy");
+        } catch (py::error_already_set&) { // raised again where an array is made
+        }
+    });
+    py::module_::import("threading")
+        .attr("Thread")(py::arg("target") = import, py::arg("name") = "sdfcsg-numpy")
+        .attr("start")();
+}
+
 // A Python value as a value of the scene format: numbers, strings, sequences (lists, tuples,
 // NumPy arrays) and dicts of them; None is absent.
 m::Value value(py::handle v) {
     if (v.is_none()) return {};
     if (py::isinstance<py::bool_>(v)) return m::Value::json(v.cast<bool>() ? "true" : "false");
-    if (py::isinstance<py::int_>(v) || py::isinstance<py::float_>(v) ||
-        py::isinstance(v, py::module_::import("numpy").attr("number")))
+    if (py::isinstance<py::int_>(v) || py::isinstance<py::float_>(v) || isNumpyScalar(v))
         return m::Value(v.cast<double>());
     if (py::isinstance<py::str>(v)) return m::Value(v.cast<std::string>());
     if (py::isinstance<py::dict>(v)) { // a camera, a light
@@ -187,10 +214,20 @@ Device& device() {
     static Device held;
     return held;
 }
-Context& context() {
+// The context, made on first use; without Python's lock held, so that other threads run meanwhile.
+Result<Context*> sharedContext() {
+    static std::mutex making;
+    std::lock_guard lock(making);
     Device& d = device();
-    if (!d.context) d.context = unwrap(Context::create());
-    return *d.context;
+    if (!d.context) {
+        auto made = Context::create();
+        if (!made) return made.error();
+        d.context = std::move(*made);
+    }
+    return d.context.get();
+}
+Context& context() {
+    return *unwrap(sharedContext());
 }
 
 // A scene from a Shape or a Scene.
@@ -252,7 +289,15 @@ Image renderImage(py::handle object, uint32_t width, uint32_t height, const py::
     options.shadows = shadows;
     options.grid = grid;
     options.progress = interruptible(progress);
-    auto renderer = unwrap(Renderer::create(context(), scene));
+    // The device is made ready (the context, the kernels) without Python's lock, so that other
+    // threads run meanwhile (NumPy's import, for render()'s array). The render itself calls
+    // `progress` between bands, and so holds the lock.
+    auto renderer = unwrap([&]() -> Result<std::unique_ptr<Renderer>> {
+        py::gil_scoped_release release;
+        auto context = sharedContext();
+        if (!context) return context.error();
+        return Renderer::create(**context, scene);
+    }());
     Image image = unwrap(renderer->render(options));
     if (PyErr_Occurred()) throw py::error_already_set(); // raised by progress after the last band
     return image;
@@ -481,6 +526,7 @@ PYBIND11_MODULE(sdfcsg, module) {
         "render",
         [](py::handle object, uint32_t width, uint32_t height, py::object camera, std::string mode,
            uint32_t aa, bool shadows, bool grid, py::object progress) {
+            importNumpyMeanwhile();
             return imageArray(
                 renderImage(object, width, height, camera, mode, aa, shadows, grid, progress));
         },
