@@ -61,7 +61,7 @@ def test_every_kind_as_a_program_builds_its_example(name, example, monkeypatch):
     same_json(run_program(program).json(), scene.json())
 
 
-# Definitions in an order their uses do not follow, one unused, a use inside a definition, "$name"
+# Definitions in an order their uses do not follow, unused ones, names the program takes itself, a use inside a definition, "$name"
 # values in place of a transform and a colour, a parameter named as a Python keyword, texts that
 # need escapes, and every setting of the top level.
 TRICKY = r"""{
@@ -78,7 +78,8 @@ TRICKY = r"""{
     "leg": {"parameters": {"class": 1.0, "where": [0, 0.5, 0], "tint": "#804020"},
             "node": {"type": "cylinder", "radius": 0.1, "height": "$class", "translate": "$where",
                      "color": "$tint"}},
-    "s": {"node": {"type": "sphere", "radius": 0.2}}
+    "s": {"node": {"type": "sphere", "radius": 0.2}},
+    "len": {"node": {"type": "use", "definition": "s"}}
   },
   "root": {"type": "difference", "smooth": 0.05, "name": "a \\ name", "children": [
     {"type": "use", "definition": "chair", "scale": [1, 2, 1]},
@@ -94,8 +95,11 @@ def test_definitions_settings_and_escapes_as_a_program(tmp_path):
     program = scene.python("tricky.json")
     assert 'leg = s.Part(' in program and '**{"class": 1}' in program
     assert program.index("leg = s.Part(") < program.index("chair = s.Part(")
-    assert "s_ = s.Part(" in program and "parts=[chair, leg, s_]" in program
+    assert "s_ = s.Part(" in program and "parts=[chair, leg, s_, len_]" in program
     same_json(run_program(program).json(), scene.json())
+    (tmp_path / "tricky.py").write_text(program)
+    subprocess.run([sys.executable, "tricky.py"], cwd=tmp_path, check=True)
+    same_json((tmp_path / "tricky.json").read_text(), scene.json())
 
 
 def test_a_program_run_by_python_saves_the_scene(tmp_path):

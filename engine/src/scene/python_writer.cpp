@@ -138,7 +138,9 @@ class Writer {
             for (const std::string& name : order)
                 out += part(name);
         }
-        out += "root = " + node(asObject(document_)["root"].value_unsafe(), 0) + "\n\n";
+        // A scene made in code may have no nodes, which the loader would refuse as the file would.
+        out += "root = " + (top["root"].get(value) ? std::string("s.Shape()") : node(value, 0)) +
+               "\n\n";
 
         std::vector<std::string> args = {"root"};
         for (std::string_view key : {"name", "description", "camera", "lights", "background"})
@@ -161,7 +163,7 @@ class Writer {
 
   private:
     // Names the program itself uses.
-    inline static const std::set<std::string> kTaken = {"s", "sys", "root", "scene"};
+    inline static const std::set<std::string> kTaken = {"s", "sys", "len", "root", "scene"};
 
     element document_;
     std::map<std::string, element> definitions_;
