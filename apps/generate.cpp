@@ -250,6 +250,9 @@ int generateAndWrite(std::string_view command, std::string_view request, Generat
     }
     const std::string out = args.get("-o").empty() ? args.get("--output") : args.get("-o");
     if (out.empty()) return usageError(command, "missing -o OUT.json");
+    const std::string emit = args.has("--emit") ? args.get("--emit") : "json";
+    if (emit != "json" && emit != "python")
+        return usageError(command, "--emit expects json or python");
 
     Recording recording;
     if (auto ready = recording.setUp(args, options); !ready) return fail(ready.error());
@@ -273,7 +276,13 @@ int generateAndWrite(std::string_view command, std::string_view request, Generat
             return fail(generated.error());
         }
     }
-    if (auto written = writeOutput(out, generated->json); !written) return fail(written.error());
+    // As Python, the program saves the scene beside it by default: chair.py writes chair.json.
+    const std::string text =
+        emit == "python"
+            ? model::toPython(generated->scene,
+                              fs::path(out).filename().replace_extension(".json").string())
+            : generated->json;
+    if (auto written = writeOutput(out, text); !written) return fail(written.error());
     printSummary(out, *generated, stats);
     if (const std::string png = args.get("--render"); !png.empty()) {
         Renders renders;
@@ -297,6 +306,9 @@ accepts it, else JSON mode, else plain text; the summary line names the mode use
 
 Options:
   -o, --output FILE  the scene to write (required)
+  --emit json|python the scene's JSON (default), or a Python program that builds it with the
+                     sdfcsg module (docs/python.md) and saves its JSON, by default beside it
+                     (chair.py writes chair.json)
   --render FILE      also render the scene to a PNG (800 x 600)
 )";
 
@@ -308,14 +320,16 @@ changed scene, validated and repaired as by 'sdfcsg generate'.
 
 Options:
   -o, --output FILE  the scene to write (required; may be SCENE itself)
+  --emit json|python the scene's JSON (default), or a Python program that builds it, as for
+                     'sdfcsg generate'
   --render FILE      also render the new scene to a PNG (800 x 600)
 )";
 
 } // namespace
 
 int runGenerate(int argc, char** argv) {
-    Args args =
-        parseArgs(argc, argv, {"-o", "--output", "--render"}, {"--print-prompt", "--dry-run"});
+    Args args = parseArgs(argc, argv, {"-o", "--output", "--render", "--emit"},
+                          {"--print-prompt", "--dry-run"});
     if (args.has("--help") || args.has("-h"))
         return std::printf("%s%s", kGenerateHelp, kLlmOptionsHelp), kOk;
     if (!args.error.empty()) return usageError("generate", args.error);
@@ -326,8 +340,8 @@ int runGenerate(int argc, char** argv) {
 }
 
 int runEdit(int argc, char** argv) {
-    Args args =
-        parseArgs(argc, argv, {"-o", "--output", "--render"}, {"--print-prompt", "--dry-run"});
+    Args args = parseArgs(argc, argv, {"-o", "--output", "--render", "--emit"},
+                          {"--print-prompt", "--dry-run"});
     if (args.has("--help") || args.has("-h"))
         return std::printf("%s%s", kEditHelp, kLlmOptionsHelp), kOk;
     if (!args.error.empty()) return usageError("edit", args.error);

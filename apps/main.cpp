@@ -645,10 +645,12 @@ int cmdGlsl(int argc, char** argv) {
     return emit(sdfcsg::generateSceneGlsl(*scene, options), args.get("-o", args.get("--output")));
 }
 
-const char* kConvertHelp = R"(Usage: sdfcsg convert IN -o OUT.json
+const char* kConvertHelp = R"(Usage: sdfcsg convert IN -o OUT.json|OUT.py
 
 Reads a scene in any supported format (the legacy SDFBooleanEngine node list is detected
-automatically), validates it and writes it in the current format (atomically).
+automatically), validates it and writes it in the current format (atomically). To a .py file,
+it writes a Python program that builds the scene with the sdfcsg module (docs/python.md) and
+saves its JSON, by default beside it (OUT.json).
 )";
 
 int cmdConvert(int argc, char** argv) {
@@ -660,6 +662,11 @@ int cmdConvert(int argc, char** argv) {
     if (out.empty()) return usageError("convert", "missing -o OUT.json");
     auto scene = load(args.positional[0]);
     if (!scene) return fail(scene.error());
+    const std::filesystem::path path(out);
+    if (path.extension() == ".py")
+        return emit(
+            sdfcsg::model::toPython(*scene, path.filename().replace_extension(".json").string()),
+            out);
     return emit(sdfcsg::toJson(*scene), out);
 }
 

@@ -15,8 +15,10 @@
 #include <algorithm>
 #include <cstring>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace py = pybind11;
@@ -70,15 +72,50 @@ m::Shape here(const m::Shape& shape) {
     return m::Shape(std::make_shared<const m::ShapeData>(std::move(d)));
 }
 
+// Whether NumPy is imported: the module imports it only to make an array, and a value cannot be
+// one of its scalars before something has imported it.
+bool numpyImported() {
+    return py::module_::import("sys").attr("modules").contains("numpy");
+}
+
+bool isNumpyScalar(py::handle v) {
+    return numpyImported() && py::isinstance(v, py::module_::import("numpy").attr("number"));
+}
+
+// Starts importing NumPy on a thread of its own, where nothing has imported it yet, for the
+// device's work to hide: a first render's array then finds it imported, or nearly. Once.
+void importNumpyMeanwhile() {
+    static bool started = false;
+    if (std::exchange(started, true) || numpyImported()) return;
+    const py::cpp_function import([] {
+        try {
+            py::module_::import("numpy");
+        } catch (py::error_already_set&) { // raised again where an array is made
+        }
+    });
+    py::module_::import("threading")
+        .attr("Thread")(py::arg("target") = import, py::arg("name") = "sdfcsg-numpy")
+        .attr("start")();
+}
+
 // A Python value as a value of the scene format: numbers, strings, sequences (lists, tuples,
-// NumPy arrays) of them; None is absent.
+// NumPy arrays) and dicts of them; None is absent.
 m::Value value(py::handle v) {
     if (v.is_none()) return {};
     if (py::isinstance<py::bool_>(v)) return m::Value::json(v.cast<bool>() ? "true" : "false");
-    if (py::isinstance<py::int_>(v) || py::isinstance<py::float_>(v) ||
-        py::isinstance(v, py::module_::import("numpy").attr("number")))
+    if (py::isinstance<py::int_>(v) || py::isinstance<py::float_>(v) || isNumpyScalar(v))
         return m::Value(v.cast<double>());
     if (py::isinstance<py::str>(v)) return m::Value(v.cast<std::string>());
+    if (py::isinstance<py::dict>(v)) { // a camera, a light
+        std::string json = "{";
+        for (auto [key, item] : v.cast<py::dict>()) {
+            const m::Value member = value(item);
+            json += (json.size() > 1 ? ", " : "") +
+                    m::Value(py::str(key).cast<std::string>()).json() + ": " +
+                    (member.absent() ? std::string("null") : member.json());
+        }
+        return m::Value::json(json + "}");
+    }
     if (py::hasattr(v, "__len__") && py::hasattr(v, "__getitem__")) {
         std::string json = "[";
         for (size_t i = 0; i < py::len(v); ++i) {
@@ -177,10 +214,20 @@ Device& device() {
     static Device held;
     return held;
 }
-Context& context() {
+// The context, made on first use; without Python's lock held, so that other threads run meanwhile.
+Result<Context*> sharedContext() {
+    static std::mutex making;
+    std::lock_guard lock(making);
     Device& d = device();
-    if (!d.context) d.context = unwrap(Context::create());
-    return *d.context;
+    if (!d.context) {
+        auto made = Context::create();
+        if (!made) return made.error();
+        d.context = std::move(*made);
+    }
+    return d.context.get();
+}
+Context& context() {
+    return *unwrap(sharedContext());
 }
 
 // A scene from a Shape or a Scene.
@@ -242,7 +289,15 @@ Image renderImage(py::handle object, uint32_t width, uint32_t height, const py::
     options.shadows = shadows;
     options.grid = grid;
     options.progress = interruptible(progress);
-    auto renderer = unwrap(Renderer::create(context(), scene));
+    // The device is made ready (the context, the kernels) without Python's lock, so that other
+    // threads run meanwhile (NumPy's import, for render()'s array). The render itself calls
+    // `progress` between bands, and so holds the lock.
+    auto renderer = unwrap([&]() -> Result<std::unique_ptr<Renderer>> {
+        py::gil_scoped_release release;
+        auto context = sharedContext();
+        if (!context) return context.error();
+        return Renderer::create(**context, scene);
+    }());
     Image image = unwrap(renderer->render(options));
     if (PyErr_Occurred()) throw py::error_already_set(); // raised by progress after the last band
     return image;
@@ -406,6 +461,12 @@ PYBIND11_MODULE(sdfcsg, module) {
         });
 
     sceneClass.def("json", [](const Scene& s) { return toJson(s); })
+        .def(
+            "python",
+            [](const Scene& s, std::string_view output) { return m::toPython(s, output); },
+            py::arg("output") = "scene.json",
+            "python(output='scene.json'): the scene as a Python program that builds it with this "
+            "module and saves it to its first argument, else to output.")
         .def("shape", [](const Scene& s) { return m::fromScene(s); })
         .def(
             "find", [](const Scene& s, std::string_view n) { return unwrap(m::findNode(s, n)); },
@@ -427,6 +488,27 @@ PYBIND11_MODULE(sdfcsg, module) {
         });
 
     module.def(
+        "scene",
+        [](const m::Shape& root, const py::kwargs& kwargs) {
+            m::ShapeData d = root.data();
+            std::vector<m::Arg> settings;
+            for (auto [key, v] : kwargs) {
+                const std::string name = key.cast<std::string>();
+                if (name != "parts") {
+                    settings.push_back({name, value(v)});
+                    continue;
+                }
+                for (py::handle part : v)
+                    d.parts.push_back(std::make_shared<const m::Part>(part.cast<m::Part>()));
+            }
+            return unwrap(
+                m::toScene(m::Shape(std::make_shared<const m::ShapeData>(std::move(d))), settings));
+        },
+        "scene(root, name=None, description=None, camera=None, lights=None, background=None, "
+        "parts=None) -> Scene: a shape's scene with the settings of the file's top level "
+        "(camera and each light a dict; background a colour) and parts its uses need not "
+        "reach, in this order.");
+    module.def(
         "load", [](std::string path) { return unwrap(loadScene(path)); },
         "load(path): a scene file (raises sdfcsg.Error with the file and JSON path).");
     module.def(
@@ -444,6 +526,7 @@ PYBIND11_MODULE(sdfcsg, module) {
         "render",
         [](py::handle object, uint32_t width, uint32_t height, py::object camera, std::string mode,
            uint32_t aa, bool shadows, bool grid, py::object progress) {
+            importNumpyMeanwhile();
             return imageArray(
                 renderImage(object, width, height, camera, mode, aa, shadows, grid, progress));
         },
@@ -534,21 +617,24 @@ PYBIND11_MODULE(sdfcsg, module) {
     module.def("device_name", [] { return context().deviceName(); });
     module.def("_validation_messages", [] { return context().validationMessageCount(); });
     // A function for every kind, and a method for every operation of one child, from the table;
-    // last, so that a kind named as one of the functions above (mesh, say) takes a trailing
-    // underscore (mesh_) rather than hiding it.
+    // last, so that a kind's name taken by one of the functions above is seen.
     for (const KindInfo& kind : nodeKinds()) {
         const KindInfo* k = &kind;
-        auto named = [&](py::handle scope) {
-            const std::string name(kind.name);
-            return py::hasattr(scope, name.c_str()) ? name + "_" : name;
-        };
+        // The name that toPython writes: a kind named as one of the functions above takes a
+        // trailing underscore, and a name it does not know to be taken stops the import.
+        const std::string name = m::pythonName(kind);
+        const bool method = kind.role == Role::Value || kind.role == Role::Domain;
+        if (py::hasattr(module, name.c_str()) || (method && py::hasattr(shapeClass, name.c_str())))
+            throw std::logic_error("sdfcsg: the kind " + std::string(kind.name) +
+                                   " would be named " + name +
+                                   ", which is taken: name it in pythonName (python_writer.cpp)");
         module.def(
-            named(module).c_str(),
+            name.c_str(),
             [k](py::args args, const py::kwargs& kwargs) { return build(*k, args, kwargs); },
             docstring(kind).c_str());
-        if (kind.role == Role::Value || kind.role == Role::Domain)
+        if (method)
             shapeClass.def(
-                named(shapeClass).c_str(),
+                name.c_str(),
                 [k](py::args args, const py::kwargs& kwargs) { return build(*k, args, kwargs); },
                 docstring(kind).c_str());
     }

@@ -1,6 +1,7 @@
 #!/usr/bin/python3
-"""Renders every bundled scene and tiles the pictures into one labelled PNG: the README's
-picture of the gallery (assets/readme/gallery.png).
+"""Renders every bundled scene, and the example models that examples/models.cpp builds in code,
+and tiles the pictures into one labelled PNG: the README's picture of the gallery
+(assets/readme/gallery.png).
 
 Needs a build (sh scripts/build.sh) and Debian's python3-pil (apt-get install python3-pil);
 labels are set in DejaVu Sans (fonts-dejavu-core, which the build installs already). A
@@ -9,6 +10,7 @@ renderer change:
 
     scripts/contact_sheet.py                     # writes assets/readme/gallery.png
     scripts/contact_sheet.py -o sheet.png --columns 5 --tile 320x240
+    scripts/contact_sheet.py --examples ""       # the bundled scenes only
 """
 import argparse
 import json
@@ -22,6 +24,8 @@ from PIL import Image, ImageDraw, ImageFont
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 FONT = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf"
+# The models of examples/models.cpp (and models.py), as it names their files.
+EXAMPLES = ["bracket", "gear", "vase", "lattice"]
 
 
 def main():
@@ -29,6 +33,8 @@ def main():
     parser.add_argument("-o", "--output", default=str(ROOT / "assets/readme/gallery.png"))
     parser.add_argument("--scenes", default=str(ROOT / "assets/scenes"))
     parser.add_argument("--sdfcsg", default=str(ROOT / "build/apps/sdfcsg"))
+    parser.add_argument("--examples", default=str(ROOT / "build/examples/sdfcsg_examples"),
+                        help="the examples' program, which writes their scenes; empty: none")
     parser.add_argument("--tile", default="256x192", help="size of each picture, WxH")
     parser.add_argument("--columns", type=int, default=0,
                         help="default: a sheet about half as wide again as it is tall")
@@ -39,6 +45,16 @@ def main():
     scenes = sorted(pathlib.Path(args.scenes).glob("*.json"))
     if not scenes:
         sys.exit(f"no scenes in {args.scenes}")
+    with tempfile.TemporaryDirectory() as tmp:
+        # The examples after the scenes, in the order the program writes them.
+        examples = []
+        if args.examples:
+            subprocess.run([args.examples, tmp], check=True)
+            examples = [pathlib.Path(tmp) / f"{name}.json" for name in EXAMPLES]
+        draw_sheet(args, width, height, scenes + examples, set(examples))
+
+
+def draw_sheet(args, width, height, scenes, examples):
     columns = args.columns or math.ceil(math.sqrt(1.5 * len(scenes)))
     rows = math.ceil(len(scenes) / columns)
 
@@ -49,7 +65,7 @@ def main():
 
     with tempfile.TemporaryDirectory() as tmp:
         for i, scene in enumerate(scenes):
-            png = pathlib.Path(tmp) / (scene.stem + ".png")
+            png = pathlib.Path(tmp) / f"{i:02}.png"
             print(f"[{i + 1}/{len(scenes)}] {scene.name}", flush=True)
             subprocess.run([args.sdfcsg, "render", str(scene), "-o", str(png),
                             "--width", str(width), "--height", str(height),
@@ -57,8 +73,10 @@ def main():
             x, y = (i % columns) * width, (i // columns) * (height + label_height)
             with Image.open(png) as picture:
                 sheet.paste(picture.convert("RGB"), (x, y))
-            # The scene's own title where it has one, else its file name.
+            # The scene's own title where it has one, else its file name; an example's says so.
             label = json.loads(scene.read_text()).get("name") or scene.stem
+            if scene in examples:
+                label = f"example: {label}"
             text_width = draw.textlength(label, font=font)
             draw.text((x + (width - text_width) / 2, y + height + 3), label, fill="black",
                       font=font)

@@ -5,6 +5,8 @@ of the documented shapes and types, equal between the CPU and the device."""
 import json
 import os
 import pathlib
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -162,3 +164,21 @@ def test_progress_reports_and_stops():
 
     with pytest.raises(RuntimeError, match="from the callback"):
         sdfcsg.render(sdfcsg.sphere(1), 64, 48, progress=fails)
+
+
+def test_numpy_is_imported_only_for_arrays():
+    """Building, saving and loading shapes leaves NumPy out (its import is most of a first
+    render's cost beyond the engine's); the first array brings it in."""
+    code = """
+import sys
+import sdfcsg as s
+shape = s.round_box([2, 1, 1], 0.1).color("#ff8000") - s.sphere(0.6).translate([0.5, 0.5, 0])
+s.loads(shape.json())
+assert "numpy" not in sys.modules, "imported by the modelling API"
+image = s.render(shape, 32, 24)
+assert type(image).__module__ == "numpy" and image.shape == (24, 32, 4)
+"""
+    subprocess.run([sys.executable, "-c", code], check=True)
+    # NumPy's scalars are values as Python's numbers are, once NumPy is there.
+    same(sdfcsg.sphere(np.float32(0.5)).translate(np.float64(1), 0, 0),
+         sdfcsg.sphere(0.5).translate(1, 0, 0))

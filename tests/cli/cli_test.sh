@@ -211,6 +211,9 @@ case_convert() {
     check "converted validates" 0 "$bin" validate converted.json
     check "convert round trip" 0 "$bin" convert converted.json -o again.json
     cmp -s converted.json again.json || { echo "FAIL convert is not idempotent"; failures=$((failures + 1)); }
+    # To .py, a program of the Python module (python/tests/test_program.py runs them).
+    check "convert to Python" 0 "$bin" convert converted.json -o converted.py
+    expect_text "converted program saves beside it" converted.py '    s.save(scene, sys.argv[1] if len(sys.argv) > 1 else "converted.json")'
 }
 
 case_schema() {
@@ -256,6 +259,10 @@ case_generate() {
     expect_text "generate problems" err.txt "answer: root.children[1].radius: expected a positive number, got -0.6"
     [ ! -e bad-snow.json ] || { echo "FAIL an invalid answer was written"; failures=$((failures + 1)); }
     check "edit replay" 0 "$bin" edit snow.json "make the hat red" -o edited.json $llm --replay "$recording"
+    check "generate --emit python" 0 "$bin" generate "A snowman" -o snow.py --emit python $llm --replay "$recording"
+    expect_text "generated program" snow.py "import sdfcsg as s"
+    check "generate --emit bad" 2 "$bin" generate "A snowman" -o snow.py --emit yaml $llm --replay "$recording"
+    expect_text "generate --emit bad message" err.txt "sdfcsg generate: --emit expects json or python"
     printf '# one prompt\n\nA snowman\n' >prompts.txt
     check "eval-prompts replay" 0 "$bin" eval-prompts prompts.txt --out eval $llm --replay "$recording"
     expect_text "eval first try" eval/report.txt "first-try validity: 0 of 1 (0%)"

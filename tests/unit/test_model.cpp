@@ -208,6 +208,36 @@ TEST(Model, BundledScenesConvertToShapesAndBack) {
     }
 }
 
+// Settings of the top level go through the loader, and definitions keep the scene's order, even
+// where one uses a part defined after it.
+TEST(Model, SettingsAndDefinitionsInTheScenesOrder) {
+    const Scene scene = load(R"({"version": 1, "name": "set",
+        "camera": {"eye": [3, 2, 4], "target": [0, 0.5, 0]}, "background": "#102030",
+        "definitions": {
+          "chair": {"node": {"type": "use", "definition": "leg", "translate": [0.3, 0, 0]}},
+          "leg": {"node": {"type": "cylinder", "radius": 0.1, "height": 1}}},
+        "root": {"type": "use", "definition": "chair"}})");
+    auto built =
+        m::toScene(m::fromScene(scene),
+                   {{"name", "set"},
+                    {"camera", m::Value::json(R"({"eye": [3, 2, 4], "target": [0, 0.5, 0]})")},
+                    {"background", "#102030"}});
+    ASSERT_TRUE(built) << built.error().str();
+    EXPECT_EQ(toJson(*built), toJson(scene));
+    auto bad = m::toScene(m::sphere(1), {{"camera", m::Value::json(R"({"eye": [0, 0, 0]})")}});
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error().diagnostics[0].path.substr(0, 6), "camera");
+    auto root = m::toScene(m::sphere(1), {{"root", m::Value::json("{}")}});
+    ASSERT_FALSE(root);
+    EXPECT_EQ(root.error().str(), "<model>: the scene's root comes from its shape");
+}
+
+TEST(Model, PythonNamesAreTheKindsUnlessTaken) {
+    EXPECT_EQ(m::pythonName(kindInfo(NodeKind::Sphere)), "sphere");
+    EXPECT_EQ(m::pythonName(kindInfo(NodeKind::Mesh)), "mesh_");
+    EXPECT_EQ(m::pythonName(kindInfo(NodeKind::Shell)), "shell");
+}
+
 TEST(Model, ADeepChainIsWrittenAndReleasedWithoutRecursion) {
     m::Shape s = m::sphere(1);
     for (int i = 0; i < 100000; ++i)

@@ -18,6 +18,7 @@
 #pragma once
 
 #include "sdfcsg/error.h"
+#include "sdfcsg/nodes.h"
 #include "sdfcsg/scene.h"
 
 #include <glm/vec2.hpp>
@@ -176,6 +177,9 @@ Shape operator-(const Shape& a, const Shape& b);
 // definition: its errors are the loader's, with the JSON path in the scene and, as the file, the
 // source line ("main.cpp:12") of the call that made the node at fault ("<model>" when none did).
 Result<Scene> toScene(const Shape& root);
+// The same, with the scene's settings besides its tree as JSON values by their keys: "name",
+// "description", "camera", "lights", "background" (docs/scene-format.md), checked by the loader.
+Result<Scene> toScene(const Shape& root, const std::vector<Arg>& settings);
 // The scene's JSON (toJson(Scene)): parseScene() of it gives back the scene.
 Result<std::string> toJson(const Shape& root);
 // The shape of a scene's root (every node with its values as toJson writes them, uses as uses of
@@ -183,6 +187,16 @@ Result<std::string> toJson(const Shape& root);
 Shape fromScene(const Scene& scene);
 // The shape of a scene's JSON text.
 Result<Shape> fromJson(std::string_view json, std::string_view file = "<input>");
+
+// The scene as a Python program that builds it with the module sdfcsg (docs/python.md): its
+// definitions as parts, its tree as calls of the kinds' functions and methods, its settings
+// through sdfcsg.scene(). Run, it saves the scene's JSON to its first argument, else to `output`;
+// that JSON is toJson(scene).
+std::string toPython(const Scene& scene, std::string_view output = "scene.json");
+// The Python module's name for a kind's function, and for a value or domain operation its method:
+// its JSON type, with a trailing underscore where the module or Shape has that name already
+// (mesh_).
+std::string pythonName(const KindInfo& kind);
 
 // Editing a loaded scene in place, for Renderer::updateValues (sdfcsg/render.h), which then
 // uploads or rebuilds as the change needs.

@@ -80,13 +80,18 @@ class Writer {
   public:
     std::map<std::string, std::string> made; // JSON path -> "file:line" where its node was made
 
-    // The document: {"version": 1, "definitions": ..., "root": ...}.
-    Result<std::string> scene(const Shape& root) {
+    // The document: {"version": 1, settings..., "definitions": ..., "root": ...}.
+    Result<std::string> scene(const Shape& root, const std::vector<Arg>& settings = {}) {
         std::string rootJson = tree(root, "root");
         std::string out = "{\"version\": 1";
+        for (const Arg& s : settings) {
+            if (s.name == "version" || s.name == "root" || s.name == "definitions")
+                return Error::message(ErrorKind::Usage, "<model>",
+                                      "the scene's " + s.name + " comes from its shape");
+            if (!s.value.absent()) out += ", " + jsonQuote(s.name) + ": " + s.value.json();
+        }
         if (!parts_.empty()) {
             out += ", \"definitions\": {";
-            // Parts reached inside parts come out first, as each is written on first reach.
             for (size_t i = 0; i < partJson_.size(); ++i)
                 out += (i ? ", " : "") + partJson_[i];
             out += "}";
@@ -107,6 +112,9 @@ class Writer {
             return;
         }
         parts_[p.name()] = &p;
+        // In the order first reached: a part's slot is taken before the parts its node uses.
+        const size_t slot = partJson_.size();
+        partJson_.emplace_back();
         const std::string path = "definitions." + p.name();
         std::string json = jsonQuote(p.name()) + ": {";
         if (!p.parameters().empty()) {
@@ -117,7 +125,7 @@ class Writer {
             json += "}, ";
         }
         json += "\"node\": " + (p.node() ? tree(*p.node(), path + ".node") : p.nodeJson()) + "}";
-        partJson_.push_back(std::move(json));
+        partJson_[slot] = std::move(json);
     }
 
     static std::string valueJson(const Value& v) { return v.absent() ? "null" : v.json(); }
@@ -212,9 +220,10 @@ const std::string* madeAt(const std::map<std::string, std::string>& made, const 
     return best && !best->empty() ? best : nullptr;
 }
 
-Result<Scene> parseShape(const Shape& root, const ParseOptions& options) {
+Result<Scene> parseShape(const Shape& root, const ParseOptions& options,
+                         const std::vector<Arg>& settings = {}) {
     Writer writer;
-    auto json = writer.scene(root);
+    auto json = writer.scene(root, settings);
     if (!json) return json.error();
     auto scene = parseScene(*json, "<model>", options);
     if (scene) return scene;
@@ -414,6 +423,10 @@ Shape operator-(const Shape& a, const Shape& b) {
 
 Result<Scene> toScene(const Shape& root) {
     return parseShape(root, {});
+}
+
+Result<Scene> toScene(const Shape& root, const std::vector<Arg>& settings) {
+    return parseShape(root, {}, settings);
 }
 
 Result<std::string> toJson(const Shape& root) {
