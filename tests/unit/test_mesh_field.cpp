@@ -12,6 +12,7 @@
 
 #include <glm/geometric.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -252,6 +253,65 @@ TEST(MeshNode, RoundTripKeepsTheSurface) {
     EXPECT_GT(near, 200);
 }
 
+// An OBJ of the box from `lo` to `hi`, counter-clockwise seen from outside, less the triangles
+// in `left`, and with those in `flipped` turned over.
+std::string boxObj(glm::vec3 lo, glm::vec3 hi, std::vector<int> left = {},
+                   std::vector<int> flipped = {}) {
+    std::string obj;
+    for (int i = 0; i < 8; ++i) // corner i: x from bit 0, y from bit 1, z from bit 2
+        obj += "v " + std::to_string(i & 1 ? hi.x : lo.x) + " " +
+               std::to_string(i & 2 ? hi.y : lo.y) + " " + std::to_string(i & 4 ? hi.z : lo.z) +
+               "\n";
+    const int quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                             {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+    for (int t = 0; t < 12; ++t) {
+        const int* q = quads[t / 2];
+        int a = q[0], b = q[1 + t % 2], c = q[2 + t % 2];
+        if (std::count(left.begin(), left.end(), t)) continue;
+        if (std::count(flipped.begin(), flipped.end(), t)) std::swap(b, c);
+        obj += "f " + std::to_string(a + 1) + " " + std::to_string(b + 1) + " " +
+               std::to_string(c + 1) + "\n";
+    }
+    return obj;
+}
+
+// A file beside the tests' scenes, written for one test.
+std::filesystem::path writeTestFile(const std::string& name, const std::string& text) {
+    const std::filesystem::path path = std::filesystem::temp_directory_path() / name;
+    std::ofstream(path, std::ios::binary) << text;
+    return path;
+}
+
+// "fit" scales the mesh by one factor into the box and centres it: a 2 x 4 x 1 box, fitted to
+// 1 x 1 x 1, is 0.5 x 1 x 0.25 about the origin, its field in the scene's units.
+TEST(MeshNode, FitScalesIntoTheBox) {
+    const auto file = writeTestFile("fit_box.obj", boxObj({3.0f, -1.0f, 2.0f}, {5.0f, 3.0f, 3.0f}));
+    auto scene = parseScene(R"({"version": 1, "root": {"type": "mesh", "file": ")" + file.string() +
+                                R"(", "resolution": 64, "fit": [1, 1, 1]}})",
+                            "test.json");
+    ASSERT_TRUE(scene) << scene.error().str();
+    const Evaluator node(*scene);
+    const glm::vec3 half(0.25f, 0.5f, 0.125f);
+    for (int a = 0; a < 3; ++a)
+        for (float side : {-1.0f, 1.0f}) {
+            glm::vec3 face(0.0f), out(0.0f);
+            face[a] = side * half[a];
+            out[a] = side * 0.01f;
+            SCOPED_TRACE(std::to_string(a) + " " + std::to_string(side));
+            EXPECT_NEAR(node.distance(face), 0.0f, 1e-4f);
+            // Distances in the scene's units: 0.01 out, 0.01 in (the cell is 1/64).
+            EXPECT_NEAR(node.distance(face + out), 0.01f, 1e-4f);
+            EXPECT_NEAR(node.distance(face - out), -0.01f, 1e-4f);
+        }
+    // The bounds hold the box, and reach beyond it by no more than the field's margins (its band
+    // and a cell, 3 cells on each side) and a brick's rounding (8 cells).
+    for (int a = 0; a < 3; ++a) {
+        EXPECT_LE(node.bounds().min[a], -half[a]);
+        EXPECT_GE(node.bounds().max[a], half[a]);
+        EXPECT_LE(node.bounds().max[a] - node.bounds().min[a], 2.0f * half[a] + 14.01f / 64.0f);
+    }
+}
+
 TEST(MeshNode, ItsProblemsAreNamed) {
     auto error = [](const std::string& root, bool trusted = true) {
         ParseOptions options;
@@ -267,6 +327,11 @@ TEST(MeshNode, ItsProblemsAreNamed) {
               "scene's folder");
     EXPECT_EQ(error(R"({"type": "mesh", "file": ")" + kGearStl.string() + R"(", "resolution": 4})"),
               "test.json: root.resolution: expected at least 8, got 4");
+    EXPECT_EQ(
+        error(R"({"type": "mesh", "file": ")" + kGearStl.string() + R"(", "fit": [1, 0, 2]})"),
+        "test.json: root.fit[1]: expected a positive number, got 0");
+    EXPECT_EQ(error(R"({"type": "mesh", "file": ")" + kGearStl.string() + R"(", "fit": 2})"),
+              "test.json: root.fit: expected an array of 3 positive numbers, got 2");
 }
 
 } // namespace
