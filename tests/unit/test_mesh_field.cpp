@@ -312,6 +312,40 @@ TEST(MeshNode, FitScalesIntoTheBox) {
     }
 }
 
+// A mesh whose file has a hole and a flipped triangle gets one note, with the counts: the box
+// less one triangle (three open edges) and with another turned over (three edges between
+// triangles wound opposite ways), in a definition used twice.
+TEST(MeshNode, ItsRepairsAreNoted) {
+    writeTestFile("holed_box.obj", boxObj({-1.0f, -1.0f, -1.0f}, {1.0f, 1.0f, 1.0f}, {0}, {2}));
+    ParseOptions options;
+    options.files.folder = std::filesystem::temp_directory_path();
+    auto scene = parseScene(
+        R"({"version": 1, "definitions": {"part": {"node": {"type": "mesh",
+               "file": "holed_box.obj", "resolution": 16}}},
+            "root": {"type": "union", "children": [
+                {"type": "use", "definition": "part"},
+                {"type": "use", "definition": "part", "translate": [3, 0, 0]}]}})",
+        "test.json", options);
+    ASSERT_TRUE(scene) << scene.error().str();
+    const std::vector<FieldNote> notes = fieldNotes(*scene, Evaluator(*scene));
+    ASSERT_EQ(notes.size(), 1u);
+    EXPECT_EQ(notes[0].path, "definitions.part.node");
+    EXPECT_EQ(notes[0].message,
+              "mesh \"holed_box.obj\" is not closed and consistently oriented: 3 open edges, 3 "
+              "edges between triangles wound opposite ways (flipped triangles); its inside comes "
+              "from the generalised winding number, which fills holes and outvotes flipped "
+              "triangles");
+    // Its inside is the box's all the same.
+    const Evaluator box(*scene);
+    EXPECT_LT(box.distance(glm::vec3(0.0f)), 0.0f);
+    EXPECT_LT(box.distance(glm::vec3(-0.9f, 0.0f, 0.0f)), 0.0f); // behind the hole
+    EXPECT_GT(box.distance(glm::vec3(-1.2f, 0.0f, 0.0f)), 0.0f);
+    // A closed mesh gets none.
+    EXPECT_TRUE(
+        fieldNotes(meshScene(kGearStl.string(), 32), Evaluator(meshScene(kGearStl.string(), 32)))
+            .empty());
+}
+
 TEST(MeshNode, ItsProblemsAreNamed) {
     auto error = [](const std::string& root, bool trusted = true) {
         ParseOptions options;

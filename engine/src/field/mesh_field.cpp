@@ -584,7 +584,19 @@ Result<std::shared_ptr<const std::vector<glm::vec4>>> buildMesh(const Node& node
     if (fit != vec3(0.0f)) fitMesh(*mesh, fit);
     auto field = MeshField::make(*mesh, int(node.params[0]));
     if (!field) return fail(field.error().diagnostics[0].message);
-    return std::make_shared<const std::vector<glm::vec4>>(field->words());
+    std::vector<glm::vec4> words = field->words();
+    words.push_back(defectsWord(meshDefects(*mesh)));
+    return std::make_shared<const std::vector<glm::vec4>>(std::move(words));
+}
+
+glm::vec4 defectsWord(const MeshDefects& d) {
+    return {float(d.openEdges), float(d.crowdedEdges), float(d.flippedEdges), float(d.degenerate)};
+}
+
+MeshDefects storedDefects(const std::vector<glm::vec4>& words) {
+    if (words.empty()) return {};
+    const glm::vec4 d = words.back();
+    return {size_t(d.x), size_t(d.y), size_t(d.z), size_t(d.w)};
 }
 
 float MeshField::distance(glm::vec3 p) const {

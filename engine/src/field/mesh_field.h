@@ -100,7 +100,14 @@ class MeshField {
 // scale to undo when it is sampled.
 void fitMesh(TriangleMesh& mesh, glm::vec3 box);
 
-// The mesh node's words (Node::words, sdMesh's layout in shaders/sdf.glsl): its "file" found
+// The mesh node's words end with one more than MeshField::words(): its file's defects (open,
+// crowded and flipped edges, degenerate triangles), which sdMesh does not read, for the note that
+// tells the user (fieldNotes in sdfcsg/eval.h). Counts above 2^24 lose their last digits.
+glm::vec4 defectsWord(const MeshDefects& defects);
+MeshDefects storedDefects(const std::vector<glm::vec4>& words);
+
+// The mesh node's words (Node::words, sdMesh's layout in shaders/sdf.glsl, then defectsWord): its
+// "file" found
 // under `files` (sceneFile()) and read, fitted to its "fit" (fitMesh) where given, its field made
 // at its "resolution". Errors are for the caller to place at the node's "file"; an untrusted
 // scene's problems with the file say "unknown mesh" and nothing of the file system.
