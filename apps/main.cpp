@@ -143,7 +143,8 @@ limit exceeded, 2 bad command line, 3 file read or write failure, 4 Vulkan or sh
 
 const char* kRenderHelp = R"(Usage: sdfcsg render SCENE -o OUT.png [options]
 
-Ray-marches SCENE with a Vulkan compute pass and writes a PNG (atomically).
+Ray-marches SCENE with a Vulkan compute pass and writes a PNG (atomically). Notes on the
+scene, as validate prints them, go to standard error.
 
 Options:
   -o, --output FILE     output PNG (required); - for standard output. A symbolic link is
@@ -209,6 +210,13 @@ bool parseEvaluation(const Args& args, const char* command, sdfcsg::Evaluation& 
     return true;
 }
 
+// The scene's notes (sdfcsg::fieldNotes), one a line as FILE: JSON.PATH: note: MESSAGE.
+void printNotes(const std::string& path, const sdfcsg::Scene& scene, FILE* to) {
+    for (const sdfcsg::FieldNote& note : sdfcsg::fieldNotes(scene, sdfcsg::Evaluator(scene)))
+        std::fprintf(to, "%s: %s: note: %s\n", path.c_str(), note.path.c_str(),
+                     note.message.c_str());
+}
+
 int cmdRender(int argc, char** argv) {
     Args args("render", argc, argv,
               {"-o", "--output", "--width", "--height", "--mode", "--eye", "--target", "--fov",
@@ -253,6 +261,7 @@ int cmdRender(int argc, char** argv) {
 
     auto scene = load(args.positional[0]);
     if (!scene) return fail(scene.error());
+    printNotes(args.positional[0], *scene, stderr);
 
     // Camera: explicit flags override the scene's camera, which overrides automatic framing.
     if (args.has("--eye") || args.has("--target") || args.has("--fov")) {
@@ -307,7 +316,8 @@ OBJ with normals and colours ("v x y z r g b"), binary STL for printing, glTF 2.
 3MF with colours for slicers (z up: the scene's y axis becomes the build direction).
 The mesh is indexed, and closed and manifold wherever the surface lies inside the bounds;
 where the bounds cut the surface it is open, and a note says so. Its triangles and vertices
-are ordered for the GPU's vertex cache and fetch.
+are ordered for the GPU's vertex cache and fetch. Notes on the scene, as validate prints
+them, go to standard error.
 
 --simplify and --target-triangles merge triangles where the surface allows (meshoptimizer's
 edge collapses): vertices stay where they were, with their normals and colours, the outline
@@ -515,6 +525,7 @@ int cmdMesh(int argc, char** argv) {
     catchInterrupts(); // from here on, an interruption is reported (the watchdog's grace)
     auto scene = load(args.positional[0]);
     if (!scene) return fail(scene.error());
+    printNotes(args.positional[0], *scene, stderr);
     if (auto fits = sdfcsg::checkEvaluation(*scene, evaluation); !fits) return fail(fits.error());
     sdfcsg::ContextOptions contextOptions;
     contextOptions.device = args.get("--device");
@@ -584,8 +595,9 @@ Parses and validates each scene (current or legacy format) and prints every prob
 one per line as FILE: JSON.PATH: MESSAGE (or FILE:LINE:COLUMN: MESSAGE for syntax errors).
 For a valid scene, notes where an offset, a shell or a smooth blend acts on a field that is
 not a distance (under a twist, bend or taper, a scale that differs between axes, an
-ellipsoid, or within another smooth blend), and by how much it lands off, as
-FILE: JSON.PATH: note: MESSAGE.
+ellipsoid, or within another smooth blend), and by how much it lands off; and mesh nodes
+whose files are not closed and consistently oriented (open edges, flipped triangles...),
+whose inside comes from the winding number; as FILE: JSON.PATH: note: MESSAGE.
 Exits with 0 if all scenes are valid, 1 if any is not, 3 if a file cannot be read.
 )";
 
@@ -604,10 +616,7 @@ int cmdValidate(int argc, char** argv) {
         }
         std::printf("%s: ok (%zu node%s)\n", path.c_str(), scene->nodes.size(),
                     scene->nodes.size() == 1 ? "" : "s");
-        const sdfcsg::Evaluator evaluator(*scene);
-        for (const sdfcsg::FieldNote& note : sdfcsg::fieldNotes(*scene, evaluator))
-            std::printf("%s: %s: note: %s\n", path.c_str(), note.path.c_str(),
-                        note.message.c_str());
+        printNotes(path, *scene, stdout);
     }
     return worst;
 }

@@ -55,6 +55,20 @@ case_validate() {
     expect_text "validate note" out.txt "twisted.json: root: note: offset over a field that is not a distance (twist at root.children[0] divides its field by up to 2.65): the surface lies about 0.3 from the child's (divided by the field's gradient, to first order; 0.3 to 0.794 without)"
     expect_text "validate shading note" out.txt "twisted.json: root: note: ambient occlusion and soft shadows over a field that is not a distance (twist at root.children[0] divides its field by up to 2.65): the shading can be darker where its values lie below the distance (down to 1/2.65 of it); --no-ao and --no-shadows leave them out"
 
+    # A mesh whose file has a hole (a box less one triangle) and a flipped triangle: validate,
+    # render and mesh each note it once.
+    printf 'v %s\n' "-1 -1 -1" "1 -1 -1" "-1 1 -1" "1 1 -1" "-1 -1 1" "1 -1 1" "-1 1 1" "1 1 1" >holed.obj
+    printf 'f %s\n' "1 7 3" "2 8 4" "2 8 6" "1 2 6" "1 6 5" "3 7 8" "3 8 4" "1 3 4" "1 4 2" "5 6 8" "5 8 7" >>holed.obj
+    printf '{"version": 1, "root": {"type": "mesh", "file": "holed.obj", "resolution": 16}}' >holed.json
+    holed_note='holed.json: root: note: mesh "holed.obj" is not closed and consistently oriented: 3 open edges, 3 edges between triangles wound opposite ways (flipped triangles); its inside comes from the generalised winding number, which fills holes and outvotes flipped triangles'
+    check "validate holed mesh" 0 "$bin" validate holed.json
+    expect_text "validate holed mesh note" out.txt "$holed_note"
+    check "render holed mesh" 0 "$bin" render holed.json -o holed.png --width 32 --height 24
+    expect_text "render holed mesh note" err.txt "$holed_note"
+    check "mesh holed mesh" 0 "$bin" mesh holed.json -o holed.ply --resolution 16
+    expect_text "mesh holed mesh note" err.txt "$holed_note"
+    [ "$(grep -c 'note:' err.txt)" -eq 1 ] || { echo "FAIL mesh holed mesh: one note"; cat err.txt; failures=$((failures + 1)); }
+
     printf '{"version": 1, "root": {"type": "sphere", "radius": -1}}' >bad.json
     check "validate bad" 1 "$bin" validate bad.json
     expect_text "validate bad message" err.txt "bad.json: root.radius: expected a positive number, got -1"

@@ -12,6 +12,7 @@
 
 #include <glm/geometric.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -299,6 +300,99 @@ TEST(MeshNode, RoundTripKeepsTheSurface) {
     EXPECT_GT(near, 200);
 }
 
+// An OBJ of the box from `lo` to `hi`, counter-clockwise seen from outside, less the triangles
+// in `left`, and with those in `flipped` turned over.
+std::string boxObj(glm::vec3 lo, glm::vec3 hi, std::vector<int> left = {},
+                   std::vector<int> flipped = {}) {
+    std::string obj;
+    for (int i = 0; i < 8; ++i) // corner i: x from bit 0, y from bit 1, z from bit 2
+        obj += "v " + std::to_string(i & 1 ? hi.x : lo.x) + " " +
+               std::to_string(i & 2 ? hi.y : lo.y) + " " + std::to_string(i & 4 ? hi.z : lo.z) +
+               "\n";
+    const int quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                             {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+    for (int t = 0; t < 12; ++t) {
+        const int* q = quads[t / 2];
+        int a = q[0], b = q[1 + t % 2], c = q[2 + t % 2];
+        if (std::count(left.begin(), left.end(), t)) continue;
+        if (std::count(flipped.begin(), flipped.end(), t)) std::swap(b, c);
+        obj += "f " + std::to_string(a + 1) + " " + std::to_string(b + 1) + " " +
+               std::to_string(c + 1) + "\n";
+    }
+    return obj;
+}
+
+// A file beside the tests' scenes, written for one test.
+std::filesystem::path writeTestFile(const std::string& name, const std::string& text) {
+    const std::filesystem::path path = std::filesystem::temp_directory_path() / name;
+    std::ofstream(path, std::ios::binary) << text;
+    return path;
+}
+
+// "fit" scales the mesh by one factor into the box and centres it: a 2 x 4 x 1 box, fitted to
+// 1 x 1 x 1, is 0.5 x 1 x 0.25 about the origin, its field in the scene's units.
+TEST(MeshNode, FitScalesIntoTheBox) {
+    const auto file = writeTestFile("fit_box.obj", boxObj({3.0f, -1.0f, 2.0f}, {5.0f, 3.0f, 3.0f}));
+    auto scene = parseScene(R"({"version": 1, "root": {"type": "mesh", "file": ")" + file.string() +
+                                R"(", "resolution": 64, "fit": [1, 1, 1]}})",
+                            "test.json");
+    ASSERT_TRUE(scene) << scene.error().str();
+    const Evaluator node(*scene);
+    const glm::vec3 half(0.25f, 0.5f, 0.125f);
+    for (int a = 0; a < 3; ++a)
+        for (float side : {-1.0f, 1.0f}) {
+            glm::vec3 face(0.0f), out(0.0f);
+            face[a] = side * half[a];
+            out[a] = side * 0.01f;
+            SCOPED_TRACE(std::to_string(a) + " " + std::to_string(side));
+            EXPECT_NEAR(node.distance(face), 0.0f, 1e-4f);
+            // Distances in the scene's units: 0.01 out, 0.01 in (the cell is 1/64).
+            EXPECT_NEAR(node.distance(face + out), 0.01f, 1e-4f);
+            EXPECT_NEAR(node.distance(face - out), -0.01f, 1e-4f);
+        }
+    // The bounds hold the box, and reach beyond it by no more than the field's margins (its band
+    // and a cell, 3 cells on each side) and a brick's rounding (8 cells).
+    for (int a = 0; a < 3; ++a) {
+        EXPECT_LE(node.bounds().min[a], -half[a]);
+        EXPECT_GE(node.bounds().max[a], half[a]);
+        EXPECT_LE(node.bounds().max[a] - node.bounds().min[a], 2.0f * half[a] + 14.01f / 64.0f);
+    }
+}
+
+// A mesh whose file has a hole and a flipped triangle gets one note, with the counts: the box
+// less one triangle (three open edges) and with another turned over (three edges between
+// triangles wound opposite ways), in a definition used twice.
+TEST(MeshNode, ItsRepairsAreNoted) {
+    writeTestFile("holed_box.obj", boxObj({-1.0f, -1.0f, -1.0f}, {1.0f, 1.0f, 1.0f}, {0}, {2}));
+    ParseOptions options;
+    options.files.folder = std::filesystem::temp_directory_path();
+    auto scene = parseScene(
+        R"({"version": 1, "definitions": {"part": {"node": {"type": "mesh",
+               "file": "holed_box.obj", "resolution": 16}}},
+            "root": {"type": "union", "children": [
+                {"type": "use", "definition": "part"},
+                {"type": "use", "definition": "part", "translate": [3, 0, 0]}]}})",
+        "test.json", options);
+    ASSERT_TRUE(scene) << scene.error().str();
+    const std::vector<FieldNote> notes = fieldNotes(*scene, Evaluator(*scene));
+    ASSERT_EQ(notes.size(), 1u);
+    EXPECT_EQ(notes[0].path, "definitions.part.node");
+    EXPECT_EQ(notes[0].message,
+              "mesh \"holed_box.obj\" is not closed and consistently oriented: 3 open edges, 3 "
+              "edges between triangles wound opposite ways (flipped triangles); its inside comes "
+              "from the generalised winding number, which fills holes and outvotes flipped "
+              "triangles");
+    // Its inside is the box's all the same.
+    const Evaluator box(*scene);
+    EXPECT_LT(box.distance(glm::vec3(0.0f)), 0.0f);
+    EXPECT_LT(box.distance(glm::vec3(-0.9f, 0.0f, 0.0f)), 0.0f); // behind the hole
+    EXPECT_GT(box.distance(glm::vec3(-1.2f, 0.0f, 0.0f)), 0.0f);
+    // A closed mesh gets none.
+    EXPECT_TRUE(
+        fieldNotes(meshScene(kGearStl.string(), 32), Evaluator(meshScene(kGearStl.string(), 32)))
+            .empty());
+}
+
 TEST(MeshNode, ItsProblemsAreNamed) {
     auto error = [](const std::string& root, bool trusted = true) {
         ParseOptions options;
@@ -314,6 +408,11 @@ TEST(MeshNode, ItsProblemsAreNamed) {
               "scene's folder");
     EXPECT_EQ(error(R"({"type": "mesh", "file": ")" + kGearStl.string() + R"(", "resolution": 4})"),
               "test.json: root.resolution: expected at least 8, got 4");
+    EXPECT_EQ(
+        error(R"({"type": "mesh", "file": ")" + kGearStl.string() + R"(", "fit": [1, 0, 2]})"),
+        "test.json: root.fit[1]: expected a positive number, got 0");
+    EXPECT_EQ(error(R"({"type": "mesh", "file": ")" + kGearStl.string() + R"(", "fit": 2})"),
+              "test.json: root.fit: expected an array of 3 positive numbers, got 2");
 }
 
 } // namespace

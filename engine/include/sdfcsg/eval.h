@@ -127,9 +127,12 @@ class Evaluator {
 // scale that differs between axes (the smallest factor), an ellipsoid, and within a smooth
 // blend's radius. One note per dependent node, naming it by its JSON path, in the file's order;
 // then one at the root where the renderer's ambient occlusion and soft shadows, which read the
-// field as a distance, show the loss (a factor of 2 or more).
+// field as a distance, show the loss (a factor of 2 or more). Among them, in the file's order,
+// one per mesh node whose file is not a closed, consistently oriented surface (open edges, edges
+// of three or more triangles, flipped or degenerate triangles), with the counts, since its inside
+// comes from the winding number rather than from the file's orientation.
 struct FieldNote {
-    std::string path;    // the dependent node, e.g. "root.children[1]"
+    std::string path;    // the dependent node or mesh, e.g. "root.children[1]"
     std::string message; // what it depends on, where that stops being a distance, and how much
 };
 std::vector<FieldNote> fieldNotes(const Scene& scene, const Evaluator& evaluator);

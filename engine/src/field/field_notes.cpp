@@ -1,17 +1,19 @@
 // Where a scene's field stops being a distance, and which operations depend on it being one
-// (sdfcsg/eval.h, fieldNotes). Offsets, shells and smooth blends act on the field's values: over
-// a field whose values lie below the distance by up to a factor L, an offset r would land between
-// r and L r from the child's surface and a shell of thickness t be t to L t thick, but for their
-// division by the field's gradient (FlatNode::loss), which brings them near r and t to first
-// order; a blend of radius k reaches up to L k.
+// (sdfcsg/eval.h, fieldNotes); and the mesh nodes whose files needed repair. Offsets, shells and
+// smooth blends act on the field's values: over a field whose values lie below the distance by up
+// to a factor L, an offset r would land between r and L r from the child's surface and a shell of
+// thickness t be t to L t thick, but for their division by the field's gradient (FlatNode::loss),
+// which brings them near r and t to first order; a blend of radius k reaches up to L k.
 #include "sdfcsg/eval.h"
 #include "sdfcsg/nodes.h"
 
+#include "field/mesh_field.h"
 #include "field/sdf.h"
 
 #include <algorithm>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 namespace sdfcsg {
 namespace {
@@ -110,6 +112,35 @@ std::string noteOf(const Node& n, const Loss& loss) {
     return kind + " over a field that is not a distance (" + loss.cause + "): " + effect;
 }
 
+// "3 open edges" and the like, the nouns in the singular and the plural.
+std::string counted(size_t n, const std::string& one, const std::string& many,
+                    const std::string& rest) {
+    return std::to_string(n) + " " + (n == 1 ? one : many) + rest;
+}
+
+// A mesh node whose file is not a closed, consistently oriented surface (detail::MeshDefects):
+// what was found, and where its inside comes from instead. Empty for a clean mesh.
+std::string meshNote(const Node& n) {
+    if (!n.words) return {};
+    const detail::MeshDefects d = detail::storedDefects(*n.words);
+    std::vector<std::string> found;
+    if (d.openEdges) found.push_back(counted(d.openEdges, "open edge", "open edges", ""));
+    if (d.crowdedEdges)
+        found.push_back(counted(d.crowdedEdges, "edge", "edges", " of three or more triangles"));
+    if (d.flippedEdges)
+        found.push_back(counted(d.flippedEdges, "edge", "edges",
+                                " between triangles wound opposite ways (flipped triangles)"));
+    if (d.degenerate)
+        found.push_back(counted(d.degenerate, "triangle", "triangles", " of no area"));
+    if (found.empty()) return {};
+    std::string list;
+    for (size_t i = 0; i < found.size(); ++i)
+        list += (i == 0 ? "" : ", ") + found[i];
+    return "mesh \"" + n.strings[0] + "\" is not closed and consistently oriented: " + list +
+           "; its inside comes from the generalised winding number, which fills holes and "
+           "outvotes flipped triangles";
+}
+
 } // namespace
 
 std::vector<FieldNote> fieldNotes(const Scene& scene, const Evaluator& evaluator) {
@@ -124,6 +155,13 @@ std::vector<FieldNote> fieldNotes(const Scene& scene, const Evaluator& evaluator
         const bool dependent =
             n.kind == NodeKind::Offset || n.kind == NodeKind::Shell || smoothOf(n) > 0.0f;
         if (dependent && loss.any) notes.push_back({n.path, noteOf(n, loss)});
+        // A mesh in a definition used more than once: one note for its one path.
+        if (n.kind == NodeKind::Mesh)
+            if (std::string note = meshNote(n);
+                !note.empty() && std::none_of(notes.begin(), notes.end(), [&](const FieldNote& f) {
+                    return f.path == n.path && f.message == note;
+                }))
+                notes.push_back({n.path, note});
         const Loss own = ownLoss(n, evaluator.nodes()[i]);
         if (worse(own, loss) || (own.any && !loss.any)) loss = own;
         losses[i] = loss;

@@ -21,6 +21,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <thread>
@@ -586,6 +587,19 @@ std::vector<glm::vec4> MeshField::words() const {
     return w;
 }
 
+void fitMesh(TriangleMesh& mesh, glm::vec3 box) {
+    Box b;
+    for (const vec3& p : mesh.positions)
+        b.add(p);
+    const vec3 size = b.hi - b.lo, centre = 0.5f * (b.lo + b.hi);
+    float scale = std::numeric_limits<float>::infinity();
+    for (int a = 0; a < 3; ++a)
+        if (size[a] > 0.0f) scale = std::min(scale, box[a] / size[a]);
+    if (!std::isfinite(scale)) return; // one point: MeshField::make refuses it
+    for (vec3& p : mesh.positions)
+        p = (p - centre) * scale;
+}
+
 Result<std::shared_ptr<const std::vector<glm::vec4>>> buildMesh(const Node& node,
                                                                 const SceneFiles& files) {
     const std::string& name = node.strings[0];
@@ -600,9 +614,23 @@ Result<std::shared_ptr<const std::vector<glm::vec4>>> buildMesh(const Node& node
     if (!in && !in.eof()) return fail("cannot be read");
     auto mesh = readTriangleMesh(bytes, file->extension().string(), file->parent_path());
     if (!mesh) return fail(mesh.error().diagnostics[0].message);
+    const vec3 fit(node.params[1], node.params[2], node.params[3]);
+    if (fit != vec3(0.0f)) fitMesh(*mesh, fit);
     auto field = MeshField::make(*mesh, int(node.params[0]));
     if (!field) return fail(field.error().diagnostics[0].message);
-    return std::make_shared<const std::vector<glm::vec4>>(field->words());
+    std::vector<glm::vec4> words = field->words();
+    words.push_back(defectsWord(meshDefects(*mesh)));
+    return std::make_shared<const std::vector<glm::vec4>>(std::move(words));
+}
+
+glm::vec4 defectsWord(const MeshDefects& d) {
+    return {float(d.openEdges), float(d.crowdedEdges), float(d.flippedEdges), float(d.degenerate)};
+}
+
+MeshDefects storedDefects(const std::vector<glm::vec4>& words) {
+    if (words.empty()) return {};
+    const glm::vec4 d = words.back();
+    return {size_t(d.x), size_t(d.y), size_t(d.z), size_t(d.w)};
 }
 
 float MeshField::distance(glm::vec3 p) const {

@@ -98,10 +98,23 @@ class MeshField {
     std::vector<float> samples_; // kBrickSamples per stored brick, x fastest
 };
 
-// The mesh node's words (Node::words, sdMesh's layout in shaders/sdf.glsl): its "file" found
-// under `files` (sceneFile()) and read, its field made at its "resolution". Errors are for the
-// caller to place at the node's "file"; an untrusted scene's problems with the file say
-// "unknown mesh" and nothing of the file system.
+// Scales the mesh by one factor on every axis and moves its box's centre to the origin, so that
+// its box fits `box` and touches it on at least one axis (the mesh node's "fit"). Done to the
+// triangles before the field is made, the field holds distances in the scene's units, with no
+// scale to undo when it is sampled.
+void fitMesh(TriangleMesh& mesh, glm::vec3 box);
+
+// The mesh node's words end with one more than MeshField::words(): its file's defects (open,
+// crowded and flipped edges, degenerate triangles), which sdMesh does not read, for the note that
+// tells the user (fieldNotes in sdfcsg/eval.h). Counts above 2^24 lose their last digits.
+glm::vec4 defectsWord(const MeshDefects& defects);
+MeshDefects storedDefects(const std::vector<glm::vec4>& words);
+
+// The mesh node's words (Node::words, sdMesh's layout in shaders/sdf.glsl, then defectsWord): its
+// "file" found
+// under `files` (sceneFile()) and read, fitted to its "fit" (fitMesh) where given, its field made
+// at its "resolution". Errors are for the caller to place at the node's "file"; an untrusted
+// scene's problems with the file say "unknown mesh" and nothing of the file system.
 Result<std::shared_ptr<const std::vector<glm::vec4>>> buildMesh(const Node& node,
                                                                 const SceneFiles& files);
 

@@ -313,6 +313,16 @@ constexpr ParamInfo kMesh[] = {
      1024.0f,
      {},
      8.0f},
+    {"fit",
+     Vec3,
+     Positive,
+     1,
+     false,
+     {0, 0, 0},
+     "length",
+     "A box [x, y, z] the mesh is made to fit: scaled by one factor on every axis (its "
+     "proportions kept) until it touches the box's sides, and centred on the origin. Absent: the "
+     "file's own units and place."},
 };
 constexpr std::string_view kImageInside[] = {"dark", "light"};
 constexpr ParamInfo kImage[] = {
@@ -901,7 +911,8 @@ constexpr KindInfo kKinds[] = {
          return true;
      }},
     {NodeKind::Mesh, "mesh", false, kMesh,
-     "A triangle mesh read from a file, in the file's units, STL and 3MF turned from z up to y up "
+     "A triangle mesh read from a file, in the file's units or scaled to fit a box, STL and 3MF "
+     "turned from z up to y up "
      "(only where the user names a file). "
      "Its field is the distance to the triangles, exact near the surface (sampled in bricks, "
      "interpolated) and a bound beyond; the inside is what the generalised winding number "
