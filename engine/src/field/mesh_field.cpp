@@ -583,12 +583,17 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
     // known takes the nearest of the triangles nearest to its 26 neighbours, or the one its box
     // reached if nearer (the nearest triangle of a point is also the nearest of the points
     // between it and the surface, which lie near its neighbours).
-    std::vector<uint8_t> known(sampleCount, 0);
+    // `source`: the nearest triangle of each known sample that has one, which its neighbours
+    // take up; `touched`: whether a sample has a neighbour with one.
+    std::vector<uint8_t> known(sampleCount, 0), touched(sampleCount, 0), reached(sampleCount, 0);
+    std::vector<uint8_t> since(sampleCount, 0); // the layer from which a source is taken up
+    std::vector<uint32_t> source(sampleCount, kNone), fresh(sampleCount, kNone);
     for (size_t at = 0; at < sampleCount; ++at)
-        known[at] = best[at] < reach * reach;
+        if (best[at] < reach * reach) known[at] = 1, source[at] = nearest[at];
     constexpr size_t kNowhere = ~size_t(0);
-    std::vector<uint32_t> fresh(sampleCount, kNone);
-    std::vector<uint8_t> reached(sampleCount, 0);
+    // Bricks where a sample became a source in the last layer: only their neighbours have new
+    // triangles to take up.
+    std::vector<uint8_t> grown(brickCount, 1);
     // Layers by distance, half a cell deep: a sample is known once it is nearer than the layer's
     // far side, when the samples between it and the surface are known.
     const float step = 0.5f * f.cell_;
@@ -608,6 +613,9 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
                 const int32_t slot = in ? f.slots_[slotOf(there)] : kOutside;
                 around[k] = slot >= 0 ? size_t(slot) : kNowhere;
             }
+            bool news = false;
+            for (int k = 0; k < 27; ++k)
+                news = news || (around[k] != kNowhere && grown[around[k] / kBrickSamples]);
             // A neighbour's sample, this brick's where it holds it (its copy of the faces it
             // shares), else the neighbouring brick's.
             const auto sampleAt = [&](glm::ivec3 l) {
@@ -625,40 +633,50 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
                     for (int x = 0; x <= kBrick; ++x) {
                         const size_t at = b * kBrickSamples + local(x, y, z);
                         if (known[at]) continue;
+                        if (!news) { // nothing new about it: only the layer has grown
+                            reached[at] = touched[at] && best[at] < within2 ? 2 : 0;
+                            any = any || reached[at];
+                            continue;
+                        }
                         const bool inner =
                             x > 0 && x < kBrick && y > 0 && y < kBrick && z > 0 && z < kBrick;
                         const vec3 p = pointAt(home * kBrick + glm::ivec3(x, y, z));
                         uint32_t seen[27] = {nearest[at]};
                         int count = 1;
                         fresh[at] = nearest[at];
-                        bool touched = false;
                         for (int dz = -1; dz <= 1; ++dz)
                             for (int dy = -1; dy <= 1; ++dy)
                                 for (int dx = -1; dx <= 1; ++dx) {
                                     const size_t n =
                                         inner ? at + local(dx + 1, dy + 1, dz + 1) - local(1, 1, 1)
                                               : sampleAt(glm::ivec3(x + dx, y + dy, z + dz));
-                                    if (n == kNowhere || !known[n]) continue;
-                                    touched = true;
-                                    const uint32_t t = nearest[n];
-                                    if (t == kNone ||
-                                        std::find(seen, seen + count, t) != seen + count)
-                                        continue;
+                                    // Sources of earlier layers were taken up then.
+                                    const uint32_t t = n == kNowhere ? kNone : source[n];
+                                    if (t == kNone || since[n] != layer) continue;
+                                    touched[at] = 1;
+                                    if (std::find(seen, seen + count, t) != seen + count) continue;
                                     seen[count++] = t;
                                     const float d2 = nearer(p, t, best[at]);
                                     if (d2 < best[at]) best[at] = d2, fresh[at] = t;
                                 }
-                        // 1: a known neighbour, 2: and now known itself.
-                        reached[at] = touched ? best[at] < within2 ? 2 : 1 : 0;
+                        // 1: a neighbour with a triangle, 2: and now known itself.
+                        reached[at] = touched[at] ? best[at] < within2 ? 2 : 1 : 0;
                         any = any || reached[at] == 2;
                     }
             if (any) grew = true;
         });
         if (!grew) break;
         parallelFor(brickCount, [&](size_t b) {
-            for (size_t at = b * kBrickSamples; at < (b + 1) * kBrickSamples; ++at)
-                if (reached[at])
-                    nearest[at] = fresh[at], known[at] = reached[at] == 2, reached[at] = 0;
+            grown[b] = 0;
+            for (size_t at = b * kBrickSamples; at < (b + 1) * kBrickSamples; ++at) {
+                if (reached[at] == 1) nearest[at] = fresh[at];
+                if (reached[at] == 2) {
+                    nearest[at] = source[at] = fresh[at], known[at] = 1;
+                    since[at] = uint8_t(layer + 1);
+                    grown[b] = grown[b] || fresh[at] != kNone;
+                }
+                reached[at] = 0;
+            }
         });
     }
     fresh = {};
