@@ -68,6 +68,7 @@ const char* kHelp =
                    [--evaluation E]
        sdfcsg bench --mesh [--scenes DIR] [--resolutions 128,256,512] [--runs N]
                    [--method dc|mc] [--simplify E] [--error] [--report]
+       sdfcsg bench --mesh-node FILE... [--resolution N] [--runs N]
 
 For every scene (*.json) in DIR (default assets/scenes), prints the median milliseconds per
 frame in shaded mode with and without bounding-box skipping (after two warm-up frames; a frame
@@ -108,6 +109,9 @@ distance from the surface of points spread over every triangle (not only its ver
 by the CPU evaluator, in cells: the largest and the 99th percentile. --report adds the median
 seconds of the mesh report on each mesh (as sdfcsg mesh --report computes it, walls from the
 field included), beside the extraction and not in its total.
+
+With --mesh-node, prints for every mesh file the median seconds from the file to a mesh node's
+ready field ('sdfcsg bench --mesh-node --help' says more).
 )";
 
 using Clock = std::chrono::steady_clock;
@@ -634,6 +638,8 @@ std::string readText(const fs::path& path) {
 } // namespace
 
 int runBench(int argc, char** argv) {
+    if (std::find(argv, argv + argc, std::string_view("--mesh-node")) != argv + argc)
+        return runMeshNodeBench(argc, argv);
     if (std::find(argv, argv + argc, std::string_view("--mesh")) != argv + argc) {
         for (int j = 0; j < argc; ++j)
             if (std::string_view(argv[j]) == "--help" || std::string_view(argv[j]) == "-h")

@@ -164,6 +164,101 @@ TEST(MeshField, HolesAndFlippedTrianglesKeepTheInside) {
     }
 }
 
+// The distance from p to the triangle abc, by brute force: to its plane where p projects inside
+// it, else to the nearest of its three edges.
+float distanceToTriangle(glm::vec3 p, glm::vec3 a, glm::vec3 b, glm::vec3 c) {
+    const auto toSegment = [&](glm::vec3 u, glm::vec3 v) {
+        const glm::vec3 e = v - u;
+        const float t = glm::clamp(glm::dot(p - u, e) / glm::dot(e, e), 0.0f, 1.0f);
+        return glm::length(p - (u + t * e));
+    };
+    const glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
+    const glm::vec3 q = p - glm::dot(p - a, n) * n;
+    if (glm::dot(glm::cross(b - a, q - a), n) >= 0.0f &&
+        glm::dot(glm::cross(c - b, q - b), n) >= 0.0f &&
+        glm::dot(glm::cross(a - c, q - c), n) >= 0.0f)
+        return std::abs(glm::dot(p - a, n));
+    return std::min({toSegment(a, b), toSegment(b, c), toSegment(c, a)});
+}
+
+// A lumpy ball: an icosphere's vertices moved in and out at random, so that it has folds and
+// hollows, closed and consistently oriented.
+TriangleMesh lumpyBall(uint32_t seed) {
+    TriangleMesh mesh = triangles(icosphere(3));
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(0.75f, 1.25f);
+    for (glm::vec3& p : mesh.positions)
+        p *= u(rng);
+    return mesh;
+}
+
+// At the field's samples (the grid's points) within the band, the field is the distance to the
+// nearest of all the triangles, signed by the winding number; a cell beyond the band, within a
+// tenth of a cell of it; farther, a bound of the right sign. Closed meshes and ones with holes and
+// flipped triangles alike.
+void expectSamplesAreDistances(const TriangleMesh& mesh, int cells, uint32_t seed) {
+    auto field = MeshField::make(mesh, cells);
+    ASSERT_TRUE(field) << field.error().str();
+    const float cell = field->cell(), band = field->band();
+    std::mt19937 rng(seed);
+    std::vector<glm::vec3> points;
+    const glm::ivec3 last = field->bricks() * MeshField::kBrick;
+    while (points.size() < 1500) {
+        const glm::ivec3 g(std::uniform_int_distribution<int>(0, last.x)(rng),
+                           std::uniform_int_distribution<int>(0, last.y)(rng),
+                           std::uniform_int_distribution<int>(0, last.z)(rng));
+        const glm::vec3 p = field->origin() + cell * glm::vec3(g);
+        // Mostly points near the surface, where the field is exact.
+        if (field->distance(p) < 2.0f * band || points.size() % 4 == 0) points.push_back(p);
+    }
+    const std::vector<float> winding = windingNumbers(mesh, points);
+    int exact = 0;
+    for (size_t i = 0; i < points.size(); ++i) {
+        const glm::vec3 p = points[i];
+        float d = INFINITY;
+        for (const glm::uvec3& t : mesh.triangles)
+            d = std::min(d, distanceToTriangle(p, mesh.positions[t.x], mesh.positions[t.y],
+                                               mesh.positions[t.z]));
+        const float v = field->distance(p);
+        SCOPED_TRACE(testing::Message() << p.x << " " << p.y << " " << p.z << ": " << v
+                                        << " against " << d << ", winding " << winding[i]);
+        if (d < 0.05f * cell) continue; // on the surface: either sign
+        if (std::abs(winding[i] - 0.5f) > 0.1f) {
+            ASSERT_EQ(v<0.0f, winding[i]> 0.5f);
+        }
+        if (d < band - 1e-3f * cell) {
+            ++exact;
+            ASSERT_NEAR(std::abs(v), d, 1e-3f * cell);
+        } else if (d < band + cell) {
+            ASSERT_NEAR(std::abs(v), d, 0.1f * cell);
+        } else {
+            ASSERT_LE(std::abs(v), d + 0.1f * cell);
+        }
+    }
+    EXPECT_GT(exact, 200);
+}
+
+TEST(MeshField, SamplesAreTheDistanceToTheNearestTriangle) {
+    for (uint32_t seed : {1u, 2u, 3u}) {
+        SCOPED_TRACE(seed);
+        expectSamplesAreDistances(lumpyBall(seed), 40, seed);
+    }
+    // Holes and flipped triangles: signed by the winding number instead.
+    TriangleMesh torn = lumpyBall(4);
+    std::vector<glm::uvec3> kept;
+    for (size_t i = 0; i < torn.triangles.size(); ++i) {
+        glm::uvec3 t = torn.triangles[i];
+        if (i % 31 == 0) continue;
+        if (i % 17 == 0) std::swap(t.y, t.z);
+        kept.push_back(t);
+    }
+    torn.triangles = kept;
+    ASSERT_TRUE(meshDefects(torn).any());
+    expectSamplesAreDistances(torn, 40, 4);
+    // Triangles far smaller than a cell, as meshes of a million triangles have at 128 cells.
+    expectSamplesAreDistances(triangles(icosphere(4)), 16, 5);
+}
+
 TEST(MeshField, HostileFilesAreRefused) {
     const TriangleMesh sphere = triangles(icosphere(1));
     auto text = [](const Result<TriangleMesh>& r) {

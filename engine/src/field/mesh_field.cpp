@@ -13,6 +13,7 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
+#include <glm/vector_relational.hpp>
 
 #include <algorithm>
 #include <array>
@@ -25,7 +26,7 @@
 #include <numbers>
 #include <optional>
 #include <thread>
-#include <unordered_map>
+#include <utility>
 
 namespace sdfcsg::detail {
 
@@ -227,6 +228,70 @@ class Hierarchy {
     std::vector<Node> nodes_;
 };
 
+// The triangles' edges, 3 t + e for the edge from corner e to corner e + 1 of triangle t, ordered
+// by the two vertices they join, so that the edges between one pair of vertices make a run: a
+// counting sort by the lesser vertex, then each vertex's few edges sorted by the greater. Edges
+// from a vertex to itself are left out.
+uint64_t edgeKey(const TriangleMesh& mesh, uint32_t edge) {
+    const glm::uvec3& t = mesh.triangles[edge / 3];
+    const uint32_t u = t[int(edge % 3)], v = t[int(edge % 3 + 1) % 3];
+    return (uint64_t(std::min(u, v)) << 32) | std::max(u, v);
+}
+std::vector<uint32_t> edgesInPairs(const TriangleMesh& mesh) {
+    std::vector<uint32_t> start(mesh.positions.size() + 1, 0);
+    const uint32_t edges = uint32_t(3 * mesh.triangles.size());
+    const auto lesser = [&](uint32_t e) { return uint32_t(edgeKey(mesh, e) >> 32); };
+    const auto loop = [&](uint32_t e) { return uint32_t(edgeKey(mesh, e)) == lesser(e); };
+    for (uint32_t e = 0; e < edges; ++e)
+        if (!loop(e)) ++start[lesser(e) + 1];
+    for (size_t v = 1; v < start.size(); ++v)
+        start[v] += start[v - 1];
+    std::vector<uint32_t> order(start.back());
+    std::vector<uint32_t> next(start.begin(), start.end() - 1);
+    for (uint32_t e = 0; e < edges; ++e)
+        if (!loop(e)) order[next[lesser(e)]++] = e;
+    for (size_t v = 0; v + 1 < start.size(); ++v)
+        std::sort(order.begin() + start[v], order.begin() + start[v + 1],
+                  [&](uint32_t a, uint32_t b) { return edgeKey(mesh, a) < edgeKey(mesh, b); });
+    return order;
+}
+
+// Calls run(first, last) for each run of `order` (edgesInPairs) along one pair of vertices.
+template <class Run>
+void forEachPair(const TriangleMesh& mesh, const std::vector<uint32_t>& order, Run&& run) {
+    for (size_t k = 0; k < order.size();) {
+        size_t end = k + 1;
+        while (end < order.size() && edgeKey(mesh, order[end]) == edgeKey(mesh, order[k]))
+            ++end;
+        run(k, end);
+        k = end;
+    }
+}
+
+MeshDefects countDefects(const TriangleMesh& mesh, const std::vector<uint32_t>& pairs) {
+    MeshDefects d;
+    for (const glm::uvec3& t : mesh.triangles) {
+        const vec3 a = mesh.positions[t.x], b = mesh.positions[t.y], c = mesh.positions[t.z];
+        if (glm::length(glm::cross(b - a, c - a)) == 0.0f) ++d.degenerate;
+    }
+    forEachPair(mesh, pairs, [&](size_t first, size_t last) {
+        // How many of the pair's edges run from its lesser vertex to its greater.
+        size_t forward = 0;
+        for (size_t k = first; k < last; ++k) {
+            const glm::uvec3& t = mesh.triangles[pairs[k] / 3];
+            forward += t[int(pairs[k] % 3)] < t[int(pairs[k] % 3 + 1) % 3];
+        }
+        const size_t n = last - first;
+        if (n == 1)
+            ++d.openEdges;
+        else if (n > 2)
+            ++d.crowdedEdges;
+        else if (forward != 1)
+            ++d.flippedEdges;
+    });
+    return d;
+}
+
 // The angle-weighted pseudonormals of a closed, consistently oriented mesh (Baerentzen and Aanaes
 // 2005): at the feature of the mesh nearest to p (a face, an edge or a corner), p lies outside
 // exactly where it is on the side its pseudonormal points to.
@@ -235,13 +300,11 @@ struct Pseudonormals {
     std::vector<std::array<vec3, 3>> edges; // per triangle, edges ab, bc, ca: the two faces' sum
     std::vector<vec3> faces;
 
-    explicit Pseudonormals(const TriangleMesh& mesh)
+    Pseudonormals() = default;
+    // `pairs`: the mesh's edgesInPairs.
+    Pseudonormals(const TriangleMesh& mesh, const std::vector<uint32_t>& pairs)
         : corners(mesh.positions.size(), vec3(0.0f)), edges(mesh.triangles.size()),
           faces(mesh.triangles.size()) {
-        std::unordered_map<uint64_t, vec3> edgeSums;
-        const auto key = [](uint32_t u, uint32_t v) {
-            return (uint64_t(std::min(u, v)) << 32) | std::max(u, v);
-        };
         for (size_t t = 0; t < mesh.triangles.size(); ++t) {
             const glm::uvec3 i = mesh.triangles[t];
             const vec3 p[3] = {mesh.positions[i.x], mesh.positions[i.y], mesh.positions[i.z]};
@@ -253,14 +316,15 @@ struct Pseudonormals {
                 const float angle =
                     l > 0.0f ? std::acos(glm::clamp(glm::dot(e1, e2) / l, -1.0f, 1.0f)) : 0.0f;
                 corners[i[c]] += angle * faces[t];
-                edgeSums[key(i[c], i[(c + 1) % 3])] += faces[t];
             }
         }
-        for (size_t t = 0; t < mesh.triangles.size(); ++t) {
-            const glm::uvec3 i = mesh.triangles[t];
-            for (int e = 0; e < 3; ++e)
-                edges[t][e] = edgeSums[key(i[e], i[(e + 1) % 3])];
-        }
+        forEachPair(mesh, pairs, [&](size_t first, size_t last) {
+            vec3 sum(0.0f);
+            for (size_t k = first; k < last; ++k)
+                sum += faces[pairs[k] / 3];
+            for (size_t k = first; k < last; ++k)
+                edges[pairs[k] / 3][pairs[k] % 3] = sum;
+        });
     }
 
     vec3 at(const TriangleMesh& mesh, uint32_t t, int feature) const {
@@ -384,29 +448,7 @@ Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::strin
 }
 
 MeshDefects meshDefects(const TriangleMesh& mesh) {
-    MeshDefects d;
-    // Each undirected edge: how many triangles use it in each direction.
-    std::unordered_map<uint64_t, glm::uvec2> edges;
-    for (const glm::uvec3& t : mesh.triangles) {
-        const vec3 a = mesh.positions[t.x], b = mesh.positions[t.y], c = mesh.positions[t.z];
-        if (glm::length(glm::cross(b - a, c - a)) == 0.0f) ++d.degenerate;
-        for (int e = 0; e < 3; ++e) {
-            const uint32_t u = t[e], v = t[(e + 1) % 3];
-            if (u == v) continue;
-            const uint64_t key = (uint64_t(std::min(u, v)) << 32) | std::max(u, v);
-            ++edges[key][u < v ? 0 : 1];
-        }
-    }
-    for (const auto& [key, uses] : edges) {
-        const uint32_t n = uses.x + uses.y;
-        if (n == 1)
-            ++d.openEdges;
-        else if (n > 2)
-            ++d.crowdedEdges;
-        else if (uses.x != 1)
-            ++d.flippedEdges;
-    }
-    return d;
+    return countDefects(mesh, edgesInPairs(mesh));
 }
 
 std::vector<float> windingNumbers(const TriangleMesh& mesh, const std::vector<glm::vec3>& points) {
@@ -447,103 +489,270 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
         return (size_t(b.z) * size_t(f.bricks_.y) + size_t(b.y)) * size_t(f.bricks_.x) +
                size_t(b.x);
     };
-    // The bricks within reach of each triangle's box hold samples; each lists those triangles.
-    std::vector<std::pair<uint32_t, uint32_t>> touches; // (slot, triangle)
-    size_t stored = 0;
-    for (uint32_t t = 0; t < mesh.triangles.size(); ++t) {
-        Box tb;
-        for (int c = 0; c < 3; ++c)
-            tb.add(mesh.positions[mesh.triangles[t][c]]);
-        const glm::ivec3 lo = brickOf(tb.lo - margin), hi = brickOf(tb.hi + margin);
+    const auto brickOfSlot = [&](size_t s) {
+        return glm::ivec3(int(s % size_t(f.bricks_.x)),
+                          int(s / size_t(f.bricks_.x) % size_t(f.bricks_.y)),
+                          int(s / (size_t(f.bricks_.x) * size_t(f.bricks_.y))));
+    };
+    const auto corners = [&](uint32_t t) {
+        const glm::uvec3 i = mesh.triangles[t];
+        return std::array<vec3, 3>{mesh.positions[i.x], mesh.positions[i.y], mesh.positions[i.z]};
+    };
+    // Calls visit(slot) for each brick that triangle t's box, grown by `grow`, meets.
+    const auto forBricksNear = [&](uint32_t t, float grow, auto&& visit) {
+        const std::array<vec3, 3> c = corners(t);
+        const glm::ivec3 lo = brickOf(glm::min(c[0], glm::min(c[1], c[2])) - grow),
+                         hi = brickOf(glm::max(c[0], glm::max(c[1], c[2])) + grow);
         for (int z = lo.z; z <= hi.z; ++z)
             for (int y = lo.y; y <= hi.y; ++y)
-                for (int x = lo.x; x <= hi.x; ++x) {
-                    const size_t s = slotOf({x, y, z});
-                    if (f.slots_[s] == kOutside) f.slots_[s] = 0, ++stored;
-                    touches.emplace_back(uint32_t(s), t);
-                }
-        const size_t bytes = stored * kBrickSamples * sizeof(float) + slots * sizeof(int32_t) +
-                             touches.size() * sizeof(touches[0]);
+                for (int x = lo.x; x <= hi.x; ++x)
+                    visit(slotOf({x, y, z}));
+    };
+    const uint32_t triangleCount = uint32_t(mesh.triangles.size());
+
+    // The bricks within `margin` of a triangle's box hold samples.
+    size_t stored = 0;
+    for (uint32_t t = 0; t < triangleCount; ++t) {
+        forBricksNear(t, margin, [&](size_t s) {
+            if (f.slots_[s] == kOutside) f.slots_[s] = 0, ++stored;
+        });
+        const size_t bytes = stored * kBrickSamples * sizeof(float) + slots * sizeof(int32_t);
         if (bytes > kMaxMeshFieldBytes) return tooLarge(bytes);
     }
-    std::sort(touches.begin(), touches.end());
-    // Stored bricks in slot order, each with its range of `touches`.
-    std::vector<std::pair<uint32_t, size_t>> bricks; // (slot, first touch)
-    for (size_t k = 0; k < touches.size(); ++k)
-        if (k == 0 || touches[k].first != touches[k - 1].first) {
-            f.slots_[touches[k].first] = int32_t(bricks.size() * kBrickSamples);
-            bricks.emplace_back(touches[k].first, k);
+    std::vector<uint32_t> brickSlots; // the stored bricks' slots, in order
+    brickSlots.reserve(stored);
+    for (size_t s = 0; s < slots; ++s)
+        if (f.slots_[s] != kOutside) {
+            f.slots_[s] = int32_t(brickSlots.size() * kBrickSamples);
+            brickSlots.push_back(uint32_t(s));
         }
-    bricks.emplace_back(0, touches.size());
-    f.samples_.resize((bricks.size() - 1) * kBrickSamples);
-    const auto brickCorner = [&](size_t s) {
-        const size_t x = s % size_t(f.bricks_.x),
-                     y = (s / size_t(f.bricks_.x)) % size_t(f.bricks_.y),
-                     z = s / (size_t(f.bricks_.x) * size_t(f.bricks_.y));
-        return f.origin_ + brickSize * vec3(float(x), float(y), float(z));
+    const size_t brickCount = brickSlots.size(), sampleCount = brickCount * kBrickSamples;
+
+    // Each brick's list of the triangles whose box, grown by `reach`, meets it: a counting sort
+    // by brick. The lists count against the limit too.
+    const float reach = f.band_;
+    std::vector<size_t> first(brickCount + 1, 0);
+    size_t touches = 0;
+    for (uint32_t t = 0; t < triangleCount; ++t) {
+        forBricksNear(t, reach,
+                      [&](size_t s) { ++first[size_t(f.slots_[s]) / kBrickSamples], ++touches; });
+        const size_t bytes =
+            sampleCount * sizeof(float) + slots * sizeof(int32_t) + touches * sizeof(uint32_t);
+        if (bytes > kMaxMeshFieldBytes) return tooLarge(bytes);
+    }
+    for (size_t b = 0, sum = 0; b <= brickCount; ++b)
+        sum += std::exchange(first[b], sum);
+    std::vector<uint32_t> near(first.back());
+    {
+        std::vector<size_t> next(first.begin(), first.end() - 1);
+        for (uint32_t t = 0; t < triangleCount; ++t)
+            forBricksNear(t, reach,
+                          [&](size_t s) { near[next[size_t(f.slots_[s]) / kBrickSamples]++] = t; });
+    }
+
+    // Each sample's squared distance to its nearest triangle, and which, where nearer than the
+    // margin. Samples are indexed as the field stores them; a sample's point comes from its
+    // place in the whole grid, so that the copies of a sample two bricks share are the same.
+    constexpr uint32_t kNone = ~0u;
+    std::vector<float> best(sampleCount, margin * margin);
+    std::vector<uint32_t> nearest(sampleCount, kNone);
+    const auto brickBase = [&](size_t b) { return brickOfSlot(brickSlots[b]) * kBrick; };
+    const auto pointAt = [&](glm::ivec3 g) { return f.origin_ + f.cell_ * vec3(g); };
+    const auto local = [](int x, int y, int z) {
+        return (size_t(z) * kBrickSide + size_t(y)) * kBrickSide + size_t(x);
     };
-    // The sign: from the pseudonormals where the mesh is closed and consistently oriented, else
-    // from the winding number. Samples beyond every triangle's reach are at least `margin` from
-    // the surface, as are their neighbours at least margin - cell: no surface lies between
-    // them, and they take a neighbour's sign.
-    const bool clean = !meshDefects(mesh).any();
-    const Pseudonormals normals(clean ? mesh : TriangleMesh{});
-    const Hierarchy h(mesh);
-    parallelFor(bricks.size() - 1, [&](size_t b) {
-        const vec3 corner = brickCorner(bricks[b].first);
-        float* out = &f.samples_[b * kBrickSamples];
-        float best[kBrickSamples];
-        uint32_t nearest[kBrickSamples];
-        std::fill(best, best + kBrickSamples, margin * margin);
-        std::fill(nearest, nearest + kBrickSamples, ~0u);
-        for (size_t k = bricks[b].second; k < bricks[b + 1].second; ++k) {
-            const uint32_t t = touches[k].second;
-            const glm::uvec3 i = mesh.triangles[t];
-            const vec3 a = mesh.positions[i.x], bb = mesh.positions[i.y], c = mesh.positions[i.z];
-            const vec3 lo = (glm::min(a, glm::min(bb, c)) - margin - corner) / f.cell_;
-            const vec3 hi = (glm::max(a, glm::max(bb, c)) + margin - corner) / f.cell_;
-            const glm::ivec3 from = glm::max(glm::ivec3(glm::ceil(lo)), glm::ivec3(0));
-            const glm::ivec3 to = glm::min(glm::ivec3(glm::floor(hi)), glm::ivec3(kBrick));
-            const vec3 normal = glm::cross(bb - a, c - a);
+    // The distance to triangle t where it may be less than `best` (its plane's is no more).
+    const auto nearer = [&](vec3 p, uint32_t t, float best2) {
+        const std::array<vec3, 3> c = corners(t);
+        const vec3 normal = glm::cross(c[1] - c[0], c[2] - c[0]);
+        const float plane = glm::dot(p - c[0], normal);
+        if (plane * plane >= best2 * glm::dot(normal, normal)) return best2;
+        return nearestOnTriangle(p, c[0], c[1], c[2]).distance2;
+    };
+
+    // Exact within `reach` of the surface: every triangle against the samples near it, those
+    // in its box grown by `reach` and in the ball about the box's centre that holds them.
+    parallelFor(brickCount, [&](size_t b) {
+        const glm::ivec3 base = brickBase(b);
+        const vec3 corner = pointAt(base);
+        for (size_t k = first[b]; k < first[b + 1]; ++k) {
+            const uint32_t t = near[k];
+            const std::array<vec3, 3> c = corners(t);
+            const vec3 lo = (glm::min(c[0], glm::min(c[1], c[2])) - corner) / f.cell_;
+            const vec3 hi = (glm::max(c[0], glm::max(c[1], c[2])) - corner) / f.cell_;
+            const vec3 centre = 0.5f * (lo + hi);
+            const float ball = glm::length(0.5f * (hi - lo)) + reach / f.cell_ + 1e-3f;
+            const glm::ivec3 from =
+                glm::max(glm::ivec3(glm::ceil(lo - reach / f.cell_)), glm::ivec3(0));
+            const glm::ivec3 to =
+                glm::min(glm::ivec3(glm::floor(hi + reach / f.cell_)), glm::ivec3(kBrick));
+            const vec3 normal = glm::cross(c[1] - c[0], c[2] - c[0]);
             const float area2 = glm::dot(normal, normal);
+            // The triangle lies within `radius` of `middle`: no nearer to p than |p - middle|
+            // less that, nor than its plane.
+            const vec3 middle = corner + f.cell_ * centre;
+            const float radius = f.cell_ * glm::length(0.5f * (hi - lo));
             for (int z = from.z; z <= to.z; ++z)
-                for (int y = from.y; y <= to.y; ++y)
-                    for (int x = from.x; x <= to.x; ++x) {
-                        const size_t s =
-                            (size_t(z) * kBrickSide + size_t(y)) * kBrickSide + size_t(x);
-                        const vec3 p = corner + f.cell_ * vec3(float(x), float(y), float(z));
-                        // The plane's distance is at most the triangle's: most samples are
-                        // already nearer another.
-                        const float plane = glm::dot(p - a, normal);
-                        if (plane * plane >= best[s] * area2) continue;
-                        const float d2 = nearestOnTriangle(p, a, bb, c).distance2;
-                        if (d2 < best[s]) best[s] = d2, nearest[s] = t;
+                for (int y = from.y; y <= to.y; ++y) {
+                    const float dy = float(y) - centre.y, dz = float(z) - centre.z;
+                    const float row2 = ball * ball - dy * dy - dz * dz;
+                    if (row2 < 0.0f) continue;
+                    const float row = std::sqrt(row2);
+                    const int x0 = std::max(from.x, int(std::ceil(centre.x - row)));
+                    const int x1 = std::min(to.x, int(std::floor(centre.x + row)));
+                    for (int x = x0; x <= x1; ++x) {
+                        const size_t at = b * kBrickSamples + local(x, y, z);
+                        const vec3 p = pointAt(base + glm::ivec3(x, y, z));
+                        const float far = std::sqrt(best[at]) + radius;
+                        if (glm::dot(p - middle, p - middle) >= far * far) continue;
+                        const float plane = glm::dot(p - c[0], normal);
+                        if (plane * plane >= best[at] * area2) continue;
+                        const float d2 = nearestOnTriangle(p, c[0], c[1], c[2]).distance2;
+                        if (d2 < best[at]) best[at] = d2, nearest[at] = t;
                     }
+                }
         }
-        // Signs of the samples a triangle reached, then passed on to the rest.
+    });
+
+    // Out to the margin by dilation: layer by layer, each sample next to one with its triangle
+    // known takes the nearest of the triangles nearest to its 26 neighbours, or the one its box
+    // reached if nearer (the nearest triangle of a point is also the nearest of the points
+    // between it and the surface, which lie near its neighbours).
+    // `source`: the nearest triangle of each known sample that has one, which its neighbours
+    // take up; `touched`: whether a sample has a neighbour with one.
+    std::vector<uint8_t> known(sampleCount, 0), touched(sampleCount, 0), reached(sampleCount, 0);
+    std::vector<uint8_t> since(sampleCount, 0); // the layer from which a source is taken up
+    std::vector<uint32_t> source(sampleCount, kNone), fresh(sampleCount, kNone);
+    for (size_t at = 0; at < sampleCount; ++at)
+        if (best[at] < reach * reach) known[at] = 1, source[at] = nearest[at];
+    constexpr size_t kNowhere = ~size_t(0);
+    // Bricks where a sample became a source in the last layer: only their neighbours have new
+    // triangles to take up.
+    std::vector<uint8_t> grown(brickCount, 1);
+    // Layers by distance, half a cell deep: a sample is known once it is nearer than the layer's
+    // far side, when the samples between it and the surface are known.
+    const float step = 0.5f * f.cell_;
+    const int layers = int(std::ceil((margin - reach) / step)) + 4;
+    for (int layer = 0; layer < layers; ++layer) {
+        const float within = reach + float(layer + 1) * step;
+        const float within2 = within >= margin ? INFINITY : within * within;
+        std::atomic<bool> grew{false};
+        parallelFor(brickCount, [&](size_t b) {
+            const glm::ivec3 home = brickBase(b) / kBrick;
+            // The first samples of this brick and the 26 about it (kNowhere: none stored).
+            size_t around[27];
+            for (int k = 0; k < 27; ++k) {
+                const glm::ivec3 there = home + glm::ivec3(k % 3, k / 3 % 3, k / 9) - 1;
+                const bool in = glm::all(glm::greaterThanEqual(there, glm::ivec3(0))) &&
+                                glm::all(glm::lessThan(there, f.bricks_));
+                const int32_t slot = in ? f.slots_[slotOf(there)] : kOutside;
+                around[k] = slot >= 0 ? size_t(slot) : kNowhere;
+            }
+            bool news = false;
+            for (int k = 0; k < 27; ++k)
+                news = news || (around[k] != kNowhere && grown[around[k] / kBrickSamples]);
+            // A neighbour's sample, this brick's where it holds it (its copy of the faces it
+            // shares), else the neighbouring brick's.
+            const auto sampleAt = [&](glm::ivec3 l) {
+                int k = 13;
+                for (int a = 0, weight = 1; a < 3; ++a, weight *= 3)
+                    if (l[a] < 0)
+                        l[a] += kBrick, k -= weight;
+                    else if (l[a] > kBrick)
+                        l[a] -= kBrick, k += weight;
+                return around[k] == kNowhere ? kNowhere : around[k] + local(l.x, l.y, l.z);
+            };
+            bool any = false;
+            for (int z = 0; z <= kBrick; ++z)
+                for (int y = 0; y <= kBrick; ++y)
+                    for (int x = 0; x <= kBrick; ++x) {
+                        const size_t at = b * kBrickSamples + local(x, y, z);
+                        if (known[at]) continue;
+                        if (!news) { // nothing new about it: only the layer has grown
+                            reached[at] = touched[at] && best[at] < within2 ? 2 : 0;
+                            any = any || reached[at];
+                            continue;
+                        }
+                        const bool inner =
+                            x > 0 && x < kBrick && y > 0 && y < kBrick && z > 0 && z < kBrick;
+                        const vec3 p = pointAt(home * kBrick + glm::ivec3(x, y, z));
+                        uint32_t seen[27] = {nearest[at]};
+                        int count = 1;
+                        fresh[at] = nearest[at];
+                        for (int dz = -1; dz <= 1; ++dz)
+                            for (int dy = -1; dy <= 1; ++dy)
+                                for (int dx = -1; dx <= 1; ++dx) {
+                                    const size_t n =
+                                        inner ? at + local(dx + 1, dy + 1, dz + 1) - local(1, 1, 1)
+                                              : sampleAt(glm::ivec3(x + dx, y + dy, z + dz));
+                                    // Sources of earlier layers were taken up then.
+                                    const uint32_t t = n == kNowhere ? kNone : source[n];
+                                    if (t == kNone || since[n] != layer) continue;
+                                    touched[at] = 1;
+                                    if (std::find(seen, seen + count, t) != seen + count) continue;
+                                    seen[count++] = t;
+                                    const float d2 = nearer(p, t, best[at]);
+                                    if (d2 < best[at]) best[at] = d2, fresh[at] = t;
+                                }
+                        // 1: a neighbour with a triangle, 2: and now known itself.
+                        reached[at] = touched[at] ? best[at] < within2 ? 2 : 1 : 0;
+                        any = any || reached[at] == 2;
+                    }
+            if (any) grew = true;
+        });
+        if (!grew) break;
+        parallelFor(brickCount, [&](size_t b) {
+            grown[b] = 0;
+            for (size_t at = b * kBrickSamples; at < (b + 1) * kBrickSamples; ++at) {
+                if (reached[at] == 1) nearest[at] = fresh[at];
+                if (reached[at] == 2) {
+                    nearest[at] = source[at] = fresh[at], known[at] = 1;
+                    since[at] = uint8_t(layer + 1);
+                    grown[b] = grown[b] || fresh[at] != kNone;
+                }
+                reached[at] = 0;
+            }
+        });
+    }
+    fresh = {};
+
+    // The sign: from the pseudonormals where the mesh is closed and consistently oriented, else
+    // from the winding number. Samples without a triangle are at least `margin` from the
+    // surface, as are their neighbours at least margin - cell: no surface lies between them,
+    // and they take a neighbour's sign.
+    const std::vector<uint32_t> pairs = edgesInPairs(mesh);
+    const bool clean = !countDefects(mesh, pairs).any();
+    const Pseudonormals normals = clean ? Pseudonormals(mesh, pairs) : Pseudonormals();
+    std::optional<Hierarchy> h;
+    if (!clean) h.emplace(mesh);
+    f.samples_.resize(sampleCount);
+    std::vector<uint8_t> signless(brickCount, 0); // bricks with no sample near a triangle
+    parallelFor(brickCount, [&](size_t b) {
+        const vec3 corner = pointAt(brickBase(b));
+        const size_t at0 = b * kBrickSamples;
         int8_t sign[kBrickSamples] = {};
         const auto point = [&](int s) {
-            return corner + f.cell_ * vec3(float(s % kBrickSide),
-                                           float(s / kBrickSide % kBrickSide),
-                                           float(s / (kBrickSide * kBrickSide)));
+            return pointAt(brickBase(b) + glm::ivec3(s % kBrickSide, s / kBrickSide % kBrickSide,
+                                                     s / (kBrickSide * kBrickSide)));
         };
         bool any = false;
         for (int s = 0; s < kBrickSamples; ++s) {
-            if (nearest[s] == ~0u) continue;
+            const uint32_t t = nearest[at0 + size_t(s)];
+            if (t == kNone) continue;
             const vec3 p = point(s);
             bool inside;
             if (clean) {
-                const glm::uvec3 i = mesh.triangles[nearest[s]];
-                const Nearest n = nearestOnTriangle(p, mesh.positions[i.x], mesh.positions[i.y],
-                                                    mesh.positions[i.z]);
-                inside = glm::dot(p - n.point, normals.at(mesh, nearest[s], n.feature)) < 0.0f;
+                const std::array<vec3, 3> c = corners(t);
+                const Nearest n = nearestOnTriangle(p, c[0], c[1], c[2]);
+                inside = glm::dot(p - n.point, normals.at(mesh, t, n.feature)) < 0.0f;
             } else {
-                inside = h.winding(p) >= 0.5f;
+                inside = h->winding(p) >= 0.5f;
             }
             sign[s] = inside ? -1 : 1;
             any = true;
         }
-        if (!any) sign[0] = h.winding(point(0)) >= 0.5f ? -1 : 1;
+        if (!any && clean) signless[b] = 1, sign[0] = 1; // signed below, with the empty bricks
+        if (!any && !clean) sign[0] = h->winding(corner) >= 0.5f ? -1 : 1;
         for (bool changed = true; changed;) {
             changed = false;
             for (int s = 0; s < kBrickSamples; ++s) {
@@ -563,13 +772,58 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
             }
         }
         for (int s = 0; s < kBrickSamples; ++s)
-            out[s] = float(sign[s]) * std::sqrt(best[s]);
+            f.samples_[at0 + size_t(s)] = float(sign[s]) * std::sqrt(best[at0 + size_t(s)]);
     });
-    // Bricks without samples: their centre's inside.
-    parallelFor(slots, [&](size_t s) {
-        if (f.slots_[s] == kOutside && h.winding(brickCorner(s) + 0.5f * brickSize) >= 0.5f)
+    if (!clean) {
+        // Bricks without samples: their centre's inside.
+        parallelFor(slots, [&](size_t s) {
+            if (f.slots_[s] == kOutside &&
+                h->winding(pointAt(brickOfSlot(s) * kBrick) + 0.5f * brickSize) >= 0.5f)
+                f.slots_[s] = kInside;
+        });
+        return f;
+    }
+    // On a clean mesh, bricks without samples and those with no sample near a triangle hold no
+    // surface (it would be within a cell of a sample): each is all inside or all outside, as the
+    // point of its face it shares with a signed brick, whose sample there has its sign. Signed
+    // outward from the signed bricks through their neighbours.
+    std::vector<int8_t> inside(slots, 0); // of the unsigned: -1 inside, 1 outside, 0 not yet
+    std::vector<size_t> queue;
+    for (size_t b = 0; b < brickCount; ++b)
+        if (!signless[b]) queue.push_back(brickSlots[b]);
+    for (size_t k = 0; k < queue.size(); ++k) {
+        const size_t s = queue[k];
+        const glm::ivec3 here = brickOfSlot(s);
+        const int32_t slot = f.slots_[s];
+        const bool hasSamples = slot >= 0 && !signless[size_t(slot) / kBrickSamples];
+        for (int a = 0; a < 3; ++a)
+            for (int side = -1; side <= 1; side += 2) {
+                glm::ivec3 there = here;
+                there[a] += side;
+                if (there[a] < 0 || there[a] >= f.bricks_[a]) continue;
+                const size_t n = slotOf(there);
+                const int32_t nslot = f.slots_[n];
+                const bool signedThere = nslot >= 0 && !signless[size_t(nslot) / kBrickSamples];
+                if (signedThere || inside[n] != 0) continue;
+                glm::ivec3 face(kBrick / 2);
+                face[a] = side > 0 ? kBrick : 0;
+                inside[n] =
+                    hasSamples
+                        ? (f.samples_[size_t(slot) + local(face.x, face.y, face.z)] < 0.0f ? -1 : 1)
+                        : inside[s];
+                queue.push_back(n);
+            }
+    }
+    for (size_t s = 0; s < slots; ++s) {
+        if (inside[s] >= 0) continue;
+        if (f.slots_[s] == kOutside) {
             f.slots_[s] = kInside;
-    });
+        } else {
+            float* samples = &f.samples_[size_t(f.slots_[s])];
+            for (int k = 0; k < kBrickSamples; ++k)
+                samples[k] = -samples[k];
+        }
+    }
     return f;
 }
 

@@ -67,7 +67,10 @@ class MeshField {
 
     // `cells`: the cells along the box's longest side; the band reaches `bandCells` cells from
     // the surface (at least the diagonal of one cell, so that every cell the surface crosses
-    // has its samples). Refused where the field would exceed kMaxMeshFieldBytes.
+    // has its samples). Samples within the band hold the exact distance to the nearest
+    // triangle; those up to a cell beyond it, the distance to the nearest of the triangles
+    // nearest to their neighbours (within a few hundredths of a cell of it); the rest, the band
+    // plus a cell. Refused where the field would exceed kMaxMeshFieldBytes.
     static Result<MeshField> make(const TriangleMesh& mesh, int cells, float bandCells = 2.0f);
 
     // The signed distance at p, in the mesh's units: exact to interpolation within the band, a
