@@ -444,8 +444,11 @@ SDF_FN float sdMesh(vec3 p, float firstAt, float bx, float ox, float oy, float o
     float c101 = meshWord(samples, k + 82u SDF_DATA_ARG);
     float c011 = meshWord(samples, k + 90u SDF_DATA_ARG);
     float c111 = meshWord(samples, k + 91u SDF_DATA_ARG);
-    return mix(mix(mix(c000, c100, t.x), mix(c010, c110, t.x), t.y),
-               mix(mix(c001, c101, t.x), mix(c011, c111, t.x), t.y), t.z);
+    // Samples reach a cell beyond the band, the bricks without them stop at it: clamped to the
+    // band, the field meets theirs without a step (and stays a bound).
+    return clamp(mix(mix(mix(c000, c100, t.x), mix(c010, c110, t.x), t.y),
+                     mix(mix(c001, c101, t.x), mix(c011, c111, t.x), t.y), t.z),
+                 -band, band);
 }
 
 // CSG operators: IQ's polynomial smooth minimum with blend radius k, and smooth max(a, b) =

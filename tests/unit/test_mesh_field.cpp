@@ -132,6 +132,17 @@ TEST(MeshField, DistanceOfASphereMesh) {
     // Sparse: only bricks near the sphere hold samples.
     EXPECT_LT(field->storedBricks(),
               size_t(field->bricks().x * field->bricks().y * field->bricks().z));
+    // Without a step anywhere, where the band ends and the bricks without samples begin
+    // included: sphere tracing and pruning need a field that changes no faster than the
+    // distance (a tenth more allowed for trilinear interpolation).
+    std::mt19937 rng(5);
+    std::normal_distribution<float> n(0.0f, 1.0f);
+    for (const glm::vec3& p : randomPoints(6, 40000, 1.6f)) {
+        const glm::vec3 q = p + 0.5f * cell * glm::normalize(glm::vec3(n(rng), n(rng), n(rng)));
+        ASSERT_LE(std::abs(field->distance(p) - field->distance(q)), 1.1f * 0.5f * cell + 1e-6f)
+            << p.x << " " << p.y << " " << p.z << ": " << field->distance(p) << " and "
+            << field->distance(q);
+    }
 }
 
 // A sphere with a hole cut in it and some triangles turned over still has the ball as its

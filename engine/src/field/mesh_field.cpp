@@ -908,7 +908,8 @@ float MeshField::distance(glm::vec3 p) const {
                 x10 = glm::mix(at(0, 1, 0), at(1, 1, 0), t.x);
     const float x01 = glm::mix(at(0, 0, 1), at(1, 0, 1), t.x),
                 x11 = glm::mix(at(0, 1, 1), at(1, 1, 1), t.x);
-    return glm::mix(glm::mix(x00, x10, t.y), glm::mix(x01, x11, t.y), t.z);
+    return std::clamp(glm::mix(glm::mix(x00, x10, t.y), glm::mix(x01, x11, t.y), t.z), -band_,
+                      band_); // as sdMesh: no step where the bricks without samples begin
 }
 
 } // namespace sdfcsg::detail
