@@ -204,8 +204,9 @@ TriangleMesh lumpyBall(uint32_t seed) {
 }
 
 // At the field's samples (the grid's points) within the band, the field is the distance to the
-// nearest of all the triangles, signed by the winding number; a cell beyond the band, within a
-// tenth of a cell of it; farther, a bound of the right sign. Closed meshes and ones with holes and
+// nearest of all the triangles, signed by the winding number; a cell beyond the band, the band
+// (its samples, within a tenth of a cell of the distance, read clamped to it); farther, a bound
+// of the right sign. Closed meshes and ones with holes and
 // flipped triangles alike.
 void expectSamplesAreDistances(const TriangleMesh& mesh, int cells, uint32_t seed) {
     auto field = MeshField::make(mesh, cells);
@@ -240,8 +241,8 @@ void expectSamplesAreDistances(const TriangleMesh& mesh, int cells, uint32_t see
         if (d < band - 1e-3f * cell) {
             ++exact;
             ASSERT_NEAR(std::abs(v), d, 1e-3f * cell);
-        } else if (d < band + cell) {
-            ASSERT_NEAR(std::abs(v), d, 0.1f * cell);
+        } else if (d < band + cell) { // stored within a tenth of a cell, read clamped to the band
+            ASSERT_NEAR(std::abs(v), std::min(d, band), 0.1f * cell);
         } else {
             ASSERT_LE(std::abs(v), d + 0.1f * cell);
         }
@@ -437,6 +438,32 @@ std::filesystem::path writeTestFile(const std::string& name, const std::string& 
 
 // "fit" scales the mesh by one factor into the box and centres it: a 2 x 4 x 1 box, fitted to
 // 1 x 1 x 1, is 0.5 x 1 x 0.25 about the origin, its field in the scene's units.
+// A band wider than its two cells keeps the distance exact as far as it reaches, as a shell or
+// an offset of the mesh needs; beyond, the field holds the band.
+TEST(MeshNode, ItsBandIsAsWideAsAsked) {
+    const auto file =
+        writeTestFile("band_box.obj", boxObj({-1.0f, -1.0f, -1.0f}, {1.0f, 1.0f, 1.0f}));
+    auto node = [&](const std::string& band) {
+        auto scene = parseScene(R"({"version": 1, "root": {"type": "mesh", "file": ")" +
+                                    file.string() + R"(", "resolution": 32)" + band + "}}",
+                                "test.json");
+        EXPECT_TRUE(scene) << scene.error().str();
+        return Evaluator(scene ? *scene : Scene{});
+    };
+    const Evaluator narrow = node(""), wide = node(R"(, "band": 0.5)");
+    for (float d : {0.1f, 0.2f, 0.3f, 0.45f}) {
+        SCOPED_TRACE(d);
+        EXPECT_NEAR(wide.distance({1.0f + d, 0.2f, -0.3f}), d, 1e-3f);
+        EXPECT_NEAR(wide.distance({0.3f, 1.0f - d, 0.1f}), -d, 1e-3f);
+        // Two cells of 1/16: beyond them, a bound well below the distance.
+        const float bound = narrow.distance({1.0f + d, 0.2f, -0.3f});
+        if (d < 0.125f)
+            EXPECT_NEAR(bound, d, 1e-3f);
+        else
+            EXPECT_LT(bound, d - 0.05f);
+    }
+}
+
 TEST(MeshNode, FitScalesIntoTheBox) {
     const auto file = writeTestFile("fit_box.obj", boxObj({3.0f, -1.0f, 2.0f}, {5.0f, 3.0f, 3.0f}));
     auto scene = parseScene(R"({"version": 1, "root": {"type": "mesh", "file": ")" + file.string() +

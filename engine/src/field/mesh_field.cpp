@@ -870,7 +870,18 @@ Result<std::shared_ptr<const std::vector<glm::vec4>>> buildMesh(const Node& node
     if (!mesh) return fail(mesh.error().diagnostics[0].message);
     const vec3 fit(node.params[1], node.params[2], node.params[3]);
     if (fit != vec3(0.0f)) fitMesh(*mesh, fit);
-    auto field = MeshField::make(*mesh, int(node.params[0]));
+    // The band: two cells, or as far as the node's "band" reaches.
+    const int cells = int(node.params[0]);
+    float bandCells = 2.0f;
+    if (const float band = node.params[4]; band > 0.0f) {
+        Box box;
+        for (const vec3& p : mesh->positions)
+            box.add(p);
+        const vec3 size = box.hi - box.lo;
+        if (const float longest = std::max({size.x, size.y, size.z}); longest > 0.0f)
+            bandCells = std::max(bandCells, band * float(cells) / longest);
+    }
+    auto field = MeshField::make(*mesh, cells, bandCells);
     if (!field) return fail(field.error().diagnostics[0].message);
     std::vector<glm::vec4> words = field->words();
     words.push_back(defectsWord(meshDefects(*mesh)));

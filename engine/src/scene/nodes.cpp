@@ -323,6 +323,16 @@ constexpr ParamInfo kMesh[] = {
      "A box [x, y, z] the mesh is made to fit: scaled by one factor on every axis (its "
      "proportions kept) until it touches the box's sides, and centred on the origin. Absent: the "
      "file's own units and place."},
+    {"band",
+     Number,
+     Positive,
+     4,
+     false,
+     {0, 0, 0},
+     "length",
+     "How far from the surface the field is the exact distance (beyond, a bound). Absent: two "
+     "cells. A shell or offset of the mesh, or a smooth blend with it, needs a band wider than "
+     "its thickness, distance or blend radius; a wider band holds more of the field's 64 MiB."},
 };
 constexpr std::string_view kImageInside[] = {"dark", "light"};
 constexpr ParamInfo kImage[] = {
