@@ -483,12 +483,11 @@ TEST(MeshNode, FitScalesIntoTheBox) {
             EXPECT_NEAR(node.distance(face + out), 0.01f, 1e-4f);
             EXPECT_NEAR(node.distance(face - out), -0.01f, 1e-4f);
         }
-    // The bounds hold the box, and reach beyond it by no more than the field's margins (its band
-    // and a cell, 3 cells on each side) and a brick's rounding (8 cells).
+    // The bounds are the fitted box (not the field's grid, which reaches a band and a cell
+    // beyond it, and up to a whole brick).
     for (int a = 0; a < 3; ++a) {
-        EXPECT_LE(node.bounds().min[a], -half[a]);
-        EXPECT_GE(node.bounds().max[a], half[a]);
-        EXPECT_LE(node.bounds().max[a] - node.bounds().min[a], 2.0f * half[a] + 14.01f / 64.0f);
+        EXPECT_NEAR(node.bounds().min[a], -half[a], 1e-4f);
+        EXPECT_NEAR(node.bounds().max[a], half[a], 1e-4f);
     }
 }
 

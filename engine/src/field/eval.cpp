@@ -307,10 +307,18 @@ template <class V> float dist(const V& v) {
 // listed by contour), its box, and the grid's rows and cell side (or the number of contours);
 // image, sdImage's (image.h): the same of its grid of distances; heightmap, sdHeightmap's: its
 // samples per row, half extents along x and z, height, 0, rows and 1 / its Lipschitz bound.
-Params wordsParams(const std::vector<glm::vec4>* words) {
+// Mesh, sdMesh's (mesh_field.h): its bricks along x, the grid's corner and cell, its bricks along
+// y and z; then, for its bounds, the mesh's size and its least corner's distance from the grid's
+// (from the word before the last).
+Params wordsParams(NodeKind kind, const std::vector<glm::vec4>* words) {
     if (!words || words->size() < 2) return Params{};
     const glm::vec4 layout = (*words)[0], box = (*words)[1];
-    return {0.0f, layout.x, box.x, box.y, box.z, box.w, layout.y, layout.z};
+    Params k{0.0f, layout.x, box.x, box.y, box.z, box.w, layout.y, layout.z};
+    if (kind == NodeKind::Mesh && words->size() >= 4) {
+        const glm::vec4 mesh = (*words)[words->size() - 2];
+        k[8] = mesh.x, k[9] = mesh.y, k[10] = mesh.z, k[11] = mesh.w;
+    }
+    return k;
 }
 
 Role roleOf(NodeKind kind) {
@@ -563,7 +571,7 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
         n.params = sdf::kernelParams(src.kind, src.params);
         if (hasWords(src.kind)) {
             n.words = src.words;
-            n.params = wordsParams(src.words.get());
+            n.params = wordsParams(src.kind, src.words.get());
         }
         // Transitions keep other values in those slots.
         const bool boolean = roleOf(src.kind) == Role::Boolean && !isTransition(src.kind);

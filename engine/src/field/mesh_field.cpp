@@ -884,6 +884,12 @@ Result<std::shared_ptr<const std::vector<glm::vec4>>> buildMesh(const Node& node
     auto field = MeshField::make(*mesh, cells, bandCells);
     if (!field) return fail(field.error().diagnostics[0].message);
     std::vector<glm::vec4> words = field->words();
+    // After sdMesh's words, which it never reads past: the mesh's box, for the kind's bounds (its
+    // size, and how far its least corner lies from the grid's), then the repairs for the notes.
+    Box box;
+    for (const vec3& p : mesh->positions)
+        box.add(p);
+    words.push_back(glm::vec4(box.hi - box.lo, box.lo.x - field->origin().x));
     words.push_back(defectsWord(meshDefects(*mesh)));
     return std::make_shared<const std::vector<glm::vec4>>(std::move(words));
 }

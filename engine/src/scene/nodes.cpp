@@ -929,9 +929,10 @@ constexpr KindInfo kKinds[] = {
      "says, so meshes with holes or flipped triangles still have one.",
      R"("file": "gear.stl", "resolution": 96)", "sdMesh", kMeshArgs, nullptr,
      [](const Params& k, vec3& lo, vec3& hi) {
-         // The field's grid: bricks of 8 cells from its corner.
-         lo = vec3(k[2], k[3], k[4]);
-         hi = lo + 8.0f * k[5] * vec3(k[1], k[6], k[7]);
+         // The mesh's box, which holds its inside (within the hull of its triangles), at its
+         // place in the field's grid.
+         lo = vec3(k[2], k[3], k[4]) + k[11];
+         hi = lo + vec3(k[8], k[9], k[10]);
          return true;
      }},
     {NodeKind::CappedTorus, "capped_torus", false, kCappedTorus,
