@@ -78,15 +78,18 @@ Status Document::open(const std::filesystem::path& path) {
 }
 
 bool Document::pollReload() {
-    if (!watcher_.poll()) return pollReads();
-    auto scene = loadScene(path_);
+    return watcher_.poll() ? reloaded(loadScene(path_)) : pollReads();
+}
+
+// A reload is one more step, so an edit made outside can be undone like one made here; one that
+// fails keeps the scene on screen, and its errors.
+bool Document::reloaded(Result<Scene> scene) {
     ++version_;
     if (!scene) {
         error_ = scene.error();
         return true;
     }
     error_.reset();
-    // A reload is one more step, so an edit made outside can be undone like one made here.
     history_.endMerge();
     history_.push(std::move(*scene));
     loaded_ = true;
@@ -112,16 +115,7 @@ bool Document::pollReads() {
     if (!changed) return false;
     ParseOptions options;
     options.files = scene().files;
-    auto again = parseScene(toJson(scene()), scene().file, options);
-    ++version_;
-    if (!again) {
-        error_ = again.error();
-        return true;
-    }
-    error_.reset();
-    history_.endMerge();
-    history_.push(std::move(*again));
-    return true;
+    return reloaded(parseScene(toJson(scene()), scene().file, options));
 }
 
 void Document::replace(Scene scene) {

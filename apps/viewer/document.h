@@ -81,6 +81,7 @@ class Document {
 
   private:
     bool pollReads();
+    bool reloaded(Result<Scene> scene);
 
     std::filesystem::path path_;
     FileWatcher watcher_;
