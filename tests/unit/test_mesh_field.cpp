@@ -483,11 +483,11 @@ TEST(MeshNode, FitScalesIntoTheBox) {
             EXPECT_NEAR(node.distance(face + out), 0.01f, 1e-4f);
             EXPECT_NEAR(node.distance(face - out), -0.01f, 1e-4f);
         }
-    // The bounds are the fitted box (not the field's grid, which reaches a band and a cell
-    // beyond it, and up to a whole brick).
+    // The bounds are the fitted box and a cell (1/64) (not the field's grid, which reaches a band
+    // and a cell beyond it, and up to a whole brick).
     for (int a = 0; a < 3; ++a) {
-        EXPECT_NEAR(node.bounds().min[a], -half[a], 1e-4f);
-        EXPECT_NEAR(node.bounds().max[a], half[a], 1e-4f);
+        EXPECT_NEAR(node.bounds().min[a], -half[a] - 1.0f / 64.0f, 1e-4f);
+        EXPECT_NEAR(node.bounds().max[a], half[a] + 1.0f / 64.0f, 1e-4f);
     }
 }
 

@@ -884,13 +884,21 @@ Result<std::shared_ptr<const std::vector<glm::vec4>>> buildMesh(const Node& node
     auto field = MeshField::make(*mesh, cells, bandCells);
     if (!field) return fail(field.error().diagnostics[0].message);
     std::vector<glm::vec4> words = field->words();
-    // After sdMesh's words, which it never reads past: the mesh's box, for the kind's bounds (its
-    // size, and how far its least corner lies from the grid's), then the repairs for the notes.
+    // After sdMesh's words, which it never reads past: the box of its inside, for the kind's
+    // bounds (its size, and how far its least corner lies from the grid's), then the repairs for
+    // the notes. A closed, consistently oriented mesh's inside lies in its triangles' box; where
+    // triangles are flipped, the winding number can pass a half beyond it, and the box is the
+    // grid's.
+    const MeshDefects defects = meshDefects(*mesh);
     Box box;
     for (const vec3& p : mesh->positions)
         box.add(p);
+    if (defects.any()) {
+        box.lo = field->origin();
+        box.hi = box.lo + field->cell() * float(MeshField::kBrick) * vec3(field->bricks());
+    }
     words.push_back(glm::vec4(box.hi - box.lo, box.lo.x - field->origin().x));
-    words.push_back(defectsWord(meshDefects(*mesh)));
+    words.push_back(defectsWord(defects));
     return std::make_shared<const std::vector<glm::vec4>>(std::move(words));
 }
 

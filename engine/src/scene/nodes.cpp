@@ -929,10 +929,10 @@ constexpr KindInfo kKinds[] = {
      "says, so meshes with holes or flipped triangles still have one.",
      R"("file": "gear.stl", "resolution": 96)", "sdMesh", kMeshArgs, nullptr,
      [](const Params& k, vec3& lo, vec3& hi) {
-         // The mesh's box, which holds its inside (within the hull of its triangles), at its
-         // place in the field's grid.
-         lo = vec3(k[2], k[3], k[4]) + k[11];
-         hi = lo + vec3(k[8], k[9], k[10]);
+         // The box of the mesh's inside (buildMesh()) at its place in the field's grid, and a
+         // cell more: the interpolated field's surface may pass it by up to a cell.
+         lo = vec3(k[2], k[3], k[4]) + (k[11] - k[5]);
+         hi = lo + vec3(k[8], k[9], k[10]) + 2.0f * k[5];
          return true;
      }},
     {NodeKind::CappedTorus, "capped_torus", false, kCappedTorus,
