@@ -363,11 +363,7 @@ std::optional<int> parseMeshArgs(int argc, char** argv, MeshArgs& args) {
             ok = parseCount(argv[++i], 1, 1000, args.runs);
         else
             ok = false;
-        if (!ok) {
-            std::fprintf(stderr, "sdfcsg bench: bad argument '%s'\nTry 'sdfcsg bench --help'.\n",
-                         argv[i]);
-            return 2;
-        }
+        if (!ok) return usageError("bench", "bad argument '" + std::string(argv[i]) + "'");
     }
     return std::nullopt;
 }
@@ -538,11 +534,7 @@ std::optional<int> parseRenderArgs(int argc, char** argv, RenderArgs& args) {
                                              : Evaluation::Auto;
         } else
             ok = false;
-        if (!ok) {
-            std::fprintf(stderr, "sdfcsg bench: bad argument '%s'\nTry 'sdfcsg bench --help'.\n",
-                         argv[i]);
-            return 2;
-        }
+        if (!ok) return usageError("bench", "bad argument '" + std::string(argv[i]) + "'");
     }
     return std::nullopt;
 }

@@ -1,6 +1,7 @@
 // sdfcsg bench --mesh-node: the time from a mesh file to a mesh node's ready field (the file
 // read, its triangles welded, its distance field baked), per file.
 #include "bench.h"
+#include "cli.h"
 
 #include <sdfcsg/sdfcsg.h>
 
@@ -70,11 +71,7 @@ int runMeshNodeBench(int argc, char** argv) {
             files.emplace_back(a);
         else
             ok = false;
-        if (!ok) {
-            std::fprintf(stderr, "sdfcsg bench: bad argument '%s'\nTry 'sdfcsg bench --help'.\n",
-                         argv[i]);
-            return 2;
-        }
+        if (!ok) return usageError("bench", "bad argument '" + std::string(argv[i]) + "'");
     }
     if (files.empty()) {
         std::fprintf(stderr, "sdfcsg bench: --mesh-node needs mesh files\n");
