@@ -239,13 +239,16 @@ Scene sceneOf(py::handle object) {
 
 // A progress callback for long work: Ctrl-C stops it (the signal is seen between bands), and so
 // does `progress(fraction)` returning False or raising; the error then raised is that exception
-// or KeyboardInterrupt, left set for raise().
+// or KeyboardInterrupt, left set for raise(). It takes Python's lock for each call, so that the
+// work may run without it; the callable is held where copies of the callback need no lock.
 std::function<bool(float)> interruptible(py::object progress = py::none()) {
-    return [progress](float done) {
+    auto callable = std::make_shared<py::object>(std::move(progress));
+    return [callable](float done) {
+        py::gil_scoped_acquire lock;
         if (PyErr_CheckSignals() != 0) return false;
-        if (progress.is_none()) return true;
+        if (callable->is_none()) return true;
         try {
-            const py::object answer = progress(done);
+            const py::object answer = (*callable)(done);
             return answer.is_none() || answer.cast<bool>();
         } catch (py::error_already_set& e) {
             e.restore();
@@ -289,16 +292,16 @@ Image renderImage(py::handle object, uint32_t width, uint32_t height, const py::
     options.shadows = shadows;
     options.grid = grid;
     options.progress = interruptible(progress);
-    // The device is made ready (the context, the kernels) without Python's lock, so that other
-    // threads run meanwhile (NumPy's import, for render()'s array). The render itself calls
-    // `progress` between bands, and so holds the lock.
-    auto renderer = unwrap([&]() -> Result<std::unique_ptr<Renderer>> {
+    // The device's work runs without Python's lock, so that other threads run meanwhile (NumPy's
+    // import, for render()'s array); `progress` takes it between bands.
+    Image image = unwrap([&]() -> Result<Image> {
         py::gil_scoped_release release;
         auto context = sharedContext();
         if (!context) return context.error();
-        return Renderer::create(**context, scene);
+        auto renderer = Renderer::create(**context, scene);
+        if (!renderer) return renderer.error();
+        return (*renderer)->render(options);
     }());
-    Image image = unwrap(renderer->render(options));
     if (PyErr_Occurred()) throw py::error_already_set(); // raised by progress after the last band
     return image;
 }
