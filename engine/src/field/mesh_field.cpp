@@ -458,7 +458,8 @@ std::vector<float> windingNumbers(const TriangleMesh& mesh, const std::vector<gl
     return w;
 }
 
-Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float bandCells) {
+Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float bandCells,
+                                  size_t maxBytes) {
     Box box;
     for (const vec3& p : mesh.positions)
         box.add(p);
@@ -476,9 +477,9 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
     const auto tooLarge = [&](size_t bytes) {
         return reason("a field of " + std::to_string(bytes >> 20) + " MiB at " +
                       std::to_string(cells) + " cells, over the limit of " +
-                      std::to_string(kMaxMeshFieldBytes >> 20) + " MiB");
+                      std::to_string(maxBytes >> 20) + " MiB");
     };
-    if (slots > kMaxMeshFieldBytes / sizeof(int32_t)) return tooLarge(slots * sizeof(int32_t));
+    if (slots > maxBytes / sizeof(int32_t)) return tooLarge(slots * sizeof(int32_t));
     f.slots_.assign(slots, kOutside);
     const float brickSize = f.cell_ * float(kBrick);
     const auto brickOf = [&](vec3 p) {
@@ -517,7 +518,7 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
             if (f.slots_[s] == kOutside) f.slots_[s] = 0, ++stored;
         });
         const size_t bytes = stored * kBrickSamples * sizeof(float) + slots * sizeof(int32_t);
-        if (bytes > kMaxMeshFieldBytes) return tooLarge(bytes);
+        if (bytes > maxBytes) return tooLarge(bytes);
     }
     std::vector<uint32_t> brickSlots; // the stored bricks' slots, in order
     brickSlots.reserve(stored);
@@ -538,7 +539,7 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
                       [&](size_t s) { ++first[size_t(f.slots_[s]) / kBrickSamples], ++touches; });
         const size_t bytes =
             sampleCount * sizeof(float) + slots * sizeof(int32_t) + touches * sizeof(uint32_t);
-        if (bytes > kMaxMeshFieldBytes) return tooLarge(bytes);
+        if (bytes > maxBytes) return tooLarge(bytes);
     }
     for (size_t b = 0, sum = 0; b <= brickCount; ++b)
         sum += std::exchange(first[b], sum);

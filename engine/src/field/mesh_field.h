@@ -70,8 +70,10 @@ class MeshField {
     // has its samples). Samples within the band hold the exact distance to the nearest
     // triangle; those up to a cell beyond it, the distance to the nearest of the triangles
     // nearest to their neighbours (within a few hundredths of a cell of it); the rest, the band
-    // plus a cell. Refused where the field would exceed kMaxMeshFieldBytes.
-    static Result<MeshField> make(const TriangleMesh& mesh, int cells, float bandCells = 2.0f);
+    // plus a cell. Refused where the field would exceed `maxBytes` (a mesh node's limit, unless a
+    // test measuring meshes asks for more).
+    static Result<MeshField> make(const TriangleMesh& mesh, int cells, float bandCells = 2.0f,
+                                  size_t maxBytes = kMaxMeshFieldBytes);
 
     // The signed distance at p, in the mesh's units: exact to interpolation within the band, a
     // bound of the right sign (the band's width, or the distance to the grid's box plus it)
