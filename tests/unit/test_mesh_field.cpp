@@ -108,6 +108,32 @@ TEST(MeshField, EveryFormatReadsTheSameTriangles) {
             farthest = std::max(farthest, std::abs(glm::length(p - centre) - 1.0f));
         EXPECT_LT(farthest, 1e-5f);
     }
+    // Binary STL is read without Assimp: an ASCII STL of the same triangles, and a binary one
+    // whose header announces colours, both read through Assimp, come out the same.
+    const TriangleMesh t = triangles(sphere);
+    std::string ascii = "solid sphere\n";
+    for (const glm::uvec3& f : t.triangles) {
+        ascii += "facet normal 0 0 0\nouter loop\n";
+        for (int c = 0; c < 3; ++c) {
+            char line[128];
+            const glm::vec3 p = t.positions[f[c]];
+            std::snprintf(line, sizeof line, "vertex %.9g %.9g %.9g\n", p.x, p.y, p.z);
+            ascii += line;
+        }
+        ascii += "endloop\nendfacet\n";
+    }
+    ascii += "endsolid sphere\n";
+    std::string coloured = binaryStl(t, uint32_t(t.triangles.size()));
+    const std::string header = "COLOR=\x80\x80\x80\xff model";
+    coloured.replace(0, header.size(), header);
+    const auto fast = readTriangleMesh(binaryStl(t, uint32_t(t.triangles.size())), ".stl");
+    ASSERT_TRUE(fast) << fast.error().str();
+    for (const std::string& other : {ascii, coloured}) {
+        const auto slow = readTriangleMesh(other, ".stl");
+        ASSERT_TRUE(slow) << slow.error().str();
+        EXPECT_EQ(slow->positions, fast->positions);
+        EXPECT_EQ(slow->triangles, fast->triangles);
+    }
 }
 
 TEST(MeshField, DistanceOfASphereMesh) {

@@ -8,6 +8,7 @@
 #include "sdfcsg/nodes.h"
 
 #include <algorithm>
+#include <fstream>
 
 namespace sdfcsg::detail {
 
@@ -56,6 +57,18 @@ Result<fs::path> sceneFile(std::string_view name, const SceneFiles& files, uintm
     if (fs::file_size(file, ec) > maxBytes || ec)
         return reason("larger than " + std::to_string(maxBytes >> 20) + " MiB");
     return file;
+}
+
+Result<std::string> readFileBytes(const fs::path& file, uintmax_t maxBytes) {
+    std::ifstream in(file, std::ios::binary);
+    std::error_code ec;
+    const uintmax_t size = fs::file_size(file, ec);
+    if (!in || ec) return reason("cannot be read");
+    if (size > maxBytes) return reason("larger than " + std::to_string(maxBytes >> 20) + " MiB");
+    std::string bytes(size_t(size), '\0');
+    in.read(bytes.data(), std::streamsize(size));
+    if (size_t(in.gcount()) != bytes.size()) return reason("cannot be read");
+    return bytes;
 }
 
 std::string untrustedFileProblem(std::string_view what, std::string_view name,

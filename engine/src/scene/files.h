@@ -21,6 +21,10 @@ namespace sdfcsg::detail {
 Result<std::filesystem::path> sceneFile(std::string_view name, const SceneFiles& files,
                                         uintmax_t maxBytes);
 
+// The bytes of `file`, as many as its size when opened (refused over `maxBytes`: "larger than N
+// MiB", a file that may have grown since sceneFile() looked), read in one piece.
+Result<std::string> readFileBytes(const std::filesystem::path& file, uintmax_t maxBytes);
+
 // What any problem with the file `name` (`what`: "font") says in an untrusted scene:
 // "unknown WHAT \"NAME\"" and `hint`, nothing about the file system.
 std::string untrustedFileProblem(std::string_view what, std::string_view name,

@@ -27,7 +27,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <iterator>
 #include <memory>
 #include <string>
@@ -99,9 +98,9 @@ std::vector<float> squaredDistances(const std::vector<bool>& inside, bool want, 
 } // namespace
 
 Result<GreyImage> readPng(const std::filesystem::path& file) {
-    std::ifstream in(file, std::ios::binary);
-    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (!in && !in.eof()) return problem("cannot be read");
+    const auto read = readFileBytes(file, kMaxImageBytes);
+    if (!read) return read.error();
+    const std::string& bytes = *read;
     // The signature, then the IHDR chunk: length, type, width, height.
     static constexpr unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
     const auto* b = reinterpret_cast<const unsigned char*>(bytes.data());
