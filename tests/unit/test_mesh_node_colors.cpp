@@ -224,25 +224,38 @@ TEST_F(MeshNodeColorsGpu, KernelsGiveTheCpusColours) {
     EXPECT_LE(badColour, points.size() / 500);
 }
 
-// Scene -> mesh (PLY with vertex colours, GLB with a material per colour) -> mesh node: each box
-// keeps its colour.
+// Scene -> mesh (PLY with vertex colours, GLB with linear vertex colours or a material per
+// colour) -> mesh node: each box keeps its colour. A GLB without colours (its triangles take
+// Assimp's default material) takes the node's.
 TEST_F(MeshNodeColorsGpu, ExportedColoursReadBack) {
     const Scene scene = sceneFrom(R"({"version": 1, "root": {"type": "union", "children": [
         {"type": "box", "size": [1, 1, 1], "translate": [-0.5, 0, 0], "color": [0.8, 0.4, 0.2]},
         {"type": "box", "size": [1, 1, 1], "translate": [0.5, 0, 0], "color": [0.1, 0.5, 0.9]}]}})");
-    for (MeshFormat format : {MeshFormat::Ply, MeshFormat::Glb}) {
-        SCOPED_TRACE(std::string(meshFormatName(format)));
+    const struct {
+        MeshFormat format;
+        bool regions, colors;
+    } cases[] = {{MeshFormat::Ply, false, true},
+                 {MeshFormat::Glb, false, true},
+                 {MeshFormat::Glb, true, true},
+                 {MeshFormat::Glb, false, false}};
+    for (const auto& c : cases) {
+        SCOPED_TRACE(std::string(meshFormatName(c.format)) + (c.regions ? " regions" : "") +
+                     (c.colors ? "" : " without colours"));
         MeshOptions options;
         options.resolution = 48;
-        options.colorRegions = format == MeshFormat::Glb;
+        options.colorRegions = c.regions;
         auto mesh = extractMesh(context(), scene, options);
         ASSERT_TRUE(mesh) << mesh.error().str();
-        const auto file = writeFile("mesh_colors_round." + std::string(meshFormatName(format)),
-                                    encodeMesh(*mesh, format));
+        if (!c.colors) mesh->colors.clear();
+        const auto file = writeFile("mesh_colors_round." + std::string(meshFormatName(c.format)),
+                                    encodeMesh(*mesh, c.format));
         const Evaluator ev(meshScene(file));
         ASSERT_FALSE(ev.nodes().empty());
-        EXPECT_TRUE(ev.nodes()[0].ownColors);
-        expectColors(ev, {0.8f, 0.4f, 0.2f}, {0.1f, 0.5f, 0.9f}, 1.0f / 255.0f);
+        EXPECT_EQ(ev.nodes()[0].ownColors, c.colors);
+        if (c.colors)
+            expectColors(ev, {0.8f, 0.4f, 0.2f}, {0.1f, 0.5f, 0.9f}, 1.0f / 255.0f);
+        else
+            expectColors(ev, kNodeColor, kNodeColor, 0.0f);
     }
 }
 

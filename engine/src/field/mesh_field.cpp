@@ -409,15 +409,18 @@ vec3 linearToSrgb(vec3 c) {
     return out;
 }
 
-// A material's colour where it is one the file gives (an OBJ's Kd, a glTF's baseColorFactor),
-// as 0xRRGGBB: not Assimp's default material (named so, or a glTF's unnamed one), nor one whose
-// colour multiplies a texture, which is not read. An OBJ material that its .mtl lacks (or whose
-// .mtl is missing) gets Assimp's default grey, 0.6: that grey counts as no colour in an OBJ.
-uint32_t materialColor(const aiMaterial& m, bool linear) {
+// Material `index` of the scene's colour where it is one the file gives (an OBJ's Kd, a glTF's
+// baseColorFactor), as 0xRRGGBB: not Assimp's default material (named so; a glTF's is the last,
+// which the triangles without a material take), nor one whose colour multiplies a texture, which
+// is not read. An OBJ material that its .mtl lacks (or whose .mtl is missing) gets Assimp's
+// default grey, 0.6: that grey counts as no colour in an OBJ.
+uint32_t materialColor(const aiScene& scene, unsigned index, bool linear) {
+    if (index >= scene.mNumMaterials || (linear && index + 1 == scene.mNumMaterials))
+        return kNoColor;
+    const aiMaterial& m = *scene.mMaterials[index];
     aiString name;
     m.Get(AI_MATKEY_NAME, name);
-    if (std::strcmp(name.C_Str(), AI_DEFAULT_MATERIAL_NAME) == 0 || (linear && name.length == 0))
-        return kNoColor;
+    if (std::strcmp(name.C_Str(), AI_DEFAULT_MATERIAL_NAME) == 0) return kNoColor;
     if (m.GetTextureCount(aiTextureType_DIFFUSE) + m.GetTextureCount(aiTextureType_BASE_COLOR) > 0)
         return kNoColor;
     aiColor4D c;
@@ -474,9 +477,7 @@ Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::strin
         const aiMesh& part = *scene->mMeshes[m];
         const aiColor4D* vertexColors = part.mColors[0];
         const uint32_t material =
-            materials && part.mMaterialIndex < scene->mNumMaterials
-                ? materialColor(*scene->mMaterials[part.mMaterialIndex], linear)
-                : kNoColor;
+            materials ? materialColor(*scene, part.mMaterialIndex, linear) : kNoColor;
         colored = colored || vertexColors || material != kNoColor;
         for (unsigned f = 0; f < part.mNumFaces; ++f) {
             const aiFace& face = part.mFaces[f];
