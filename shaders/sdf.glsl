@@ -413,10 +413,11 @@ SDF_FN float sdHeightmap(vec3 p, float firstAt, float nx, float hx, float hz, fl
 }
 
 // Mesh: the field of a triangle mesh (engine/src/field/mesh_field.h, from `first`): word 0 holds
-// the grid's bricks along x, y, z and the band, word 1 its corner and cell; from word 2 a slot
-// per brick (its samples' first index over 729, or -1 outside, -2 inside), four to a word, then
-// the bricks' 9^3 samples each, four to a word. Trilinear within a brick with samples; the band,
-// a bound of the right sign, in one without; beyond the grid, the distance to it plus the band.
+// the grid's bricks along x, y, z and the band, word 1 its corner and cell, word 2 where its
+// colours begin (0: it has none); from word 3 a slot per brick (its samples' first index over
+// 729, or -1 outside, -2 inside), four to a word, then the bricks' 9^3 samples each, four to a
+// word, then as many colours. Trilinear within a brick with samples; the band, a bound of the
+// right sign, in one without; beyond the grid, the distance to it plus the band.
 SDF_FN float meshWord(uint at, uint k SDF_DATA_PARAM) {
     return SDF_DATA(at + k / 4u)[int(k % 4u)];
 }
@@ -430,9 +431,9 @@ SDF_FN float sdMesh(vec3 p, float firstAt, float bx, float ox, float oy, float o
     vec3 outside = max(max(-g, g - 8.0f * bricks), vec3(0.0f));
     if (outside.x + outside.y + outside.z > 0.0f) return length(outside) * cell + band;
     vec3 b = min(floor(g / 8.0f), bricks - 1.0f);
-    float slot = meshWord(first + 2u, uint(b.x + bx * (b.y + by * b.z)) SDF_DATA_ARG);
+    float slot = meshWord(first + 3u, uint(b.x + bx * (b.y + by * b.z)) SDF_DATA_ARG);
     if (slot < 0.0f) return slot < -1.5f ? -band : band;
-    uint samples = first + 2u + (uint(bx * by * bz) + 3u) / 4u;
+    uint samples = first + 3u + (uint(bx * by * bz) + 3u) / 4u;
     vec3 local = min(g - 8.0f * b, vec3(8.0f));
     vec3 i = min(floor(local), vec3(7.0f));
     vec3 t = local - i;
@@ -449,6 +450,28 @@ SDF_FN float sdMesh(vec3 p, float firstAt, float bx, float ox, float oy, float o
     return clamp(mix(mix(mix(c000, c100, t.x), mix(c010, c110, t.x), t.y),
                      mix(mix(c001, c101, t.x), mix(c011, c111, t.x), t.y), t.z),
                  -band, band);
+}
+
+// The mesh's colour at p (MeshField::color): the colour of the sample nearest to p, stored as
+// r 65536 + g 256 + b (exact in a float; -1 for none), or the node's `color` where there is none.
+SDF_FN vec3 colorMesh(vec3 p, float firstAt, float bx, float ox, float oy, float oz, float cell,
+                      float by, float bz, vec3 color SDF_DATA_PARAM) {
+    uint first = uint(firstAt);
+    float colorsAt = SDF_DATA(first + 2u).x;
+    vec3 bricks = vec3(bx, by, bz);
+    vec3 g = (p - vec3(ox, oy, oz)) / cell;
+    if (colorsAt == 0.0f || min(g.x, min(g.y, g.z)) < 0.0f ||
+        max(g.x - 8.0f * bx, max(g.y - 8.0f * by, g.z - 8.0f * bz)) > 0.0f)
+        return color;
+    vec3 b = min(floor(g / 8.0f), bricks - 1.0f);
+    float slot = meshWord(first + 3u, uint(b.x + bx * (b.y + by * b.z)) SDF_DATA_ARG);
+    if (slot < 0.0f) return color;
+    vec3 i = clamp(floor(g - 8.0f * b + 0.5f), vec3(0.0f), vec3(8.0f));
+    float c = meshWord(first + uint(colorsAt),
+                       uint(slot) * 729u + uint(i.x + 9.0f * (i.y + 9.0f * i.z)) SDF_DATA_ARG);
+    if (c < 0.0f) return color;
+    float r = floor(c / 65536.0f), gb = c - 65536.0f * r, g8 = floor(gb / 256.0f);
+    return vec3(r, g8, gb - 256.0f * g8) * (1.0f / 255.0f);
 }
 
 // CSG operators: IQ's polynomial smooth minimum with blend radius k, and smooth max(a, b) =
@@ -588,6 +611,16 @@ SDF_FN float sdPrimitive(uint kind, vec3 q, vec4 a, vec4 b, uint kinds SDF_DATA_
     if (SDF_IS(kKindImage))
         return sdImage(q, a.x, a.y, vec2(a.z, a.w), vec2(b.x, b.y), b.z, b.w SDF_DATA_ARG);
     return 1e30f;
+}
+
+// A primitive's own colour at q, by the formula its table entry names (KindInfo::colorFunction),
+// from the point and parameters sdPrimitive takes and the node's `color`, which the kinds without
+// one keep; `kinds` as sdPrimitive's.
+SDF_FN vec3 sdPrimitiveColor(uint kind, vec3 q, vec4 a, vec4 b, vec3 color,
+                             uint kinds SDF_DATA_PARAM) {
+    if (SDF_IS(kKindMesh))
+        return colorMesh(q, a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, color SDF_DATA_ARG);
+    return color;
 }
 #undef SDF_IS
 

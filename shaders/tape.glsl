@@ -12,9 +12,12 @@
 // kind of operation, less Union: union 1, intersection 2, difference 4, transition_linear 8,
 // transition_radial 16, shell 32, offset 64),
 // SDFCSG_TAPE_BALLS (1 where every sphere is a ball, detail::isBall, in kernels that may follow
-// values, CodegenOptions::inlineParams; KINDS then lacks the sphere's bit) and
-// SDFCSG_TAPE_DOMAINS (the most domain operations nested in one another, 0 for none). Only BALLS
-// follows values (the spheres' scales): Renderer::updateValues recompiles where it changes.
+// values, CodegenOptions::inlineParams; KINDS then lacks the sphere's bit),
+// SDFCSG_TAPE_DOMAINS (the most domain operations nested in one another, 0 for none) and
+// SDFCSG_TAPE_COLORS (a bit for each kind of primitive with a node that has colours of its own,
+// ownColors in sdfcsg/nodes.h; 0u for none, which leaves their code out). Only BALLS follows
+// values (the spheres' scales): Renderer::updateValues recompiles where it changes; COLORS
+// follows the nodes' words, which sameStructure compares.
 
 // Mirrors packField() in engine/src/field/prune.cpp: a header of 12 words (origin xyz and leaf cell
 // side as float bits, levels, leaf cells per axis xyz, 1 when bounded, whole-tape length, first
@@ -78,9 +81,18 @@ vec4 tapeOp(uint kind, vec4 a, vec4 b, float k, uint blend) {
 // A swizzle, one shuffle; vec3(v) compiles to three extracts and a construct.
 #define TAPE_XYZ(v) (v).xyz
 
+// A primitive's value with its colour: the node's, or for the kinds in SDFCSG_TAPE_COLORS their
+// formula's (sdPrimitiveColor), which gives the node's colour where the node has none of its own.
+vec4 tapeColored(uint kind, uint i, vec3 p, float d) {
+    if (((SDFCSG_TAPE_COLORS >> kind) & 1u) == 0u) return withColor(i, d);
+    return vec4(sdPrimitiveColor(kind, toLocal(i, p), nodes[i].p0, nodes[i].p1, nodes[i].color.rgb,
+                                 SDFCSG_TAPE_COLORS),
+                d);
+}
+
 #define TAPE_VALUE float
 #define TAPE_RUN tapeDistanceRun
-#define TAPE_LEAF(i, d) (d)
+#define TAPE_LEAF(kind, i, p, d) (d)
 #define TAPE_DIST(v) (v)
 #define TAPE_WITH(v, d) (d)
 #include "tape_run.glsl"
@@ -92,7 +104,7 @@ vec4 tapeOp(uint kind, vec4 a, vec4 b, float k, uint blend) {
 
 #define TAPE_VALUE vec4
 #define TAPE_RUN tapeSampleRun
-#define TAPE_LEAF(i, d) withColor(i, d)
+#define TAPE_LEAF(kind, i, p, d) tapeColored(kind, i, p, d)
 #define TAPE_DIST(v) (v).w
 #define TAPE_WITH(v, d) vec4((v).rgb, d)
 #include "tape_run.glsl"

@@ -5,8 +5,8 @@
 // suffix, no swizzles (TAPE_XYZ(v): v's first three components).
 //
 // The includer defines TAPE_VALUE (float, or vec4 with colour), TAPE_RUN (the function's name),
-// TAPE_LEAF(i, d) (a primitive's value), TAPE_DIST(v) and TAPE_WITH(v, d) (a value's distance,
-// and v with another), TAPE_ARRAY(T, name, n) (a local array of n T; in C++ one of the machine's
+// TAPE_LEAF(kind, i, p, d) (primitive i's value from its distance d at p), TAPE_DIST(v) and
+// TAPE_WITH(v, d) (a value's distance, and v with another), TAPE_ARRAY(T, name, n) (a local array of n T; in C++ one of the machine's
 // own, sized for its tapes), what the loop reads of node i (TAPE_A(i) and TAPE_B(i): its kernel
 // parameters; TAPE_SCALE(i); TAPE_MIN(i) and TAPE_MAX(i): its bounds; TAPE_CHILD(i): a domain
 // operation's child), field[] (the instructions), tapePrimitive, tapeOp, kTapeUnion and the node
@@ -44,7 +44,7 @@ TAPE_VALUE TAPE_RUN(uint begin, uint end, vec3 p) {
         uint i = ins & ((1u << SDFCSG_TAPE_NODE_BITS) - 1u);
         uint kind = (ins >> SDFCSG_TAPE_KIND_SHIFT) & 0x3fu;
         if (kind < kTapeUnion) {
-            TAPE_VALUE d = TAPE_LEAF(i, tapePrimitive(kind, i, p));
+            TAPE_VALUE d = TAPE_LEAF(kind, i, p, tapePrimitive(kind, i, p));
             uint fold = (ins >> SDFCSG_TAPE_FOLD_SHIFT) & 3u;
             if (fold != 0u) {
                 acc = tapeOp(fold + kTapeUnion - 1u, acc, d, uintBitsToFloat(field[++at]),

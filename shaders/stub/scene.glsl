@@ -48,4 +48,5 @@ vec4 sceneSample(vec3 p) {
 #define SDFCSG_TAPE_OPERATIONS (SDFCSG_BOOLEAN_OPERATION_BITS | SDFCSG_VALUE_OPERATION_BITS)
 #define SDFCSG_TAPE_BALLS 1
 #define SDFCSG_TAPE_DOMAINS 2
+#define SDFCSG_TAPE_COLORS 0xffffffffu
 #include "tape.glsl"

@@ -31,6 +31,8 @@ struct Probe {
     // Pruned tapes (shaders/tape.glsl), held to the CPU's pruned field
     // (engine/src/field/prune.cpp).
     bool tapes = false;
+    // Values written into the code as literals (CodegenOptions::inlineParams).
+    bool inlineParams = false;
 };
 
 inline constexpr Probe kProbes[] = {
@@ -47,6 +49,7 @@ inline std::vector<glm::vec4> probeGpu(Context& context, const Scene& scene,
     CodegenOptions codegen;
     codegen.boundsTests = probe.boundsTests;
     codegen.evaluation = probe.tapes ? Evaluation::Tapes : Evaluation::Inlined;
+    codegen.inlineParams = probe.inlineParams;
     const std::string glsl = generateSceneGlsl(scene, codegen);
     if (!probe.boundsTests) {
         EXPECT_EQ(glsl.find("Needs("), std::string::npos) << glsl;

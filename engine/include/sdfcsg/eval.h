@@ -53,6 +53,9 @@ struct FlatNode {
     // the formula alone would fall below (a scale that differs per axis). Domain operations'
     // values always are.
     bool boundsFloor = false;
+    // A primitive with colours of its own (ownColors in sdfcsg/nodes.h, a mesh's): its colour at
+    // a point is its kind's colorFunction's, `color` where that has none.
+    bool ownColors = false;
     // How far the node's value may fall below the distance: it lies between distance / loss and
     // the distance (1: a distance, as far as the field knows). Twist, bend and taper divide by
     // their Lipschitz bound, a scale that differs per axis multiplies by its smallest factor, an

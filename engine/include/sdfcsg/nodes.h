@@ -10,6 +10,7 @@
 #include "sdfcsg/kinds.h"
 
 #include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
 
 #include <array>
 #include <cstdint>
@@ -133,6 +134,13 @@ struct KindInfo {
     // child's value is divided by it, and the map only sees points clamped into the node's
     // bounds (the formula in shaders/sdf.glsl, domainFinish).
     float (*lipschitz)(const Params& kernel, glm::vec3 lo, glm::vec3 hi) = nullptr;
+    // Primitives whose nodes may have colours of their own (a mesh's vertex or material colours):
+    // the formula in shaders/sdf.glsl of the colour at a local point, which takes the point, the
+    // arguments of `function` and the node's colour (what it gives where it has none); and
+    // whether a node's words (Node::words) hold colours. A node whose words hold none takes its
+    // node's colour, and the code calls no formula for it (ownColors).
+    std::string_view colorFunction{};
+    bool (*colored)(std::span<const glm::vec4> words) = nullptr;
 };
 
 // Keys every node may carry besides its parameters.
@@ -147,6 +155,12 @@ std::span<const KindInfo> nodeKinds();
 // "children" with one operand (a sphere; a circle under extrude and revolve).
 std::string exampleNodeJson(const KindInfo& kind);
 const KindInfo& kindInfo(NodeKind kind);
+// Whether a node of this kind with these words (Node::words, may be null) has colours of its own
+// (KindInfo::colored), which its kind's colorFunction gives.
+inline bool ownColors(NodeKind kind, const std::vector<glm::vec4>* words) {
+    const KindInfo& info = kindInfo(kind);
+    return info.colored && words && info.colored(*words);
+}
 
 // A kind's parameters in the order the modelling API (sdfcsg/model.h) and the Python module take
 // them by position: the required ones first, then the optional ones, each in the table's order.

@@ -103,6 +103,25 @@ class Emitter {
             }
             out_ += ") * nodes[i].color.w);\n}\n";
         }
+        // `vec3 meshColor(uint i, vec3 p)` for the kinds with a node that has colours of its own.
+        std::array<bool, kNodeKindCount> colored{};
+        for (const Node& n : scene_.nodes)
+            colored[size_t(n.kind)] = colored[size_t(n.kind)] || ownColors(n.kind, n.words.get());
+        for (const KindInfo& info : nodeKinds()) {
+            if (!colored[size_t(info.kind)]) continue;
+            out_ += "vec3 ";
+            out_ += info.name;
+            out_ += "Color(uint i, vec3 p) {\n    return ";
+            out_ += info.colorFunction;
+            out_ += "(toLocal(i, p)";
+            for (const KernelArg& arg : info.args) {
+                out_ += ", nodes[i].";
+                out_ += paramVector(arg.slot);
+                out_ += '.';
+                out_ += swizzle(arg.slot, arg.count);
+            }
+            out_ += ", nodes[i].color.rgb);\n}\n";
+        }
         out_ += '\n';
     }
 
@@ -473,34 +492,46 @@ class Emitter {
             out_ += "nodeSmooth(" + indexExpr(op) + ")";
     }
 
+    // Node i's value with its colour: the node's, or its own where it has colours of its own
+    // (ownColors), by its kind's colorFunction at the same point, from the same arguments.
     void leaf(uint32_t i) {
+        const Node& n = scene_.nodes[i];
+        const KindInfo& info = kindInfo(n.kind);
+        const bool colored = sample_ && ownColors(n.kind, n.words.get());
         if (!lit_) {
             const std::string index = indexExpr(i);
-            if (sample_) out_ += "withColor(" + index + ", ";
-            out_ += kindInfo(scene_.nodes[i].kind).name;
+            if (colored)
+                out_ +=
+                    "vec4(" + std::string(info.name) + "Color(" + index + ", " + point() + "), ";
+            else if (sample_)
+                out_ += "withColor(" + index + ", ";
+            out_ += info.name;
             out_ += "Node(" + index + ", " + point() + ")";
             if (sample_) out_ += ')';
             return;
         }
         const detail::GpuNode& g = (*lit_)[i];
-        if (sample_) {
-            out_ += "vec4(";
-            appendVector(out_, &g.color.x, 3);
-            out_ += ", ";
-        }
-        const KindInfo& info = kindInfo(scene_.nodes[i].kind);
         const bool outline = inlinedOutline(i); // its data is in the function's code
-        const bool floored = g.bmin.w != 0.0f;  // FlatNode::boundsFloor
-        if (floored) out_ += "max(";
-        out_ += outline ? "outline" + std::to_string(i) : std::string(info.function);
-        out_ += '(';
+        // The local point and the formula's arguments after it.
+        const size_t mark = out_.size();
         localPoint(i, point());
         const float params[8] = {g.p0.x, g.p0.y, g.p0.z, g.p0.w, g.p1.x, g.p1.y, g.p1.z, g.p1.w};
         for (const KernelArg& arg : outline ? std::span<const KernelArg>{} : info.args) {
             out_ += ", ";
             appendVector(out_, params + arg.slot, arg.count);
         }
-        out_ += ')';
+        const std::string args = out_.substr(mark);
+        out_.resize(mark);
+        if (sample_) {
+            out_ += "vec4(";
+            if (colored) out_ += std::string(info.colorFunction) + "(" + args + ", ";
+            appendVector(out_, &g.color.x, 3);
+            out_ += colored ? "), " : ", ";
+        }
+        const bool floored = g.bmin.w != 0.0f; // FlatNode::boundsFloor
+        if (floored) out_ += "max(";
+        out_ += outline ? "outline" + std::to_string(i) : std::string(info.function);
+        out_ += '(' + args + ')';
         if (g.color.w != 1.0f) { // x * 1 is x: leaving it out changes no bit
             out_ += " * ";
             appendFloat(out_, g.color.w);
@@ -675,12 +706,13 @@ std::string generateSceneGlsl(const Scene& scene, const CodegenOptions& options)
         // too): else every operation folds in the primitive before it at once (tape.glsl), and
         // pruning keeps that so. All follow the structure, not values, so that a value edit
         // stays an upload (every blend profile is kept: a profile is a value), but for one:
-        uint32_t kinds = 0, operations = 0;
+        uint32_t kinds = 0, operations = 0, colors = 0;
         const uint32_t domains = domainNesting(scene);
         bool stackRead = domains > 0;
         for (const FlatNode& n : nodes) {
             const Role role = kindInfo(n.kind).role;
             if (role == Role::Primitive) kinds |= 1u << uint32_t(n.kind);
+            if (n.ownColors) colors |= 1u << uint32_t(n.kind);
             if (role == Role::Boolean || role == Role::Value)
                 operations |= 1u << (uint32_t(n.kind) - uint32_t(NodeKind::Union));
             if (role != Role::Boolean) continue;
@@ -705,6 +737,7 @@ std::string generateSceneGlsl(const Scene& scene, const CodegenOptions& options)
                "u\n#define SDFCSG_TAPE_OPERATIONS " + std::to_string(operations) +
                "\n#define SDFCSG_TAPE_BALLS " + (balls ? "1" : "0") +
                "\n#define SDFCSG_TAPE_DOMAINS " + std::to_string(domains) +
+               "\n#define SDFCSG_TAPE_COLORS " + std::to_string(colors) + "u" +
                "\n#include \"tape.glsl\"\n"
                "float sceneDistance(vec3 p) { return tapeDistance(p); }\n"
                "vec4 sceneSample(vec3 p) { return tapeSample(p); }\n";

@@ -283,6 +283,14 @@ glm::vec3 localPoint(const FlatNode& n, glm::vec3 p) {
             m[0][2] * p.x + m[1][2] * p.y + m[2][2] * p.z + n.offset.z};
 }
 
+// A primitive's own colour at p (FlatNode::ownColors).
+glm::vec3 ownColor(const FlatNode& n, glm::vec3 p) {
+    return sdf::sdPrimitiveColor(uint32_t(n.kind), localPoint(n, p),
+                                 {n.params[0], n.params[1], n.params[2], n.params[3]},
+                                 {n.params[4], n.params[5], n.params[6], n.params[7]}, n.color,
+                                 sdf::kAllKinds, n.words->data());
+}
+
 // The value types of sceneDistance (float) and sceneSample (vec4: colour, distance in w).
 template <class V> V leaf(const FlatNode& n, glm::vec3 p) {
     float d = sdf::evalPrimitive(n.kind, localPoint(n, p), n.params,
@@ -292,7 +300,7 @@ template <class V> V leaf(const FlatNode& n, glm::vec3 p) {
     if constexpr (std::is_same_v<V, float>)
         return d;
     else
-        return glm::vec4(n.color, d);
+        return glm::vec4(n.ownColors ? ownColor(n, p) : n.color, d);
 }
 template <class V> float dist(const V& v) {
     if constexpr (std::is_same_v<V, float>)
@@ -503,6 +511,10 @@ glm::vec3 nodeLocalPoint(const FlatNode& node, glm::vec3 p) {
     return localPoint(node, p);
 }
 
+glm::vec3 primitiveColor(const FlatNode& node, glm::vec3 p) {
+    return node.ownColors ? ownColor(node, p) : node.color;
+}
+
 } // namespace detail
 
 struct Evaluator::Pruned {
@@ -572,6 +584,7 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
         if (hasWords(src.kind)) {
             n.words = src.words;
             n.params = wordsParams(src.kind, src.words.get());
+            n.ownColors = ownColors(src.kind, src.words.get());
         }
         // Transitions keep other values in those slots.
         const bool boolean = roleOf(src.kind) == Role::Boolean && !isTransition(src.kind);

@@ -104,6 +104,19 @@ Nearest nearestOnTriangle(vec3 p, vec3 a, vec3 b, vec3 c) {
     return sum > 0.0f ? at(a + ab * (vb / sum) + ac * (vc / sum), 6) : at(a, 0);
 }
 
+// The barycentric coordinates of q, a point of the triangle abc; a degenerate triangle's, its
+// first corner's.
+vec3 barycentric(vec3 q, vec3 a, vec3 b, vec3 c) {
+    const vec3 ab = b - a, ac = c - a, aq = q - a;
+    const float d00 = glm::dot(ab, ab), d01 = glm::dot(ab, ac), d11 = glm::dot(ac, ac);
+    const float d20 = glm::dot(aq, ab), d21 = glm::dot(aq, ac);
+    const float det = d00 * d11 - d01 * d01;
+    if (!(det > 0.0f)) return {1.0f, 0.0f, 0.0f};
+    const float v = std::clamp((d11 * d20 - d01 * d21) / det, 0.0f, 1.0f),
+                w = std::clamp((d00 * d21 - d01 * d20) / det, 0.0f, 1.0f - v);
+    return {1.0f - v - w, v, w};
+}
+
 // ---- A hierarchy of triangles: boxes for the nearest triangle, dipoles for the winding ----
 
 struct Box {
@@ -380,6 +393,45 @@ class FolderFiles : public Assimp::IOSystem {
     uintmax_t read_ = 0;
 };
 
+uint32_t packColor(vec3 c) {
+    const glm::uvec3 b = glm::uvec3(glm::round(glm::clamp(c, 0.0f, 1.0f) * 255.0f));
+    return b.r << 16 | b.g << 8 | b.b;
+}
+
+// glTF's colours are linear: to sRGB (IEC 61966-2-1), as scene colours are, the inverse of what
+// the exporter does.
+vec3 linearToSrgb(vec3 c) {
+    vec3 out;
+    for (int k = 0; k < 3; ++k) {
+        const float v = std::clamp(c[k], 0.0f, 1.0f);
+        out[k] = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+    }
+    return out;
+}
+
+// Material `index` of the scene's colour where it is one the file gives (an OBJ's Kd, a glTF's
+// baseColorFactor), as 0xRRGGBB: not Assimp's default material (named so; a glTF's is the last,
+// which the triangles without a material take), nor one whose colour multiplies a texture, which
+// is not read. An OBJ material that its .mtl lacks (or whose .mtl is missing) gets Assimp's
+// default grey, 0.6: that grey counts as no colour in an OBJ.
+uint32_t materialColor(const aiScene& scene, unsigned index, bool linear) {
+    if (index >= scene.mNumMaterials || (linear && index + 1 == scene.mNumMaterials))
+        return kNoColor;
+    const aiMaterial& m = *scene.mMaterials[index];
+    aiString name;
+    m.Get(AI_MATKEY_NAME, name);
+    if (std::strcmp(name.C_Str(), AI_DEFAULT_MATERIAL_NAME) == 0) return kNoColor;
+    if (m.GetTextureCount(aiTextureType_DIFFUSE) + m.GetTextureCount(aiTextureType_BASE_COLOR) > 0)
+        return kNoColor;
+    aiColor4D c;
+    if (m.Get(AI_MATKEY_BASE_COLOR, c) != AI_SUCCESS &&
+        m.Get(AI_MATKEY_COLOR_DIFFUSE, c) != AI_SUCCESS)
+        return kNoColor;
+    const vec3 rgb(c.r, c.g, c.b);
+    if (!linear && rgb == vec3(0.6f)) return kNoColor;
+    return packColor(linear ? linearToSrgb(rgb) : rgb);
+}
+
 } // namespace
 
 Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::string& extension,
@@ -402,12 +454,16 @@ Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::strin
         uint32_t at; // triangle * 3 + corner
     };
     std::vector<Corner> corners;
+    std::vector<uint32_t> colors; // per corner
+    bool colored = false;
     const bool zUp = hint == "stl" || hint == "3mf";
-    const auto add = [&](float x, float y, float z) {
+    const bool linear = hint == "gltf" || hint == "glb", materials = linear || hint == "obj";
+    const auto add = [&](float x, float y, float z, uint32_t color) {
         if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) return false;
         // The printing formats build along z: their z is the scene's y.
         corners.push_back(
             {(zUp ? vec3(x, z, -y) : vec3(x, y, z)) + 0.0f, uint32_t(corners.size())});
+        colors.push_back(color);
         return true;
     };
     const auto tooMany = [](size_t faces) {
@@ -416,18 +472,23 @@ Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::strin
     };
     // A binary STL (an 80-byte header, the triangle count, then 50 bytes per triangle: a normal,
     // three corners, two attribute bytes), the most common mesh file and the one sdfcsg writes,
-    // is read here: through Assimp it takes four times as long as the whole field. Those whose
-    // header says they hold colours go to Assimp, which reads them.
+    // is read here: through Assimp it takes four times as long as the whole field. Those with
+    // colours (a header that says so, or a triangle's attribute with its top bit set) go to
+    // Assimp, which reads them.
     const size_t stlFaces = bytes.size() >= 84 ? read32(bytes, 80) : 0;
-    if (hint == "stl" && bytes.size() == 84 + 50 * stlFaces &&
-        std::string_view(bytes.data(), 80).find("COLOR=") == std::string_view::npos) {
+    bool plainStl = hint == "stl" && bytes.size() == 84 + 50 * stlFaces &&
+                    std::string_view(bytes.data(), 80).find("COLOR=") == std::string_view::npos;
+    for (size_t f = 0; plainStl && f < stlFaces; ++f)
+        plainStl = (uint8_t(bytes[84 + 50 * f + 49]) & 0x80) == 0;
+    if (plainStl) {
         if (stlFaces > kMaxMeshTriangles) return tooMany(stlFaces);
         corners.reserve(3 * stlFaces);
+        colors.reserve(3 * stlFaces);
         for (size_t f = 0; f < stlFaces; ++f)
             for (size_t c = 0; c < 3; ++c) {
                 float v[3];
                 std::memcpy(v, bytes.data() + 84 + 50 * f + 12 * (c + 1), sizeof v);
-                if (!add(v[0], v[1], v[2])) return reason("a NaN or infinite vertex");
+                if (!add(v[0], v[1], v[2], kNoColor)) return reason("a NaN or infinite vertex");
             }
     } else {
         Assimp::Importer importer;
@@ -443,14 +504,27 @@ Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::strin
             faces += scene->mMeshes[m]->mNumFaces;
         if (faces > kMaxMeshTriangles) return tooMany(faces);
         corners.reserve(3 * faces);
+        colors.reserve(3 * faces);
         for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
             const aiMesh& part = *scene->mMeshes[m];
+            const aiColor4D* vertexColors = part.mColors[0];
+            const uint32_t material =
+                materials ? materialColor(*scene, part.mMaterialIndex, linear) : kNoColor;
+            colored = colored || vertexColors || material != kNoColor;
             for (unsigned f = 0; f < part.mNumFaces; ++f) {
                 const aiFace& face = part.mFaces[f];
                 if (face.mNumIndices != 3) continue;
                 for (int c = 0; c < 3; ++c) {
                     const aiVector3D& v = part.mVertices[face.mIndices[c]];
-                    if (!add(v.x, v.y, v.z)) return reason("a NaN or infinite vertex");
+                    uint32_t color = material;
+                    if (vertexColors) {
+                        const aiColor4D& k = vertexColors[face.mIndices[c]];
+                        const vec3 rgb(k.r, k.g, k.b);
+                        color = std::isfinite(k.r + k.g + k.b)
+                                    ? packColor(linear ? linearToSrgb(rgb) : rgb)
+                                    : kNoColor;
+                    }
+                    if (!add(v.x, v.y, v.z, color)) return reason("a NaN or infinite vertex");
                 }
             }
         }
@@ -478,6 +552,7 @@ Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::strin
         mesh.triangles[corners[k].at / 3][corners[k].at % 3] = uint32_t(mesh.positions.size() - 1);
     }
     if (mesh.triangles.empty()) return reason("no triangles");
+    if (colored) mesh.colors = std::move(colors);
     return mesh;
 }
 
@@ -545,13 +620,15 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
     };
     const uint32_t triangleCount = uint32_t(mesh.triangles.size());
 
-    // The bricks within `margin` of a triangle's box hold samples.
+    // The bricks within `margin` of a triangle's box hold samples, and with colours as many
+    // colours.
+    const size_t sampleBytes = sizeof(float) * (mesh.colors.empty() ? 1 : 2);
     size_t stored = 0;
     for (uint32_t t = 0; t < triangleCount; ++t) {
         forBricksNear(t, margin, [&](size_t s) {
             if (f.slots_[s] == kOutside) f.slots_[s] = 0, ++stored;
         });
-        const size_t bytes = stored * kBrickSamples * sizeof(float) + slots * sizeof(int32_t);
+        const size_t bytes = stored * kBrickSamples * sampleBytes + slots * sizeof(int32_t);
         if (bytes > maxBytes) return tooLarge(bytes);
     }
     std::vector<uint32_t> brickSlots; // the stored bricks' slots, in order
@@ -572,7 +649,7 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
         forBricksNear(t, reach,
                       [&](size_t s) { ++first[size_t(f.slots_[s]) / kBrickSamples], ++touches; });
         const size_t bytes =
-            sampleCount * sizeof(float) + slots * sizeof(int32_t) + touches * sizeof(uint32_t);
+            sampleCount * sampleBytes + slots * sizeof(int32_t) + touches * sizeof(uint32_t);
         if (bytes > maxBytes) return tooLarge(bytes);
     }
     for (size_t b = 0, sum = 0; b <= brickCount; ++b)
@@ -751,6 +828,35 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
     }
     fresh = {};
 
+    // Each sample's colour: the colour of its nearest triangle at the point of it nearest to the
+    // sample, from its corners' by the point's barycentric coordinates.
+    if (!mesh.colors.empty()) {
+        f.colors_.assign(sampleCount, -1.0f);
+        parallelFor(brickCount, [&](size_t b) {
+            for (int s = 0; s < kBrickSamples; ++s) {
+                const size_t at = b * kBrickSamples + size_t(s);
+                const uint32_t t = nearest[at];
+                if (t == kNone) continue;
+                const uint32_t* k = &mesh.colors[3 * size_t(t)];
+                if (k[0] == kNoColor || k[1] == kNoColor || k[2] == kNoColor) continue;
+                const std::array<vec3, 3> c = corners(t);
+                const vec3 q = nearestOnTriangle(
+                                   pointAt(brickBase(b) +
+                                           glm::ivec3(s % kBrickSide, s / kBrickSide % kBrickSide,
+                                                      s / (kBrickSide * kBrickSide))),
+                                   c[0], c[1], c[2])
+                                   .point;
+                const vec3 w = barycentric(q, c[0], c[1], c[2]);
+                vec3 rgb(0.0f);
+                for (int corner = 0; corner < 3; ++corner)
+                    rgb += w[corner] * vec3(float(k[corner] >> 16), float(k[corner] >> 8 & 255u),
+                                            float(k[corner] & 255u));
+                const glm::uvec3 v = glm::uvec3(glm::round(glm::clamp(rgb, 0.0f, 255.0f)));
+                f.colors_[at] = float(v.r * 65536u + v.g * 256u + v.b);
+            }
+        });
+    }
+
     // The sign: from the pseudonormals where the mesh is closed and consistently oriented, else
     // from the winding number. Samples without a triangle are at least `margin` from the
     // surface, as are their neighbours at least margin - cell: no surface lies between them,
@@ -863,17 +969,37 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
 }
 
 std::vector<glm::vec4> MeshField::words() const {
-    std::vector<glm::vec4> w(2 + (slots_.size() + 3) / 4 + (samples_.size() + 3) / 4,
-                             glm::vec4(0.0f));
+    const size_t at = 3 + (slots_.size() + 3) / 4, colorsAt = at + (samples_.size() + 3) / 4;
+    std::vector<glm::vec4> w(colorsAt + (colors_.size() + 3) / 4, glm::vec4(0.0f));
     w[0] = glm::vec4(float(bricks_.x), float(bricks_.y), float(bricks_.z), band_);
     w[1] = glm::vec4(origin_, cell_);
+    w[2].x = colors_.empty() ? 0.0f : float(colorsAt); // exact: the words stay under 2^24
     for (size_t s = 0; s < slots_.size(); ++s)
-        w[2 + s / 4][int(s % 4)] =
+        w[3 + s / 4][int(s % 4)] =
             slots_[s] < 0 ? float(slots_[s]) : float(slots_[s] / kBrickSamples);
-    const size_t at = 2 + (slots_.size() + 3) / 4;
     for (size_t k = 0; k < samples_.size(); ++k)
         w[at + k / 4][int(k % 4)] = samples_[k];
+    for (size_t k = 0; k < colors_.size(); ++k)
+        w[colorsAt + k / 4][int(k % 4)] = colors_[k];
     return w;
+}
+
+glm::vec3 MeshField::color(glm::vec3 p, glm::vec3 fallback) const {
+    const vec3 g = (p - origin_) / cell_;
+    if (colors_.empty() || glm::any(glm::lessThan(g, vec3(0.0f))) ||
+        glm::any(glm::greaterThan(g, vec3(bricks_ * kBrick))))
+        return fallback;
+    const glm::ivec3 b = glm::min(glm::ivec3(g) / kBrick, bricks_ - 1);
+    const int32_t slot =
+        slots_[(size_t(b.z) * size_t(bricks_.y) + size_t(b.y)) * size_t(bricks_.x) + size_t(b.x)];
+    if (slot < 0) return fallback;
+    const glm::ivec3 i = glm::clamp(glm::ivec3(glm::floor(g - vec3(b * kBrick) + 0.5f)),
+                                    glm::ivec3(0), glm::ivec3(kBrick));
+    const float c =
+        colors_[size_t(slot) + (size_t(i.z) * kBrickSide + size_t(i.y)) * kBrickSide + size_t(i.x)];
+    if (c < 0.0f) return fallback;
+    const uint32_t v = uint32_t(c);
+    return vec3(float(v >> 16), float(v >> 8 & 255u), float(v & 255u)) * (1.0f / 255.0f);
 }
 
 void fitMesh(TriangleMesh& mesh, glm::vec3 box) {

@@ -31,10 +31,19 @@ inline constexpr size_t kMaxMeshFieldBytes = size_t(64) << 20;
 struct TriangleMesh {
     std::vector<glm::vec3> positions;
     std::vector<glm::uvec3> triangles; // indices into positions, counter-clockwise seen outside
+    // Per corner, three per triangle in the triangles' order: the file's colour there as 0xRRGGBB,
+    // as shown on screen (sRGB), or kNoColor; empty where the file has no colours at all.
+    std::vector<uint32_t> colors;
 };
+inline constexpr uint32_t kNoColor = ~0u;
 
 // The triangles of an STL (binary or ASCII), OBJ, PLY, glTF (.gltf or binary .glb) or 3MF file,
-// read through Assimp with every node's transform applied, points and lines left out. STL and
+// read through Assimp with every node's transform applied, points and lines left out, with its
+// colours: per vertex where it has them (PLY, OBJ's "v x y z r g b", glTF's COLOR_0, a binary
+// STL's), else its materials' diffuse or base colour (OBJ's .mtl Kd, glTF's baseColorFactor;
+// Assimp's default material is no colour, nor is an OBJ's Kd of its default grey 0.6, which a
+// material missing from the .mtl gets; 3MF's are not read: Assimp 5.2 gives each of its objects
+// one material whatever its triangles say). glTF's linear colours are turned to sRGB. STL and
 // 3MF, made for printing, are z up (as sdfcsg writes them): they are turned so that their z is
 // +y. `bytes` is the file's contents and `extension` its name's (".stl", ...), which tells the
 // format. The files it names (a glTF's buffers, an OBJ's materials) are read from `folder` alone,
@@ -60,7 +69,8 @@ MeshDefects meshDefects(const TriangleMesh& mesh);
 // The sampled field: a grid of bricks of kBrick cells over the mesh's box grown by the band;
 // a brick within the band of a triangle holds (kBrick + 1)^3 samples of the signed distance (its
 // corners shared with its neighbours, so that trilinear interpolation never leaves the brick),
-// any other the sign of its inside alone.
+// any other the sign of its inside alone. A mesh with colours gives each sample the colour of its
+// nearest point of the surface too.
 class MeshField {
   public:
     static constexpr int kBrick = 8;
@@ -79,6 +89,11 @@ class MeshField {
     // bound of the right sign (the band's width, or the distance to the grid's box plus it)
     // beyond.
     float distance(glm::vec3 p) const;
+    // The mesh's colour at p: that of the sample nearest to p (the colour of the surface within
+    // a cell of it), or `fallback` (the node's colour) where the mesh has no colours, the sample's
+    // nearest corner has none, or p lies in no brick with samples. sdMesh's colour, colorMesh.
+    glm::vec3 color(glm::vec3 p, glm::vec3 fallback) const;
+    bool hasColors() const { return !colors_.empty(); }
 
     glm::vec3 origin() const { return origin_; }
     float cell() const { return cell_; }
@@ -86,9 +101,9 @@ class MeshField {
     glm::ivec3 bricks() const { return bricks_; }
     size_t storedBricks() const { return samples_.size() / kBrickSamples; }
     size_t bytes() const {
-        return samples_.size() * sizeof(float) + slots_.size() * sizeof(int32_t);
+        return (samples_.size() + colors_.size()) * sizeof(float) + slots_.size() * sizeof(int32_t);
     }
-    // sdMesh's words (shaders/sdf.glsl).
+    // sdMesh's and colorMesh's words (shaders/sdf.glsl).
     std::vector<glm::vec4> words() const;
 
   private:
@@ -101,6 +116,9 @@ class MeshField {
     glm::ivec3 bricks_{0};
     std::vector<int32_t> slots_; // per brick: its samples' index, or kOutside / kInside
     std::vector<float> samples_; // kBrickSamples per stored brick, x fastest
+    // As samples_, each sample's colour as r 65536 + g 256 + b (exact in a float), -1 for none;
+    // empty for a mesh without colours.
+    std::vector<float> colors_;
 };
 
 // Scales the mesh by one factor on every axis and moves its box's centre to the origin, so that

@@ -139,11 +139,11 @@ template <class V> class Machine {
     float nodeSmooth(uint i) const { return nodes_[i].smooth; }
     uint nodeBlend(uint i) const { return nodes_[i].blend; }
     float nodeBoundsDistance(uint i, vec3 p) const { return nodes_[i].bounds.signedDistance(p); }
-    V leaf(uint i, float d) const {
+    V leaf(uint i, vec3 p, float d) const {
         if constexpr (std::is_same_v<V, float>)
             return d;
         else
-            return vec4(nodes_[i].color, d);
+            return vec4(primitiveColor(nodes_[i], p), d);
     }
 
     // Every branch compiled in: the stack, every operation, domain operations. The arrays are
@@ -163,7 +163,7 @@ template <class V> class Machine {
 // Flattened: else GCC calls domainPoint out of line at both its sites, which costs the pruning
 // of a scene of repetitions (chain.json) 9% more instructions.
 #define TAPE_RUN execute [[gnu::flatten]]
-#define TAPE_LEAF(i, d) leaf(i, d)
+#define TAPE_LEAF(kind, i, p, d) leaf(i, p, d)
 #define TAPE_DIST(v) distanceOf(v)
 #define TAPE_WITH(v, d) withDistance(v, d)
 #include "../../shaders/tape_run.glsl"

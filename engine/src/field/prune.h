@@ -116,5 +116,7 @@ void primitiveValues(const FlatNode& node, const glm::vec3* p, uint32_t count, f
 float transitionValue(const FlatNode& op, glm::vec3 p, float a, float b);
 // p in the node's local space, as nodes.glsl's toLocal computes it (eval.cpp).
 glm::vec3 nodeLocalPoint(const FlatNode& node, glm::vec3 p);
+// A primitive's colour at p: its own (FlatNode::ownColors) or the node's (eval.cpp).
+glm::vec3 primitiveColor(const FlatNode& node, glm::vec3 p);
 
 } // namespace sdfcsg::detail

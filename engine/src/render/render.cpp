@@ -180,11 +180,17 @@ static size_t wordCount(const Node& n) {
     return n.words ? n.words->size() : 0;
 }
 
+// Whether the code calls node n's colour formula (ownColors).
+static bool colored(const Node& n) {
+    return ownColors(n.kind, n.words.get());
+}
+
 bool sameStructure(const Scene& a, const Scene& b) {
     if (a.nodes.size() != b.nodes.size()) return false;
     for (size_t i = 0; i < a.nodes.size(); ++i)
         if (a.nodes[i].kind != b.nodes[i].kind || a.nodes[i].children != b.nodes[i].children ||
-            wordCount(a.nodes[i]) != wordCount(b.nodes[i]))
+            wordCount(a.nodes[i]) != wordCount(b.nodes[i]) ||
+            colored(a.nodes[i]) != colored(b.nodes[i]))
             return false;
     return true;
 }

@@ -926,7 +926,11 @@ constexpr KindInfo kKinds[] = {
      "(only where the user names a file). "
      "Its field is the distance to the triangles, exact near the surface (sampled in bricks, "
      "interpolated) and a bound beyond; the inside is what the generalised winding number "
-     "says, so meshes with holes or flipped triangles still have one.",
+     "says, so meshes with holes or flipped triangles still have one. "
+     "Its colour is the file's where it has colours: per vertex (PLY, OBJ, glTF, a binary STL's) "
+     "or per material (an OBJ's .mtl beside it, glTF's base colour), that of the surface nearest "
+     "to the point within a cell; elsewhere, and for files without colours (3MF's are not read), "
+     "the node's.",
      R"("file": "gear.stl", "resolution": 96)", "sdMesh", kMeshArgs, nullptr,
      [](const Params& k, vec3& lo, vec3& hi) {
          // The box of the mesh's inside (buildMesh()) at its place in the field's grid, and a
@@ -934,6 +938,10 @@ constexpr KindInfo kKinds[] = {
          lo = vec3(k[2], k[3], k[4]) + (k[11] - k[5]);
          hi = lo + vec3(k[8], k[9], k[10]) + 2.0f * k[5];
          return true;
+     },
+     Role::Primitive, nullptr, nullptr, nullptr, "colorMesh",
+     [](std::span<const glm::vec4> words) {
+         return words.size() > 2 && words[2].x != 0.0f; // sdMesh's layout
      }},
     {NodeKind::CappedTorus, "capped_torus", false, kCappedTorus,
      "Arc of a ring around the y axis (a horseshoe, a handle), centred on +z.",
