@@ -109,7 +109,7 @@ TEST(MeshField, EveryFormatReadsTheSameTriangles) {
         EXPECT_LT(farthest, 1e-5f);
     }
     // Binary STL is read without Assimp: an ASCII STL of the same triangles, and a binary one
-    // whose header announces colours, both read through Assimp, come out the same.
+    // with colours, both read through Assimp, come out the same.
     const TriangleMesh t = triangles(sphere);
     std::string ascii = "solid sphere\n";
     for (const glm::uvec3& f : t.triangles) {
@@ -123,16 +123,19 @@ TEST(MeshField, EveryFormatReadsTheSameTriangles) {
         ascii += "endloop\nendfacet\n";
     }
     ascii += "endsolid sphere\n";
-    std::string coloured = binaryStl(t, uint32_t(t.triangles.size()));
-    const std::string header = "COLOR=\x80\x80\x80\xff model";
-    coloured.replace(0, header.size(), header);
     const auto fast = readTriangleMesh(binaryStl(t, uint32_t(t.triangles.size())), ".stl");
     ASSERT_TRUE(fast) << fast.error().str();
-    for (const std::string& other : {ascii, coloured}) {
-        const auto slow = readTriangleMesh(other, ".stl");
+    // A triangle's attribute with its top bit set holds its colour (15 bits): that file too.
+    std::string attributes = binaryStl(t, uint32_t(t.triangles.size()));
+    for (size_t f = 0; f < t.triangles.size(); ++f)
+        attributes[84 + 50 * f + 49] = char(0xfc); // red
+    EXPECT_TRUE(fast->colors.empty());
+    for (const std::string* other : {&ascii, &attributes}) {
+        const auto slow = readTriangleMesh(*other, ".stl");
         ASSERT_TRUE(slow) << slow.error().str();
         EXPECT_EQ(slow->positions, fast->positions);
         EXPECT_EQ(slow->triangles, fast->triangles);
+        EXPECT_EQ(slow->colors.empty(), other == &ascii);
     }
 }
 

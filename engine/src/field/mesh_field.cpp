@@ -458,12 +458,11 @@ Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::strin
     bool colored = false;
     const bool zUp = hint == "stl" || hint == "3mf";
     const bool linear = hint == "gltf" || hint == "glb", materials = linear || hint == "obj";
-    const auto add = [&](float x, float y, float z, uint32_t color) {
+    const auto add = [&](float x, float y, float z) {
         if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) return false;
         // The printing formats build along z: their z is the scene's y.
         corners.push_back(
             {(zUp ? vec3(x, z, -y) : vec3(x, y, z)) + 0.0f, uint32_t(corners.size())});
-        colors.push_back(color);
         return true;
     };
     const auto tooMany = [](size_t faces) {
@@ -473,22 +472,19 @@ Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::strin
     // A binary STL (an 80-byte header, the triangle count, then 50 bytes per triangle: a normal,
     // three corners, two attribute bytes), the most common mesh file and the one sdfcsg writes,
     // is read here: through Assimp it takes four times as long as the whole field. Those with
-    // colours (a header that says so, or a triangle's attribute with its top bit set) go to
-    // Assimp, which reads them.
+    // colours (a triangle's attribute with its top bit set) go to Assimp, which reads them.
     const size_t stlFaces = bytes.size() >= 84 ? read32(bytes, 80) : 0;
-    bool plainStl = hint == "stl" && bytes.size() == 84 + 50 * stlFaces &&
-                    std::string_view(bytes.data(), 80).find("COLOR=") == std::string_view::npos;
+    bool plainStl = hint == "stl" && bytes.size() == 84 + 50 * stlFaces;
     for (size_t f = 0; plainStl && f < stlFaces; ++f)
         plainStl = (uint8_t(bytes[84 + 50 * f + 49]) & 0x80) == 0;
     if (plainStl) {
         if (stlFaces > kMaxMeshTriangles) return tooMany(stlFaces);
         corners.reserve(3 * stlFaces);
-        colors.reserve(3 * stlFaces);
         for (size_t f = 0; f < stlFaces; ++f)
             for (size_t c = 0; c < 3; ++c) {
                 float v[3];
                 std::memcpy(v, bytes.data() + 84 + 50 * f + 12 * (c + 1), sizeof v);
-                if (!add(v[0], v[1], v[2], kNoColor)) return reason("a NaN or infinite vertex");
+                if (!add(v[0], v[1], v[2])) return reason("a NaN or infinite vertex");
             }
     } else {
         Assimp::Importer importer;
@@ -524,7 +520,8 @@ Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::strin
                                     ? packColor(linear ? linearToSrgb(rgb) : rgb)
                                     : kNoColor;
                     }
-                    if (!add(v.x, v.y, v.z, color)) return reason("a NaN or infinite vertex");
+                    if (!add(v.x, v.y, v.z)) return reason("a NaN or infinite vertex");
+                    colors.push_back(color);
                 }
             }
         }
