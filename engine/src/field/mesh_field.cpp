@@ -859,7 +859,8 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
     // surface, as are their neighbours at least margin - cell: no surface lies between them,
     // and they take a neighbour's sign.
     const std::vector<uint32_t> pairs = edgesInPairs(mesh);
-    const bool clean = !countDefects(mesh, pairs).any();
+    f.defects_ = countDefects(mesh, pairs);
+    const bool clean = !f.defects_.any();
     const Pseudonormals normals = clean ? Pseudonormals(mesh, pairs) : Pseudonormals();
     std::optional<Hierarchy> h;
     if (!clean) h.emplace(mesh);
@@ -1046,7 +1047,7 @@ Result<std::shared_ptr<const std::vector<glm::vec4>>> buildMesh(const Node& node
     // the notes. A closed, consistently oriented mesh's inside lies in its triangles' box; where
     // triangles are flipped, the winding number can pass a half beyond it, and the box is the
     // grid's.
-    const MeshDefects defects = meshDefects(*mesh);
+    const MeshDefects defects = field->defects();
     Box box;
     for (const vec3& p : mesh->positions)
         box.add(p);

@@ -99,6 +99,8 @@ class MeshField {
     float cell() const { return cell_; }
     float band() const { return band_; }
     glm::ivec3 bricks() const { return bricks_; }
+    // The mesh's defects (meshDefects), counted as the field was made.
+    const MeshDefects& defects() const { return defects_; }
     size_t storedBricks() const { return samples_.size() / kBrickSamples; }
     size_t bytes() const {
         return (samples_.size() + colors_.size()) * sizeof(float) + slots_.size() * sizeof(int32_t);
@@ -114,6 +116,7 @@ class MeshField {
     glm::vec3 origin_{0.0f}; // the grid's least corner
     float cell_ = 1.0f, band_ = 1.0f;
     glm::ivec3 bricks_{0};
+    MeshDefects defects_;
     std::vector<int32_t> slots_; // per brick: its samples' index, or kOutside / kInside
     std::vector<float> samples_; // kBrickSamples per stored brick, x fastest
     // As samples_, each sample's colour as r 65536 + g 256 + b (exact in a float), -1 for none;
