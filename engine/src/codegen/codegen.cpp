@@ -85,6 +85,17 @@ class Emitter {
                 if (inlinedOutline(i)) outlineFunction(i);
             return;
         }
+        // `function(toLocal(i, p), ARGS` of the kind's parameters in node i.
+        const auto call = [&](const KindInfo& info, std::string_view function) {
+            out_ += function;
+            out_ += "(toLocal(i, p)";
+            for (const KernelArg& arg : info.args) {
+                out_ += ", nodes[i].";
+                out_ += paramVector(arg.slot);
+                out_ += '.';
+                out_ += swizzle(arg.slot, arg.count);
+            }
+        };
         std::array<bool, kNodeKindCount> used{};
         for (const Node& n : scene_.nodes)
             used[size_t(n.kind)] = true;
@@ -93,14 +104,7 @@ class Emitter {
             out_ += "float ";
             out_ += info.name;
             out_ += "Node(uint i, vec3 p) {\n    return floorAtBounds(i, p, ";
-            out_ += info.function;
-            out_ += "(toLocal(i, p)";
-            for (const KernelArg& arg : info.args) {
-                out_ += ", nodes[i].";
-                out_ += paramVector(arg.slot);
-                out_ += '.';
-                out_ += swizzle(arg.slot, arg.count);
-            }
+            call(info, info.function);
             out_ += ") * nodes[i].color.w);\n}\n";
         }
         // `vec3 meshColor(uint i, vec3 p)` for the kinds with a node that has colours of its own.
@@ -112,14 +116,7 @@ class Emitter {
             out_ += "vec3 ";
             out_ += info.name;
             out_ += "Color(uint i, vec3 p) {\n    return ";
-            out_ += info.colorFunction;
-            out_ += "(toLocal(i, p)";
-            for (const KernelArg& arg : info.args) {
-                out_ += ", nodes[i].";
-                out_ += paramVector(arg.slot);
-                out_ += '.';
-                out_ += swizzle(arg.slot, arg.count);
-            }
+            call(info, info.colorFunction);
             out_ += ", nodes[i].color.rgb);\n}\n";
         }
         out_ += '\n';
