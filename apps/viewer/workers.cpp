@@ -197,9 +197,11 @@ bool RenderWorker::compiling() const {
 void RenderWorker::adoptBuilds(const RenderJob& job) {
     if (auto built = liveBuilder_->take();
         built && built->renderer && (*built->renderer)->uploads(*job.scene)) {
+        // The frame on hand stays where the baked renderer drew it: a live one arriving between
+        // two jobs of the same scene does not redraw it.
+        if (drawn_ && drawn_->renderer == live_.get()) drawn_.reset();
         live_ = std::move(*built->renderer);
         liveVersion_ = built->version; // it holds that version's values
-        drawn_.reset();
     }
     if (auto built = bakeBuilder_->take();
         built && built->renderer && built->version == job.sceneVersion) {
