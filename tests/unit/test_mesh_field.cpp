@@ -835,6 +835,15 @@ TEST(MeshField, HostileThreeMfFilesAreRefused) {
     EXPECT_EQ(text(readTriangleMesh(threeMf("<svg/>"), ".3mf")),
               "3D/3dmodel.model, line 1: the document is not a 3MF model (its root is <svg>, not "
               "the core specification's <model>)");
+    // One attribute of 8 MiB, which expat 2.5 would scan again with every MiB inflated.
+    std::string wideTag = modelXml(meshObject(sphere, 1), R"(<item objectid="1"/>)");
+    wideTag.insert(wideTag.find("<vertex x=\"") + 11, size_t(8) << 20, ' ');
+    EXPECT_EQ(text(readTriangleMesh(threeMf(wideTag), ".3mf")),
+              "3D/3dmodel.model, line 1: a tag, comment or other markup of more than 4 MiB");
+    std::string nested;
+    for (int k = 0; k < 100; ++k)
+        nested += "<x>";
+    EXPECT_EQ(read(nested), "3D/3dmodel.model, line 1: elements nested more than 64 deep");
     EXPECT_EQ(text(readTriangleMesh(threeMf(""), ".3mf")),
               "3D/3dmodel.model, line 1: no element found");
     // No model part where _rels/.rels says.

@@ -1,7 +1,8 @@
 // A 3MF file's triangles and colours (read_3mf.h). The model is XML of up to a gigabyte, parsed by
 // expat as zlib inflates it: a streaming parser holds one piece at a time, where a tree would
 // hold the whole document several times over. Expat also bounds what entities expand to; 3MF's
-// packages may not hold a DTD at all (ECMA-376 part 2, 8.1.4), so one is refused outright.
+// packages may not hold a DTD at all (ECMA-376 part 2, requirement M1.18), so one is refused
+// outright.
 #include "field/read_3mf.h"
 
 #include "field/mesh_field.h"
@@ -13,6 +14,7 @@
 #include <glm/matrix.hpp>
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -42,6 +44,11 @@ constexpr size_t kMaxParts = size_t(1) << 20, kMaxColors = size_t(1) << 24;
 // each component's: components of empty objects give no triangles but would still be walked.
 constexpr int kMaxDepth = 32;
 constexpr uint64_t kMaxPlaced = uint64_t(1) << 24;
+// Elements within elements, which expat keeps a record of each: a model needs 6, extensions a
+// few more.
+constexpr size_t kMaxNesting = 64;
+// One tag (its attributes), comment or processing instruction: 3MF's are a few hundred bytes.
+constexpr uint64_t kMaxToken = uint64_t(4) << 20;
 
 Error problem(std::string text) {
     return Error::message(ErrorKind::Validation, {}, std::move(text));
@@ -58,6 +65,12 @@ Name split(const char* name) {
     return {s.substr(0, bar), s.substr(bar + 1)};
 }
 
+// An attribute's value for a message, in quotes, cut short where it is long.
+std::string quoted(const char* text) {
+    const std::string_view s(text);
+    return "\"" + std::string(s.substr(0, 40)) + (s.size() > 40 ? "...\"" : "\"");
+}
+
 std::string_view trimmed(std::string_view s) {
     while (!s.empty() &&
            (s.front() == ' ' || s.front() == '\t' || s.front() == '\n' || s.front() == '\r'))
@@ -68,12 +81,36 @@ std::string_view trimmed(std::string_view s) {
     return s;
 }
 
-std::optional<uint32_t> parseIndex(std::string_view s) {
-    s = trimmed(s);
-    uint32_t v = 0;
-    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (ec != std::errc() || end != s.data() + s.size() || s.empty()) return std::nullopt;
-    return v;
+// A whole number under 2^32 with optional spaces about it (ST_ResourceID, ST_ResourceIndex).
+std::optional<uint32_t> parseIndex(const char* s) {
+    const auto space = [](char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; };
+    while (space(*s))
+        ++s;
+    uint64_t v = 0;
+    const char* digits = s;
+    for (; *s >= '0' && *s <= '9'; ++s)
+        if ((v = v * 10 + uint64_t(*s - '0')) > 0xffffffffu) return std::nullopt;
+    const bool some = s != digits;
+    while (space(*s))
+        ++s;
+    return some && *s == '\0' ? std::optional(uint32_t(v)) : std::nullopt;
+}
+
+// Whether the attribute name `a` is `name` (of no namespace: expat names the others "uri|name").
+bool named(const char* a, std::string_view name) {
+    for (char c : name)
+        if (*a++ != c) return false;
+    return *a == '\0';
+}
+
+// The values of the attributes `names`, in one pass over the element's; nullptr where absent.
+template <size_t N>
+std::array<const char*, N> attributes(const char** atts, const std::string_view (&names)[N]) {
+    std::array<const char*, N> values{};
+    for (; *atts; atts += 2)
+        for (size_t k = 0; k < N; ++k)
+            if (named(atts[0], names[k])) values[k] = atts[1];
+    return values;
 }
 
 // A number of XML Schema's form (ST_Number: a sign, digits, a point, an exponent), or nullptr;
@@ -125,7 +162,7 @@ std::optional<glm::mat4> parseTransform(std::string_view s) {
 }
 
 struct Component {
-    uint32_t object; // its index in Model::objects
+    uint32_t object; // its index in ModelReader::objects_
     glm::mat4 transform;
 };
 
@@ -186,10 +223,22 @@ class ModelReader {
     // Parses the next piece of the document (the last where `last`); false once it has failed.
     bool feed(std::string_view piece, bool last) {
         if (error_) return false;
-        if (XML_Parse(parser_, piece.data(), int(piece.size()), last) != XML_STATUS_ERROR)
-            return true;
-        if (!error_) error_ = where() + XML_ErrorString(XML_GetErrorCode(parser_));
-        return false;
+        if (XML_Parse(parser_, piece.data(), int(piece.size()), last) == XML_STATUS_ERROR) {
+            if (!error_) error_ = where() + XML_ErrorString(XML_GetErrorCode(parser_));
+            return false;
+        }
+        // Expat 2.5 scans a token left unfinished at a piece's end again from its start with
+        // every piece (2.6 defers that), so one tag or comment of hundreds of MB, deflated to a
+        // small file, would take hours: the unfinished token, from where expat stands to the
+        // bytes fed, is bounded.
+        fed_ += piece.size();
+        const XML_Index at = XML_GetCurrentByteIndex(parser_);
+        if (at >= 0 && fed_ - uint64_t(at) > kMaxToken) {
+            error_ = where() + "a tag, comment or other markup of more than " +
+                     std::to_string(kMaxToken >> 20) + " MiB";
+            return false;
+        }
+        return true;
     }
     const std::optional<std::string>& error() const { return error_; }
 
@@ -216,12 +265,15 @@ class ModelReader {
     // An index attribute: absent (nullopt) or a whole number, else a failure.
     bool index(const char** atts, const char* what, const char* element,
                std::optional<uint32_t>& v) {
-        const char* text = attribute(atts, what);
+        return index(attribute(atts, what), what, element, v);
+    }
+    bool index(const char* text, const char* what, const char* element,
+               std::optional<uint32_t>& v) {
         if (!text) return true;
         v = parseIndex(text);
         if (!v)
-            fail(std::string("a ") + element + "'s " + what + " \"" + text +
-                 "\" that is not a whole number under 2^32");
+            fail(std::string("a ") + element + "'s " + what + " " + quoted(text) +
+                 " that is not a whole number under 2^32");
         return bool(v);
     }
     bool required(const char** atts, const char* what, const char* element,
@@ -257,8 +309,8 @@ class ModelReader {
         if (!text) return glm::mat4(1.0f);
         auto m = parseTransform(text);
         if (!m)
-            fail(std::string("a ") + element + "'s transform \"" + text +
-                 "\" that is not 12 finite numbers");
+            fail(std::string("a ") + element + "'s transform " + quoted(text) +
+                 " that is not 12 finite numbers");
         return m;
     }
     bool newResource(uint32_t id) {
@@ -287,6 +339,7 @@ class ModelReader {
     PropertyGroup* group_ = nullptr; // the one being read
     std::vector<Component> items_;
     size_t parts_ = 0, vertices_ = 0, triangles_ = 0, colors_ = 0;
+    uint64_t fed_ = 0; // bytes of the document given to expat
 };
 
 void ModelReader::start(const char* name, const char** atts) {
@@ -295,13 +348,15 @@ void ModelReader::start(const char* name, const char** atts) {
     const bool root = open_.empty();
     open_.push_back(Tag::Other);
     if (error_) return;
+    if (open_.size() > kMaxNesting)
+        return fail("elements nested more than " + std::to_string(kMaxNesting) + " deep");
     Tag& tag = open_.back();
     const Name n = split(name);
     const bool core = n.space == kCore || n.space.empty(), material = n.space == kMaterial;
     if (root) {
         if (!core || n.local != "model") {
-            fail("the document is not a 3MF model (its root is <" + std::string(n.local) +
-                 ">, not the core specification's <model>)");
+            fail("the document is not a 3MF model (its root is <" +
+                 std::string(n.local.substr(0, 40)) + ">, not the core specification's <model>)");
             return;
         }
         tag = Tag::Model;
@@ -363,7 +418,7 @@ void ModelReader::start(const char* name, const char** atts) {
         if (!text)
             fail("a <" + std::string(n.local) + "> without its " + what);
         else if (!color)
-            fail(std::string("a colour \"") + text + "\" that is not #RRGGBB or #RRGGBBAA");
+            fail("a colour " + quoted(text) + " that is not #RRGGBB or #RRGGBBAA");
         else if (++colors_ > kMaxColors)
             fail("more than " + std::to_string(kMaxColors) + " colours");
         else
@@ -402,16 +457,18 @@ void ModelReader::end() {
 }
 
 void ModelReader::vertex(const char** atts) {
+    static constexpr std::string_view kNames[] = {"x", "y", "z"};
+    const auto texts = attributes(atts, kNames);
     glm::vec3 p;
     for (int k = 0; k < 3; ++k) {
-        const char* axis = k == 0 ? "x" : k == 1 ? "y" : "z";
-        const char* text = attribute(atts, axis);
+        const char* axis = kNames[k].data();
+        const char* text = texts[size_t(k)];
         if (!text) return fail(std::string("a vertex without its ") + axis);
         const std::string_view s = trimmed(text);
         const char* stop = parseNumber(s.data(), s.data() + s.size(), p[k]);
         if (!stop || stop != s.data() + s.size())
-            return fail(std::string("a vertex whose ") + axis + " \"" + text +
-                        "\" is not a number");
+            return fail(std::string("a vertex whose ") + axis + " " + quoted(text) +
+                        " is not a number");
     }
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
         return fail("a NaN or infinite vertex");
@@ -423,16 +480,20 @@ void ModelReader::vertex(const char** atts) {
 void ModelReader::triangle(const char** atts) {
     Object& o = objects_.back();
     std::optional<uint32_t> v[3], pid, p[3];
+    static constexpr std::string_view kNames[] = {"v1", "v2", "v3", "p1", "p2", "p3", "pid"};
+    const auto texts = attributes(atts, kNames);
     static const char* const vs[3] = {"v1", "v2", "v3"};
     static const char* const ps[3] = {"p1", "p2", "p3"};
     for (int k = 0; k < 3; ++k) {
-        if (!required(atts, vs[k], "triangle", v[k]) || !index(atts, ps[k], "triangle", p[k]))
+        if (!index(texts[size_t(k)], vs[k], "triangle", v[k]) ||
+            !index(texts[size_t(k) + 3], ps[k], "triangle", p[k]))
             return;
+        if (!v[k]) return fail(std::string("a triangle without its ") + vs[k]);
         if (*v[k] >= o.vertices.size())
             return fail(std::string("a triangle's ") + vs[k] + " (" + std::to_string(*v[k]) +
                         ") past its object's " + std::to_string(o.vertices.size()) + " vertices");
     }
-    if (!index(atts, "pid", "triangle", pid)) return;
+    if (!index(texts[6], "pid", "triangle", pid)) return;
     if (++triangles_ > maxTriangles_)
         return fail("more than " + std::to_string(maxTriangles_) + " triangles");
     o.triangles.push_back({*v[0], *v[1], *v[2]});
@@ -557,7 +618,7 @@ Status readThreeMf(std::string_view file, const ThreeMfCorners& out, size_t maxT
                    uint64_t maxModelBytes) {
     const auto directory = zipDirectory(file);
     if (!directory) return problem("not a 3MF file: " + directory.error().diagnostics[0].message);
-    // Part names are compared without case (ECMA-376 part 2, 9.1.1.1).
+    // Part names are compared without case (ECMA-376 part 2, requirement M1.12).
     const auto find = [&](std::string_view name) -> const ZipDirectoryEntry* {
         for (const ZipDirectoryEntry& e : *directory)
             if (sameName(e.name, name)) return &e;
