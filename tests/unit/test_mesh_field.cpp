@@ -850,6 +850,9 @@ TEST(MeshField, HostileThreeMfFilesAreRefused) {
     const ZipEntry lonely[] = {{"3D/model.model", "<model/>"}};
     EXPECT_EQ(text(readTriangleMesh(zipArchive(lonely).value(), ".3mf")),
               "a 3MF without its model part (3D/3dmodel.model)");
+    // A 3MF under another name does not reach Assimp's own 3MF reader.
+    EXPECT_EQ(text(readTriangleMesh(good, ".zip")).rfind("not a mesh file that can be read", 0),
+              0u);
     // A build of nothing.
     EXPECT_EQ(read(meshObject(sphere, 1), ""), "no triangles");
 }
