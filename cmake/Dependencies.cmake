@@ -11,6 +11,7 @@ find_package(Freetype REQUIRED)  # glyph outlines for text (engine/src/scene/fon
 find_package(Fontconfig REQUIRED)  # fonts named by family (engine/src/scene/font.cpp)
 find_package(ZLIB REQUIRED)  # deflate and CRC-32 for 3MF's ZIP container (engine/src/io/zip.cpp)
 find_package(assimp REQUIRED)  # mesh files read by mesh nodes (engine/src/field/mesh_field.cpp)
+find_package(EXPAT REQUIRED)  # the XML of 3MF models read by mesh nodes (engine/src/field/read_3mf.cpp)
 find_package(meshoptimizer REQUIRED)  # mesh simplification (engine/src/mesh/mesh_simplify.cpp)
 find_path(STB_INCLUDE_DIR stb_image_write.h PATH_SUFFIXES stb REQUIRED)
 find_program(GLSLANG_VALIDATOR glslangValidator REQUIRED)

@@ -8,7 +8,7 @@ PACKAGES="build-essential cmake ninja-build pkg-config git
   libcurl4-openssl-dev libcpp-httplib-dev
   libglfw3-dev libimgui-dev xvfb xauth gdb
   libfreetype-dev libfontconfig-dev fonts-dejavu-core zlib1g-dev libmeshoptimizer-dev
-  libassimp-dev
+  libassimp-dev libexpat1-dev
   clang-14 libclang-rt-14-dev clang-format
   pybind11-dev python3-dev python3-numpy python3-pytest"
 missing=""

@@ -2,6 +2,8 @@
 // (engine/src/field/mesh_field.h): against an analytic sphere, with holes and flipped triangles,
 // and with hostile files.
 #include "field/mesh_field.h"
+#include "field/read_3mf.h"
+#include "io/zip.h"
 
 #include <sdfcsg/eval.h>
 #include <sdfcsg/export.h>
@@ -86,6 +88,47 @@ std::string binaryStl(const TriangleMesh& mesh, uint32_t count) {
         s.append(2, '\0');
     }
     return s;
+}
+
+// A 3MF package of `model`, its model part where _rels/.rels says (`part`).
+std::string threeMf(const std::string& model, const std::string& part = "3D/3dmodel.model") {
+    const std::string rels =
+        R"(<?xml version="1.0" encoding="UTF-8"?>
+<Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships">
+ <Relationship Target="/)" +
+        part +
+        R"(" Id="rel0" Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/>
+</Relationships>)";
+    const ZipEntry entries[] = {{"_rels/.rels", rels}, {part, model}};
+    return zipArchive(entries).value();
+}
+
+// A model of `resources` and `build`, all on line 1.
+std::string modelXml(const std::string& resources, const std::string& build) {
+    return R"(<?xml version="1.0" encoding="UTF-8"?><model unit="millimeter" )"
+           R"(xmlns="http://schemas.microsoft.com/3dmanufacturing/core/2015/02" )"
+           R"(xmlns:m="http://schemas.microsoft.com/3dmanufacturing/material/2015/02">)"
+           "<resources>" +
+           resources + "</resources><build>" + build + "</build></model>";
+}
+
+// An object of `mesh`'s vertices and triangles, with `attributes` on the object and `corners`
+// on each triangle.
+std::string meshObject(const TriangleMesh& mesh, int id, const std::string& attributes = "",
+                       const std::string& corners = "") {
+    std::string s = "<object id=\"" + std::to_string(id) + "\" type=\"model\"" + attributes +
+                    "><mesh><vertices>";
+    for (const glm::vec3& p : mesh.positions) {
+        char line[128];
+        std::snprintf(line, sizeof line, "<vertex x=\"%.9g\" y=\"%.9g\" z=\"%.9g\"/>", p.x, p.y,
+                      p.z);
+        s += line;
+    }
+    s += "</vertices><triangles>";
+    for (const glm::uvec3& t : mesh.triangles)
+        s += "<triangle v1=\"" + std::to_string(t[0]) + "\" v2=\"" + std::to_string(t[1]) +
+             "\" v3=\"" + std::to_string(t[2]) + "\"" + corners + "/>";
+    return s + "</triangles></mesh></object>";
 }
 
 TEST(MeshField, EveryFormatReadsTheSameTriangles) {
@@ -323,7 +366,7 @@ TEST(MeshField, HostileFilesAreRefused) {
     const uint32_t huge = 0xfffffffeu;
     std::memcpy(&bomb[directory + 24], &huge, 4);
     EXPECT_EQ(text(readTriangleMesh(bomb, ".3mf")),
-              "a 3MF whose parts unpack to more than 1024 MiB");
+              "3D/3dmodel.model unpacks to more than 1024 MiB");
     EXPECT_EQ(text(readTriangleMesh("PK", ".3mf")),
               "not a 3MF file: no ZIP directory that can be read");
     // A field too large for memory is refused before it is made.
@@ -574,6 +617,244 @@ TEST(MeshNode, ItsProblemsAreNamed) {
         "test.json: root.fit[1]: expected a positive number, got 0");
     EXPECT_EQ(error(R"({"type": "mesh", "file": ")" + kGearStl.string() + R"(", "fit": 2})"),
               "test.json: root.fit: expected an array of 3 positive numbers, got 2");
+}
+
+} // namespace
+} // namespace sdfcsg::detail
+
+namespace sdfcsg::detail {
+namespace {
+
+// Objects placed by components and build items, their transforms 4x3 matrices whose last row
+// is the translation (3MF Core 3.3), composed component first; a mirroring one keeps the
+// triangles facing out.
+TEST(MeshField, ThreeMfPlacesItsObjects) {
+    const TriangleMesh sphere = triangles(icosphere(2));
+    // Object 1 the sphere; object 2 it, moved by (1, 2, 3) and mirrored in x; the build item
+    // moves object 2 by (10, 20, 30) and scales it by 2.
+    const std::string model = modelXml(
+        meshObject(sphere, 1) + R"(<object id="2"><components><component objectid="1" )"
+                                R"(transform="-1 0 0 0 1 0 0 0 1 1 2 3"/></components></object>)",
+        R"(<item objectid="2" transform="2 0 0 0 2 0 0 0 2 10 20 30"/>)");
+    const auto read = readTriangleMesh(threeMf(model), ".3mf");
+    ASSERT_TRUE(read) << read.error().str();
+    EXPECT_EQ(read->triangles.size(), sphere.triangles.size());
+    EXPECT_TRUE(read->colors.empty());
+    // In the file, the centre is 2 * (1, 2, 3) + (10, 20, 30) = (12, 24, 36) and the radius 2;
+    // turned to y up, (x, z, -y).
+    const glm::vec3 centre(12.0f, 36.0f, -24.0f);
+    float farthest = 0.0f;
+    for (const glm::vec3& p : read->positions)
+        farthest = std::max(farthest, std::abs(glm::length(p - centre) - 2.0f));
+    EXPECT_LT(farthest, 1e-5f);
+    EXPECT_FALSE(meshDefects(*read).any());
+    const std::vector<float> inside = windingNumbers(*read, {centre});
+    EXPECT_NEAR(inside[0], 1.0f, 0.05f); // facing out: +1 inside (fast winding numbers)
+    // Objects outside the build, and supports, give no triangles.
+    const auto supported = readTriangleMesh(
+        threeMf(modelXml(meshObject(sphere, 1) + meshObject(sphere, 2) +
+                             R"(<object id="3" type="support"><components><component )"
+                             R"(objectid="1"/></components></object>)",
+                         R"(<item objectid="2"/><item objectid="3"/>)"),
+                "3D/other.model"),
+        ".3mf");
+    ASSERT_TRUE(supported) << supported.error().str();
+    EXPECT_EQ(supported->triangles.size(), sphere.triangles.size());
+}
+
+// A base material per triangle (p1 alone) and a colour group per corner, in one object; a
+// triangle of no property group has no colour, and a texture's none either.
+TEST(MeshField, ThreeMfColours) {
+    TriangleMesh quad;
+    quad.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}};
+    quad.triangles = {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {0, 4, 1}};
+    const std::string object =
+        R"(<object id="5" pid="1" pindex="1"><mesh><vertices>)"
+        R"(<vertex x="0" y="0" z="0"/><vertex x="1" y="0" z="0"/><vertex x="1" y="1" z="0"/>)"
+        R"(<vertex x="0" y="1" z="0"/><vertex x="0" y="0" z="1"/></vertices><triangles>)"
+        R"(<triangle v1="0" v2="1" v3="2"/>)"                                     // object's: blue
+        R"(<triangle v1="0" v2="2" v3="3" pid="2" p1="0" p2="1" p3="2"/>)"        // corners
+        R"(<triangle v1="0" v2="3" v3="4" pid="3" p1="0"/>)"                      // a texture's
+        R"(<triangle v1="0" v2="4" v3="1" p1="0"/></triangles></mesh></object>)"; // red
+    const std::string model = modelXml(
+        R"(<basematerials id="1"><base name="red" displaycolor="#FF0000"/>)"
+        R"(<base name="blue" displaycolor="#0000ffcc"/></basematerials>)"
+        R"(<m:colorgroup id="2"><m:color color="#102030"/><m:color color="#405060FF"/>)"
+        R"(<m:color color="#708090"/></m:colorgroup>)"
+        R"(<m:texture2dgroup id="3" texid="9"><m:tex2coord u="0" v="0"/></m:texture2dgroup>)" +
+            object,
+        R"(<item objectid="5"/>)");
+    const auto read = readTriangleMesh(threeMf(model), ".3mf");
+    ASSERT_TRUE(read) << read.error().str();
+    ASSERT_EQ(read->colors.size(), 12u);
+    const std::vector<uint32_t> want = {0x0000ff, 0x0000ff, 0x0000ff, 0x102030, 0x405060, 0x708090,
+                                        kNoColor, kNoColor, kNoColor, 0xff0000, 0xff0000, 0xff0000};
+    EXPECT_EQ(read->colors, want);
+}
+
+// Hostile and broken 3MF files: each refused with its reason, the part and line named where the
+// model's XML is at fault.
+TEST(MeshField, HostileThreeMfFilesAreRefused) {
+    const TriangleMesh sphere = triangles(icosphere(1));
+    auto text = [](const Result<TriangleMesh>& r) {
+        return r ? std::string("read") : r.error().diagnostics[0].message;
+    };
+    auto read = [&](const std::string& resources,
+                    const std::string& build = R"(<item objectid="1"/>)") {
+        return text(readTriangleMesh(threeMf(modelXml(resources, build)), ".3mf"));
+    };
+    const std::string good = threeMf(modelXml(meshObject(sphere, 1), R"(<item objectid="1"/>)"));
+    ASSERT_EQ(text(readTriangleMesh(good, ".3mf")), "read");
+    // Truncated: the ZIP's directory, at its end, is gone.
+    EXPECT_EQ(text(readTriangleMesh(good.substr(0, good.size() / 2), ".3mf")),
+              "not a 3MF file: no ZIP directory that can be read");
+    // A ZIP bomb: 64 MiB of the model's XML (spaces inside its root) deflated to a small file,
+    // its directory declaring 4096 bytes. Refused as the inflated bytes pass that, not after.
+    std::string padded = modelXml(meshObject(sphere, 1), R"(<item objectid="1"/>)");
+    padded.insert(padded.find("<resources>"), size_t(64) << 20, ' ');
+    std::string bomb = threeMf(padded);
+    EXPECT_LT(bomb.size(), size_t(1) << 20);
+    const size_t directory = bomb.rfind(std::string("PK\1\2", 4));
+    ASSERT_NE(directory, std::string::npos);
+    const uint32_t declared = 4096;
+    std::memcpy(&bomb[directory + 24], &declared, 4);
+    EXPECT_EQ(text(readTriangleMesh(bomb, ".3mf")),
+              "3D/3dmodel.model unpacks to more than the 4096 bytes its ZIP directory declares");
+    // The same under its true size, with the limit below it: refused from the directory.
+    EXPECT_EQ(readThreeMf(threeMf(padded), {}, 100, 1 << 20).error().diagnostics[0].message,
+              "3D/3dmodel.model unpacks to more than 1 MiB");
+    // Triangles past the limit: counted as they are read.
+    EXPECT_EQ(readThreeMf(good, {}, 50, 1 << 20).error().diagnostics[0].message,
+              "3D/3dmodel.model, line 1: more than 50 triangles");
+    // Placed past the limit by build items, each object within it.
+    EXPECT_EQ(readThreeMf(threeMf(modelXml(meshObject(sphere, 1),
+                                           R"(<item objectid="1"/><item objectid="1"/>)")),
+                          {}, 100, 1 << 20)
+                  .error()
+                  .diagnostics[0]
+                  .message,
+              "more than 100 triangles (160)");
+    // A damaged deflate stream, and a CRC that does not match.
+    std::string damaged = good;
+    const size_t data = damaged.find("3D/3dmodel.model") + 16;
+    damaged[data + 40] = char(~damaged[data + 40]);
+    EXPECT_NE(text(readTriangleMesh(damaged, ".3mf")).find("3D/3dmodel.model"), std::string::npos);
+    std::string crc = good;
+    const size_t entry = crc.rfind(std::string("PK\1\2", 4)); // the model's, the last
+    crc[entry + 16] = char(~crc[entry + 16]);
+    EXPECT_EQ(text(readTriangleMesh(crc, ".3mf")),
+              "3D/3dmodel.model is damaged: its CRC-32 does not match");
+    // Indices: out of range, not whole numbers, 2^31 and past 2^32.
+    const std::string vertices =
+        R"(<vertex x="0" y="0" z="0"/><vertex x="1" y="0" z="0"/><vertex x="0" y="1" z="0"/>)";
+    const auto one = [&](const std::string& triangle, const std::string& more = "") {
+        return read(more + R"(<object id="1"><mesh><vertices>)" + vertices +
+                    "</vertices><triangles>" + triangle + "</triangles></mesh></object>");
+    };
+    EXPECT_EQ(one(R"(<triangle v1="0" v2="1" v3="3"/>)"),
+              "3D/3dmodel.model, line 1: a triangle's v3 (3) past its object's 3 vertices");
+    EXPECT_EQ(one(R"(<triangle v1="0" v2="2147483648" v3="1"/>)"),
+              "3D/3dmodel.model, line 1: a triangle's v2 (2147483648) past its object's 3 "
+              "vertices");
+    EXPECT_EQ(one(R"(<triangle v1="0" v2="1" v3="4294967296"/>)"),
+              "3D/3dmodel.model, line 1: a triangle's v3 \"4294967296\" that is not a whole "
+              "number under 2^32");
+    EXPECT_EQ(one(R"(<triangle v1="0" v2="-1" v3="2"/>)"),
+              "3D/3dmodel.model, line 1: a triangle's v2 \"-1\" that is not a whole number under "
+              "2^32");
+    EXPECT_EQ(one(R"(<triangle v1="0" v2="1"/>)"),
+              "3D/3dmodel.model, line 1: a triangle without its v3");
+    // Colours: an index past its group, a group not defined, a colour that is not one.
+    const std::string group = R"(<m:colorgroup id="7"><m:color color="#ff0000"/></m:colorgroup>)";
+    EXPECT_EQ(one(R"(<triangle v1="0" v2="1" v3="2" pid="7" p1="0" p2="1"/>)", group),
+              "3D/3dmodel.model, line 1: a triangle's p2 (1) past the 1 entries of property "
+              "group 7");
+    EXPECT_EQ(one(R"(<triangle v1="0" v2="1" v3="2" pid="8" p1="0"/>)", group),
+              "3D/3dmodel.model, line 1: a triangle names property group 8, which no resource "
+              "before it defines");
+    EXPECT_EQ(one(R"(<triangle v1="0" v2="1" v3="2" pid="7"/>)", group),
+              "3D/3dmodel.model, line 1: a triangle with a property group but no index (p1 or "
+              "pindex)");
+    EXPECT_EQ(read(R"(<m:colorgroup id="7"><m:color color="red"/></m:colorgroup>)"),
+              "3D/3dmodel.model, line 1: a colour \"red\" that is not #RRGGBB or #RRGGBBAA");
+    // Vertices: NaN, infinite, not a number.
+    EXPECT_EQ(read(R"(<object id="1"><mesh><vertices><vertex x="nan" y="0" z="0"/>)"
+                   "</vertices></mesh></object>"),
+              "3D/3dmodel.model, line 1: a NaN or infinite vertex");
+    EXPECT_EQ(read(R"(<object id="1"><mesh><vertices><vertex x="0" y="1e39" z="0"/>)"
+                   "</vertices></mesh></object>"),
+              "3D/3dmodel.model, line 1: a NaN or infinite vertex");
+    EXPECT_EQ(read(R"(<object id="1"><mesh><vertices><vertex x="0" y="one" z="0"/>)"
+                   "</vertices></mesh></object>"),
+              "3D/3dmodel.model, line 1: a vertex whose y \"one\" is not a number");
+    // A transform that moves a vertex out of floats' range.
+    EXPECT_EQ(read(meshObject(sphere, 1),
+                   R"(<item objectid="1" transform="3e38 0 0 0 1 0 0 0 1 3e38 0 0"/>)"),
+              "a NaN or infinite vertex");
+    EXPECT_EQ(read(meshObject(sphere, 1), R"(<item objectid="1" transform="1 0 0 0 1 0 0 0 1"/>)"),
+              "3D/3dmodel.model, line 1: a build item's transform \"1 0 0 0 1 0 0 0 1\" that is "
+              "not 12 finite numbers");
+    // Objects: named before they are defined, twice, or in another part.
+    EXPECT_EQ(read(meshObject(sphere, 1), R"(<item objectid="2"/>)"),
+              "3D/3dmodel.model, line 1: a build item names object 2, which no object before it "
+              "defines");
+    EXPECT_EQ(read(R"(<object id="2"><components><component objectid="2"/></components></object>)"),
+              "3D/3dmodel.model, line 1: a component names object 2, which no object before it "
+              "defines");
+    EXPECT_EQ(read(meshObject(sphere, 1) + meshObject(sphere, 1)),
+              "3D/3dmodel.model, line 1: two resources of id 1");
+    EXPECT_EQ(
+        read(
+            R"(<object id="2" xmlns:p="http://schemas.microsoft.com/3dmanufacturing/production/2015/06">)"
+            R"(<components><component objectid="1" p:path="/3D/other.model"/></components></object>)"),
+        "3D/3dmodel.model, line 1: a component of an object in another model part (p:path), "
+        "which is not read");
+    // Components nested deeper than 32, and placing objects 27 million times.
+    std::string deep = meshObject(sphere, 1);
+    for (int id = 2; id <= 40; ++id)
+        deep += "<object id=\"" + std::to_string(id) + "\"><components><component objectid=\"" +
+                std::to_string(id - 1) + "\"/></components></object>";
+    EXPECT_EQ(read(deep), "3D/3dmodel.model, line 1: components nested more than 32 deep");
+    std::string wide = R"(<object id="1"><mesh><vertices/><triangles/></mesh></object>)";
+    for (int id = 2; id <= 4; ++id) {
+        wide += "<object id=\"" + std::to_string(id) + "\"><components>";
+        for (int k = 0; k < 300; ++k)
+            wide += "<component objectid=\"" + std::to_string(id - 1) + "\"/>";
+        wide += "</components></object>";
+    }
+    EXPECT_EQ(read(wide, R"(<item objectid="4"/>)"),
+              "a build that places objects more than 16777216 times");
+    // XML: not well-formed, a DTD (entities that expand a billionfold), not a 3MF model.
+    EXPECT_EQ(read(R"(<object id="1"><mesh></object>)"),
+              "3D/3dmodel.model, line 1: mismatched tag");
+    EXPECT_EQ(text(readTriangleMesh(threeMf(R"(<?xml version="1.0"?>
+<!DOCTYPE model [<!ENTITY a "aaaaaaaaaa"><!ENTITY b "&a;&a;&a;&a;&a;&a;&a;&a;&a;&a;">]>
+<model xmlns="http://schemas.microsoft.com/3dmanufacturing/core/2015/02">&b;</model>)"),
+                                    ".3mf")),
+              "3D/3dmodel.model, line 2: a DTD, which a 3MF model may not hold");
+    EXPECT_EQ(text(readTriangleMesh(threeMf("<svg/>"), ".3mf")),
+              "3D/3dmodel.model, line 1: the document is not a 3MF model (its root is <svg>, not "
+              "the core specification's <model>)");
+    // One attribute of 8 MiB, which expat 2.5 would scan again with every MiB inflated.
+    std::string wideTag = modelXml(meshObject(sphere, 1), R"(<item objectid="1"/>)");
+    wideTag.insert(wideTag.find("<vertex x=\"") + 11, size_t(8) << 20, ' ');
+    EXPECT_EQ(text(readTriangleMesh(threeMf(wideTag), ".3mf")),
+              "3D/3dmodel.model, line 1: a tag, comment or other markup of more than 4 MiB");
+    std::string nested;
+    for (int k = 0; k < 100; ++k)
+        nested += "<x>";
+    EXPECT_EQ(read(nested), "3D/3dmodel.model, line 1: elements nested more than 64 deep");
+    EXPECT_EQ(text(readTriangleMesh(threeMf(""), ".3mf")),
+              "3D/3dmodel.model, line 1: no element found");
+    // No model part where _rels/.rels says.
+    const ZipEntry lonely[] = {{"3D/model.model", "<model/>"}};
+    EXPECT_EQ(text(readTriangleMesh(zipArchive(lonely).value(), ".3mf")),
+              "a 3MF without its model part (3D/3dmodel.model)");
+    // A 3MF under another name does not reach Assimp's own 3MF reader.
+    EXPECT_EQ(text(readTriangleMesh(good, ".zip")).rfind("not a mesh file that can be read", 0),
+              0u);
+    // A build of nothing.
+    EXPECT_EQ(read(meshObject(sphere, 1), ""), "no triangles");
 }
 
 } // namespace

@@ -4,6 +4,7 @@
 // exported meshes read back.
 #include "field/mesh_field.h"
 #include "gpu_probe.h"
+#include "io/zip.h"
 
 #include <sdfcsg/export.h>
 #include <sdfcsg/mesh.h>
@@ -89,6 +90,42 @@ std::string twoHalvesObj(const std::string& mtl, bool materials) {
     return obj;
 }
 
+// A 3MF of the two halves, z up as the format is: each triangle of base material 0 (left) or 1
+// (right) where `perTriangle`, else each corner of colour 0 or 1 of a colour group.
+std::string twoColor3mf(const std::string& left, const std::string& right, bool perTriangle) {
+    std::string vertices, triangles;
+    int count = 0;
+    for (int half = 0; half < 2; ++half)
+        for (const auto& t : twoHalves(half)) {
+            for (const glm::vec3& p : t) // (x, y, z) -> (x, -z, y)
+                vertices += "<vertex x=\"" + number(p.x) + "\" y=\"" + number(-p.z) + "\" z=\"" +
+                            number(p.y) + "\"/>\n";
+            const std::string c = std::to_string(half);
+            triangles += "<triangle v1=\"" + std::to_string(count) + "\" v2=\"" +
+                         std::to_string(count + 1) + "\" v3=\"" + std::to_string(count + 2) +
+                         "\" p1=\"" + c + (perTriangle ? "" : "\" p2=\"" + c + "\" p3=\"" + c) +
+                         "\"/>\n";
+            count += 3;
+        }
+    const std::string group = perTriangle
+                                  ? "<basematerials id=\"1\"><base name=\"left\" displaycolor=\"" +
+                                        left + "\"/><base name=\"right\" displaycolor=\"" + right +
+                                        "\"/></basematerials>\n"
+                                  : "<m:colorgroup id=\"1\"><m:color color=\"" + left +
+                                        "\"/><m:color color=\"" + right + "\"/></m:colorgroup>\n";
+    const std::string model =
+        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<model unit=\"millimeter\" "
+        "xmlns=\"http://schemas.microsoft.com/3dmanufacturing/core/2015/02\" "
+        "xmlns:m=\"http://schemas.microsoft.com/3dmanufacturing/material/2015/"
+        "02\">\n<resources>\n" +
+        group + "<object id=\"2\" pid=\"1\" pindex=\"0\"><mesh><vertices>\n" + vertices +
+        "</vertices><triangles>\n" + triangles +
+        "</triangles></mesh></object>\n</resources>\n<build><item objectid=\"2\"/></build>\n"
+        "</model>\n";
+    const detail::ZipEntry entries[] = {{"3D/3dmodel.model", model}};
+    return detail::zipArchive(entries).value();
+}
+
 Scene sceneFrom(const std::string& json) {
     auto scene = parseScene(json, "test.json");
     if (!scene) ADD_FAILURE() << scene.error().str();
@@ -159,6 +196,20 @@ TEST(MeshNodeColors, PlyVertexColoursAreTheSurfaces) {
     EXPECT_EQ(ev.sample(glm::vec3(0.0f, 0.0f, 0.0f)).color, kNodeColor);
 }
 
+// A 3MF's base materials, one per triangle, and its colour group's colours, per corner (sRGB, as
+// 3MF's are; the alpha of #RRGGBBAA left out): each half its own, exactly.
+TEST(MeshNodeColors, ThreeMfColoursAreTheSurfaces) {
+    for (const bool perTriangle : {true, false}) {
+        SCOPED_TRACE(perTriangle ? "base materials" : "colour group");
+        const auto file =
+            writeFile("mesh_colors_halves.3mf", twoColor3mf("#E6280A", "#145AFA80", perTriangle));
+        const Evaluator ev(meshScene(file));
+        ASSERT_EQ(ev.nodes().size(), 1u);
+        EXPECT_TRUE(ev.nodes()[0].ownColors);
+        expectColors(ev, glm::vec3(230, 40, 10) / 255.0f, glm::vec3(20, 90, 250) / 255.0f, 1e-6f);
+    }
+}
+
 // An OBJ's materials, from the .mtl beside it; the node's colour where it has none, and the
 // code then calls no colour formula.
 TEST(MeshNodeColors, ObjMaterialColoursAreTheSurfaces) {
@@ -225,8 +276,9 @@ TEST_F(MeshNodeColorsGpu, KernelsGiveTheCpusColours) {
 }
 
 // Scene -> mesh (PLY with vertex colours, GLB with linear vertex colours or a material per
-// colour) -> mesh node: each box keeps its colour. A GLB without colours (its triangles take
-// Assimp's default material) takes the node's.
+// colour, 3MF with a colour group or a base material per colour) -> mesh node: each box keeps its
+// colour. A GLB or 3MF without colours (a GLB's triangles take Assimp's default material) takes
+// the node's.
 TEST_F(MeshNodeColorsGpu, ExportedColoursReadBack) {
     const Scene scene = sceneFrom(R"({"version": 1, "root": {"type": "union", "children": [
         {"type": "box", "size": [1, 1, 1], "translate": [-0.5, 0, 0], "color": [0.8, 0.4, 0.2]},
@@ -234,10 +286,10 @@ TEST_F(MeshNodeColorsGpu, ExportedColoursReadBack) {
     const struct {
         MeshFormat format;
         bool regions, colors;
-    } cases[] = {{MeshFormat::Ply, false, true},
-                 {MeshFormat::Glb, false, true},
-                 {MeshFormat::Glb, true, true},
-                 {MeshFormat::Glb, false, false}};
+    } cases[] = {{MeshFormat::Ply, false, true},     {MeshFormat::Glb, false, true},
+                 {MeshFormat::Glb, true, true},      {MeshFormat::Glb, false, false},
+                 {MeshFormat::ThreeMf, false, true}, {MeshFormat::ThreeMf, true, true},
+                 {MeshFormat::ThreeMf, false, false}};
     for (const auto& c : cases) {
         SCOPED_TRACE(std::string(meshFormatName(c.format)) + (c.regions ? " regions" : "") +
                      (c.colors ? "" : " without colours"));

@@ -1,10 +1,12 @@
 // A mesh's signed distance field (mesh_field.h).
 #include "field/mesh_field.h"
 
+#include "field/read_3mf.h"
 #include "mesh/radix_sort.h"
 #include "scene/files.h"
 #include "scene/parse_util.h"
 
+#include <assimp/BaseImporter.h>
 #include <assimp/IOSystem.hpp>
 #include <assimp/Importer.hpp>
 #include <assimp/MemoryIOWrapper.h>
@@ -44,32 +46,6 @@ uint32_t read32(const std::string& s, size_t at) {
     for (int i = 3; i >= 0; --i)
         v = (v << 8) | uint8_t(s[at + size_t(i)]);
     return v;
-}
-uint32_t read16(const std::string& s, size_t at) {
-    return uint32_t(uint8_t(s[at])) | uint32_t(uint8_t(s[at + 1])) << 8;
-}
-
-// What a ZIP archive's central directory says its entries unpack to, or nullopt where it cannot
-// be read (or uses ZIP64, whose sizes are elsewhere). Assimp unpacks each entry into a buffer of
-// the size its directory entry declares, so the declared sizes bound what reading takes.
-std::optional<uint64_t> zipUnpackedSize(const std::string& s) {
-    if (s.size() < 22) return std::nullopt;
-    const size_t lowest = s.size() > 22 + 65535 ? s.size() - 22 - 65535 : 0;
-    for (size_t end = s.size() - 22 + 1; end-- > lowest;) {
-        if (read32(s, end) != 0x06054b50u) continue;
-        const uint32_t entries = read16(s, end + 10), offset = read32(s, end + 16);
-        uint64_t total = 0;
-        size_t at = offset;
-        for (uint32_t e = 0; e < entries; ++e) {
-            if (at + 46 > s.size() || read32(s, at) != 0x02014b50u) return std::nullopt;
-            const uint32_t size = read32(s, at + 24);
-            if (size == 0xffffffffu) return std::nullopt;
-            total += size;
-            at += 46 + size_t(read16(s, at + 28)) + read16(s, at + 30) + read16(s, at + 32);
-        }
-        return total;
-    }
-    return std::nullopt;
 }
 
 // The squared distance from p to the triangle abc, and which feature of it is nearest: 0, 1, 2
@@ -440,13 +416,6 @@ Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::strin
         extension.size() > 1 && extension[0] == '.' ? extension.substr(1) : extension;
     std::transform(hint.begin(), hint.end(), hint.begin(),
                    [](unsigned char c) { return char(std::tolower(c)); });
-    if (hint == "3mf") {
-        const auto unpacked = zipUnpackedSize(bytes);
-        if (!unpacked) return reason("not a 3MF file: no ZIP directory that can be read");
-        if (*unpacked > 4 * kMaxMeshFileBytes)
-            return reason("a 3MF whose parts unpack to more than " +
-                          std::to_string((4 * kMaxMeshFileBytes) >> 20) + " MiB");
-    }
     // One vertex per position across the file's meshes, so that edges between them are shared:
     // the corners sorted by position, each run of equal ones made one vertex.
     struct Corner {
@@ -477,7 +446,21 @@ Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::strin
     bool plainStl = hint == "stl" && bytes.size() == 84 + 50 * stlFaces;
     for (size_t f = 0; plainStl && f < stlFaces; ++f)
         plainStl = (uint8_t(bytes[84 + 50 * f + 49]) & 0x80) == 0;
-    if (plainStl) {
+    if (hint == "3mf") {
+        // Read here: Assimp 5.2 gives each 3MF object one material whatever its triangles say.
+        const ThreeMfCorners out{[&](size_t faces) {
+                                     corners.reserve(3 * faces);
+                                     colors.reserve(3 * faces);
+                                 },
+                                 [&](vec3 p, uint32_t color) {
+                                     add(p.x, p.y, p.z); // finite, as the reader checks
+                                     colors.push_back(color);
+                                     colored = colored || color != kNoColor;
+                                 }};
+        if (const Status read = readThreeMf(bytes, out, kMaxMeshTriangles, 4 * kMaxMeshFileBytes);
+            !read)
+            return read.error();
+    } else if (plainStl) {
         if (stlFaces > kMaxMeshTriangles) return tooMany(stlFaces);
         corners.reserve(3 * stlFaces);
         for (size_t f = 0; f < stlFaces; ++f)
@@ -489,6 +472,10 @@ Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::strin
     } else {
         Assimp::Importer importer;
         importer.SetIOHandler(new FolderFiles(folder)); // the importer's to delete
+        // Nor does a 3MF under another name reach Assimp's, which unpacks a ZIP's entries whole.
+        if (Assimp::BaseImporter* threeMf = importer.GetImporter("3mf");
+            threeMf && importer.UnregisterLoader(threeMf) == AI_SUCCESS)
+            delete threeMf;
         const aiScene* scene = importer.ReadFileFromMemory(
             bytes.data(), bytes.size(), aiProcess_Triangulate | aiProcess_PreTransformVertices,
             hint.c_str());

@@ -38,20 +38,21 @@ struct TriangleMesh {
 inline constexpr uint32_t kNoColor = ~0u;
 
 // The triangles of an STL (binary or ASCII), OBJ, PLY, glTF (.gltf or binary .glb) or 3MF file,
-// read through Assimp with every node's transform applied, points and lines left out, with its
-// colours: per vertex where it has them (PLY, OBJ's "v x y z r g b", glTF's COLOR_0, a binary
-// STL's), else its materials' diffuse or base colour (OBJ's .mtl Kd, glTF's baseColorFactor;
-// Assimp's default material is no colour, nor is an OBJ's Kd of its default grey 0.6, which a
-// material missing from the .mtl gets; 3MF's are not read: Assimp 5.2 gives each of its objects
-// one material whatever its triangles say). glTF's linear colours are turned to sRGB. STL and
+// read through Assimp with every node's transform applied (a binary STL without colours and a
+// 3MF by sdfcsg's own readers: read_3mf.h), points and lines left out, with its colours: per
+// vertex where it has them (PLY, OBJ's "v x y z r g b", glTF's COLOR_0, a binary STL's), else its
+// materials' diffuse or base colour (OBJ's .mtl Kd, glTF's baseColorFactor; Assimp's default
+// material is no colour, nor is an OBJ's Kd of its default grey 0.6, which a material missing
+// from the .mtl gets); a 3MF's per triangle or corner, from its base materials' display colours
+// and colour groups. glTF's linear colours are turned to sRGB. STL and
 // 3MF, made for printing, are z up (as sdfcsg writes them): they are turned so that their z is
 // +y. `bytes` is the file's contents and `extension` its name's (".stl", ...), which tells the
 // format. The files it names (a glTF's buffers, an OBJ's materials) are read from `folder` alone,
 // as an untrusted scene's are (SceneFiles): no absolute path, no "..", nothing outside it; none
 // where `folder` is empty.
-// Errors are the reason alone, for the caller to place ("not a mesh file Assimp reads: ...", "no
-// triangles", "more than N triangles", "a NaN or infinite vertex", "a 3MF whose parts unpack to
-// more than N MiB").
+// Errors are the reason alone, for the caller to place ("not a mesh file that can be read: ...",
+// "no triangles", "more than N triangles", "a NaN or infinite vertex", a 3MF's "3D/3dmodel.model,
+// line 12: a triangle's v3 (7) past its object's 3 vertices").
 Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::string& extension,
                                       const std::filesystem::path& folder = {});
 

@@ -927,10 +927,10 @@ constexpr KindInfo kKinds[] = {
      "Its field is the distance to the triangles, exact near the surface (sampled in bricks, "
      "interpolated) and a bound beyond; the inside is what the generalised winding number "
      "says, so meshes with holes or flipped triangles still have one. "
-     "Its colour is the file's where it has colours: per vertex (PLY, OBJ, glTF, a binary STL's) "
-     "or per material (an OBJ's .mtl beside it, glTF's base colour), that of the surface nearest "
-     "to the point within a cell; elsewhere, and for files without colours (3MF's are not read), "
-     "the node's.",
+     "Its colour is the file's where it has colours: per vertex (PLY, OBJ, glTF, a binary STL's), "
+     "per material (an OBJ's .mtl beside it, glTF's base colour) or per triangle or corner (3MF's "
+     "base materials and colour groups), that of the surface nearest to the point within a cell; "
+     "elsewhere, and for files without colours, the node's.",
      R"("file": "gear.stl", "resolution": 96)", "sdMesh", kMeshArgs, nullptr,
      [](const Params& k, vec3& lo, vec3& hi) {
          // The box of the mesh's inside (buildMesh()) at its place in the field's grid, and a
