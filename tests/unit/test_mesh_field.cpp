@@ -343,6 +343,59 @@ TEST(MeshField, SamplesAreTheDistanceToTheNearestTriangle) {
     expectSamplesAreDistances(triangles(icosphere(4)), 16, 5);
 }
 
+// The samples beyond the band, which the dilation fills from their neighbours' nearest
+// triangles: read from the field's words, those within a cell beyond it hold the distance to a
+// triangle, so no less than the exact distance, and within a few hundredths of a cell of it; the
+// rest no more than their distance (the band plus a cell where nothing reached them).
+TEST(MeshField, SamplesBeyondTheBandAreNearTheirDistance) {
+    for (const float bandCells : {2.0f, 3.5f}) {
+        SCOPED_TRACE(bandCells);
+        const TriangleMesh mesh = lumpyBall(7);
+        auto field = MeshField::make(mesh, 40, bandCells);
+        ASSERT_TRUE(field) << field.error().str();
+        const std::vector<glm::vec4> w = field->words();
+        const glm::ivec3 bricks = field->bricks();
+        const size_t slots = size_t(bricks.x) * size_t(bricks.y) * size_t(bricks.z);
+        const size_t samplesAt = 4 * (3 + (slots + 3) / 4);
+        const float* words = &w[0].x;
+        const float cell = field->cell(), band = field->band(), margin = band + cell;
+        constexpr int side = MeshField::kBrick + 1;
+        std::mt19937 rng(7);
+        int beyond = 0;
+        for (size_t slot = 0; slot < slots; ++slot) {
+            const float index = words[12 + slot];
+            if (index < 0.0f) continue;
+            const glm::ivec3 brick(int(slot % size_t(bricks.x)),
+                                   int(slot / size_t(bricks.x) % size_t(bricks.y)),
+                                   int(slot / (size_t(bricks.x) * size_t(bricks.y))));
+            for (int s = 0; s < side * side * side; ++s) {
+                if (rng() % 16 != 0) continue; // a sixteenth of them, for time
+                const glm::ivec3 g = brick * MeshField::kBrick +
+                                     glm::ivec3(s % side, s / side % side, s / (side * side));
+                const glm::vec3 p = field->origin() + cell * glm::vec3(g);
+                float d = INFINITY;
+                for (const glm::uvec3& t : mesh.triangles)
+                    d = std::min(d, distanceToTriangle(p, mesh.positions[t.x], mesh.positions[t.y],
+                                                       mesh.positions[t.z]));
+                const float v =
+                    std::abs(words[samplesAt + size_t(index) * side * side * side + size_t(s)]);
+                SCOPED_TRACE(testing::Message()
+                             << p.x << " " << p.y << " " << p.z << ": " << v << " against " << d);
+                if (d < band) {
+                    ASSERT_NEAR(v, d, 1e-3f * cell);
+                } else if (d < margin - 0.05f * cell) {
+                    ++beyond;
+                    ASSERT_GE(v, d - 1e-3f * cell);
+                    ASSERT_LE(v, d + 0.05f * cell);
+                } else {
+                    ASSERT_LE(v, std::max(d, margin) + 1e-3f * cell);
+                }
+            }
+        }
+        EXPECT_GT(beyond, 400) << beyond << " samples within a cell beyond the band";
+    }
+}
+
 TEST(MeshField, HostileFilesAreRefused) {
     const TriangleMesh sphere = triangles(icosphere(1));
     auto text = [](const Result<TriangleMesh>& r) {

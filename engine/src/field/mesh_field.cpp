@@ -714,17 +714,28 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
     // known takes the nearest of the triangles nearest to its 26 neighbours, or the one its box
     // reached if nearer (the nearest triangle of a point is also the nearest of the points
     // between it and the surface, which lie near its neighbours).
-    // `source`: the nearest triangle of each known sample that has one, which its neighbours
-    // take up; `touched`: whether a sample has a neighbour with one.
+    // `offer`: the nearest triangle of each sample of the front, those that became known with
+    // one in the last layer (kNone elsewhere), which their neighbours take up; `touched`: whether
+    // a sample has had a neighbour with one. Only the front's neighbours have new triangles to
+    // take up, and only touched samples can become known: a layer visits those alone, not the
+    // far samples that make most of the bricks and never change.
     std::vector<uint8_t> known(sampleCount, 0), touched(sampleCount, 0), reached(sampleCount, 0);
-    std::vector<uint8_t> since(sampleCount, 0); // the layer from which a source is taken up
-    std::vector<uint32_t> source(sampleCount, kNone), fresh(sampleCount, kNone);
-    for (size_t at = 0; at < sampleCount; ++at)
-        if (best[at] < reach * reach) known[at] = 1, source[at] = nearest[at];
+    std::vector<uint32_t> offer(sampleCount, kNone), fresh(sampleCount, kNone);
+    // Per brick, sets of its samples as bits (x) in rows (y, z): the front, the touched not yet
+    // known (a deeper layer may reach them), and those a layer visits.
+    using Rows = std::array<uint16_t, kBrickSide * kBrickSide>;
+    std::vector<Rows> front(brickCount, Rows{}), pending(brickCount, Rows{}), visits(brickCount);
+    std::vector<uint8_t> moving(brickCount, 0); // whether a brick has a front or touched samples
+    parallelFor(brickCount, [&](size_t b) {
+        for (size_t s = 0; s < kBrickSamples; ++s) {
+            const size_t at = b * kBrickSamples + s;
+            if (!(best[at] < reach * reach)) continue;
+            known[at] = 1, offer[at] = nearest[at];
+            if (offer[at] != kNone) front[b][s / kBrickSide] |= uint16_t(1u << (s % kBrickSide));
+        }
+        moving[b] = std::any_of(front[b].begin(), front[b].end(), [](uint16_t r) { return r; });
+    });
     constexpr size_t kNowhere = ~size_t(0);
-    // Bricks where a sample became a source in the last layer: only their neighbours have new
-    // triangles to take up.
-    std::vector<uint8_t> grown(brickCount, 1);
     // Layers by distance, half a cell deep: a sample is known once it is nearer than the layer's
     // far side, when the samples between it and the surface are known.
     const float step = 0.5f * f.cell_;
@@ -737,16 +748,56 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
             const glm::ivec3 home = brickBase(b) / kBrick;
             // The first samples of this brick and the 26 about it (kNowhere: none stored).
             size_t around[27];
+            bool stirred = false;
             for (int k = 0; k < 27; ++k) {
                 const glm::ivec3 there = home + glm::ivec3(k % 3, k / 3 % 3, k / 9) - 1;
                 const bool in = glm::all(glm::greaterThanEqual(there, glm::ivec3(0))) &&
                                 glm::all(glm::lessThan(there, f.bricks_));
                 const int32_t slot = in ? f.slots_[slotOf(there)] : kOutside;
                 around[k] = slot >= 0 ? size_t(slot) : kNowhere;
+                stirred = stirred || (slot >= 0 && moving[size_t(slot) / kBrickSamples]);
             }
-            bool news = false;
-            for (int k = 0; k < 27; ++k)
-                news = news || (around[k] != kNowhere && grown[around[k] / kBrickSamples]);
+            Rows& visit = visits[b];
+            visit = Rows{};
+            if (!stirred) return;
+            // The front about the brick, one sample beyond its faces (11 x 11 rows of 11 bits),
+            // as its samples read their neighbours (sampleAt below): the brick's own copy of
+            // each sample it holds, else the one in from the neighbour's face. Then grown by a
+            // sample along each axis: the samples next to it.
+            constexpr int kAround = kBrickSide + 2;
+            const auto frontRow = [&](int k, int y, int z) -> uint32_t {
+                return around[k] == kNowhere ? 0u
+                                             : front[around[k] / kBrickSamples][z * kBrickSide + y];
+            };
+            std::array<uint16_t, kAround * kAround> grown{};
+            // Along one axis, place p of the 11 is sample l of the brick o (0, 1, 2: before, this,
+            // after).
+            const auto place = [](int p, int& o, int& l) {
+                o = p == 0 ? 0 : p == kAround - 1 ? 2 : 1;
+                l = p == 0 ? kBrick - 1 : p == kAround - 1 ? 1 : p - 1;
+            };
+            for (int pz = 0; pz < kAround; ++pz)
+                for (int py = 0; py < kAround; ++py) {
+                    int oy, ly, oz, lz;
+                    place(py, oy, ly), place(pz, oz, lz);
+                    const int k = 3 * oy + 9 * oz;
+                    const uint32_t row = frontRow(k + 1, ly, lz) << 1 |
+                                         (frontRow(k, ly, lz) >> (kBrick - 1) & 1u) |
+                                         (frontRow(k + 2, ly, lz) >> 1 & 1u) << (kAround - 1);
+                    grown[size_t(pz * kAround + py)] = uint16_t(row | row << 1 | row >> 1);
+                }
+            bool any = false;
+            for (int z = 0; z <= kBrick; ++z)
+                for (int y = 0; y <= kBrick; ++y) {
+                    uint32_t row = 0;
+                    for (int dz = 0; dz < 3; ++dz)
+                        for (int dy = 0; dy < 3; ++dy)
+                            row |= grown[size_t((z + dz) * kAround + y + dy)];
+                    const size_t r = size_t(z * kBrickSide + y);
+                    visit[r] = uint16_t((row >> 1 & 0x1ffu) | pending[b][r]);
+                    any = any || visit[r];
+                }
+            if (!any) return;
             // A neighbour's sample, this brick's where it holds it (its copy of the faces it
             // shares), else the neighbouring brick's.
             const auto sampleAt = [&](glm::ivec3 l) {
@@ -758,18 +809,18 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
                         l[a] -= kBrick, k += weight;
                 return around[k] == kNowhere ? kNowhere : around[k] + local(l.x, l.y, l.z);
             };
-            bool any = false;
+            bool grows = false;
             for (int z = 0; z <= kBrick; ++z)
-                for (int y = 0; y <= kBrick; ++y)
+                for (int y = 0; y <= kBrick; ++y) {
+                    uint16_t& row = visit[size_t(z * kBrickSide + y)];
                     for (int x = 0; x <= kBrick; ++x) {
                         const size_t at = b * kBrickSamples + local(x, y, z);
-                        if (known[at]) continue;
-                        if (!news) { // nothing new about it: only the layer has grown
-                            reached[at] = touched[at] && best[at] < within2 ? 2 : 0;
-                            any = any || reached[at];
+                        if (!(row >> x & 1u)) continue;
+                        if (known[at]) {
+                            row = uint16_t(row & ~(1u << x));
                             continue;
                         }
-                        const bool inner =
+                        const bool inside =
                             x > 0 && x < kBrick && y > 0 && y < kBrick && z > 0 && z < kBrick;
                         const vec3 p = pointAt(home * kBrick + glm::ivec3(x, y, z));
                         uint32_t seen[27] = {nearest[at]};
@@ -779,11 +830,10 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
                             for (int dy = -1; dy <= 1; ++dy)
                                 for (int dx = -1; dx <= 1; ++dx) {
                                     const size_t n =
-                                        inner ? at + local(dx + 1, dy + 1, dz + 1) - local(1, 1, 1)
-                                              : sampleAt(glm::ivec3(x + dx, y + dy, z + dz));
-                                    // Sources of earlier layers were taken up then.
-                                    const uint32_t t = n == kNowhere ? kNone : source[n];
-                                    if (t == kNone || since[n] != layer) continue;
+                                        inside ? at + local(dx + 1, dy + 1, dz + 1) - local(1, 1, 1)
+                                               : sampleAt(glm::ivec3(x + dx, y + dy, z + dz));
+                                    const uint32_t t = n == kNowhere ? kNone : offer[n];
+                                    if (t == kNone) continue;
                                     touched[at] = 1;
                                     if (std::find(seen, seen + count, t) != seen + count) continue;
                                     seen[count++] = t;
@@ -792,25 +842,39 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
                                 }
                         // 1: a neighbour with a triangle, 2: and now known itself.
                         reached[at] = touched[at] ? best[at] < within2 ? 2 : 1 : 0;
-                        any = any || reached[at] == 2;
+                        grows = grows || reached[at] == 2;
                     }
-            if (any) grew = true;
+                }
+            if (grows) grew = true;
         });
         if (!grew) break;
         parallelFor(brickCount, [&](size_t b) {
-            grown[b] = 0;
-            for (size_t at = b * kBrickSamples; at < (b + 1) * kBrickSamples; ++at) {
-                if (reached[at] == 1) nearest[at] = fresh[at];
-                if (reached[at] == 2) {
-                    nearest[at] = source[at] = fresh[at], known[at] = 1;
-                    since[at] = uint8_t(layer + 1);
-                    grown[b] = grown[b] || fresh[at] != kNone;
+            Rows& fr = front[b];
+            for (size_t r = 0; r < fr.size(); ++r)
+                for (int x = 0; x <= kBrick; ++x)
+                    if (fr[r] >> x & 1u)
+                        offer[b * kBrickSamples + r * kBrickSide + size_t(x)] = kNone;
+            fr = Rows{}, pending[b] = Rows{};
+            bool any = false;
+            for (size_t r = 0; r < fr.size(); ++r)
+                for (int x = 0; x <= kBrick; ++x) {
+                    if (!(visits[b][r] >> x & 1u)) continue;
+                    const size_t at = b * kBrickSamples + r * kBrickSide + size_t(x);
+                    if (reached[at] == 1) {
+                        nearest[at] = fresh[at];
+                        pending[b][r] = uint16_t(pending[b][r] | 1u << x);
+                    }
+                    if (reached[at] == 2) {
+                        nearest[at] = offer[at] = fresh[at], known[at] = 1;
+                        if (fresh[at] != kNone) fr[r] = uint16_t(fr[r] | 1u << x);
+                    }
+                    any = any || reached[at] != 0;
+                    reached[at] = 0;
                 }
-                reached[at] = 0;
-            }
+            moving[b] = any;
         });
     }
-    fresh = {};
+    fresh = {}, offer = {}, front = {}, pending = {}, visits = {};
 
     // Each sample's colour: the colour of its nearest triangle at the point of it nearest to the
     // sample, from its corners' by the point's barycentric coordinates.
