@@ -37,12 +37,15 @@ endif()
 # What the tests' environment adds under the sanitizers (appended to each test's ENVIRONMENT,
 # hence the leading ';'): the leak suppressions for lavapipe, whose driver is preloaded so that
 # the Vulkan loader's unloading it does not leave its leaks unnamed (tests/sanitizers/lsan.supp);
-# and a factor for the command-line tests' deadlines (Ctrl-C within a second), since the leak
-# check at exit scans the whole heap, hundreds of megabytes after a large mesh.
+# a factor for the command-line tests' deadlines (Ctrl-C within a second), since the leak check at
+# exit scans the whole heap, hundreds of megabytes after a large mesh; and 3 seeds for each seeded
+# mesh property test (SDFCSG_MESH_SEEDS): the sanitizers look for memory and undefined-behaviour
+# errors along code paths that 3 random scenes take as well as 40, and the release suite runs
+# every seed (40 scenes of many small primitives took 139 s of the sanitized suite's time).
 set(SDFCSG_SANITIZER_ENV "")
 if(SDFCSG_SANITIZERS)
     find_library(SDFCSG_LAVAPIPE_LIBRARY vulkan_lvp)
-    set(SDFCSG_SANITIZER_ENV ";LSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/tests/sanitizers/lsan.supp:print_suppressions=0;UBSAN_OPTIONS=print_stacktrace=1;SDFCSG_TEST_DEADLINE_SCALE=3")
+    set(SDFCSG_SANITIZER_ENV ";LSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/tests/sanitizers/lsan.supp:print_suppressions=0;UBSAN_OPTIONS=print_stacktrace=1;SDFCSG_TEST_DEADLINE_SCALE=3;SDFCSG_MESH_SEEDS=3")
     if(SDFCSG_LAVAPIPE_LIBRARY)
         # The preloaded driver precedes the sanitizer runtime in the library list.
         string(APPEND SDFCSG_SANITIZER_ENV
