@@ -141,6 +141,12 @@ struct KindInfo {
     // node's colour, and the code calls no formula for it (ownColors).
     std::string_view colorFunction{};
     bool (*colored)(std::span<const glm::vec4> words) = nullptr;
+    // Primitives whose field may fall below their box's signed distance far from the solid (a
+    // mesh's, whose grid of bricks reaches past its box: beyond the grid the field is the
+    // distance to the grid plus the band). Their value is floored at that distance, as an
+    // unevenly scaled node's is (FlatNode::boundsFloor): it stays a bound, since the surface lies
+    // within the box.
+    bool floored = false;
 };
 
 // Keys every node may carry besides its parameters.

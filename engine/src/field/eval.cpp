@@ -577,8 +577,9 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
         n.offset = glm::vec3(a.offset);
         n.scale = float(a.scale);
         // Times the smallest factor, a field grows more slowly than its box's distance along
-        // the other axes (at 1/2 of it along the largest of factors 1 and 2).
-        n.boundsFloor = !isOperation(src.kind) && a.uneven;
+        // the other axes (at 1/2 of it along the largest of factors 1 and 2); and some kinds'
+        // fields do so of themselves (KindInfo::floored).
+        n.boundsFloor = !isOperation(src.kind) && (a.uneven || kindInfo(src.kind).floored);
         n.color = src.color ? *src.color : upNode ? upNode->color : kDefaultColor;
         n.params = sdf::kernelParams(src.kind, src.params);
         if (hasWords(src.kind)) {

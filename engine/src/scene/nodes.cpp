@@ -942,7 +942,8 @@ constexpr KindInfo kKinds[] = {
      Role::Primitive, nullptr, nullptr, nullptr, "colorMesh",
      [](std::span<const glm::vec4> words) {
          return words.size() > 2 && words[2].x != 0.0f; // sdMesh's layout
-     }},
+     },
+     true},
     {NodeKind::CappedTorus, "capped_torus", false, kCappedTorus,
      "Arc of a ring around the y axis (a horseshoe, a handle), centred on +z.",
      R"("major_radius": 0.8, "minor_radius": 0.2, "angle": 250)", "sdCappedTorus", kA0A1A2A3,
