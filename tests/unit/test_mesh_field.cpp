@@ -512,13 +512,8 @@ TEST(MeshNode, FieldIsTheMeshFields) {
     }
 }
 
-// Scene -> mesh -> mesh node: the scene's surface is the node's, within the mesh's own error (its
-// cells at 56) and the field's interpolation; and both agree on the inside away from it. (The
-// gear's field is a bound, not a distance, so values away from the surface differ.)
-TEST(MeshNode, RoundTripKeepsTheSurface) {
-    auto gear = loadScene(std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes/gear.json");
-    ASSERT_TRUE(gear) << gear.error().str();
-    const Evaluator scene(*gear), node(meshScene(kGearStl.string(), 128));
+void roundTripKeepsTheSurface(const Scene& gear, const std::filesystem::path& file) {
+    const Evaluator scene(gear), node(meshScene(file.string(), 128));
     const glm::vec3 size = scene.bounds().max - scene.bounds().min;
     const float cell = std::max({size.x, size.y, size.z}) / 56.0f;
     std::mt19937 rng(4);
@@ -535,6 +530,32 @@ TEST(MeshNode, RoundTripKeepsTheSurface) {
         }
     }
     EXPECT_GT(near, 200);
+}
+
+// Scene -> mesh -> mesh node: the scene's surface is the node's, within the mesh's own error (its
+// cells at 56) and the field's interpolation; and both agree on the inside away from it. (The
+// gear's field is a bound, not a distance, so values away from the surface differ.) The mesh as
+// STL, and as 3MF in the unit sdfcsg writes by default, which comes back at the same size.
+TEST(MeshNode, RoundTripKeepsTheSurface) {
+    auto gear = loadScene(std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes/gear.json");
+    ASSERT_TRUE(gear) << gear.error().str();
+    std::ifstream in(kGearStl, std::ios::binary);
+    const auto stl = readTriangleMesh(
+        std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()),
+        ".stl");
+    ASSERT_TRUE(stl) << stl.error().str();
+    Mesh mesh;
+    mesh.positions = stl->positions;
+    for (const glm::uvec3& t : stl->triangles)
+        mesh.indices.insert(mesh.indices.end(), {t.x, t.y, t.z});
+    const std::filesystem::path threeMf =
+        std::filesystem::path(SDFCSG_TEST_OUTPUT_DIR) / "gear_round_trip.3mf";
+    std::filesystem::create_directories(threeMf.parent_path());
+    std::ofstream(threeMf, std::ios::binary) << encodeMesh(mesh, MeshFormat::ThreeMf);
+    for (const std::filesystem::path& file : {kGearStl, threeMf}) {
+        SCOPED_TRACE(file.filename().string());
+        roundTripKeepsTheSurface(*gear, file);
+    }
 }
 
 // An OBJ of the box from `lo` to `hi`, counter-clockwise seen from outside, less the triangles
@@ -1070,6 +1091,17 @@ TEST(MeshField, HostileThreeMfPartsAreRefused) {
                           R"(</vertices><triangles><triangle v1="0" v2="0" v3="1"/>)"
                           R"(</triangles></mesh></object>)")}}),
               "3D/Objects/a.model, line 1: a triangle's v3 (1) past its object's 1 vertices");
+    // A part damaged in its package: its CRC (the last entry's, so the directory's last).
+    std::string damaged =
+        threeMfProject(modelXml(R"(<object id="2"><components><component objectid="1" )"
+                                R"(p:path="/3D/Objects/a.model"/></components></object>)",
+                                R"(<item objectid="2"/>)", "millimeter", kProductionModel),
+                       {{"3D/Objects/a.model", good}});
+    const size_t last = damaged.rfind(std::string("PK\1\2", 4));
+    ASSERT_NE(last, std::string::npos);
+    damaged[last + 16] = char(~damaged[last + 16]);
+    EXPECT_EQ(text(readTriangleMesh(damaged, ".3mf")),
+              "3D/Objects/a.model is damaged: its CRC-32 does not match");
     // Parts naming parts, which the production extension forbids: nested, or in a cycle.
     const std::string nested = part(R"(<object id="1"><components><component objectid="1" )"
                                     R"(p:path="/3D/Objects/b.model"/></components></object>)");
