@@ -34,13 +34,19 @@ for target in $targets; do
         glsl) seeds="assets/scenes tests/data/valid tests/data/legacy" ;;
         # HTTP answers of language models (first byte: API and status, see fuzz_llm.cpp).
         llm) seeds="tests/fuzz/llm_corpus" ;;
+        # 3MF packages, and model parts' XML to pack into them (see fuzz_3mf.cpp).
+        3mf) seeds="tests/fuzz/3mf_corpus" ;;
         *) seeds="tests/fuzz/corpus assets/scenes tests/data/valid tests/data/legacy" ;;
+    esac
+    case $target in
+        3mf) dict="tests/fuzz/3mf.dict" ;;
+        *) dict="$build/tests/fuzz/scene.dict" ;;
     esac
     mkdir -p "$build/corpus/$target" "$build/artifacts/$target"
     echo "fuzz_$target: $seconds s"
     # shellcheck disable=SC2086
     if ! "$build/tests/fuzz/fuzz_$target" "$build/corpus/$target" $seeds \
-        -dict="$build/tests/fuzz/scene.dict" -max_total_time="$seconds" -timeout=30 \
+        -dict="$dict" -max_total_time="$seconds" -timeout=30 \
         -rss_limit_mb=4096 -print_final_stats=1 -artifact_prefix="$build/artifacts/$target/" \
         ${FUZZ_ARGS:-} 2>"$build/fuzz_$target.log"; then
         status=1

@@ -103,9 +103,12 @@ std::string threeMf(const std::string& model, const std::string& part = "3D/3dmo
     return zipArchive(entries).value();
 }
 
-// A model of `resources` and `build`, all on line 1.
-std::string modelXml(const std::string& resources, const std::string& build) {
-    return R"(<?xml version="1.0" encoding="UTF-8"?><model unit="millimeter" )"
+// A model of `resources` and `build`, all on line 1, in `unit`: by default centimetres, one unit
+// of a scene (as sdfcsg writes 3MF), so that its coordinates are read as they are; `more`, more
+// attributes of its model element.
+std::string modelXml(const std::string& resources, const std::string& build,
+                     const std::string& unit = "centimeter", const std::string& more = "") {
+    return R"(<?xml version="1.0" encoding="UTF-8"?><model unit=")" + unit + "\" " + more +
            R"(xmlns="http://schemas.microsoft.com/3dmanufacturing/core/2015/02" )"
            R"(xmlns:m="http://schemas.microsoft.com/3dmanufacturing/material/2015/02">)"
            "<resources>" +
@@ -140,8 +143,8 @@ TEST(MeshField, EveryFormatReadsTheSameTriangles) {
                               MeshFormat::ThreeMf}) {
         const std::string name(meshFormatName(format));
         SCOPED_TRACE(name);
-        auto read =
-            readTriangleMesh(encodeMesh(sphere, format, LengthUnit::Millimeter), "." + name);
+        // In the unit sdfcsg writes by default, whose 3MF reads back at the same size.
+        auto read = readTriangleMesh(encodeMesh(sphere, format), "." + name);
         ASSERT_TRUE(read) << read.error().str();
         EXPECT_EQ(read->triangles.size(), sphere.indices.size() / 3);
         EXPECT_EQ(read->positions.size(), sphere.positions.size()); // STL's corners welded
@@ -509,13 +512,8 @@ TEST(MeshNode, FieldIsTheMeshFields) {
     }
 }
 
-// Scene -> mesh -> mesh node: the scene's surface is the node's, within the mesh's own error (its
-// cells at 56) and the field's interpolation; and both agree on the inside away from it. (The
-// gear's field is a bound, not a distance, so values away from the surface differ.)
-TEST(MeshNode, RoundTripKeepsTheSurface) {
-    auto gear = loadScene(std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes/gear.json");
-    ASSERT_TRUE(gear) << gear.error().str();
-    const Evaluator scene(*gear), node(meshScene(kGearStl.string(), 128));
+void roundTripKeepsTheSurface(const Scene& gear, const std::filesystem::path& file) {
+    const Evaluator scene(gear), node(meshScene(file.string(), 128));
     const glm::vec3 size = scene.bounds().max - scene.bounds().min;
     const float cell = std::max({size.x, size.y, size.z}) / 56.0f;
     std::mt19937 rng(4);
@@ -532,6 +530,32 @@ TEST(MeshNode, RoundTripKeepsTheSurface) {
         }
     }
     EXPECT_GT(near, 200);
+}
+
+// Scene -> mesh -> mesh node: the scene's surface is the node's, within the mesh's own error (its
+// cells at 56) and the field's interpolation; and both agree on the inside away from it. (The
+// gear's field is a bound, not a distance, so values away from the surface differ.) The mesh as
+// STL, and as 3MF in the unit sdfcsg writes by default, which comes back at the same size.
+TEST(MeshNode, RoundTripKeepsTheSurface) {
+    auto gear = loadScene(std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes/gear.json");
+    ASSERT_TRUE(gear) << gear.error().str();
+    std::ifstream in(kGearStl, std::ios::binary);
+    const auto stl = readTriangleMesh(
+        std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()),
+        ".stl");
+    ASSERT_TRUE(stl) << stl.error().str();
+    Mesh mesh;
+    mesh.positions = stl->positions;
+    for (const glm::uvec3& t : stl->triangles)
+        mesh.indices.insert(mesh.indices.end(), {t.x, t.y, t.z});
+    const std::filesystem::path threeMf =
+        std::filesystem::path(SDFCSG_TEST_OUTPUT_DIR) / "gear_round_trip.3mf";
+    std::filesystem::create_directories(threeMf.parent_path());
+    std::ofstream(threeMf, std::ios::binary) << encodeMesh(mesh, MeshFormat::ThreeMf);
+    for (const std::filesystem::path& file : {kGearStl, threeMf}) {
+        SCOPED_TRACE(file.filename().string());
+        roundTripKeepsTheSurface(*gear, file);
+    }
 }
 
 // An OBJ of the box from `lo` to `hi`, counter-clockwise seen from outside, less the triangles
@@ -776,15 +800,15 @@ TEST(MeshField, HostileThreeMfFilesAreRefused) {
     EXPECT_EQ(text(readTriangleMesh(bomb, ".3mf")),
               "3D/3dmodel.model unpacks to more than the 4096 bytes its ZIP directory declares");
     // The same under its true size, with the limit below it: refused from the directory.
-    EXPECT_EQ(readThreeMf(threeMf(padded), {}, 100, 1 << 20).error().diagnostics[0].message,
+    EXPECT_EQ(readThreeMf(threeMf(padded), {}, 100, 1 << 20, 10.0).error().diagnostics[0].message,
               "3D/3dmodel.model unpacks to more than 1 MiB");
     // Triangles past the limit: counted as they are read.
-    EXPECT_EQ(readThreeMf(good, {}, 50, 1 << 20).error().diagnostics[0].message,
+    EXPECT_EQ(readThreeMf(good, {}, 50, 1 << 20, 10.0).error().diagnostics[0].message,
               "3D/3dmodel.model, line 1: more than 50 triangles");
     // Placed past the limit by build items, each object within it.
     EXPECT_EQ(readThreeMf(threeMf(modelXml(meshObject(sphere, 1),
                                            R"(<item objectid="1"/><item objectid="1"/>)")),
-                          {}, 100, 1 << 20)
+                          {}, 100, 1 << 20, 10.0)
                   .error()
                   .diagnostics[0]
                   .message,
@@ -858,12 +882,6 @@ TEST(MeshField, HostileThreeMfFilesAreRefused) {
               "defines");
     EXPECT_EQ(read(meshObject(sphere, 1) + meshObject(sphere, 1)),
               "3D/3dmodel.model, line 1: two resources of id 1");
-    EXPECT_EQ(
-        read(
-            R"(<object id="2" xmlns:p="http://schemas.microsoft.com/3dmanufacturing/production/2015/06">)"
-            R"(<components><component objectid="1" p:path="/3D/other.model"/></components></object>)"),
-        "3D/3dmodel.model, line 1: a component of an object in another model part (p:path), "
-        "which is not read");
     // Components nested deeper than 32, and placing objects 27 million times.
     std::string deep = meshObject(sphere, 1);
     for (int id = 2; id <= 40; ++id)
@@ -910,6 +928,297 @@ TEST(MeshField, HostileThreeMfFilesAreRefused) {
               0u);
     // A build of nothing.
     EXPECT_EQ(read(meshObject(sphere, 1), ""), "no triangles");
+}
+
+// A 3MF package as slicers write their projects: the root model where _rels/.rels says, and
+// `parts` (name without its leading '/', contents) that its p:path attributes name, listed in the
+// root's own relationships.
+std::string threeMfProject(const std::string& root,
+                           const std::vector<std::pair<std::string, std::string>>& parts) {
+    std::string rels = R"(<?xml version="1.0" encoding="UTF-8"?>
+<Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships">)";
+    for (size_t k = 0; k < parts.size(); ++k)
+        rels += "<Relationship Target=\"/" + parts[k].first + "\" Id=\"rel" +
+                std::to_string(k + 1) +
+                "\" Type=\"http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel\"/>";
+    rels += "</Relationships>";
+    std::vector<std::pair<std::string, std::string>> all = {
+        {"_rels/.rels",
+         R"(<?xml version="1.0" encoding="UTF-8"?>
+<Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships">
+ <Relationship Target="/3D/3dmodel.model" Id="rel0" Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/>
+</Relationships>)"},
+        {"3D/_rels/3dmodel.model.rels", rels},
+        {"3D/3dmodel.model", root}};
+    all.insert(all.end(), parts.begin(), parts.end());
+    std::vector<ZipEntry> entries;
+    for (const auto& [name, data] : all)
+        entries.push_back({name, data});
+    return zipArchive(entries).value();
+}
+
+// The production extension's namespace and its requirement, as slicers declare them.
+const std::string kProductionModel =
+    R"(xmlns:p="http://schemas.microsoft.com/3dmanufacturing/production/2015/06" )"
+    R"(requiredextensions="p" )";
+
+// The largest distance of a position of `mesh` from a sphere of `radius` about the nearest of
+// `centres`, relative to the radius; and how many positions each centre is nearest to.
+std::pair<float, std::vector<size_t>>
+offSpheres(const TriangleMesh& mesh, const std::vector<glm::vec3>& centres, float radius) {
+    float worst = 0.0f;
+    std::vector<size_t> count(centres.size());
+    for (const glm::vec3& p : mesh.positions) {
+        size_t best = 0;
+        for (size_t k = 1; k < centres.size(); ++k)
+            if (glm::length(p - centres[k]) < glm::length(p - centres[best])) best = k;
+        ++count[best];
+        worst = std::max(worst, std::abs(glm::length(p - centres[best]) - radius) / radius);
+    }
+    return {worst, count};
+}
+
+// A project of several model parts, as Bambu Studio, Orca and PrusaSlicer write them: the root
+// model's objects are components naming objects of /3D/Objects/object_1.model by p:path, one of
+// them twice, and a build item names one there directly. The part is read once, its ids its own
+// (object 1 is another in the root), its build ignored, and its millimetres are tenths of a scene
+// unit.
+TEST(MeshField, ThreeMfPartsOfAProject) {
+    const TriangleMesh sphere = triangles(icosphere(2));
+    const std::string objects = modelXml(
+        meshObject(sphere, 1) + R"(<object id="2"><components><component objectid="1" )"
+                                R"(transform="1 0 0 0 1 0 0 0 1 5 0 0"/></components></object>)",
+        R"(<item objectid="1" transform="1 0 0 0 1 0 0 0 1 -50 0 0"/>)", "millimeter",
+        kProductionModel);
+    TriangleMesh big = sphere; // the root's own object 1, of radius 3
+    for (glm::vec3& p : big.positions)
+        p *= 3.0f;
+    const std::string root =
+        modelXml(meshObject(big, 1) +
+                     R"(<object id="3" p:UUID="00000003-61cb-4c03-9d28-80fed5dfa1dc" type="model">)"
+                     R"(<components>)"
+                     R"(<component p:path="/3D/Objects/object_1.model" objectid="1" )"
+                     R"(transform="1 0 0 0 1 0 0 0 1 0 0 10"/>)"
+                     R"(<component p:path="/3D/Objects/object_1.model" objectid="2"/>)"
+                     R"(<component objectid="1" transform="1 0 0 0 1 0 0 0 1 0 10 0"/>)"
+                     R"(</components></object>)",
+                 R"(<item objectid="3" transform="1 0 0 0 1 0 0 0 1 100 0 0" printable="1"/>)"
+                 R"(<item p:path="/3d/objects/OBJECT_1.model" objectid="1" )"
+                 R"(transform="1 0 0 0 1 0 0 0 1 0 0 -20"/>)",
+                 "millimeter", kProductionModel);
+    const std::string file = threeMfProject(root, {{"3D/Objects/object_1.model", objects}});
+    const auto read = readTriangleMesh(file, ".3mf");
+    ASSERT_TRUE(read) << read.error().str();
+    EXPECT_EQ(read->triangles.size(), 4 * sphere.triangles.size());
+    // In the file's millimetres the small spheres are about (100, 0, 10), (105, 0, 0) and
+    // (0, 0, -20), the big one about (100, 10, 0); in scene units, tenths of those turned y up.
+    const std::vector<glm::vec3> small = {
+        {10.0f, 1.0f, 0.0f}, {10.5f, 0.0f, 0.0f}, {0.0f, -2.0f, 0.0f}};
+    TriangleMesh smalls, bigs;
+    for (const glm::vec3& p : read->positions)
+        (glm::length(p - glm::vec3(10.0f, 0.0f, -1.0f)) < 0.5f ? bigs : smalls)
+            .positions.push_back(p);
+    const auto [offSmall, perSmall] = offSpheres(smalls, small, 0.1f);
+    EXPECT_LT(offSmall, 1e-5f);
+    EXPECT_EQ(perSmall, std::vector<size_t>(3, sphere.positions.size()));
+    const auto [offBig, perBig] = offSpheres(bigs, {{10.0f, 0.0f, -1.0f}}, 0.3f);
+    EXPECT_LT(offBig, 1e-5f);
+    EXPECT_EQ(perBig[0], sphere.positions.size());
+    // Read once: the parts' bytes together are all it may unpack, and one byte less is refused.
+    const uint64_t bytes = root.size() + objects.size();
+    EXPECT_TRUE(readThreeMf(file, {[](size_t) {}, [](glm::vec3, uint32_t) {}}, 10000, bytes, 10.0));
+    EXPECT_EQ(readThreeMf(file, {}, 10000, bytes - 1, 10.0).error().diagnostics[0].message,
+              "3D/Objects/object_1.model: the model parts unpack to more than " +
+                  std::to_string(bytes - 1) + " bytes together");
+    // A p:path naming the root itself is an object of the root.
+    const auto itself =
+        readTriangleMesh(threeMf(modelXml(meshObject(sphere, 1),
+                                          R"(<item objectid="1" p:path="/3D/3dmodel.model"/>)",
+                                          "centimeter", kProductionModel)),
+                         ".3mf");
+    ASSERT_TRUE(itself) << itself.error().str();
+    EXPECT_EQ(itself->triangles.size(), sphere.triangles.size());
+}
+
+// Parts that cannot be read, each refused with where it was named and why.
+TEST(MeshField, HostileThreeMfPartsAreRefused) {
+    const TriangleMesh sphere = triangles(icosphere(1));
+    auto text = [](const Result<TriangleMesh>& r) {
+        return r ? std::string("read") : r.error().diagnostics[0].message;
+    };
+    // A root whose object 2 is object 1 of `path`, with `parts` in the package.
+    auto read = [&](const std::string& path,
+                    const std::vector<std::pair<std::string, std::string>>& parts) {
+        const std::string root =
+            modelXml(R"(<object id="2"><components><component objectid="1" p:path=")" + path +
+                         R"("/></components></object>)",
+                     R"(<item objectid="2"/>)", "millimeter", kProductionModel);
+        return text(readTriangleMesh(threeMfProject(root, parts), ".3mf"));
+    };
+    const auto part = [&](const std::string& resources) {
+        return modelXml(resources, "", "millimeter", kProductionModel);
+    };
+    const std::string good = part(meshObject(sphere, 1));
+    ASSERT_EQ(read("/3D/Objects/a.model", {{"3D/Objects/a.model", good}}), "read");
+    EXPECT_EQ(read("/3D/Objects/missing.model", {{"3D/Objects/a.model", good}}),
+              "3D/3dmodel.model, line 1: a component's p:path \"/3D/Objects/missing.model\" "
+              "naming a part the package does not hold");
+    // Not a part of the package: relative, empty segments, a way up and out.
+    for (const char* outside : {"3D/Objects/a.model", "../3D/Objects/a.model", "/3D//a.model",
+                                "/3D/../3D/Objects/a.model", "//host/3D/Objects/a.model", "/"})
+        EXPECT_EQ(read(outside, {{"3D/Objects/a.model", good}}),
+                  "3D/3dmodel.model, line 1: a component's p:path \"" + std::string(outside) +
+                      "\" that is not an absolute part name, such as "
+                      "\"/3D/Objects/object_1.model\"");
+    // Parts that are no models: a thumbnail, a slicer's settings.
+    EXPECT_EQ(read("/Metadata/plate_1.png", {{"Metadata/plate_1.png", "\x89PNG\r\n\x1a\n"}}),
+              "3D/3dmodel.model, line 1: a component's p:path \"/Metadata/plate_1.png\" naming "
+              "Metadata/plate_1.png, which is not a 3MF model part (line 1: not well-formed "
+              "(invalid token))");
+    EXPECT_EQ(read("/Metadata/model_settings.config",
+                   {{"Metadata/model_settings.config", "<config><object id=\"1\"/></config>"}}),
+              "3D/3dmodel.model, line 1: a component's p:path \"/Metadata/model_settings.config\" "
+              "naming Metadata/model_settings.config, which is not a 3MF model part (line 1: the "
+              "document is not a 3MF model (its root is <config>, not the core specification's "
+              "<model>))");
+    // An object the part does not define, and a part at fault itself, named as it is.
+    EXPECT_EQ(read("/3D/Objects/a.model", {{"3D/Objects/a.model", part(meshObject(sphere, 3))}}),
+              "3D/3dmodel.model, line 1: a component names object 1 of /3D/Objects/a.model, "
+              "which defines none");
+    EXPECT_EQ(read("/3D/Objects/a.model",
+                   {{"3D/Objects/a.model",
+                     part(R"(<object id="1"><mesh><vertices><vertex x="0" y="0" z="0"/>)"
+                          R"(</vertices><triangles><triangle v1="0" v2="0" v3="1"/>)"
+                          R"(</triangles></mesh></object>)")}}),
+              "3D/Objects/a.model, line 1: a triangle's v3 (1) past its object's 1 vertices");
+    // A part damaged in its package: its CRC (the last entry's, so the directory's last).
+    std::string damaged =
+        threeMfProject(modelXml(R"(<object id="2"><components><component objectid="1" )"
+                                R"(p:path="/3D/Objects/a.model"/></components></object>)",
+                                R"(<item objectid="2"/>)", "millimeter", kProductionModel),
+                       {{"3D/Objects/a.model", good}});
+    const size_t last = damaged.rfind(std::string("PK\1\2", 4));
+    ASSERT_NE(last, std::string::npos);
+    damaged[last + 16] = char(~damaged[last + 16]);
+    EXPECT_EQ(text(readTriangleMesh(damaged, ".3mf")),
+              "3D/Objects/a.model is damaged: its CRC-32 does not match");
+    // Parts naming parts, which the production extension forbids: nested, or in a cycle.
+    const std::string nested = part(R"(<object id="1"><components><component objectid="1" )"
+                                    R"(p:path="/3D/Objects/b.model"/></components></object>)");
+    EXPECT_EQ(
+        read("/3D/Objects/a.model", {{"3D/Objects/a.model", nested}, {"3D/Objects/b.model", good}}),
+        "3D/Objects/a.model, line 1: a component's p:path \"/3D/Objects/b.model\" outside "
+        "the root model (3D/3dmodel.model), which the production extension forbids");
+    const std::string cycle =
+        part(meshObject(sphere, 2) + R"(<object id="1"><components><component objectid="2" )"
+                                     R"(p:path="/3D/3dmodel.model"/></components></object>)");
+    EXPECT_EQ(read("/3D/Objects/a.model", {{"3D/Objects/a.model", cycle}}),
+              "3D/Objects/a.model, line 1: a component's p:path \"/3D/3dmodel.model\" outside the "
+              "root model (3D/3dmodel.model), which the production extension forbids");
+    // Components nested deeper than 32 across parts: 31 in the part, 2 more in the root.
+    std::string deep = meshObject(sphere, 100);
+    for (int id = 101; id <= 131; ++id)
+        deep += "<object id=\"" + std::to_string(id) + "\"><components><component objectid=\"" +
+                std::to_string(id - 1) + "\"/></components></object>";
+    EXPECT_EQ(read("/3D/Objects/a.model",
+                   {{"3D/Objects/a.model",
+                     part(deep + R"(<object id="1"><components><component objectid="131"/>)"
+                                 R"(</components></object>)")}}),
+              "3D/3dmodel.model, line 1: components nested more than 32 deep");
+}
+
+// The model's unit: a scene unit is a centimetre, as sdfcsg writes 3MF by default, so a file in
+// inches comes in 2.54 units a unit; a part in another unit than the root's is converted to it.
+TEST(MeshField, ThreeMfUnits) {
+    const TriangleMesh sphere = triangles(icosphere(2));
+    const std::pair<const char*, float> units[] = {{"micron", 1e-4f},    {"millimeter", 0.1f},
+                                                   {"centimeter", 1.0f}, {"inch", 2.54f},
+                                                   {"foot", 30.48f},     {"meter", 100.0f}};
+    for (const auto& [unit, scale] : units) {
+        SCOPED_TRACE(unit);
+        const auto read = readTriangleMesh(
+            threeMf(modelXml(meshObject(sphere, 1),
+                             R"(<item objectid="1" transform="1 0 0 0 1 0 0 0 1 2 0 0"/>)", unit)),
+            ".3mf");
+        ASSERT_TRUE(read) << read.error().str();
+        EXPECT_LT(offSpheres(*read, {{2.0f * scale, 0.0f, 0.0f}}, scale).first, 1e-5f);
+    }
+    // Absent: millimetres, the specification's default.
+    std::string none = modelXml(meshObject(sphere, 1), R"(<item objectid="1"/>)");
+    none.erase(none.find("unit=\"centimeter\""), 17);
+    const auto inMillimetres = readTriangleMesh(threeMf(none), ".3mf");
+    ASSERT_TRUE(inMillimetres) << inMillimetres.error().str();
+    EXPECT_LT(offSpheres(*inMillimetres, {glm::vec3(0.0f)}, 0.1f).first, 1e-5f);
+    // A root in inches placing a part's millimetres one inch along x: 2.54 units, radius 0.1.
+    const std::string root =
+        modelXml(R"(<object id="2"><components><component objectid="1" )"
+                 R"(p:path="/3D/Objects/a.model" transform="1 0 0 0 1 0 0 0 1 1 0 0"/>)"
+                 R"(</components></object>)",
+                 R"(<item objectid="2"/>)", "inch", kProductionModel);
+    const auto mixed = readTriangleMesh(
+        threeMfProject(root,
+                       {{"3D/Objects/a.model", modelXml(meshObject(sphere, 1), "", "millimeter")}}),
+        ".3mf");
+    ASSERT_TRUE(mixed) << mixed.error().str();
+    EXPECT_LT(offSpheres(*mixed, {{2.54f, 0.0f, 0.0f}}, 0.1f).first, 1e-5f);
+    // What sdfcsg writes in each unit comes back at its printed size.
+    Mesh ball = icosphere(2);
+    for (LengthUnit unit : {LengthUnit::Millimeter, LengthUnit::Centimeter, LengthUnit::Inch}) {
+        const auto back = readTriangleMesh(encodeMesh(ball, MeshFormat::ThreeMf, unit), ".3mf");
+        ASSERT_TRUE(back) << back.error().str();
+        const float radius = float(millimetres(unit) / 10.0);
+        EXPECT_LT(offSpheres(*back, {glm::vec3(0.0f)}, radius).first, 1e-5f);
+    }
+    EXPECT_EQ(
+        readTriangleMesh(
+            threeMf(modelXml(meshObject(sphere, 1), R"(<item objectid="1"/>)", "furlong")), ".3mf")
+            .error()
+            .diagnostics[0]
+            .message,
+        "3D/3dmodel.model, line 1: a model unit \"furlong\" that is not micron, millimeter, "
+        "centimeter, inch, foot or meter");
+}
+
+// Extensions: those a model requires are read or the model refused; any other's elements are
+// skipped, wherever they are (3MF Core 2.3.1).
+TEST(MeshField, ThreeMfExtensions) {
+    const TriangleMesh sphere = triangles(icosphere(1));
+    auto text = [](const Result<TriangleMesh>& r) {
+        return r ? std::string("read") : r.error().diagnostics[0].message;
+    };
+    const std::string beams =
+        R"(xmlns:b="http://schemas.microsoft.com/3dmanufacturing/beamlattice/2017/02" )";
+    const std::string slices =
+        R"(xmlns:s="http://schemas.microsoft.com/3dmanufacturing/slice/2015/07" )";
+    auto read = [&](const std::string& more, const std::string& resources) {
+        return text(readTriangleMesh(
+            threeMf(modelXml(resources, R"(<item objectid="1"/>)", "centimeter", more)), ".3mf"));
+    };
+    const std::string ball = meshObject(sphere, 1);
+    EXPECT_EQ(read(R"(requiredextensions=" m " )", ball), "read");
+    EXPECT_EQ(read(beams + R"(requiredextensions="m b" )", ball),
+              "3D/3dmodel.model, line 1: a model that requires an extension that is not read, "
+              "\"http://schemas.microsoft.com/3dmanufacturing/beamlattice/2017/02\" (of those, "
+              "only materials and production are)");
+    EXPECT_EQ(read(R"(requiredextensions="sc" )", ball),
+              "3D/3dmodel.model, line 1: a model that requires the extension of prefix \"sc\", "
+              "which it does not declare");
+    // Not required: a slice stack among the resources, a beam lattice in the mesh, elements of
+    // no known namespace among the vertices and triangles and in the build, all skipped.
+    std::string lattice = ball;
+    lattice.insert(lattice.find("</mesh>"),
+                   R"(<b:beamlattice radius="1"><b:beams><b:beam v1="0" v2="9999"/></b:beams>)"
+                   R"(</b:beamlattice>)");
+    lattice.insert(lattice.find("<vertex "), R"(<x:vertex x="nan" y="0" z="0"/>)");
+    lattice.insert(lattice.find("<triangle "), R"(<x:triangle v1="0" v2="1" v3="99999"/>)");
+    const auto skipped = readTriangleMesh(
+        threeMf(modelXml(R"(<s:slicestack id="7"><s:slice ztop="1"/></s:slicestack>)" + lattice,
+                         R"(<x:item objectid="99"/><item objectid="1"/>)", "centimeter",
+                         beams + slices + R"(xmlns:x="urn:example:unknown" )")),
+        ".3mf");
+    ASSERT_TRUE(skipped) << skipped.error().str();
+    EXPECT_EQ(skipped->triangles.size(), sphere.triangles.size());
+    EXPECT_EQ(skipped->positions.size(), sphere.positions.size());
 }
 
 } // namespace

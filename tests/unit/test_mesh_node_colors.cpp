@@ -114,7 +114,7 @@ std::string twoColor3mf(const std::string& left, const std::string& right, bool 
                                   : "<m:colorgroup id=\"1\"><m:color color=\"" + left +
                                         "\"/><m:color color=\"" + right + "\"/></m:colorgroup>\n";
     const std::string model =
-        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<model unit=\"millimeter\" "
+        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<model unit=\"centimeter\" "
         "xmlns=\"http://schemas.microsoft.com/3dmanufacturing/core/2015/02\" "
         "xmlns:m=\"http://schemas.microsoft.com/3dmanufacturing/material/2015/"
         "02\">\n<resources>\n" +

@@ -31,7 +31,8 @@ enum class MeshFormat {
 // The length that one scene unit stands for, where the format says (3MF).
 enum class LengthUnit { Millimeter, Centimeter, Meter, Inch };
 // Scenes are modelled a few units across (the bundled ones 1.3 to 10): one unit a centimetre
-// prints them 1.3 to 10 cm wide, where millimetres, 3MF's own default, made a 1 mm pawn.
+// prints them 1.3 to 10 cm wide, where millimetres, 3MF's own default, made a 1 mm pawn. A mesh
+// node reads a 3MF's coordinates into this unit too, so that what is written comes back its size.
 inline constexpr LengthUnit kDefaultLengthUnit = LengthUnit::Centimeter;
 
 // The format named by a path's extension (case-insensitive), or nullopt.

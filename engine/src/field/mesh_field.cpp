@@ -5,6 +5,7 @@
 #include "mesh/radix_sort.h"
 #include "scene/files.h"
 #include "scene/parse_util.h"
+#include "sdfcsg/export.h"
 
 #include <assimp/BaseImporter.h>
 #include <assimp/IOSystem.hpp>
@@ -457,7 +458,8 @@ Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::strin
                                      colors.push_back(color);
                                      colored = colored || color != kNoColor;
                                  }};
-        if (const Status read = readThreeMf(bytes, out, kMaxMeshTriangles, 4 * kMaxMeshFileBytes);
+        if (const Status read = readThreeMf(bytes, out, kMaxMeshTriangles, 4 * kMaxMeshFileBytes,
+                                            millimetres(kDefaultLengthUnit));
             !read)
             return read.error();
     } else if (plainStl) {

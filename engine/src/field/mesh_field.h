@@ -44,15 +44,16 @@ inline constexpr uint32_t kNoColor = ~0u;
 // materials' diffuse or base colour (OBJ's .mtl Kd, glTF's baseColorFactor; Assimp's default
 // material is no colour, nor is an OBJ's Kd of its default grey 0.6, which a material missing
 // from the .mtl gets); a 3MF's per triangle or corner, from its base materials' display colours
-// and colour groups. glTF's linear colours are turned to sRGB. STL and
-// 3MF, made for printing, are z up (as sdfcsg writes them): they are turned so that their z is
-// +y. `bytes` is the file's contents and `extension` its name's (".stl", ...), which tells the
-// format. The files it names (a glTF's buffers, an OBJ's materials) are read from `folder` alone,
-// as an untrusted scene's are (SceneFiles): no absolute path, no "..", nothing outside it; none
-// where `folder` is empty.
-// Errors are the reason alone, for the caller to place ("not a mesh file that can be read: ...",
-// "no triangles", "more than N triangles", "a NaN or infinite vertex", a 3MF's "3D/3dmodel.model,
-// line 12: a triangle's v3 (7) past its object's 3 vertices").
+// and colour groups. A 3MF's unit is converted to centimetres, the scene unit that sdfcsg writes
+// 3MF in by default (kDefaultLengthUnit); other formats are read as their numbers are. glTF's
+// linear colours are turned to sRGB. STL and 3MF, made for printing, are z up (as sdfcsg writes
+// them): they are turned so that their z is +y. `bytes` is the file's contents and `extension` its
+// name's (".stl", ...), which tells the format. The files it names (a glTF's buffers, an OBJ's
+// materials) are read from `folder` alone, as an untrusted scene's are (SceneFiles): no absolute
+// path, no "..", nothing outside it; none where `folder` is empty. Errors are the reason alone, for
+// the caller to place ("not a mesh file that can be read: ...", "no triangles", "more than N
+// triangles", "a NaN or infinite vertex", a 3MF's "3D/3dmodel.model, line 12: a triangle's v3 (7)
+// past its object's 3 vertices").
 Result<TriangleMesh> readTriangleMesh(const std::string& bytes, const std::string& extension,
                                       const std::filesystem::path& folder = {});
 

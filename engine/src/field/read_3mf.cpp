@@ -39,7 +39,7 @@ constexpr std::string_view kCore = "http://schemas.microsoft.com/3dmanufacturing
 constexpr char kSeparator = '|'; // between a name's namespace and its local part, as expat gives
 // Objects, components and build items together, each a few dozen bytes of XML that costs more
 // than that to keep; and the colours of property groups.
-constexpr size_t kMaxParts = size_t(1) << 20, kMaxColors = size_t(1) << 24;
+constexpr size_t kMaxElements = size_t(1) << 20, kMaxColors = size_t(1) << 24;
 // Components within components: deeper is no model anyone makes. Objects placed, counted with
 // each component's: components of empty objects give no triangles but would still be walked.
 constexpr int kMaxDepth = 32;
@@ -162,7 +162,7 @@ std::optional<glm::mat4> parseTransform(std::string_view s) {
 }
 
 struct Component {
-    uint32_t object; // its index in ModelReader::objects_
+    uint32_t object; // its index in Package::objects
     glm::mat4 transform;
 };
 
@@ -185,6 +185,92 @@ struct PropertyGroup {
     std::vector<uint32_t> values;
 };
 
+// How many millimetres one unit of a model is (3MF Core 3.4, ST_Unit), or nullopt.
+std::optional<double> unitMillimetres(std::string_view unit) {
+    static constexpr std::pair<std::string_view, double> kUnits[] = {
+        {"micron", 0.001}, {"millimeter", 1.0}, {"centimeter", 10.0},
+        {"inch", 25.4},    {"foot", 304.8},     {"meter", 1000.0}};
+    for (const auto& [name, mm] : kUnits)
+        if (trimmed(unit) == name) return mm;
+    return std::nullopt;
+}
+
+// A p:path as the name of a ZIP entry, or nullopt where it is not a part of the package. A part
+// name is absolute ("/3D/Objects/object_1.model"), its segments neither empty, "." nor ".."
+// (ECMA-376 part 2, 9.1.1.1), so that it cannot reach outside the package; its ZIP entry is the
+// same name without the leading '/' (annex B.3): both are the URI's form, percent-encoded alike,
+// so they are compared as they are, only without case (M1.12).
+std::optional<std::string_view> partEntryName(std::string_view path) {
+    path = trimmed(path);
+    if (!path.starts_with('/')) return std::nullopt;
+    path.remove_prefix(1);
+    for (std::string_view rest = path;;) {
+        const size_t slash = rest.find('/');
+        const std::string_view segment = rest.substr(0, slash);
+        if (segment.empty() || segment == "." || segment == ".." ||
+            segment.find('\\') != std::string_view::npos)
+            return std::nullopt;
+        if (slash == std::string_view::npos) return path;
+        rest.remove_prefix(slash + 1);
+    }
+}
+
+bool sameName(std::string_view a, std::string_view b) {
+    return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
+               return std::tolower(uint8_t(x)) == std::tolower(uint8_t(y));
+           });
+}
+
+std::string lowered(std::string_view s) {
+    std::string out(s);
+    std::transform(out.begin(), out.end(), out.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
+    return out;
+}
+
+// The package and what its model parts hold together. How parts are looked up: the root model
+// (the one _rels/.rels names) is read first; a component or build item of it with a p:path names
+// an object of another model part, which is read whole the first time any names it - the root's
+// parsing waiting meanwhile - and its objects' ids kept under its name, so that every later
+// reference finds them there and no part is read twice. Only the root may name other parts
+// (Production Extension 3.2: a p:path anywhere else is an error), so parts are one level deep
+// and cannot name each other in a cycle; their builds are ignored, as that section requires.
+struct Package {
+    struct Part {
+        std::unordered_map<uint32_t, uint32_t> ids; // object id -> index in objects
+        double unit = 1.0;                          // millimetres per unit of its coordinates
+    };
+
+    Package(std::string_view bytes, std::vector<ZipDirectoryEntry> entries, size_t triangleLimit,
+            uint64_t byteLimit)
+        : file(bytes), directory(std::move(entries)), maxTriangles(triangleLimit),
+          maxBytes(byteLimit) {
+        for (const ZipDirectoryEntry& e : directory)
+            byName.emplace(lowered(e.name), &e); // the first of a name, as a scan would find
+    }
+    Package(const Package&) = delete;
+    Package& operator=(const Package&) = delete;
+
+    // The entry `name`, found without case (ECMA-376 part 2, requirement M1.12) and at once:
+    // every p:path is looked up.
+    const ZipDirectoryEntry* find(std::string_view name) const {
+        const auto it = byName.find(lowered(name));
+        return it == byName.end() ? nullptr : it->second;
+    }
+
+    std::string_view file;
+    const std::vector<ZipDirectoryEntry> directory;
+    std::unordered_map<std::string, const ZipDirectoryEntry*> byName; // by lower-case name
+    std::string root = "3D/3dmodel.model";                            // the root model's entry name
+    size_t maxTriangles;
+    uint64_t maxBytes;
+
+    std::vector<Object> objects;                 // every part's
+    std::unordered_map<std::string, Part> parts; // those read, by their entry name in lower case
+    size_t elements = 0, vertices = 0, triangles = 0, colors = 0;
+    uint64_t unpacked = 0; // bytes of model parts inflated, all of them together
+};
+
 enum class Tag : uint8_t {
     Other, // unknown, or an extension's that holds nothing to read: it and all within it skipped
     Model,
@@ -201,10 +287,18 @@ enum class Tag : uint8_t {
 
 class ModelReader {
   public:
-    ModelReader(std::string part, size_t maxTriangles)
-        : part_(std::move(part)), maxTriangles_(maxTriangles) {
+    // Reads the model part `part` of `package`, its root model where `root`.
+    ModelReader(Package& package, std::string part, bool root)
+        : package_(package), part_(std::move(part)), root_(root) {
         parser_ = XML_ParserCreateNS(nullptr, kSeparator);
         XML_SetUserData(parser_, this);
+        // The prefixes the root element declares, which its requiredextensions names.
+        XML_SetStartNamespaceDeclHandler(parser_,
+                                         [](void* self, const char* prefix, const char* uri) {
+                                             auto& reader = *static_cast<ModelReader*>(self);
+                                             if (reader.open_.empty() && prefix)
+                                                 reader.declared_[prefix] = uri ? uri : "";
+                                         });
         XML_SetElementHandler(
             parser_,
             [](void* self, const char* name, const char** atts) {
@@ -223,6 +317,14 @@ class ModelReader {
     // Parses the next piece of the document (the last where `last`); false once it has failed.
     bool feed(std::string_view piece, bool last) {
         if (error_) return false;
+        if ((package_.unpacked += piece.size()) > package_.maxBytes) {
+            const uint64_t limit = package_.maxBytes;
+            error_ = part_ + ": the model parts unpack to more than " +
+                     (limit % (1 << 20) == 0 ? std::to_string(limit >> 20) + " MiB"
+                                             : std::to_string(limit) + " bytes") +
+                     " together";
+            return false;
+        }
         if (XML_Parse(parser_, piece.data(), int(piece.size()), last) == XML_STATUS_ERROR) {
             if (!error_) error_ = where() + XML_ErrorString(XML_GetErrorCode(parser_));
             return false;
@@ -241,15 +343,19 @@ class ModelReader {
         return true;
     }
     const std::optional<std::string>& error() const { return error_; }
-
-    Status emit(const ThreeMfCorners& out) const;
+    // Whether its root element was a 3MF model.
+    bool rooted() const { return rooted_; }
+    double unit() const { return unit_; }
+    const std::vector<Component>& items() const { return items_; }
 
   private:
     std::string where() const {
         return part_ + ", line " + std::to_string(XML_GetCurrentLineNumber(parser_)) + ": ";
     }
-    void fail(const std::string& text) {
-        if (!error_) error_ = where() + text;
+    void fail(const std::string& text) { failWith(where() + text); }
+    // Fails with a message that names its own part and line: another part's.
+    void failWith(const std::string& message) {
+        if (!error_) error_ = message;
         XML_StopParser(parser_, XML_FALSE);
     }
 
@@ -282,37 +388,15 @@ class ModelReader {
         if (!v) fail(std::string("a ") + element + " without its " + what);
         return bool(v);
     }
-    bool countPart() {
-        if (++parts_ <= kMaxParts) return true;
-        fail("more than " + std::to_string(kMaxParts) + " objects, components and build items");
+    bool countElement() {
+        if (++package_.elements <= kMaxElements) return true;
+        fail("more than " + std::to_string(kMaxElements) + " objects, components and build items");
         return false;
     }
-    // The object that `atts`' objectid names, defined before it; nullopt after failing.
-    std::optional<uint32_t> namedObject(const char** atts, const char* element) {
-        std::optional<uint32_t> id;
-        if (!required(atts, "objectid", element, id)) return std::nullopt;
-        if (attribute(atts, "path", kProduction)) {
-            fail(std::string("a ") + element +
-                 " of an object in another model part (p:path), which is not read");
-            return std::nullopt;
-        }
-        const auto it = objectIds_.find(*id);
-        if (it == objectIds_.end()) {
-            fail(std::string("a ") + element + " names object " + std::to_string(*id) +
-                 ", which no object before it defines");
-            return std::nullopt;
-        }
-        return it->second;
-    }
-    std::optional<glm::mat4> transform(const char** atts, const char* element) {
-        const char* text = attribute(atts, "transform");
-        if (!text) return glm::mat4(1.0f);
-        auto m = parseTransform(text);
-        if (!m)
-            fail(std::string("a ") + element + "'s transform " + quoted(text) +
-                 " that is not 12 finite numbers");
-        return m;
-    }
+    // The object that `atts`' objectid names, defined before it in this part or in the one its
+    // p:path names, placed by its transform: a component or build item; nullopt after failing.
+    std::optional<Component> placed(const char** atts, const char* element);
+    const Package::Part* otherPart(const char* path, const char* element);
     bool newResource(uint32_t id) {
         if (objectIds_.count(id) || groups_.count(id)) {
             fail("two resources of id " + std::to_string(id));
@@ -326,21 +410,128 @@ class ModelReader {
     void vertex(const char** atts);
     void triangle(const char** atts);
 
+    void model(const char** atts);
+
+    Package& package_;
     XML_Parser parser_;
     std::string part_;
-    size_t maxTriangles_;
+    bool root_, rooted_ = false;
+    double unit_ = 1.0; // millimetres per unit of its coordinates
     std::optional<std::string> error_;
-    std::vector<Tag> open_; // the elements open, outermost first
+    std::vector<Tag> open_;                                 // the elements open, outermost first
+    std::unordered_map<std::string, std::string> declared_; // the root's prefixes -> namespaces
 
-    std::vector<Object> objects_;
-    std::unordered_map<uint32_t, uint32_t> objectIds_; // id -> index in objects_
+    std::unordered_map<uint32_t, uint32_t> objectIds_; // id -> index in package_.objects
     std::optional<uint32_t> objectId_;                 // of the object being read
+    uint32_t current_ = 0;                             // its index in package_.objects
     std::unordered_map<uint32_t, PropertyGroup> groups_;
     PropertyGroup* group_ = nullptr; // the one being read
     std::vector<Component> items_;
-    size_t parts_ = 0, vertices_ = 0, triangles_ = 0, colors_ = 0;
     uint64_t fed_ = 0; // bytes of the document given to expat
 };
+
+// The model element: its unit, and the extensions it requires, of which only the materials' and
+// the production extension's are read (3MF Core 2.3.1: a consumer refuses a document requiring
+// one it does not support; any other extension's elements it skips).
+void ModelReader::model(const char** atts) {
+    rooted_ = true;
+    if (const char* unit = attribute(atts, "unit")) {
+        const auto mm = unitMillimetres(unit);
+        if (!mm)
+            return fail("a model unit " + quoted(unit) +
+                        " that is not micron, millimeter, centimeter, inch, foot or meter");
+        unit_ = *mm;
+    }
+    const char* required = attribute(atts, "requiredextensions");
+    for (std::string_view rest = required ? required : ""; !(rest = trimmed(rest)).empty();) {
+        const size_t space = rest.find_first_of(" \t\n\r");
+        const std::string prefix(rest.substr(0, space));
+        rest.remove_prefix(prefix.size());
+        const auto uri = declared_.find(prefix);
+        if (uri == declared_.end())
+            return fail("a model that requires the extension of prefix " + quoted(prefix.c_str()) +
+                        ", which it does not declare");
+        if (uri->second != kMaterial && uri->second != kProduction)
+            return fail("a model that requires an extension that is not read, \"" +
+                        uri->second.substr(0, 100) + (uri->second.size() > 100 ? "...\"" : "\"") +
+                        " (of those, only materials and production are)");
+    }
+}
+
+const Package::Part* ModelReader::otherPart(const char* path, const char* element) {
+    const std::string what = std::string("a ") + element + "'s p:path " + quoted(path);
+    if (!root_) {
+        fail(what + " outside the root model (" + package_.root +
+             "), which the production extension forbids");
+        return nullptr;
+    }
+    const auto name = partEntryName(path);
+    if (!name) {
+        fail(what + " that is not an absolute part name, such as \"/3D/Objects/object_1.model\"");
+        return nullptr;
+    }
+    const std::string key = lowered(*name);
+    if (const auto known = package_.parts.find(key); known != package_.parts.end())
+        return &known->second;
+    const ZipDirectoryEntry* entry = package_.find(*name);
+    if (!entry) {
+        fail(what + " naming a part the package does not hold");
+        return nullptr;
+    }
+    ModelReader part(package_, entry->name, false);
+    const Status unpacked =
+        zipUnpack(package_.file, *entry, package_.maxBytes,
+                  [&](std::string_view piece) { return part.feed(piece, false); });
+    if (!part.error() && unpacked) part.feed({}, true);
+    // An error before its root element, within the bytes it may unpack: no model.
+    if (part.error() && !part.rooted() && package_.unpacked <= package_.maxBytes) {
+        // Its own message names it: what follows its name is why it is no model.
+        const std::string& why = *part.error();
+        fail(what + " naming " + entry->name + ", which is not a 3MF model part (" +
+             why.substr(std::min(why.size(), entry->name.size() + 2)) + ")");
+        return nullptr;
+    }
+    if (part.error() || !unpacked) {
+        failWith(part.error() ? *part.error() : unpacked.error().diagnostics[0].message);
+        return nullptr;
+    }
+    return &(package_.parts[key] = {std::move(part.objectIds_), part.unit_});
+}
+
+std::optional<Component> ModelReader::placed(const char** atts, const char* element) {
+    std::optional<uint32_t> id;
+    if (!required(atts, "objectid", element, id)) return std::nullopt;
+    const std::unordered_map<uint32_t, uint32_t>* ids = &objectIds_;
+    double scale = 1.0; // from the other part's unit to this one's
+    const char* path = attribute(atts, "path", kProduction);
+    const auto name = path ? partEntryName(path) : std::nullopt;
+    if (path && (!root_ || !(name && sameName(*name, part_)))) { // the root's own is no other
+        const Package::Part* part = otherPart(path, element);
+        if (!part) return std::nullopt;
+        ids = &part->ids;
+        scale = part->unit / unit_;
+    }
+    const auto it = ids->find(*id);
+    if (it == ids->end()) {
+        fail(std::string("a ") + element + " names object " + std::to_string(*id) +
+             (ids == &objectIds_ ? ", which no object before it defines"
+                                 : " of " + std::string(trimmed(path)) + ", which defines none"));
+        return std::nullopt;
+    }
+    glm::mat4 m(1.0f);
+    if (const char* text = attribute(atts, "transform")) {
+        const auto parsed = parseTransform(text);
+        if (!parsed) {
+            fail(std::string("a ") + element + "'s transform " + quoted(text) +
+                 " that is not 12 finite numbers");
+            return std::nullopt;
+        }
+        m = *parsed;
+    }
+    if (scale != 1.0) m = m * glm::mat4(glm::mat3(float(scale)));
+    if (!countElement()) return std::nullopt;
+    return Component{it->second, m};
+}
 
 void ModelReader::start(const char* name, const char** atts) {
     // Its tag is pushed first: expat may still call end() for it after a failure stops parsing.
@@ -360,24 +551,27 @@ void ModelReader::start(const char* name, const char** atts) {
             return;
         }
         tag = Tag::Model;
+        model(atts);
     } else if (parent == Tag::Other || parent == Tag::Leaf) {
         tag = Tag::Other;
     } else if (parent == Tag::Model && core) {
-        tag = n.local == "resources" ? Tag::Resources
-              : n.local == "build"   ? Tag::Build
-                                     : Tag::Other;
+        // Only the root's build places objects (Production Extension 2).
+        tag = n.local == "resources"        ? Tag::Resources
+              : n.local == "build" && root_ ? Tag::Build
+                                            : Tag::Other;
     } else if (parent == Tag::Resources && core && n.local == "object") {
         tag = Tag::Object;
         std::optional<uint32_t> id;
         Object o;
         if (!required(atts, "id", "object", id) || !newResource(*id) ||
             !index(atts, "pid", "object", o.pid) || !index(atts, "pindex", "object", o.pindex) ||
-            !countPart())
+            !countElement())
             return;
         const char* type = attribute(atts, "type");
         o.model = !type || trimmed(type) == "model";
         objectId_ = id;
-        objects_.push_back(std::move(o));
+        current_ = uint32_t(package_.objects.size());
+        package_.objects.push_back(std::move(o));
     } else if (parent == Tag::Resources &&
                ((core && n.local == "basematerials") || (material && n.local == "colorgroup") ||
                 (material && (n.local == "texture2dgroup" || n.local == "compositematerials" ||
@@ -406,9 +600,9 @@ void ModelReader::start(const char* name, const char** atts) {
         triangle(atts);
     } else if (parent == Tag::Components && core && n.local == "component") {
         tag = Tag::Leaf;
-        const auto object = namedObject(atts, "component");
-        const auto m = object ? transform(atts, "component") : std::nullopt;
-        if (m && countPart()) objects_.back().components.push_back({*object, *m});
+        // Placed before the object is taken: another part read for it adds objects.
+        if (const auto c = placed(atts, "component"))
+            package_.objects[current_].components.push_back(*c);
     } else if (parent == Tag::Colors &&
                ((core && n.local == "base") || (material && n.local == "color"))) {
         tag = Tag::Leaf;
@@ -419,15 +613,13 @@ void ModelReader::start(const char* name, const char** atts) {
             fail("a <" + std::string(n.local) + "> without its " + what);
         else if (!color)
             fail("a colour " + quoted(text) + " that is not #RRGGBB or #RRGGBBAA");
-        else if (++colors_ > kMaxColors)
+        else if (++package_.colors > kMaxColors)
             fail("more than " + std::to_string(kMaxColors) + " colours");
         else
             group_->values.push_back(*color);
     } else if (parent == Tag::Build && core && n.local == "item") {
         tag = Tag::Leaf;
-        const auto object = namedObject(atts, "build item");
-        const auto m = object ? transform(atts, "build item") : std::nullopt;
-        if (m && countPart()) items_.push_back({*object, *m});
+        if (const auto item = placed(atts, "build item")) items_.push_back(*item);
     }
 }
 
@@ -437,10 +629,10 @@ void ModelReader::end() {
     if (error_) return;
     if (tag == Tag::Object && objectId_) {
         // Its count and depth, from its components' (all defined before it, so never itself).
-        Object& o = objects_.back();
+        Object& o = package_.objects[current_];
         o.count = o.triangles.size();
         for (const Component& c : o.components) {
-            const Object& part = objects_[c.object];
+            const Object& part = package_.objects[c.object];
             o.count = std::min(o.count + part.count, kCountCap);
             o.visits = std::min(o.visits + part.visits, kCountCap);
             o.depth = std::max(o.depth, part.depth + 1);
@@ -450,7 +642,7 @@ void ModelReader::end() {
             fail("components nested more than " + std::to_string(kMaxDepth) + " deep");
             return;
         }
-        objectIds_[*objectId_] = uint32_t(objects_.size() - 1);
+        objectIds_[*objectId_] = current_;
         objectId_.reset();
     }
     if (tag == Tag::Colors) group_ = nullptr;
@@ -472,13 +664,13 @@ void ModelReader::vertex(const char** atts) {
     }
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
         return fail("a NaN or infinite vertex");
-    if (++vertices_ > 3 * maxTriangles_)
-        return fail("more than " + std::to_string(3 * maxTriangles_) + " vertices");
-    objects_.back().vertices.push_back(p);
+    if (++package_.vertices > 3 * package_.maxTriangles)
+        return fail("more than " + std::to_string(3 * package_.maxTriangles) + " vertices");
+    package_.objects[current_].vertices.push_back(p);
 }
 
 void ModelReader::triangle(const char** atts) {
-    Object& o = objects_.back();
+    Object& o = package_.objects[current_];
     std::optional<uint32_t> v[3], pid, p[3];
     static constexpr std::string_view kNames[] = {"v1", "v2", "v3", "p1", "p2", "p3", "pid"};
     const auto texts = attributes(atts, kNames);
@@ -494,8 +686,8 @@ void ModelReader::triangle(const char** atts) {
                         ") past its object's " + std::to_string(o.vertices.size()) + " vertices");
     }
     if (!index(texts[6], "pid", "triangle", pid)) return;
-    if (++triangles_ > maxTriangles_)
-        return fail("more than " + std::to_string(maxTriangles_) + " triangles");
+    if (++package_.triangles > package_.maxTriangles)
+        return fail("more than " + std::to_string(package_.maxTriangles) + " triangles");
     o.triangles.push_back({*v[0], *v[1], *v[2]});
     // Its colours: its own property group and indices, else its object's.
     if (!pid) pid = o.pid;
@@ -528,14 +720,17 @@ void ModelReader::triangle(const char** atts) {
     if (o.colored) o.colors.insert(o.colors.end(), colors, colors + 3);
 }
 
-Status ModelReader::emit(const ThreeMfCorners& out) const {
+// The triangles of the build's `items`, each scaled by `scale` last.
+Status emit(const Package& package, const std::vector<Component>& items, float scale,
+            const ThreeMfCorners& out) {
+    const std::vector<Object>& objects = package.objects;
     uint64_t total = 0, placed = 0;
-    for (const Component& item : items_) {
-        total = std::min(total + objects_[item.object].count, kCountCap);
-        placed = std::min(placed + objects_[item.object].visits, kCountCap);
+    for (const Component& item : items) {
+        total = std::min(total + objects[item.object].count, kCountCap);
+        placed = std::min(placed + objects[item.object].visits, kCountCap);
     }
-    if (total > maxTriangles_)
-        return problem("more than " + std::to_string(maxTriangles_) + " triangles (" +
+    if (total > package.maxTriangles)
+        return problem("more than " + std::to_string(package.maxTriangles) + " triangles (" +
                        (total == kCountCap ? std::string("far more") : std::to_string(total)) +
                        ")");
     if (placed > kMaxPlaced)
@@ -543,12 +738,13 @@ Status ModelReader::emit(const ThreeMfCorners& out) const {
                        " times");
     out.begin(size_t(total));
     std::vector<Component> stack;
-    for (const Component& item : items_) {
-        stack.push_back(item);
+    const glm::mat4 scaled{glm::mat3(scale)};
+    for (const Component& item : items) {
+        stack.push_back({item.object, scale == 1.0f ? item.transform : scaled * item.transform});
         while (!stack.empty()) {
             const Component visit = stack.back();
             stack.pop_back();
-            const Object& o = objects_[visit.object];
+            const Object& o = objects[visit.object];
             if (!o.model) continue;
             for (const Component& c : o.components)
                 stack.push_back({c.object, visit.transform * c.transform});
@@ -606,26 +802,14 @@ Result<std::string> modelPartName(std::string_view rels) {
     return state.target.substr(slash);
 }
 
-bool sameName(std::string_view a, std::string_view b) {
-    return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
-               return std::tolower(uint8_t(x)) == std::tolower(uint8_t(y));
-           });
-}
-
 } // namespace
 
 Status readThreeMf(std::string_view file, const ThreeMfCorners& out, size_t maxTriangles,
-                   uint64_t maxModelBytes) {
-    const auto directory = zipDirectory(file);
+                   uint64_t maxModelBytes, double unitMillimetres) {
+    auto directory = zipDirectory(file);
     if (!directory) return problem("not a 3MF file: " + directory.error().diagnostics[0].message);
-    // Part names are compared without case (ECMA-376 part 2, requirement M1.12).
-    const auto find = [&](std::string_view name) -> const ZipDirectoryEntry* {
-        for (const ZipDirectoryEntry& e : *directory)
-            if (sameName(e.name, name)) return &e;
-        return nullptr;
-    };
-    std::string modelName = "3D/3dmodel.model";
-    if (const ZipDirectoryEntry* rels = find("_rels/.rels")) {
+    Package package(file, std::move(*directory), maxTriangles, maxModelBytes);
+    if (const ZipDirectoryEntry* rels = package.find("_rels/.rels")) {
         std::string text;
         const Status unpacked = zipUnpack(file, *rels, uint64_t(1) << 20, [&](std::string_view s) {
             text += s;
@@ -634,18 +818,19 @@ Status readThreeMf(std::string_view file, const ThreeMfCorners& out, size_t maxT
         if (!unpacked) return unpacked.error();
         auto named = modelPartName(text);
         if (!named) return named.error();
-        if (!named->empty()) modelName = *named;
+        if (!named->empty()) package.root = *named;
     }
-    const ZipDirectoryEntry* model = find(modelName);
-    if (!model) return problem("a 3MF without its model part (" + modelName + ")");
-    ModelReader reader(model->name, maxTriangles);
+    const ZipDirectoryEntry* model = package.find(package.root);
+    if (!model) return problem("a 3MF without its model part (" + package.root + ")");
+    package.root = model->name;
+    ModelReader reader(package, model->name, true);
     const Status unpacked = zipUnpack(file, *model, maxModelBytes, [&](std::string_view piece) {
         return reader.feed(piece, false);
     });
     if (reader.error()) return problem(*reader.error());
     if (!unpacked) return unpacked.error();
     if (!reader.feed({}, true)) return problem(*reader.error());
-    return reader.emit(out);
+    return emit(package, reader.items(), float(reader.unit() / unitMillimetres), out);
 }
 
 } // namespace sdfcsg::detail

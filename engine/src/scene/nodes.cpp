@@ -921,8 +921,9 @@ constexpr KindInfo kKinds[] = {
          return true;
      }},
     {NodeKind::Mesh, "mesh", false, kMesh,
-     "A triangle mesh read from a file, in the file's units or scaled to fit a box, STL and 3MF "
-     "turned from z up to y up "
+     "A triangle mesh read from a file, in the file's units (a 3MF's converted to centimetres, "
+     "the scene unit sdfcsg writes 3MF in) or scaled to fit a box, STL and 3MF turned from z up "
+     "to y up "
      "(only where the user names a file). "
      "Its field is the distance to the triangles, exact near the surface (sampled in bricks, "
      "interpolated) and a bound beyond; the inside is what the generalised winding number "
