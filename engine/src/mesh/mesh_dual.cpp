@@ -11,6 +11,8 @@
 #include <array>
 #include <cmath>
 #include <thread>
+#include <tuple>
+#include <type_traits>
 #include <unordered_map>
 
 namespace sdfcsg::detail {
@@ -74,6 +76,23 @@ Diagonal diagonalOf(const Mesh& mesh, const Quad& q) {
 // sheet thinner than a cell passes through it, does not pass or fail by rounding.
 constexpr float kLeastCosine = 0.1f;
 
+// How triangle (u, v, w) faces the field: the cosine between it and the field's gradient at its
+// centre (tetrahedral differences a hundredth of a cell `h` wide, as in the tests' check), less
+// kLeastCosine; 1 where the gradient gives no direction.
+float fieldFacing(const Mesh& mesh, const Distance& distance, float h, uint32_t u, uint32_t v,
+                  uint32_t w) {
+    const std::vector<glm::vec3>& p = mesh.positions;
+    const glm::vec3 c = glm::cross(p[v] - p[u], p[w] - p[u]);
+    const glm::vec3 centre = (p[u] + p[v] + p[w]) / 3.0f;
+    const glm::vec3 taps[4] = {{1, -1, -1}, {-1, -1, 1}, {-1, 1, -1}, {1, 1, 1}};
+    glm::vec3 g(0.0f);
+    for (const glm::vec3& tap : taps)
+        g += tap * distance(centre + tap * (0.01f * h));
+    const float gg = glm::dot(g, g);
+    if (!(gg > 0.0f)) return 1.0f; // no direction to judge by
+    return glm::dot(c, g) / std::sqrt(glm::dot(c, c) * gg) - kLeastCosine;
+}
+
 // How triangle (u, v, w) faces, positive where it does not fold. By its vertices' normals alone
 // it folds (-2, below any cosine) where it faces nearly a right angle or more away from their
 // mean (a triangle of a wedge of the solid as sharp as 30 degrees faces within 75 degrees of it,
@@ -93,14 +112,7 @@ float facing(const Mesh& mesh, const Distance& distance, float h, uint32_t u, ui
     if (!distance || (!always && glm::dot(c, n[u]) >= least && glm::dot(c, n[v]) >= least &&
                       glm::dot(c, n[w]) >= least))
         return 1.0f;
-    const glm::vec3 centre = (p[u] + p[v] + p[w]) / 3.0f;
-    const glm::vec3 taps[4] = {{1, -1, -1}, {-1, -1, 1}, {-1, 1, -1}, {1, 1, 1}};
-    glm::vec3 g(0.0f);
-    for (const glm::vec3& tap : taps)
-        g += tap * distance(centre + tap * (0.01f * h));
-    const float gg = glm::dot(g, g);
-    if (!(gg > 0.0f)) return 1.0f; // no direction to judge by
-    return glm::dot(c, g) / std::sqrt(cc * gg) - kLeastCosine;
+    return fieldFacing(mesh, distance, h, u, v, w);
 }
 
 // Writes quad q into t split along a-c, as (a, b, c), (a, c, d), or along b-d, as (a, b, d),
@@ -902,6 +914,187 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
                             fans.begin() + ends[i]);
     }
     return result;
+}
+
+size_t unfoldVertices(Mesh& mesh, glm::vec3 origin, float h, const Distance& distance) {
+    if (!distance) return 0;
+    const size_t triangles = mesh.triangleCount();
+    const std::vector<glm::vec3>& p = mesh.positions;
+    // How triangle t faces the field (fieldFacing()); a triangle without a plane (as the tests'
+    // check sees it: its height under 1e-4 of a cell) counts as folding.
+    auto faces = [&](size_t t) {
+        const uint32_t* v = &mesh.indices[3 * t];
+        const glm::vec3 a = p[v[0]], b = p[v[1]], c = p[v[2]];
+        const float longest =
+            std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
+        if (!(glm::length(glm::cross(b - a, c - a)) > 1e-4f * h * longest)) return -2.0f;
+        return fieldFacing(mesh, distance, h, v[0], v[1], v[2]);
+    };
+    // Whether triangle t faces against its vertices' normals (their sum).
+    auto againstNormals = [&](size_t t) {
+        const uint32_t* v = &mesh.indices[3 * t];
+        const std::vector<glm::vec3>& n = mesh.normals;
+        return glm::dot(glm::cross(p[v[1]] - p[v[0]], p[v[2]] - p[v[0]]),
+                        n[v[0]] + n[v[1]] + n[v[2]]) < 0.0f;
+    };
+    // The vertices of the triangles that fold, in order. The field is asked only where a
+    // triangle faces more than 10 degrees away from one of its vertices' normals (as at a sharp
+    // feature, or on a surface curved within a few cells): one that faces like its vertices'
+    // normals, across a groove thinner than a cell, may still face away from the field where
+    // its centre lies near the groove's wall.
+    std::vector<uint32_t> moving, theirs;
+    inHalves(triangles, [&](size_t begin, size_t end, int half) {
+        std::vector<uint32_t>& found = half == 0 ? moving : theirs;
+        const std::vector<glm::vec3>& n = mesh.normals;
+        for (size_t t = begin; t < end; ++t) {
+            const uint32_t* v = &mesh.indices[3 * t];
+            const glm::vec3 c = glm::cross(p[v[1]] - p[v[0]], p[v[2]] - p[v[0]]);
+            const float least = 0.985f * glm::length(c); // cos 10 degrees
+            if ((glm::dot(c, n[v[0]]) >= least && glm::dot(c, n[v[1]]) >= least &&
+                 glm::dot(c, n[v[2]]) >= least) ||
+                faces(t) >= 0.0f)
+                continue;
+            found.insert(found.end(), v, v + 3);
+        }
+    });
+    moving.insert(moving.end(), theirs.begin(), theirs.end());
+    if (moving.empty()) return 0;
+    std::sort(moving.begin(), moving.end());
+    moving.erase(std::unique(moving.begin(), moving.end()), moving.end());
+    // The triangles by the cell of their centre, (cell, triangle) sorted, to find those near a
+    // vertex: a triangle spans at most two cells along each axis, so those that may meet a
+    // vertex's triangles have their centres within three cells of it.
+    auto cellKey = [&](glm::ivec3 c) {
+        c += 8; // cells just outside the grid's corner
+        return uint64_t(uint32_t(c.x)) | uint64_t(uint32_t(c.y)) << 21 |
+               uint64_t(uint32_t(c.z)) << 42;
+    };
+    auto cellOf = [&](glm::vec3 x) { return glm::ivec3(glm::floor((x - origin) / h)); };
+    std::vector<std::pair<uint64_t, uint32_t>> byCell(triangles);
+    glm::vec3 lo(INFINITY), hi(-INFINITY);
+    for (size_t t = 0; t < triangles; ++t) {
+        const uint32_t* v = &mesh.indices[3 * t];
+        byCell[t] = {cellKey(cellOf((p[v[0]] + p[v[1]] + p[v[2]]) / 3.0f)), uint32_t(t)};
+    }
+    for (const glm::vec3& x : p) {
+        lo = glm::min(lo, x);
+        hi = glm::max(hi, x);
+    }
+    std::sort(byCell.begin(), byCell.end());
+    const double tolerance = 1e-6 * double(glm::length(hi - lo)); // findSelfIntersections'
+
+    // Each vertex in turn, at each candidate point of its cell: its triangles that fold by the
+    // field, whether it lies far from the surface, its triangles that face against their
+    // vertices' normals (as the shading sees them), and the least facing of its triangles. It
+    // moves to the best candidate better than where it is whose triangles meet no more others
+    // than they did.
+    std::vector<uint32_t> local, star, saved;
+    std::vector<std::pair<uint32_t, uint32_t>> pairs;
+    size_t moved = 0;
+    for (uint32_t v : moving) {
+        const glm::vec3 placed = p[v];
+        const glm::ivec3 c = cellOf(placed);
+        local.clear();
+        for (int x = -3; x <= 3; ++x)
+            for (int y = -3; y <= 3; ++y)
+                for (int z = -3; z <= 3; ++z) {
+                    const uint64_t key = cellKey(c + glm::ivec3(x, y, z));
+                    for (auto it =
+                             std::lower_bound(byCell.begin(), byCell.end(), std::pair{key, 0u});
+                         it != byCell.end() && it->first == key; ++it)
+                        local.push_back(it->second);
+                }
+        std::sort(local.begin(), local.end());
+        star.clear();
+        for (uint32_t t : local) {
+            const uint32_t* k = &mesh.indices[3 * size_t(t)];
+            if (k[0] == v || k[1] == v || k[2] == v) star.push_back(t);
+        }
+        auto score = [&](glm::vec3 at) {
+            mesh.positions[v] = at;
+            int folds = 0, against = 0;
+            float least = 1.0f;
+            for (uint32_t t : star) {
+                const float f = faces(t);
+                folds += f < 0.0f;
+                against += againstNormals(t);
+                least = std::min(least, f);
+            }
+            const bool far = !(std::abs(distance(at)) <= 0.45f * h);
+            return std::tuple{folds, far, against, -least};
+        };
+        const auto now = score(placed);
+        if (std::get<0>(now) == 0) {
+            mesh.positions[v] = placed;
+            continue;
+        }
+        // Within its cell, and on the faces of its cell that it lies on (a fan's edge and face
+        // points): there the fans stay inside their cells.
+        const glm::vec3 cell = origin + glm::vec3(c) * h;
+        glm::vec3 inLo = cell + kInset * h, inHi = cell + (1.0f - kInset) * h;
+        for (int k = 0; k < 3; ++k) {
+            const float at = (placed[k] - origin[k]) / h;
+            if (std::abs(at - std::round(at)) <= 1e-3f) inLo[k] = inHi[k] = placed[k];
+        }
+        // Candidates: the points of a lattice of 3^3 in the cell, then where none of them
+        // unfolds all its triangles, of one of 5^3, each as it is and moved onto the surface,
+        // those nearest to where the vertex is first (where the QEF or the steps before put it,
+        // on the sharp features). The search ends once kTries of them unfold all its triangles.
+        using Score = std::remove_const_t<decltype(now)>;
+        std::vector<std::pair<Score, glm::vec3>> better;
+        std::vector<glm::vec3> lattice;
+        constexpr size_t kTries = 8;
+        size_t unfolding = 0;
+        for (const int steps : {3, 5}) {
+            if (unfolding > 0) break;
+            lattice.clear();
+            for (int x = 0; x < steps; ++x)
+                for (int y = 0; y < steps; ++y)
+                    for (int z = 0; z < steps; ++z)
+                        lattice.push_back(glm::clamp(
+                            cell + (glm::vec3(x, y, z) + 0.5f) / float(steps) * h, inLo, inHi));
+            std::stable_sort(lattice.begin(), lattice.end(), [&](glm::vec3 x, glm::vec3 y) {
+                return glm::dot(x - placed, x - placed) < glm::dot(y - placed, y - placed);
+            });
+            for (const glm::vec3& q : lattice) {
+                for (const glm::vec3& at : {q, towardSurface(distance, q, inLo, inHi, h)})
+                    if (const auto s = score(at); s < now) {
+                        better.push_back({s, at});
+                        unfolding += std::get<0>(s) == 0;
+                    }
+                if (unfolding >= kTries) break;
+            }
+        }
+        std::stable_sort(better.begin(), better.end(),
+                         [](const auto& x, const auto& y) { return x.first < y.first; });
+        // How many pairs of the vertex's triangles and others meet, with it at `at`.
+        saved.clear();
+        for (uint32_t t : local)
+            saved.insert(saved.end(), &mesh.indices[3 * size_t(t)],
+                         &mesh.indices[3 * size_t(t)] + 3);
+        auto meeting = [&](glm::vec3 at) {
+            mesh.positions[v] = at;
+            pairs.clear();
+            std::swap(mesh.indices, saved);
+            findSelfIntersections(mesh, tolerance, 1e-3, &pairs);
+            std::swap(mesh.indices, saved);
+            size_t count = 0;
+            for (const auto& [a, b] : pairs)
+                count += std::binary_search(star.begin(), star.end(), local[a]) ||
+                         std::binary_search(star.begin(), star.end(), local[b]);
+            return count;
+        };
+        const size_t before = better.empty() ? 0 : meeting(placed);
+        mesh.positions[v] = placed;
+        for (size_t k = 0; k < better.size() && k < kTries; ++k) {
+            if (meeting(better[k].second) <= before) {
+                ++moved;
+                break;
+            }
+            mesh.positions[v] = placed;
+        }
+    }
+    return moved;
 }
 
 } // namespace sdfcsg::detail
