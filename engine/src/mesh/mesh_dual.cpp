@@ -984,10 +984,9 @@ size_t unfoldVertices(Mesh& mesh, glm::vec3 origin, float h, const Distance& dis
     const double tolerance = 1e-6 * double(glm::length(hi - lo)); // findSelfIntersections'
 
     // Each vertex in turn, at each candidate point of its cell: its triangles that fold by the
-    // field, whether it lies far from the surface, its triangles that face against their
-    // vertices' normals (as the shading sees them), and the least facing of its triangles. It
-    // moves to the best candidate better than where it is whose triangles meet no more others
-    // than they did.
+    // field, its triangles that face against their vertices' normals (as the shading sees them),
+    // and the least facing of its triangles. It moves to the best candidate better than where it
+    // is whose triangles meet no more others than they did.
     std::vector<uint32_t> local, star, saved;
     std::vector<std::pair<uint32_t, uint32_t>> pairs;
     size_t moved = 0;
@@ -1020,14 +1019,15 @@ size_t unfoldVertices(Mesh& mesh, glm::vec3 origin, float h, const Distance& dis
                 against += againstNormals(t);
                 least = std::min(least, f);
             }
-            const bool far = !(std::abs(distance(at)) <= 0.45f * h);
-            return std::tuple{folds, far, against, -least};
+            return std::tuple{folds, against, -least};
         };
         const auto now = score(placed);
         if (std::get<0>(now) == 0) {
             mesh.positions[v] = placed;
             continue;
         }
+        // No candidate lies farther from the surface than 0.45 of a cell, or than the vertex.
+        const float reach = std::max(0.45f * h, std::abs(distance(placed)));
         // Within its cell, and on the faces of its cell that it lies on (a fan's edge and face
         // points): there the fans stay inside their cells.
         const glm::vec3 cell = origin + glm::vec3(c) * h;
@@ -1057,11 +1057,13 @@ size_t unfoldVertices(Mesh& mesh, glm::vec3 origin, float h, const Distance& dis
                 return glm::dot(x - placed, x - placed) < glm::dot(y - placed, y - placed);
             });
             for (const glm::vec3& q : lattice) {
-                for (const glm::vec3& at : {q, towardSurface(distance, q, inLo, inHi, h)})
+                for (const glm::vec3& at : {q, towardSurface(distance, q, inLo, inHi, h)}) {
+                    if (!(std::abs(distance(at)) <= reach)) continue;
                     if (const auto s = score(at); s < now) {
                         better.push_back({s, at});
                         unfolding += std::get<0>(s) == 0;
                     }
+                }
                 if (unfolding >= kTries) break;
             }
         }

@@ -103,10 +103,10 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
 // surface that the grid joins across an ambiguous face, or a fan's points lie about a feature
 // thinner than a cell, each of its vertices moves, one at a time, to the point of its cell, of a
 // few (a lattice, and its points moved onto the surface along the field's gradient), from which
-// fewest of its triangles face against the field, then nearest the surface (within 0.45 of a
-// cell), then fewest face against their vertices' normals, then facing best; a fan's edge and
-// face points stay on the cell's edge or face they lie on. A move is kept only where its
-// triangles then meet no more others (findSelfIntersections) than before. The field is asked
+// fewest of its triangles face against the field, then fewest face against their vertices'
+// normals, then facing best, no farther from the surface than 0.45 of a cell or than it was; a
+// fan's edge and face points stay on the cell's edge or face they lie on. A move is kept only where
+// its triangles then meet no more others (findSelfIntersections) than before. The field is asked
 // only of triangles that face more than 10 degrees away from one of their vertices' normals.
 // Does nothing without a field `distance`; `origin` and `h` are the grid's corner and cell edge.
 // Returns how many vertices moved.
