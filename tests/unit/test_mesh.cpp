@@ -265,12 +265,13 @@ std::vector<std::pair<std::string, std::string>> qualityScenes(uint32_t seeds);
 // as scripts/mesh-quality.sh measures them), meshed at odd resolutions: every vertex lies within
 // 0.6 of a cell of the surface (vertices the QEF clamped to their cell's side, and means of
 // pieces curved within their cells, are pulled onto the surface by the field: before, up to 0.73
-// of a cell), and at most 4% of a mesh's triangles face against the field. Not yet the issue's
-// 0.5 of a cell and no flipped triangle: most flipped triangles left are the fans of
-// separateCrossings() in features about a cell thin, their centres a quarter of a cell deep,
-// where the field's gradient points to another part of the surface (marching cubes, all of
-// whose vertices lie on the surface, flips 60 to 134 triangles on the first three trees at 64
-// cells; dual contouring 48 to 128).
+// of a cell), and at most 0.5% of a mesh's triangles face against the field (before
+// unfoldVertices in mesh_dual.cpp, up to 3.5%; over 12 seeds of each now at most 0.17%). Not yet
+// the 0.5 of a cell and no flipped triangle: the 113 flipped triangles left in those 96
+// meshes have not been examined one by one (unfoldVertices leaves those that no point of one
+// vertex's cell unfolds without making triangles cross, those within 10 degrees of their
+// vertices' normals, which it does not ask the field of, and all in scenes of pruned tapes,
+// kTapeMinNodes in mesh.cpp, which have no field on the host).
 TEST_F(MeshTest, RandomScenesHaveVerticesNearTheSurfaceAndFewFlippedTriangles) {
     const char* seeds = std::getenv("SDFCSG_MESH_SEEDS");
     const uint32_t count = seeds ? uint32_t(std::strtoul(seeds, nullptr, 10)) : 3u;
@@ -289,7 +290,8 @@ TEST_F(MeshTest, RandomScenesHaveVerticesNearTheSurfaceAndFewFlippedTriangles) {
             ASSERT_TRUE(mesh) << mesh.error().str();
             EXPECT_LE(maxSurfaceDistance(*mesh, evaluator), 0.6f * stats.voxelSize);
             const TriangleFacing facing = checkTriangleFacing(*mesh, evaluator, stats.voxelSize);
-            EXPECT_LE(double(facing.flipped), 0.04 * double(mesh->triangleCount())) << facing.str();
+            EXPECT_LE(double(facing.flipped), 0.005 * double(mesh->triangleCount()))
+                << facing.str();
         }
     }
 }
