@@ -385,7 +385,6 @@ ReferenceMesh referenceDualMeshOf(const Distance& distance, const Color& color,
     detail::splitTouchingSheets(mesh);
     detail::separateCrossings(mesh, copiesFrom, quadEdges, edgePoints.data(), grid.origin,
                               grid.voxelSize, distance);
-    detail::unfoldVertices(mesh, grid.origin, grid.voxelSize, distance);
     out.surfaceCut = field.surfaceCut;
     return out;
 }
