@@ -1163,10 +1163,15 @@ size_t unfoldVertices(Mesh& mesh, glm::vec3 origin, float h, const Distance& dis
         for (const auto& candidate : candidates) {
             const glm::vec3 q = candidate.second;
             if (spent >= kBudget || spent >= meshLeft) break;
+            // Onto the surface by one Newton step, kept where it brings the point nearer.
             const float d = distance(q);
-            ++spent;
-            const glm::vec3 onSurface = towardSurface(distance, q, inLo, inHi, h);
-            spent += 11;
+            const glm::vec3 g = gradientAt(distance, q, h);
+            glm::vec3 onSurface = q;
+            if (const float gg = glm::dot(g, g); gg > 1e-6f) {
+                const glm::vec3 next = glm::clamp(q - d * g / gg, inLo, inHi);
+                if (std::abs(distance(next)) < std::abs(d)) onSurface = next;
+            }
+            spent += 6;
             for (const glm::vec3& at : {onSurface, q}) {
                 if (at == placed || (at == q && !(std::abs(d) <= reach)) ||
                     (at != q && !(std::abs(d) <= reach) && !(std::abs(distance(at)) <= reach)))
