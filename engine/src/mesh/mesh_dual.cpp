@@ -1041,10 +1041,10 @@ size_t unfoldVertices(Mesh& mesh, glm::vec3 origin, float h, const Distance& dis
     // about a dozen values to move onto the surface and four per triangle (fewer where one folds
     // early: those that fold where the vertex is are asked first), so a prediction orders them:
     // each triangle's gradient where the vertex is, against the triangle's plane with the vertex
-    // at the candidate. A vertex asks the field at most kBudget times (about a lattice of 5^3),
-    // most that unfold doing so within ten candidates, and a mesh at most 100,000 times and four
-    // per triangle more: the random trees of one seed, whose thin parts fold 2,500 triangles at
-    // 131 cells, took 4.8 s without a cap.
+    // at the candidate. A vertex's search asks the field at most kBudget times (about a lattice
+    // of 5^3; most that unfold do so within ten candidates), and a mesh's searches together at
+    // most 100,000 times and four per triangle more: the random trees of one seed, whose thin
+    // parts fold 2,500 triangles at 131 cells, took 4.8 s without that cap.
     constexpr size_t kBudget = 1500;
     std::vector<float> facingNow;
     std::vector<glm::vec3> gradients;
