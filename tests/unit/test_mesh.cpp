@@ -265,12 +265,14 @@ std::vector<std::pair<std::string, std::string>> qualityScenes(uint32_t seeds);
 // as scripts/mesh-quality.sh measures them), meshed at odd resolutions: every vertex lies within
 // 0.6 of a cell of the surface (vertices the QEF clamped to their cell's side, and means of
 // pieces curved within their cells, are pulled onto the surface by the field: before, up to 0.73
-// of a cell), and at most 4% of a mesh's triangles face against the field. Not yet the issue's
-// 0.5 of a cell and no flipped triangle: most flipped triangles left are the fans of
-// separateCrossings() in features about a cell thin, their centres a quarter of a cell deep,
-// where the field's gradient points to another part of the surface (marching cubes, all of
-// whose vertices lie on the surface, flips 60 to 134 triangles on the first three trees at 64
-// cells; dual contouring 48 to 128).
+// of a cell), and at most 0.5% of a mesh's triangles face against the field (before
+// unfoldVertices in mesh_dual.cpp, up to 3.5%; over 12 seeds of each now at most 0.29%). Not yet
+// the 0.5 of a cell and no flipped triangle: the 159 flipped triangles left in those 96
+// meshes have not been examined one by one (unfoldVertices leaves those that no candidate point
+// of one vertex's cell unfolds without making triangles cross, those it reaches no more once
+// the mesh's cap on the field is spent, those within 10 degrees of their vertices' normals,
+// which it does not ask the field of, and all in scenes of pruned tapes, kTapeMinNodes in
+// mesh.cpp, which have no field on the host).
 TEST_F(MeshTest, RandomScenesHaveVerticesNearTheSurfaceAndFewFlippedTriangles) {
     const char* seeds = std::getenv("SDFCSG_MESH_SEEDS");
     const uint32_t count = seeds ? uint32_t(std::strtoul(seeds, nullptr, 10)) : 3u;
@@ -289,7 +291,8 @@ TEST_F(MeshTest, RandomScenesHaveVerticesNearTheSurfaceAndFewFlippedTriangles) {
             ASSERT_TRUE(mesh) << mesh.error().str();
             EXPECT_LE(maxSurfaceDistance(*mesh, evaluator), 0.6f * stats.voxelSize);
             const TriangleFacing facing = checkTriangleFacing(*mesh, evaluator, stats.voxelSize);
-            EXPECT_LE(double(facing.flipped), 0.04 * double(mesh->triangleCount())) << facing.str();
+            EXPECT_LE(double(facing.flipped), 0.005 * double(mesh->triangleCount()))
+                << facing.str();
         }
     }
 }
@@ -505,6 +508,42 @@ TEST_F(MeshTest, GearIsEmbeddedAtEveryResolution) {
     }
 }
 
+// The hollow gear (a mesh node's field, hollowed by a shell, engraved, a quarter cut away) has
+// features thinner than a cell at every resolution: the skin's inner creases inside the gear's
+// sharp edges, where the cut meets them, and the engraving's grooves. There a cell's one vertex
+// served two pieces of surface joined across an ambiguous face, or a fan's triangle lay across a
+// groove's wall, and up to 54 triangles faced against the field (unfoldVertices in
+// mesh_dual.cpp). At resolutions even and odd, each moving the grid against the gear, its mesh
+// is closed and manifold, no triangles cross, at most 3 face against the field (at 64 cells 3
+// of 54 are left, at 96 1 of 14, none at 128, 131 and 200: a search of every point of the
+// vertices' cells unfolded all but 2 at 64, at a cost the tests' random trees could not bear),
+// and every vertex lies within 0.6 of a cell of the surface (not yet the 0.5: at 96 and
+// 131 one vertex each lies 0.53 and 0.52 of a cell off, where the QEF placed it).
+TEST_F(MeshTest, HollowGearIsEmbeddedAtEveryResolution) {
+    const Scene scene =
+        loadOrDie(std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes/hollow_gear.json");
+    const Evaluator evaluator(scene);
+    auto mesher = Mesher::create(context(), scene);
+    ASSERT_TRUE(mesher) << mesher.error().str();
+    for (uint32_t resolution : {64u, 96u, 128u, 131u, 200u}) {
+        SCOPED_TRACE("at " + std::to_string(resolution));
+        MeshOptions options;
+        options.resolution = resolution;
+        MeshStats stats;
+        auto mesh = (*mesher)->extract(options, &stats);
+        ASSERT_TRUE(mesh) << mesh.error().str();
+        EXPECT_FALSE(stats.surfaceCut);
+        const MeshProperties m = measureMesh(*mesh);
+        EXPECT_TRUE(m.closedManifold()) << m.str();
+        EXPECT_LE(maxSurfaceDistance(*mesh, evaluator), 0.6f * stats.voxelSize);
+        const SelfIntersections crossings = findSelfIntersections(*mesh);
+        EXPECT_EQ(crossings.total(), 0u) << crossings.str();
+        const TriangleFacing facing = checkTriangleFacing(*mesh, evaluator, stats.voxelSize);
+        EXPECT_EQ(facing.degenerate, 0u) << facing.str();
+        EXPECT_LE(facing.flipped, 3u) << facing.str();
+    }
+}
+
 // Dual contouring keeps sharp edges: at resolution 128, points across every triangle of reference
 // scene A (in the benchmark's bounds, kReferenceBounds in apps/bench.cpp) and of the CSG part,
 // whose edges lie along circles and cross the grid at every angle, lie within a tenth of a cell
@@ -661,6 +700,10 @@ void expectMatchesReference(Context& context, const Scene& scene, const std::str
         MeshOptions options;
         options.method = method;
         options.resolution = resolution;
+        // The reference lacks the last step, whose discrete choices differ between two meshes
+        // that differ by rounding; the step is held to its properties by the random scenes' and
+        // the hollow gear's tests.
+        options.unfold = false;
         MeshStats stats;
         auto mesh = extractMesh(context, scene, options, &stats);
         ASSERT_TRUE(mesh) << mesh.error().str();

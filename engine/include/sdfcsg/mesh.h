@@ -94,6 +94,11 @@ struct MeshOptions {
     // colours at 256 cells, about half as long again as the extraction. Off, each vertex keeps
     // the colour where it lies and triangles across a border blend the two.
     bool colorRegions = false;
+    // Dual contouring's last host step: the vertices of triangles that still face against the
+    // field's gradient (at features thinner than a cell) move to points of their cells that
+    // unfold them (docs/robustness.md). Off, the mesh is the one a reference mesher that lacks
+    // the step makes; the field is then asked far less on the host.
+    bool unfold = true;
     // Called from the calling thread with the fraction done (0..1), at least once per batch of
     // bricks; returning false cancels the extraction (ErrorKind::Cancelled).
     std::function<bool(float)> progress;

@@ -890,6 +890,7 @@ void Extraction::finish() {
         stage("sheets", t1);
         const auto t2 = Clock::now();
         detail::separateCrossings(mesh, copiesFrom, quadEdges, edges, g.origin, g.h, distance);
+        if (options.unfold) detail::unfoldVertices(mesh, g.origin, g.h, distance);
         stage("crossings", t2);
     }
     // Colour borders, where asked for and where there can be any: the CPU's whole tree is too

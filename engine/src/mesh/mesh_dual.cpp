@@ -11,6 +11,8 @@
 #include <array>
 #include <cmath>
 #include <thread>
+#include <tuple>
+#include <type_traits>
 #include <unordered_map>
 
 namespace sdfcsg::detail {
@@ -74,6 +76,23 @@ Diagonal diagonalOf(const Mesh& mesh, const Quad& q) {
 // sheet thinner than a cell passes through it, does not pass or fail by rounding.
 constexpr float kLeastCosine = 0.1f;
 
+// How triangle (u, v, w) faces the field: the cosine between it and the field's gradient at its
+// centre (tetrahedral differences a hundredth of a cell `h` wide, as in the tests' check), less
+// kLeastCosine; 1 where the gradient gives no direction.
+float fieldFacing(const Mesh& mesh, const Distance& distance, float h, uint32_t u, uint32_t v,
+                  uint32_t w) {
+    const std::vector<glm::vec3>& p = mesh.positions;
+    const glm::vec3 c = glm::cross(p[v] - p[u], p[w] - p[u]);
+    const glm::vec3 centre = (p[u] + p[v] + p[w]) / 3.0f;
+    const glm::vec3 taps[4] = {{1, -1, -1}, {-1, -1, 1}, {-1, 1, -1}, {1, 1, 1}};
+    glm::vec3 g(0.0f);
+    for (const glm::vec3& tap : taps)
+        g += tap * distance(centre + tap * (0.01f * h));
+    const float gg = glm::dot(g, g);
+    if (!(gg > 0.0f)) return 1.0f; // no direction to judge by
+    return glm::dot(c, g) / std::sqrt(glm::dot(c, c) * gg) - kLeastCosine;
+}
+
 // How triangle (u, v, w) faces, positive where it does not fold. By its vertices' normals alone
 // it folds (-2, below any cosine) where it faces nearly a right angle or more away from their
 // mean (a triangle of a wedge of the solid as sharp as 30 degrees faces within 75 degrees of it,
@@ -93,14 +112,7 @@ float facing(const Mesh& mesh, const Distance& distance, float h, uint32_t u, ui
     if (!distance || (!always && glm::dot(c, n[u]) >= least && glm::dot(c, n[v]) >= least &&
                       glm::dot(c, n[w]) >= least))
         return 1.0f;
-    const glm::vec3 centre = (p[u] + p[v] + p[w]) / 3.0f;
-    const glm::vec3 taps[4] = {{1, -1, -1}, {-1, -1, 1}, {-1, 1, -1}, {1, 1, 1}};
-    glm::vec3 g(0.0f);
-    for (const glm::vec3& tap : taps)
-        g += tap * distance(centre + tap * (0.01f * h));
-    const float gg = glm::dot(g, g);
-    if (!(gg > 0.0f)) return 1.0f; // no direction to judge by
-    return glm::dot(c, g) / std::sqrt(cc * gg) - kLeastCosine;
+    return fieldFacing(mesh, distance, h, u, v, w);
 }
 
 // Writes quad q into t split along a-c, as (a, b, c), (a, c, d), or along b-d, as (a, b, d),
@@ -492,9 +504,9 @@ glm::vec3 towardSurface(const Distance& distance, glm::vec3 p, glm::vec3 lo, glm
 }
 
 // Runs f(begin, end, half) over [0, n), in two halves on two threads where n is large enough to
-// pay for the second.
-template <class F> void inHalves(size_t n, F&& f) {
-    if (n < 65536 || std::thread::hardware_concurrency() < 2) {
+// pay for the second (`least`: where each item costs a few values of the field, fewer).
+template <class F> void inHalves(size_t n, F&& f, size_t least = 65536) {
+    if (n < least || std::thread::hardware_concurrency() < 2) {
         f(size_t(0), n, 0);
         return;
     }
@@ -902,6 +914,291 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
                             fans.begin() + ends[i]);
     }
     return result;
+}
+
+size_t unfoldVertices(Mesh& mesh, glm::vec3 origin, float h, const Distance& distance) {
+    if (!distance) return 0;
+    const size_t triangles = mesh.triangleCount();
+    const std::vector<glm::vec3>& p = mesh.positions;
+    // How triangle t faces the field (fieldFacing()); a triangle without a plane (as the tests'
+    // check sees it: its height under 1e-4 of a cell) counts as folding.
+    auto faces = [&](size_t t, const glm::vec3* gradient = nullptr) {
+        const uint32_t* v = &mesh.indices[3 * t];
+        const glm::vec3 a = p[v[0]], b = p[v[1]], c = p[v[2]];
+        const float longest =
+            std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
+        if (!(glm::length(glm::cross(b - a, c - a)) > 1e-4f * h * longest)) return -2.0f;
+        if (!gradient) return fieldFacing(mesh, distance, h, v[0], v[1], v[2]);
+        const glm::vec3 n = glm::cross(b - a, c - a);
+        const float gg = glm::dot(*gradient, *gradient);
+        if (!(gg > 0.0f)) return 1.0f; // no direction to judge by, as fieldFacing()
+        return glm::dot(n, *gradient) / std::sqrt(glm::dot(n, n) * gg) - kLeastCosine;
+    };
+    // The vertices of the triangles that fold, in order. The field is asked only where a
+    // triangle faces more than 10 degrees away from one of its vertices' normals (as at a sharp
+    // feature, or on a surface curved within a few cells): one that faces like its vertices'
+    // normals, across a groove thinner than a cell, may still face away from the field where
+    // its centre lies near the groove's wall.
+    std::vector<uint32_t> moving, theirs;
+    inHalves(
+        triangles,
+        [&](size_t begin, size_t end, int half) {
+            std::vector<uint32_t>& found = half == 0 ? moving : theirs;
+            const std::vector<glm::vec3>& n = mesh.normals;
+            for (size_t t = begin; t < end; ++t) {
+                const uint32_t* v = &mesh.indices[3 * t];
+                const glm::vec3 c = glm::cross(p[v[1]] - p[v[0]], p[v[2]] - p[v[0]]);
+                const float least = 0.985f * glm::length(c); // cos 10 degrees
+                if (glm::dot(c, n[v[0]]) >= least && glm::dot(c, n[v[1]]) >= least &&
+                    glm::dot(c, n[v[2]]) >= least)
+                    continue;
+                // First the field's slope along the triangle's normal, two values: where it rises
+                // at half the rate of a distance or more, the gradient (the field is 1-Lipschitz)
+                // lies within 60 degrees of the normal.
+                const float cc = glm::length(c);
+                if (cc > 0.0f) {
+                    const glm::vec3 centre = (p[v[0]] + p[v[1]] + p[v[2]]) / 3.0f;
+                    const glm::vec3 step = c / cc * (0.01f * h);
+                    if (distance(centre + step) - distance(centre - step) >= 0.5f * 0.02f * h)
+                        continue;
+                }
+                if (faces(t) >= 0.0f) continue;
+                found.insert(found.end(), v, v + 3);
+            }
+        },
+        4096);
+    moving.insert(moving.end(), theirs.begin(), theirs.end());
+    if (moving.empty()) return 0;
+    std::sort(moving.begin(), moving.end());
+    moving.erase(std::unique(moving.begin(), moving.end()), moving.end());
+    // The triangles by the cell of their centre, (cell, triangle) sorted, to find those near a
+    // vertex: a triangle spans at most two cells along each axis, so those that may meet a
+    // vertex's triangles have their centres within three cells of it.
+    auto cellKey = [&](glm::ivec3 c) {
+        c += 8; // cells just outside the grid's corner
+        return uint64_t(uint32_t(c.x)) | uint64_t(uint32_t(c.y)) << 21 |
+               uint64_t(uint32_t(c.z)) << 42;
+    };
+    auto cellOf = [&](glm::vec3 x) { return glm::ivec3(glm::floor((x - origin) / h)); };
+    std::vector<std::pair<uint64_t, uint32_t>> byCell(triangles);
+    glm::vec3 lo(INFINITY), hi(-INFINITY);
+    for (size_t t = 0; t < triangles; ++t) {
+        const uint32_t* v = &mesh.indices[3 * t];
+        byCell[t] = {cellKey(cellOf((p[v[0]] + p[v[1]] + p[v[2]]) / 3.0f)), uint32_t(t)};
+    }
+    for (const glm::vec3& x : p) {
+        lo = glm::min(lo, x);
+        hi = glm::max(hi, x);
+    }
+    std::sort(byCell.begin(), byCell.end());
+    const double tolerance = 1e-6 * double(glm::length(hi - lo)); // findSelfIntersections'
+
+    // Whether a vertex's triangles meet others, with it where it is: findSelfIntersections on a
+    // small mesh of its triangles and those of `local` whose bounds reach theirs (the whole
+    // mesh's positions would make each call as slow as the mesh is large).
+    std::vector<uint32_t> local, star, order;
+    std::vector<std::pair<uint32_t, uint32_t>> pairs;
+    Mesh near;
+    std::unordered_map<uint32_t, uint32_t> numbers;
+    auto meets = [&] {
+        glm::vec3 starLo(INFINITY), starHi(-INFINITY);
+        for (uint32_t t : star)
+            for (int k = 0; k < 3; ++k) {
+                starLo = glm::min(starLo, p[mesh.indices[3 * size_t(t) + k]]);
+                starHi = glm::max(starHi, p[mesh.indices[3 * size_t(t) + k]]);
+            }
+        const float grow = 2.0f * float(tolerance);
+        near.positions.clear();
+        near.indices.clear();
+        numbers.clear();
+        order.clear(); // the triangles of `near`, by their numbers in `mesh`
+        for (uint32_t t : local) {
+            const uint32_t* k = &mesh.indices[3 * size_t(t)];
+            const glm::vec3 tLo = glm::min(p[k[0]], glm::min(p[k[1]], p[k[2]]));
+            const glm::vec3 tHi = glm::max(p[k[0]], glm::max(p[k[1]], p[k[2]]));
+            if (glm::any(glm::greaterThan(tLo, starHi + grow)) ||
+                glm::any(glm::lessThan(tHi, starLo - grow)))
+                continue;
+            order.push_back(t);
+            for (int i = 0; i < 3; ++i) {
+                const auto [it, added] = numbers.try_emplace(k[i], uint32_t(near.positions.size()));
+                if (added) near.positions.push_back(p[k[i]]);
+                near.indices.push_back(it->second);
+            }
+        }
+        pairs.clear();
+        findSelfIntersections(near, tolerance, 1e-3, &pairs);
+        size_t count = 0;
+        for (const auto& [a, b] : pairs)
+            count += std::binary_search(star.begin(), star.end(), order[a]) ||
+                     std::binary_search(star.begin(), star.end(), order[b]);
+        return count;
+    };
+
+    // Each vertex in turn, at candidate points of its cell: it moves to the first from which
+    // none of its triangles faces against the field and they meet no more others than they did
+    // (else to the one that unfolds most of them, on the same terms). A candidate costs the field
+    // about a dozen values to move onto the surface and four per triangle (fewer where one folds
+    // early: those that fold where the vertex is are asked first), so a prediction orders them:
+    // each triangle's gradient where the vertex is, against the triangle's plane with the vertex
+    // at the candidate. A vertex's search asks the field at most kBudget times (about a lattice
+    // of 5^3; most that unfold do so within ten candidates), and a mesh's searches together at
+    // most 100,000 times and four per triangle more: the random trees of one seed, whose thin
+    // parts fold 2,500 triangles at 131 cells, took 4.8 s without that cap.
+    constexpr size_t kBudget = 1500;
+    std::vector<float> facingNow;
+    std::vector<glm::vec3> gradients;
+    std::vector<std::pair<int, glm::vec3>> candidates;
+    size_t moved = 0;
+    size_t meshLeft = 100000 + 4 * triangles;
+    for (uint32_t v : moving) {
+        const glm::vec3 placed = p[v];
+        const glm::ivec3 c = cellOf(placed);
+        local.clear();
+        for (int x = -3; x <= 3; ++x)
+            for (int y = -3; y <= 3; ++y)
+                for (int z = -3; z <= 3; ++z) {
+                    const uint64_t key = cellKey(c + glm::ivec3(x, y, z));
+                    for (auto it =
+                             std::lower_bound(byCell.begin(), byCell.end(), std::pair{key, 0u});
+                         it != byCell.end() && it->first == key; ++it)
+                        local.push_back(it->second);
+                }
+        std::sort(local.begin(), local.end());
+        star.clear();
+        for (uint32_t t : local) {
+            const uint32_t* k = &mesh.indices[3 * size_t(t)];
+            if (k[0] == v || k[1] == v || k[2] == v) star.push_back(t);
+        }
+        // The star's triangles as the field sees them now; those that fold are asked first.
+        facingNow.resize(star.size());
+        gradients.resize(star.size());
+        int folds = 0;
+        for (size_t i = 0; i < star.size(); ++i) {
+            const uint32_t* k = &mesh.indices[3 * size_t(star[i])];
+            gradients[i] = gradientAt(distance, (p[k[0]] + p[k[1]] + p[k[2]]) / 3.0f, h);
+            facingNow[i] = faces(star[i], &gradients[i]);
+            folds += facingNow[i] < 0.0f;
+        }
+        if (folds == 0) continue;
+        std::vector<uint32_t> asked(star.size());
+        for (size_t i = 0; i < star.size(); ++i)
+            asked[i] = uint32_t(i);
+        std::stable_sort(asked.begin(), asked.end(),
+                         [&](uint32_t a, uint32_t b) { return facingNow[a] < facingNow[b]; });
+        // How many of the vertex's triangles fold with it at `at`, counted up to `most`.
+        size_t spent = 0;
+        auto folding = [&](glm::vec3 at, int most) {
+            mesh.positions[v] = at;
+            int n = 0;
+            for (uint32_t i : asked) {
+                spent += 4;
+                if (faces(star[i]) < 0.0f && ++n >= most) break;
+            }
+            return n;
+        };
+        // How many of the triangles the gradients where the vertex is say fold, with it at `at`.
+        auto predicted = [&](glm::vec3 at) {
+            int n = 0;
+            for (size_t i = 0; i < star.size(); ++i) {
+                const uint32_t* k = &mesh.indices[3 * size_t(star[i])];
+                glm::vec3 q[3] = {p[k[0]], p[k[1]], p[k[2]]};
+                for (int j = 0; j < 3; ++j)
+                    if (k[j] == v) q[j] = at;
+                const glm::vec3 n3 = glm::cross(q[1] - q[0], q[2] - q[0]);
+                n += glm::dot(n3, gradients[i]) <
+                     kLeastCosine * glm::length(n3) * glm::length(gradients[i]);
+            }
+            return n;
+        };
+        // No candidate lies farther from the surface than 0.45 of a cell, or than the vertex.
+        const float reach = std::max(0.45f * h, std::abs(distance(placed)));
+        // Within its cell, and on the faces of its cell that it lies on (a fan's edge and face
+        // points): there the fans stay inside their cells.
+        const glm::vec3 cell = origin + glm::vec3(c) * h;
+        glm::vec3 inLo = cell + kInset * h, inHi = cell + (1.0f - kInset) * h;
+        for (int k = 0; k < 3; ++k) {
+            const float at = (placed[k] - origin[k]) / h;
+            if (std::abs(at - std::round(at)) <= 1e-3f) inLo[k] = inHi[k] = placed[k];
+        }
+        // Candidates: the vertex pulled onto the surface, the mean of its neighbours, and the
+        // points of a lattice of 3^3 in the cell, then of 5^3, each moved onto the surface and
+        // as it is; those the gradients predict to unfold most first, then nearest to where the
+        // vertex is (where the QEF or the steps before put it, on the sharp features).
+        glm::vec3 ring(0.0f);
+        for (uint32_t t : star)
+            for (int k = 0; k < 3; ++k)
+                ring += p[mesh.indices[3 * size_t(t) + k]];
+        ring = (ring - float(star.size()) * placed) / float(2 * star.size());
+        candidates.clear();
+        candidates.push_back({-1, placed});
+        candidates.push_back({-1, glm::clamp(ring, inLo, inHi)});
+        for (const int steps : {3, 5})
+            for (int x = 0; x < steps; ++x)
+                for (int y = 0; y < steps; ++y)
+                    for (int z = 0; z < steps; ++z) {
+                        const glm::vec3 q = glm::clamp(
+                            cell + (glm::vec3(x, y, z) + 0.5f) / float(steps) * h, inLo, inHi);
+                        candidates.push_back({predicted(q), q});
+                    }
+        std::stable_sort(
+            candidates.begin() + 2, candidates.end(), [&](const auto& x, const auto& y) {
+                return x.first < y.first ||
+                       (x.first == y.first && glm::dot(x.second - placed, x.second - placed) <
+                                                  glm::dot(y.second - placed, y.second - placed));
+            });
+        // Where none unfolds all, the candidates that unfold most (fewest folding first).
+        std::vector<std::pair<int, glm::vec3>> partial;
+        size_t before = SIZE_MAX;
+        auto keeps = [&](glm::vec3 at) {
+            if (before == SIZE_MAX) {
+                mesh.positions[v] = placed;
+                before = meets();
+            }
+            mesh.positions[v] = at;
+            return meets() <= before;
+        };
+        bool done = false;
+        int fewest = folds;
+        for (const auto& candidate : candidates) {
+            const glm::vec3 q = candidate.second;
+            if (spent >= kBudget || spent >= meshLeft) break;
+            // Onto the surface by one Newton step, kept where it brings the point nearer.
+            const float d = distance(q);
+            const glm::vec3 g = gradientAt(distance, q, h);
+            glm::vec3 onSurface = q;
+            if (const float gg = glm::dot(g, g); gg > 1e-6f) {
+                const glm::vec3 next = glm::clamp(q - d * g / gg, inLo, inHi);
+                if (std::abs(distance(next)) < std::abs(d)) onSurface = next;
+            }
+            spent += 6;
+            for (const glm::vec3& at : {onSurface, q}) {
+                if (at == placed || (at == q && !(std::abs(d) <= reach)) ||
+                    (at != q && !(std::abs(d) <= reach) && !(std::abs(distance(at)) <= reach)))
+                    continue;
+                const int n = folding(at, fewest + 1);
+                if (n == 0 && keeps(at)) {
+                    done = true;
+                    break;
+                }
+                if (n > 0 && n <= fewest && n < folds) {
+                    fewest = n;
+                    partial.push_back({n, at});
+                }
+            }
+            if (done) break;
+        }
+        std::stable_sort(partial.begin(), partial.end(),
+                         [](const auto& x, const auto& y) { return x.first < y.first; });
+        for (size_t k = 0; !done && k < partial.size() && k < 3; ++k)
+            done = keeps(partial[k].second);
+        meshLeft -= std::min(meshLeft, spent);
+        if (done)
+            ++moved;
+        else
+            mesh.positions[v] = placed;
+    }
+    return moved;
 }
 
 } // namespace sdfcsg::detail

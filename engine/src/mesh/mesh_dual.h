@@ -98,4 +98,19 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
                              const EdgePoint* points, glm::vec3 origin, float h,
                              const Distance& distance);
 
+// Where a triangle still faces against the field after the steps above (by the field's gradient
+// at its centre, as the tests judge it), as where a cell's one vertex serves two pieces of
+// surface that the grid joins across an ambiguous face, or a fan's points lie about a feature
+// thinner than a cell, each of its vertices moves, one at a time, to a point of its cell (where
+// it is or the mean of its neighbours, or one of a lattice, each moved onto the surface along
+// the field's gradient or as it is) from which none of its triangles faces against the field,
+// or failing that fewest, no farther from the surface than 0.45 of a cell or than it was; a
+// fan's edge and face points stay on the cell's edge or face they lie on. A move is kept only
+// where its triangles then meet no more others (findSelfIntersections) than before. The field is
+// asked only of triangles that face more than 10 degrees away from one of their vertices'
+// normals, and a capped number of times per vertex and per mesh. Does nothing without a field
+// `distance`; `origin` and `h` are the grid's corner and cell edge. Returns how many vertices
+// moved.
+size_t unfoldVertices(Mesh& mesh, glm::vec3 origin, float h, const Distance& distance);
+
 } // namespace sdfcsg::detail
