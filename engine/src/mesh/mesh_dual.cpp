@@ -1256,7 +1256,8 @@ size_t unfoldVertices(Mesh& mesh, glm::vec3 origin, float h, const Distance& dis
                         candidates.push_back(
                             {1, glm::clamp(placed + share * (p[u] - placed), inLo, inHi)});
         for (const auto& [kind, at] : candidates) {
-            if (at == placed || (kind == 1 && !(std::abs(distance(at)) <= 0.45f * h))) continue;
+            const float e = std::abs(distance(at));
+            if (at == placed || !(e < d) || (kind == 1 && !(e <= 0.45f * h))) continue;
             mesh.positions[v] = at;
             bool folds = false;
             for (size_t i = 0; i < star.size() && !folds; ++i)
