@@ -109,8 +109,13 @@ Separation separateCrossings(Mesh& mesh, size_t copiesFrom, const std::vector<ui
 // where its triangles then meet no more others (findSelfIntersections) than before. The field is
 // asked only of triangles that face more than 10 degrees away from one of their vertices'
 // normals, and a capped number of times per vertex and per mesh. Does nothing without a field
-// `distance`; `origin` and `h` are the grid's corner and cell edge. Returns how many vertices
-// moved.
+// `distance`; `origin` and `h` are the grid's corner and cell edge. Then each vertex still
+// farther than 0.45 of a cell from the surface (one value of the field per vertex finds them)
+// moves toward it, within its cell or the face it lies on: along the field's gradient (two
+// Newton steps), all the way or a share of it, or else a quarter or half of the way toward one
+// of its neighbours where that lies within 0.45 of a cell; the first point from which none of
+// its triangles faces against the field that did not and they meet no more others. Returns how
+// many vertices moved.
 size_t unfoldVertices(Mesh& mesh, glm::vec3 origin, float h, const Distance& distance);
 
 } // namespace sdfcsg::detail
