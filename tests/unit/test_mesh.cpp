@@ -55,12 +55,11 @@ class MeshTest : public GpuTest {
         return *mesh;
     }
 
-    // The bundled scene `file` meshed at each resolution, closed and manifold and within the
-    // grid, each mesh then passed to `check` with its scene's evaluator.
+    // The scene `file` (relative to the source folder) meshed at each resolution, closed and
+    // manifold and within the grid, each mesh then passed to `check` with its scene's evaluator.
     template <typename Check>
-    void meshBundledAt(const char* file, std::initializer_list<uint32_t> resolutions, Check check) {
-        const Scene scene =
-            loadOrDie(std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/scenes" / file);
+    void meshSceneAt(const char* file, std::initializer_list<uint32_t> resolutions, Check check) {
+        const Scene scene = loadOrDie(std::filesystem::path(SDFCSG_SOURCE_DIR) / file);
         const Evaluator evaluator(scene);
         auto mesher = Mesher::create(context(), scene);
         ASSERT_TRUE(mesher) << mesher.error().str();
@@ -514,10 +513,10 @@ INSTANTIATE_TEST_SUITE_P(Scenes, BundledSceneMesh, ::testing::ValuesIn(bundledSc
 // default, each moving the grid against the gear, its mesh is closed and manifold, no triangles
 // cross, and none faces against the field.
 TEST_F(MeshTest, GearIsEmbeddedAtEveryResolution) {
-    meshBundledAt("gear.json", {64u, 96u, 101u, 118u, 128u, 142u, 151u, 200u},
-                  [](const Mesh& mesh, const Evaluator& evaluator, float h) {
-                      expectEmbedded(mesh, evaluator, h);
-                  });
+    meshSceneAt("assets/scenes/gear.json", {64u, 96u, 101u, 118u, 128u, 142u, 151u, 200u},
+                [](const Mesh& mesh, const Evaluator& evaluator, float h) {
+                    expectEmbedded(mesh, evaluator, h);
+                });
 }
 
 // The hollow gear (a mesh node's field, hollowed by a shell, engraved, a quarter cut away) has
@@ -533,11 +532,11 @@ TEST_F(MeshTest, GearIsEmbeddedAtEveryResolution) {
 // beyond 0.45 of a cell toward it, at 96 and 131 one vertex each lay 0.53 and 0.52 of a cell
 // off, where the QEF placed it).
 TEST_F(MeshTest, HollowGearIsEmbeddedAtEveryResolution) {
-    meshBundledAt("hollow_gear.json", {64u, 96u, 128u, 131u, 200u},
-                  [](const Mesh& mesh, const Evaluator& evaluator, float h) {
-                      EXPECT_LE(maxSurfaceDistance(mesh, evaluator), 0.5f * h);
-                      expectEmbedded(mesh, evaluator, h, 3);
-                  });
+    meshSceneAt("assets/scenes/hollow_gear.json", {64u, 96u, 128u, 131u, 200u},
+                [](const Mesh& mesh, const Evaluator& evaluator, float h) {
+                    EXPECT_LE(maxSurfaceDistance(mesh, evaluator), 0.5f * h);
+                    expectEmbedded(mesh, evaluator, h, 3);
+                });
 }
 
 // Dual contouring keeps sharp edges: at resolution 128, points across every triangle of reference
@@ -665,25 +664,14 @@ TEST_F(MeshTest, BenchmarkScenesAreClosedAndManifoldAtTheBenchmarkResolutions) {
 // meets now, the mesh is still closed and manifold, and the split adds edge and face points,
 // which lie within the cell's diagonal of the surface like every vertex.
 TEST_F(MeshTest, CellsOfSeveralPiecesMeshWithoutSelfIntersections) {
-    const Scene scene =
-        loadOrDie(std::filesystem::path(SDFCSG_SOURCE_DIR) / "assets/bench/groups_1k.json");
-    const Evaluator evaluator(scene);
-    auto mesher = Mesher::create(context(), scene);
-    ASSERT_TRUE(mesher) << mesher.error().str();
-    for (uint32_t resolution : {75u, 101u}) {
-        SCOPED_TRACE("at " + std::to_string(resolution));
-        MeshOptions options;
-        options.resolution = resolution;
-        MeshStats stats;
-        auto mesh = (*mesher)->extract(options, &stats);
-        ASSERT_TRUE(mesh) << mesh.error().str();
-        EXPECT_FALSE(stats.surfaceCut);
-        expectClosedManifold(*mesh);
-        float worst = 0.0f;
-        for (const glm::vec3& p : mesh->positions)
-            worst = std::max(worst, std::abs(evaluator.prunedDistance(p)));
-        EXPECT_LE(worst, std::sqrt(3.0f) * stats.voxelSize);
-    }
+    meshSceneAt("assets/bench/groups_1k.json", {75u, 101u},
+                [](const Mesh& mesh, const Evaluator& evaluator, float h) {
+                    expectClosedManifold(mesh);
+                    float worst = 0.0f;
+                    for (const glm::vec3& p : mesh.positions)
+                        worst = std::max(worst, std::abs(evaluator.prunedDistance(p)));
+                    EXPECT_LE(worst, std::sqrt(3.0f) * h);
+                });
 }
 
 // The GPU result against the CPU reference on the grid the GPU reports, by each method: same
