@@ -8,6 +8,7 @@
 #include "mesh/mesh_simplify.h"
 #include "mesh/self_intersections.h"
 
+#include <sdfcsg/compile.h>
 #include <sdfcsg/eval.h>
 #include <sdfcsg/mesh.h>
 
@@ -150,6 +151,11 @@ struct TriangleFacing {
 // the grid does not tell them apart and this holds only roughly.) Bad triangles (see
 // measureMesh) are skipped.
 inline TriangleFacing checkTriangleFacing(const Mesh& mesh, const Evaluator& evaluator, float h) {
+    // Scenes of pruned tapes by their pruned field, the whole tree near the surface (prune tests).
+    const bool pruned = evaluator.nodes().size() >= kTapeMinNodes;
+    auto field = [&](glm::vec3 p) {
+        return pruned ? evaluator.prunedDistance(p) : evaluator.distance(p);
+    };
     TriangleFacing r;
     const float e = 0.01f * h;
     const glm::vec3 taps[4] = {{1, -1, -1}, {-1, -1, 1}, {-1, 1, -1}, {1, 1, 1}};
@@ -179,7 +185,7 @@ inline TriangleFacing checkTriangleFacing(const Mesh& mesh, const Evaluator& eva
         const glm::vec3 centre((a + b + c) / 3.0);
         glm::dvec3 g(0.0);
         for (const glm::vec3& tap : taps)
-            g += glm::dvec3(tap) * double(evaluator.distance(centre + tap * e));
+            g += glm::dvec3(tap) * double(field(centre + tap * e));
         if (glm::length(g) <= 0.0) continue; // no direction to judge by
         const double cosine = glm::dot(glm::normalize(n), glm::normalize(g));
         r.worstCos = std::min(r.worstCos, cosine);

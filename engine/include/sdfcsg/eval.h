@@ -74,6 +74,14 @@ struct Sample {
     glm::vec3 color;
 };
 
+class Evaluator;
+namespace detail {
+struct PrunedField;
+// The evaluator's pruned field (field/prune.h), made on the first call and shared by its copies:
+// the kernels' tapes and prunedDistance() come from one pruning.
+const PrunedField& prunedField(const Evaluator& evaluator);
+} // namespace detail
+
 class Evaluator {
   public:
     explicit Evaluator(const Scene& scene);
@@ -89,8 +97,8 @@ class Evaluator {
     // The field evaluated per region from pruned tapes, as the GPU kernels of large scenes
     // evaluate it (docs/scale.md): distance() to 1e-5 near the surface, elsewhere a bound of the
     // same sign and no larger magnitude. Far faster than distance() on scenes of thousands of
-    // nodes, for many points; the first call prunes (about 0.1 s for 1,000 nodes), and copies
-    // of this evaluator share the result.
+    // nodes, for many points; the first call prunes (about 0.1 s for 1,000 nodes) unless the
+    // kernels' tapes were made from this evaluator or a copy (detail::prunedField).
     float prunedDistance(glm::vec3 p) const;
     // Bounds of the whole solid; infinite along axes where a plane reaches. The evaluation
     // skips by them: the field is at least their box's signed distance.
@@ -116,6 +124,7 @@ class Evaluator {
     void setBoundsSkipping(bool on) { skipping_ = on; }
 
   private:
+    friend const detail::PrunedField& detail::prunedField(const Evaluator& evaluator);
     struct Pruned; // eval.cpp
     std::vector<FlatNode> nodes_;
     Aabb solidBounds_;

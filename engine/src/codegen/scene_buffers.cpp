@@ -36,7 +36,7 @@ SceneBuffers::~SceneBuffers() {
 Result<std::vector<uint32_t>>
 SceneBuffers::fieldWords(const Scene& scene, const Evaluator& evaluator, Evaluation evaluation) {
     if (!usesTapes(scene, evaluation)) return emptyField();
-    const PrunedField field = detail::pruneField(evaluator);
+    const PrunedField& field = detail::prunedField(evaluator);
     if (const double mean = field.meanActiveLength(); mean > kMaxMeanCellInstructions)
         return prunesTooLittle(scene, mean);
     return packField(field, evaluator.nodes());

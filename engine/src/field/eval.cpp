@@ -946,8 +946,13 @@ Sample Evaluator::sample(glm::vec3 p, uint32_t node) const {
 
 float Evaluator::prunedDistance(glm::vec3 p) const {
     if (nodes_.empty()) return INFINITY;
-    std::call_once(pruned_->once, [&] { pruned_->field = detail::pruneField(*this); });
-    return pruned_->field.distance(nodes_, p);
+    return detail::prunedField(*this).distance(nodes_, p);
+}
+
+const detail::PrunedField& detail::prunedField(const Evaluator& evaluator) {
+    Evaluator::Pruned& pruned = *evaluator.pruned_;
+    std::call_once(pruned.once, [&] { pruned.field = pruneField(evaluator); });
+    return pruned.field;
 }
 
 bool provablyEmpty(const Evaluator& evaluator) {

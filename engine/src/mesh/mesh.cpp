@@ -870,13 +870,12 @@ void Extraction::finish() {
     m.skippedSurface = status[1] != 0;
     if (dual && !m.skippedSurface) {
         const auto t0 = Clock::now();
-        // The field where a few triangles need it: on scenes of pruned tapes, the CPU's whole
-        // tree is too slow and its own pruned field would be a second prune (forest_10k at 256:
-        // 1.6 -> 2.6 s), so there the vertices' normals alone decide.
-        detail::Distance distance;
+        // The field where the vertices need it: on scenes of pruned tapes, the CPU's whole tree
+        // is too slow, and the tapes the kernels run answer instead (pruned once for both).
         const Evaluator& evaluator = *m.evaluator;
-        if (evaluator.nodes().size() < kTapeMinNodes)
-            distance = [&](glm::vec3 p) { return evaluator.distance(p); };
+        detail::Distance distance = [&](glm::vec3 p) { return evaluator.distance(p); };
+        if (evaluator.nodes().size() >= kTapeMinNodes)
+            distance = [&](glm::vec3 p) { return evaluator.prunedDistance(p); };
         // The edge data, which the vertices pass wrote, lies where the dual pass read it.
         const auto* edges = m.mapped<detail::EdgePoint>(SDFCSG_BINDING_MESH_HERMITE);
         for (std::vector<glm::vec3>* positions : {&mesh.positions, &smooth})
