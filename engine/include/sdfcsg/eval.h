@@ -100,6 +100,8 @@ class Evaluator {
     // nodes, for many points; the first call prunes (about 0.1 s for 1,000 nodes) unless the
     // kernels' tapes were made from this evaluator or a copy (detail::prunedField).
     float prunedDistance(glm::vec3 p) const;
+    // The same with the colour, which is -1 where the value is a bound (far from every surface).
+    Sample prunedSample(glm::vec3 p) const;
     // Bounds of the whole solid; infinite along axes where a plane reaches. The evaluation
     // skips by them: the field is at least their box's signed distance.
     const Aabb& bounds() const { return nodes_[0].bounds; }

@@ -60,9 +60,9 @@ struct Mesh {
     std::vector<uint32_t> indices;    // counter-clockwise seen from outside
     // Empty, or each triangle's colour: the scene's colour at its centre (moved onto the
     // surface). Set by Mesher::extract with MeshOptions::colorRegions for scenes of more than
-    // one colour (below kTapeMinNodes nodes), whose meshes have an edge wherever the colour jumps,
-    // so that each triangle lies in one colour; the exporters then write 3MF and glTF in regions of
-    // one colour. A vertex on such a border keeps one of the colours that meet there in `colors`.
+    // one colour, whose meshes have an edge wherever the colour jumps, so that each triangle lies
+    // in one colour; the exporters then write 3MF and glTF in regions of one colour. A vertex on
+    // such a border keeps one of the colours that meet there in `colors`.
     std::vector<glm::vec3> triangleColors;
 
     size_t vertexCount() const { return positions.size(); }

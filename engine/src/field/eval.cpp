@@ -949,6 +949,11 @@ float Evaluator::prunedDistance(glm::vec3 p) const {
     return detail::prunedField(*this).distance(nodes_, p);
 }
 
+Sample Evaluator::prunedSample(glm::vec3 p) const {
+    if (nodes_.empty()) return {INFINITY, kDefaultColor};
+    return detail::prunedField(*this).sample(nodes_, p);
+}
+
 const detail::PrunedField& detail::prunedField(const Evaluator& evaluator) {
     Evaluator::Pruned& pruned = *evaluator.pruned_;
     std::call_once(pruned.once, [&] { pruned.field = pruneField(evaluator); });

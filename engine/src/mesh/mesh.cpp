@@ -892,11 +892,9 @@ void Extraction::finish() {
         if (options.unfold) detail::unfoldVertices(mesh, g.origin, g.h, distance);
         stage("crossings", t2);
     }
-    // Colour borders, where asked for and where there can be any: the CPU's whole tree is too
-    // slow for scenes of pruned tapes, which keep blended vertex colours.
+    // Colour borders, where asked for and where there can be any.
     const Evaluator& evaluator = *m.evaluator;
-    if (options.colorRegions && evaluator.nodes().size() < kTapeMinNodes &&
-        detail::hasSeveralColours(evaluator)) {
+    if (options.colorRegions && detail::hasSeveralColours(evaluator)) {
         const auto t0 = Clock::now();
         detail::splitColourBorders(mesh, evaluator, g.h);
         stage("colours", t0);

@@ -46,24 +46,33 @@ template <class F> void onTwoThreads(size_t n, F&& f) {
 }
 
 // The field near the surface, with differences a hundredth of a cell wide (as the dual
-// contouring's host step takes them).
+// contouring's host step takes them); on scenes of pruned tapes, the tapes' (the same near the
+// surface, where the whole tree would be far too slow).
 struct Field {
     const Evaluator& evaluator;
     float h;
+    bool pruned = evaluator.nodes().size() >= kTapeMinNodes;
+
+    float distance(glm::vec3 p) const {
+        return pruned ? evaluator.prunedDistance(p) : evaluator.distance(p);
+    }
+    glm::vec3 colour(glm::vec3 p) const {
+        return (pruned ? evaluator.prunedSample(p) : evaluator.sample(p)).color;
+    }
 
     glm::vec3 gradient(glm::vec3 p) const {
         const float s = 0.01f * h;
         const glm::vec3 taps[4] = {{1, -1, -1}, {-1, -1, 1}, {-1, 1, -1}, {1, 1, 1}};
         glm::vec3 g(0.0f);
         for (const glm::vec3& t : taps)
-            g += t * evaluator.distance(p + t * s);
+            g += t * distance(p + t * s);
         return g / (4.0f * s);
     }
     // Newton steps towards the surface, each at most a cell long; with `across` (unit length),
     // within the plane through p normal to it.
     glm::vec3 project(glm::vec3 p, int steps, glm::vec3 across = glm::vec3(0.0f)) const {
         for (int i = 0; i < steps; ++i) {
-            const float d = evaluator.distance(p);
+            const float d = distance(p);
             if (!(std::abs(d) > 1e-5f * h)) break;
             glm::vec3 g = gradient(p);
             g -= glm::dot(g, across) * across;
@@ -101,7 +110,7 @@ void searchEdge(const Field& field, const Mesh& mesh, const std::vector<glm::vec
         if (glm::distance(lo, hi) < kConverged * field.h) break;
         if (i == kMaxHalvings) return;
         const glm::vec3 m = field.project(0.5f * (lo + hi), 2, across);
-        const glm::vec3 cm = field.evaluator.sample(m).color;
+        const glm::vec3 cm = field.colour(m);
         if (colourGap(cm, cLo) <= colourGap(cm, cHi)) {
             lo = m;
             cLo = cm;
@@ -192,7 +201,7 @@ bool hasSeveralColours(const Evaluator& evaluator) {
 
 glm::vec3 surfaceColour(const Evaluator& evaluator, glm::vec3 p, float h) {
     const Field field{evaluator, h};
-    return evaluator.sample(field.project(p, 3)).color;
+    return field.colour(field.project(p, 3));
 }
 
 size_t splitColourBorders(Mesh& mesh, const Evaluator& evaluator, float h) {
@@ -250,7 +259,7 @@ size_t splitColourBorders(Mesh& mesh, const Evaluator& evaluator, float h) {
     std::vector<glm::vec3> colourAt(vertices, glm::vec3(0.0f));
     onTwoThreads(corners.size(), [&](size_t begin, size_t end) {
         for (size_t i = begin; i < end; ++i)
-            colourAt[corners[i]] = evaluator.sample(mesh.positions[corners[i]]).color;
+            colourAt[corners[i]] = field.colour(mesh.positions[corners[i]]);
     });
 
     // The edges of those triangles whose ends the evaluator colours differently, each once.
@@ -404,7 +413,7 @@ size_t splitColourBorders(Mesh& mesh, const Evaluator& evaluator, float h) {
                 mesh.normals.push_back(glm::dot(g, g) > 1e-12f ? glm::normalize(g)
                                                                : mesh.normals[v[0]]);
             }
-            if (coloured) mesh.colors.push_back(evaluator.sample(p).color);
+            if (coloured) mesh.colors.push_back(field.colour(p));
         }
         for (int k = 0; k < 3; ++k)
             if (mid[k] != kNone) made[c][k] = mid[k] = vertexOf[mid[k] - kBorderBase];
