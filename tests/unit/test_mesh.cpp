@@ -621,7 +621,7 @@ TEST_F(MeshTest, CubeCornersAreKept) {
 // 392 vertices per scene lay beyond half a cell, up to 0.91 of one), by the CPU evaluator's pruned
 // field (which the prune tests hold to the whole tree near the surface). A few vertices of the
 // forest and the flat parts, on sheets thinner than a cell (the forest's ground is 0.2 thick, its
-// cells 0.33), stay farther where every move within their cells would turn a triangle over:
+// cells 0.67), stay farther where every move within their cells would turn a triangle over:
 // at most one in 2,000, none past 0.7 of a cell. The molecule, whose balls are larger than its
 // cells, has no triangle facing against the field.
 TEST_F(MeshTest, BenchmarkScenesAreClosedWithVerticesOnTheSurface) {
