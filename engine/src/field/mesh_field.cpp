@@ -31,6 +31,7 @@
 #include <numbers>
 #include <optional>
 #include <thread>
+#include <tuple>
 #include <utility>
 
 namespace sdfcsg::detail {
@@ -1201,15 +1202,18 @@ Result<MeshField> MeshField::fromField(const std::function<float(vec3)>& value,
         }
         // Where the surface comes to a point or an edge sharper than the grid resolves (a
         // twisted box's corners), the crossings stay a few cells short of it: from each sample
-        // within a cell of the surface, Newton steps along the gradient (four taps about the
-        // point, sdf.glsl's valueTap) reach the tip, alternating between the faces that meet
-        // there.
+        // within two cells of the surface (the field's value being at most the distance), Newton
+        // steps along the gradient (four taps about the point, sdf.glsl's valueTap) reach the
+        // tip, alternating between the faces that meet there. Points that land within a
+        // sixteenth of a cell of one before count once.
         const float h = cell / 64.0f;
+        std::vector<vec3> projected;
         const glm::vec3 taps[4] = {{1, -1, -1}, {-1, -1, 1}, {-1, 1, -1}, {1, 1, 1}};
         for (int z = 0; z <= kBrick; ++z)
             for (int y = 0; y <= kBrick; ++y)
                 for (int x = 0; x <= kBrick; ++x) {
-                    if (!(std::abs(values[b * kBrickSamples + local(x, y, z)]) < cell)) continue;
+                    if (!(std::abs(values[b * kBrickSamples + local(x, y, z)]) < 2.0f * cell))
+                        continue;
                     const vec3 start = pointAt(base + glm::ivec3(x, y, z));
                     vec3 q = start;
                     float v = 0.0f;
@@ -1225,9 +1229,17 @@ Result<MeshField> MeshField::fromField(const std::function<float(vec3)>& value,
                         if (!(g2 > 1e-6f)) break;
                         q -= v / g2 * g;
                     }
-                    if (std::abs(v) <= 1e-3f * cell && glm::length(q - start) <= 2.0f * cell)
-                        found[b].push_back(q);
+                    if (std::abs(v) <= 1e-3f * cell && glm::length(q - start) <= 3.0f * cell)
+                        projected.push_back(q);
                 }
+        std::sort(projected.begin(), projected.end(), [&](vec3 a, vec3 c) {
+            const glm::ivec3 ka(glm::floor(a * (16.0f / cell))), kc(glm::floor(c * (16.0f / cell)));
+            return std::tie(ka.x, ka.y, ka.z) < std::tie(kc.x, kc.y, kc.z);
+        });
+        for (size_t k = 0; k < projected.size(); ++k)
+            if (k == 0 || glm::floor(projected[k] * (16.0f / cell)) !=
+                              glm::floor(projected[k - 1] * (16.0f / cell)))
+                found[b].push_back(projected[k]);
     });
     std::vector<size_t> firstSeed(brickCount + 1, 0);
     for (size_t b = 0; b < brickCount; ++b)
