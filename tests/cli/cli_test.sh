@@ -53,7 +53,7 @@ case_validate() {
     printf '{"version": 1, "root": {"type": "offset", "distance": 0.002, "children": [%s]}}' \
         '{"type": "twist", "angle": 90, "children": [{"type": "box", "size": [1, 2, 1]}]}' >twisted.json
     check "validate notes" 0 "$bin" validate twisted.json
-    expect_text "validate note" out.txt "twisted.json: root: note: offset over a field that is not a distance (twist at root.children[0] divides its field by up to 2.08): the surface lies about 0.002 from the child's (divided by the field's gradient, to first order, not baked: at a quarter of the distance its field would exceed 32 MiB, or its child is unbounded; 0.002 to 0.00416 without)"
+    expect_text "validate note" out.txt "twisted.json: root: note: offset over a field that is not a distance (twist at root.children[0] divides its field by up to 2.08): the surface lies about 0.002 from the child's (divided by the field's gradient, to first order, not baked: at a quarter of the distance its field would exceed 32 MiB, or its child is unbounded or of more than 256 nodes; 0.002 to 0.00416 without)"
     expect_text "validate shading note" out.txt "twisted.json: root: note: ambient occlusion and soft shadows over a field that is not a distance (twist at root.children[0] divides its field by up to 2.08): the shading can be darker where its values lie below the distance (down to 1/2.08 of it); --no-ao and --no-shadows leave them out"
 
     # A mesh whose file has a hole (a box less one triangle) and a flipped triangle: validate,

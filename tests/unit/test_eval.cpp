@@ -471,14 +471,14 @@ TEST(Eval, FieldNotesNameWhatDependsOnDistancesThatAreNot) {
               "offset over a field that is not a distance (twist at root.children[0].children[0] "
               "divides its field by up to 2.08): the surface lies about 0.002 from the child's "
               "(divided by the field's gradient, to first order, not baked: at a quarter of the "
-              "distance its field would exceed 32 MiB, or its child is unbounded; 0.002 to "
-              "0.00416 without)");
+              "distance its field would exceed 32 MiB, or its child is unbounded or of more than "
+              "256 nodes; 0.002 to 0.00416 without)");
     EXPECT_EQ(notes[1].message,
               "shell over a field that is not a distance (sphere at root.children[1].children[0], "
               "scaled unevenly: its field below the distance by up to 2): the skin is about 0.002 "
               "thick (divided by the field's gradient, to first order, not baked: at a quarter of "
-              "the distance its field would exceed 32 MiB, or its child is unbounded; 0.002 to "
-              "0.004 without)");
+              "the distance its field would exceed 32 MiB, or its child is unbounded or of more "
+              "than 256 nodes; 0.002 to 0.004 without)");
     EXPECT_EQ(notes[2].message,
               "smooth union over a field that is not a distance (ellipsoid at "
               "root.children[2].children[0]: a bound, below the distance by up to 1.67): the "
@@ -489,7 +489,7 @@ TEST(Eval, FieldNotesNameWhatDependsOnDistancesThatAreNot) {
               "root.children[3].children[0]: no distance within 0.1 of its seam): the surface "
               "lies about 0.001 from the child's (divided by the field's gradient, to first "
               "order, not baked: at a quarter of the distance its field would exceed 32 MiB, or "
-              "its child is unbounded; not 0.001 within the blend)");
+              "its child is unbounded or of more than 256 nodes; not 0.001 within the blend)");
     EXPECT_EQ(notes[4].path, "root");
     EXPECT_EQ(notes[4].message,
               "ambient occlusion and soft shadows over a field that is not a distance (twist at "

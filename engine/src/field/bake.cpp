@@ -37,6 +37,19 @@ bool severalColors(const Evaluator& e, uint32_t c) {
     return false;
 }
 
+// The nodes of node c's subtree, up to `limit` + 1.
+size_t subtreeSize(const Scene& scene, uint32_t c, size_t limit) {
+    size_t count = 0;
+    std::vector<uint32_t> open{c};
+    while (!open.empty() && count <= limit) {
+        const Node& n = scene.nodes[open.back()];
+        open.pop_back();
+        ++count;
+        open.insert(open.end(), n.children.begin(), n.children.end());
+    }
+    return count;
+}
+
 } // namespace
 
 void bakeOffsets(Scene& scene) {
@@ -55,7 +68,7 @@ void bakeOffsets(Scene& scene) {
         const float amount = std::abs(e->nodes()[i].params[0]); // in the frame's units
         const Aabb box = child.bounds;
         if (!(child.loss > kExactLoss) || !box.finite() || box.empty() || !(amount > 0.0f) ||
-            !std::isfinite(amount))
+            !std::isfinite(amount) || subtreeSize(scene, c, kMaxBakedNodes) > kMaxBakedNodes)
             continue;
         if (used + 2 >= kMaxOutlineWords) break;
         const size_t budget = std::min(kMaxBakeBytes, (kMaxOutlineWords - used - 2) * 16);

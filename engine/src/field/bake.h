@@ -7,13 +7,16 @@
 //
 // The rule: the cell is a sixteenth of the distance the node moves its surface by (the offset's
 // |distance|, half the shell's thickness, in its frame's units), grown by a quarter at a time
-// until the field fits kMaxBakeBytes (and what the scene's words have left, kMaxOutlineWords); the
-// band reaches that distance and two cells more. A node whose field would not fit at a quarter of
-// the distance keeps the first-order division by the gradient (sdf.glsl, valueNormalised), as
-// does one whose child reaches infinity (a plane) or whose child is a distance already. What
-// remains: the distance to points of the surface a cell apart exceeds the surface's by at most
-// (cell / sqrt 2)^2 / 2d, under 0.2% at 16 cells and 0.8% at 4, and trilinear interpolation
-// rounds the offset's own creases (where two nearest points meet) within a cell.
+// until the field fits kMaxBakeBytes (and what the scene's words have left, kMaxOutlineWords),
+// first with the colours where the child has several, then without; the band reaches that
+// distance and two cells more. A node whose field would not fit at a quarter of the distance
+// keeps the first-order division by the gradient (sdf.glsl, valueNormalised), as does one whose
+// child reaches infinity (a plane), has more than kMaxBakedNodes nodes, or is a distance
+// already. What remains: the distance to points of the surface a cell apart exceeds the
+// surface's by at most (cell / sqrt 2)^2 / 2d, under 0.2% at 16 cells and 0.8% at 4, and
+// trilinear interpolation rounds the creases of the offset's own surface (where the nearest
+// point jumps: a shell's inner skin at its child's convex edges, the inside corners of an
+// inward offset) by up to about half a cell (tests/unit/test_offsets.cpp).
 #pragma once
 
 #include "sdfcsg/nodes.h"
@@ -23,8 +26,11 @@
 
 namespace sdfcsg::detail {
 
-// The most one node's baked field may take, of the scene's kMaxOutlineWords (64 MiB).
+// The most one node's baked field may take, of the scene's kMaxOutlineWords (64 MiB); and the
+// most nodes its child's subtree may have, whose evaluation at each of up to millions of points
+// the load waits for (a child of 256 spheres smoothly united takes some seconds).
 inline constexpr size_t kMaxBakeBytes = size_t(32) << 20;
+inline constexpr size_t kMaxBakedNodes = 256;
 
 // Whether node n is an offset or shell that reads its child's baked distance from its words.
 inline bool baked(const Node& n) {

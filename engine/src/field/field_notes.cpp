@@ -97,7 +97,8 @@ std::string noteOf(const Node& n, const Loss& loss) {
     const std::string divides = "divided by the field's gradient, to first order, not baked: at "
                                 "a quarter of the distance its field would exceed " +
                                 std::to_string(detail::kMaxBakeBytes >> 20) +
-                                " MiB, or its child is unbounded; ";
+                                " MiB, or its child is unbounded or of more than " +
+                                std::to_string(detail::kMaxBakedNodes) + " nodes; ";
     if (n.kind == NodeKind::Offset) {
         const float r = std::abs(n.params[0]);
         effect = "the surface lies about " + number(r) + " from the child's (" + divides +
