@@ -107,8 +107,8 @@ TEST(Prune, FullTapeRunsTheWholeTree) {
 // tape: a stack of 41 values, where a right-leaning chain of unions and differences keeps every
 // left operand until its end, inside five domain operations nested in one another and value
 // operations between them, which normalise their child's field (eval.cpp, FlatNode::loss; too
-// thin against it to bake, field/bake.h) and so open as domain operations do. The whole tape gives the tree's bits. (The pruner's runs of
-// domain operations are the bundled scenes' part.)
+// thin against it to bake, field/bake.h) and so open as domain operations do. The whole tape gives
+// the tree's bits. (The pruner's runs of domain operations are the bundled scenes' part.)
 TEST(Prune, TheMachineRunsDeepStacksInNestedDomains) {
     std::string chain = R"({"type": "sphere", "radius": 0.3})";
     for (int i = 0; i < 40; ++i) {
