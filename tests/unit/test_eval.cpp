@@ -448,16 +448,17 @@ TEST(Eval, SolidBoundsAreTight) {
 }
 
 // Offsets, shells and smooth blends over fields that are not distances are noted, with how far
-// off they land; over distances, and in the bundled scenes, nothing is.
+// off they land: the offsets and shells too thin against their child to bake (field/bake.h);
+// over distances, baked, and in the bundled scenes, nothing is.
 TEST(Eval, FieldNotesNameWhatDependsOnDistancesThatAreNot) {
     const Scene scene = parseRoot(R"({"type": "union", "children": [
-        {"type": "offset", "distance": 0.3, "children": [
+        {"type": "offset", "distance": 0.002, "children": [
             {"type": "twist", "angle": 90, "children": [{"type": "box", "size": [1, 2, 1]}]}]},
-        {"type": "shell", "thickness": 0.1, "children": [
+        {"type": "shell", "thickness": 0.002, "children": [
             {"type": "sphere", "radius": 0.5, "scale": [1, 2, 1]}]},
         {"type": "union", "smooth": 0.2, "children": [
             {"type": "ellipsoid", "radii": [0.5, 0.3, 0.4]}, {"type": "sphere", "radius": 0.3}]},
-        {"type": "offset", "distance": -0.05, "children": [
+        {"type": "offset", "distance": -0.001, "children": [
             {"type": "intersection", "smooth": 0.1, "children": [
                 {"type": "sphere", "radius": 0.3}, {"type": "box", "size": [0.5, 0.5, 0.5]}]}]},
         {"type": "offset", "distance": 0.2, "children": [
@@ -468,12 +469,16 @@ TEST(Eval, FieldNotesNameWhatDependsOnDistancesThatAreNot) {
     EXPECT_EQ(notes[0].path, "root.children[0]");
     EXPECT_EQ(notes[0].message,
               "offset over a field that is not a distance (twist at root.children[0].children[0] "
-              "divides its field by up to 2.65): the surface lies about 0.3 from the child's "
-              "(divided by the field's gradient, to first order; 0.3 to 0.794 without)");
+              "divides its field by up to 2.08): the surface lies about 0.002 from the child's "
+              "(divided by the field's gradient, to first order, not baked: at a quarter of the "
+              "distance its field would exceed 32 MiB, or its child is unbounded or of more than "
+              "256 nodes; 0.002 to 0.00416 without)");
     EXPECT_EQ(notes[1].message,
               "shell over a field that is not a distance (sphere at root.children[1].children[0], "
-              "scaled unevenly: its field below the distance by up to 2): the skin is about 0.1 "
-              "thick (divided by the field's gradient, to first order; 0.1 to 0.2 without)");
+              "scaled unevenly: its field below the distance by up to 2): the skin is about 0.002 "
+              "thick (divided by the field's gradient, to first order, not baked: at a quarter of "
+              "the distance its field would exceed 32 MiB, or its child is unbounded or of more "
+              "than 256 nodes; 0.002 to 0.004 without)");
     EXPECT_EQ(notes[2].message,
               "smooth union over a field that is not a distance (ellipsoid at "
               "root.children[2].children[0]: a bound, below the distance by up to 1.67): the "
@@ -482,18 +487,23 @@ TEST(Eval, FieldNotesNameWhatDependsOnDistancesThatAreNot) {
     EXPECT_EQ(notes[3].message,
               "offset over a field that is not a distance (smooth blend at "
               "root.children[3].children[0]: no distance within 0.1 of its seam): the surface "
-              "lies about 0.05 from the child's (divided by the field's gradient, to first "
-              "order; not 0.05 within the blend)");
+              "lies about 0.001 from the child's (divided by the field's gradient, to first "
+              "order, not baked: at a quarter of the distance its field would exceed 32 MiB, or "
+              "its child is unbounded or of more than 256 nodes; not 0.001 within the blend)");
     EXPECT_EQ(notes[4].path, "root");
     EXPECT_EQ(notes[4].message,
               "ambient occlusion and soft shadows over a field that is not a distance (twist at "
-              "root.children[0].children[0] divides its field by up to 2.65): the shading can be "
-              "darker where its values lie below the distance (down to 1/2.65 of it); --no-ao "
+              "root.children[0].children[0] divides its field by up to 2.08): the shading can be "
+              "darker where its values lie below the distance (down to 1/2.08 of it); --no-ao "
               "and --no-shadows leave them out");
     // Below a loss of 2 the shading shows nothing worth a note.
     const Scene gentle = parseRoot(
         R"({"type": "twist", "angle": 40, "children": [{"type": "box", "size": [1, 2, 1]}]})");
     EXPECT_TRUE(fieldNotes(gentle, Evaluator(gentle)).empty());
+    const Scene baked = parseRoot(R"({"type": "offset", "distance": 0.3, "children": [
+        {"type": "twist", "angle": 90, "children": [{"type": "box", "size": [1, 2, 1]}]}]})");
+    EXPECT_NE(baked.nodes[0].words, nullptr);
+    EXPECT_TRUE(fieldNotes(baked, Evaluator(baked)).empty());
     for (const Scene& bundled : bundledScenes())
         EXPECT_TRUE(fieldNotes(bundled, Evaluator(bundled)).empty()) << bundled.file;
 }

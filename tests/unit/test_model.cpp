@@ -15,6 +15,7 @@
 #include <simdjson.h>
 
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace sdfcsg::test {
@@ -279,6 +280,32 @@ TEST(Model, EditsGoThroughTheLoadersChecks) {
                                      loaded.error().diagnostics[0].message);
     EXPECT_EQ(toJson(scene), toJson(edited));
     EXPECT_FALSE(m::setValue(scene, 1, "radius", m::Value()));
+}
+
+// An offset over a twist reads the twist's distance baked at load (field/bake.h): an edit of the
+// twist, or of the offset, bakes it again, to the field the edited scene's file loads with; the
+// words are never written to JSON.
+TEST(Model, EditsBakeOffsetsAgain) {
+    const auto offset = [](float distance, float angle) {
+        return R"({"type": "offset", "distance": )" + std::to_string(distance) +
+               R"(, "children": [{"type": "twist", "angle": )" + std::to_string(angle) +
+               R"(, "children": [{"type": "box", "size": [1, 2, 1]}]}]})";
+    };
+    Scene scene = parseRoot(offset(0.3f, 90.0f));
+    ASSERT_NE(scene.nodes[0].words, nullptr);
+    EXPECT_EQ(toJson(scene).find("words"), std::string::npos);
+    for (const auto& [node, key, value, distance, angle] :
+         {std::tuple{1u, "angle", 45.0f, 0.3f, 45.0f}, {0u, "distance", 0.2f, 0.2f, 45.0f}}) {
+        SCOPED_TRACE(key);
+        ASSERT_TRUE(m::setValue(scene, node, key, value));
+        const Scene loaded = parseRoot(offset(distance, angle));
+        ASSERT_NE(scene.nodes[0].words, nullptr);
+        ASSERT_NE(loaded.nodes[0].words, nullptr);
+        EXPECT_TRUE(*scene.nodes[0].words == *loaded.nodes[0].words);
+        const Evaluator edited(scene), fresh(loaded);
+        for (const glm::vec3& p : randomPoints(3, 200, 1.5f))
+            EXPECT_EQ(edited.distance(p), fresh.distance(p));
+    }
 }
 
 } // namespace

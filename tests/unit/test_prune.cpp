@@ -106,9 +106,9 @@ TEST(Prune, FullTapeRunsTheWholeTree) {
 // The C++ tape machine (shaders/tape_run.glsl, compiled in prune.cpp) sizes its arrays for the
 // tape: a stack of 41 values, where a right-leaning chain of unions and differences keeps every
 // left operand until its end, inside five domain operations nested in one another and value
-// operations between them, which normalise their child's field (eval.cpp, FlatNode::loss) and
-// so open as domain operations do. The whole tape gives the tree's bits. (The pruner's runs of
-// domain operations are the bundled scenes' part.)
+// operations between them, which normalise their child's field (eval.cpp, FlatNode::loss; too
+// thin against it to bake, field/bake.h) and so open as domain operations do. The whole tape gives
+// the tree's bits. (The pruner's runs of domain operations are the bundled scenes' part.)
 TEST(Prune, TheMachineRunsDeepStacksInNestedDomains) {
     std::string chain = R"({"type": "sphere", "radius": 0.3})";
     for (int i = 0; i < 40; ++i) {
@@ -121,10 +121,10 @@ TEST(Prune, TheMachineRunsDeepStacksInNestedDomains) {
     const Scene scene = parseRoot(
         R"({"type": "repeat", "count": [3, 1, 2], "spacing": [2.5, 1, 2.5], "children": [
             {"type": "polar_repeat", "count": 5, "radius": 0.6, "children": [
-            {"type": "offset", "distance": 0.02, "children": [
+            {"type": "offset", "distance": 0.002, "children": [
             {"type": "mirror", "axes": "x", "children": [
             {"type": "twist", "angle": 40, "children": [
-            {"type": "shell", "thickness": 0.03, "children": [
+            {"type": "shell", "thickness": 0.002, "children": [
             {"type": "elongate", "length": [0.2, 0, 0.1], "children": [)" +
         chain + "]}]}]}]}]}]}]}");
     ASSERT_FALSE(scene.nodes.empty());

@@ -8,6 +8,7 @@
 #include "sdfcsg/compile.h"
 
 #include "codegen/gpu_nodes.h"
+#include "field/bake.h"
 #include "field/prune.h"
 #include "field/sdf.h"
 #include "scene/outline.h"
@@ -704,7 +705,8 @@ std::string generateSceneGlsl(const Scene& scene, const CodegenOptions& options)
         // pruning keeps that so. All follow the structure, not values, so that a value edit
         // stays an upload (every blend profile is kept: a profile is a value), but for one:
         uint32_t kinds = 0, operations = 0, colors = 0;
-        const uint32_t domains = domainNesting(scene);
+        Scene storage;
+        const uint32_t domains = domainNesting(detail::bakedView(scene, storage));
         bool stackRead = domains > 0;
         for (const FlatNode& n : nodes) {
             const Role role = kindInfo(n.kind).role;
@@ -757,7 +759,10 @@ std::string generateSceneGlsl(const Scene& scene, const CodegenOptions& options)
     std::vector<detail::GpuNode> literals;
     if (inlined) literals = detail::packNodes(evaluator);
     out.reserve(out.size() + scene.nodes.size() * (inlined ? 500 : 200));
-    Emitter emitter(scene, out, inlined ? &literals : nullptr, options.boundsTests);
+    // A baked offset's child is a mesh node, its subtree left out (field/bake.h).
+    Scene storage;
+    Emitter emitter(detail::bakedView(scene, storage), out, inlined ? &literals : nullptr,
+                    options.boundsTests);
     emitter.helpers();
     emitter.function(false);
     out += '\n';

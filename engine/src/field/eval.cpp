@@ -4,6 +4,7 @@
 // generates, so the CPU and GPU fields agree to rounding.
 #include "sdfcsg/eval.h"
 
+#include "field/bake.h"
 #include "field/prune.h"
 #include "field/sdf.h"
 
@@ -515,6 +516,14 @@ glm::vec3 primitiveColor(const FlatNode& node, glm::vec3 p) {
     return node.ownColors ? ownColor(node, p) : node.color;
 }
 
+float subtreeValue(const Evaluator& evaluator, uint32_t node, glm::vec3 p) {
+    return evaluate<float>(evaluator.nodes(), node, p, true);
+}
+
+glm::vec3 subtreeColor(const Evaluator& evaluator, uint32_t node, glm::vec3 p) {
+    return glm::vec3(evaluate<glm::vec4>(evaluator.nodes(), node, p, true));
+}
+
 } // namespace detail
 
 struct Evaluator::Pruned {
@@ -592,6 +601,22 @@ Evaluator::Evaluator(const Scene& scene) : pruned_(std::make_shared<Pruned>()) {
         n.smooth = boolean ? float(double(src.params[0]) * a.scale) : 0.0f;
         n.blend = boolean ? uint32_t(src.params[1]) : 0u;
         n.children = src.children;
+        // The child of a baked offset or shell (field/bake.h) is its baked distance: a mesh node
+        // in the frame's space, its subtree left unvisited.
+        if (hasParent && detail::baked(scene.nodes[parent[i]])) {
+            a = Acc{};
+            n.kind = NodeKind::Mesh;
+            n.toLocal = glm::mat3(1.0f);
+            n.offset = glm::vec3(0.0f);
+            n.scale = 1.0f;
+            n.boundsFloor = kindInfo(NodeKind::Mesh).floored;
+            n.words = scene.nodes[parent[i]].words;
+            n.params = wordsParams(NodeKind::Mesh, n.words.get());
+            n.ownColors = ownColors(NodeKind::Mesh, n.words.get());
+            n.smooth = 0.0f;
+            n.blend = 0;
+            n.children.clear();
+        }
         // How far out an offset or shell above reads its child (see pass 2), in this frame.
         if (hasParent) {
             const Node& above = scene.nodes[parent[i]];

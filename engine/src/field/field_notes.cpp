@@ -7,6 +7,7 @@
 #include "sdfcsg/eval.h"
 #include "sdfcsg/nodes.h"
 
+#include "field/bake.h"
 #include "field/mesh_field.h"
 #include "field/sdf.h"
 
@@ -90,9 +91,14 @@ std::string noteOf(const Node& n, const Loss& loss) {
         (smoothOf(n) > 0.0f ? "smooth " : "") + std::string(kindInfo(n.kind).name);
     const float factor = loss.factor;
     std::string effect;
-    // Offsets and shells divide by the field's gradient (FlatNode::loss): a first-order
-    // distance, which strays where the stretch changes within their reach.
-    const std::string divides = "divided by the field's gradient, to first order; ";
+    // Offsets and shells divide by the field's gradient (FlatNode::loss) where their child's
+    // distance could not be baked (field/bake.h): a first-order distance, which strays where the
+    // stretch changes within their reach.
+    const std::string divides = "divided by the field's gradient, to first order, not baked: at "
+                                "a quarter of the distance its field would exceed " +
+                                std::to_string(detail::kMaxBakeBytes >> 20) +
+                                " MiB, or its child is unbounded or of more than " +
+                                std::to_string(detail::kMaxBakedNodes) + " nodes; ";
     if (n.kind == NodeKind::Offset) {
         const float r = std::abs(n.params[0]);
         effect = "the surface lies about " + number(r) + " from the child's (" + divides +
@@ -154,7 +160,8 @@ std::vector<FieldNote> fieldNotes(const Scene& scene, const Evaluator& evaluator
             if (c < count && worse(losses[c], loss)) loss = losses[c];
         const bool dependent =
             n.kind == NodeKind::Offset || n.kind == NodeKind::Shell || smoothOf(n) > 0.0f;
-        if (dependent && loss.any) notes.push_back({n.path, noteOf(n, loss)});
+        // A baked offset or shell reads its child's distance (field/bake.h): nothing to note.
+        if (dependent && loss.any && !detail::baked(n)) notes.push_back({n.path, noteOf(n, loss)});
         // A mesh in a definition used more than once: one note for its one path.
         if (n.kind == NodeKind::Mesh)
             if (std::string note = meshNote(n);
@@ -164,6 +171,7 @@ std::vector<FieldNote> fieldNotes(const Scene& scene, const Evaluator& evaluator
                 notes.push_back({n.path, note});
         const Loss own = ownLoss(n, evaluator.nodes()[i]);
         if (worse(own, loss) || (own.any && !loss.any)) loss = own;
+        if (detail::baked(n)) loss = own; // a distance again, but for its own scale
         losses[i] = loss;
     }
     std::reverse(notes.begin(), notes.end()); // in the file's order

@@ -4,6 +4,7 @@
 #include "field/read_3mf.h"
 #include "mesh/radix_sort.h"
 #include "scene/files.h"
+#include "scene/json_writer.h"
 #include "scene/parse_util.h"
 #include "sdfcsg/export.h"
 
@@ -30,6 +31,7 @@
 #include <numbers>
 #include <optional>
 #include <thread>
+#include <tuple>
 #include <utility>
 
 namespace sdfcsg::detail {
@@ -553,6 +555,194 @@ std::vector<float> windingNumbers(const TriangleMesh& mesh, const std::vector<gl
     return w;
 }
 
+// Out to the margin by dilation: layer by layer, each sample next to one with its feature
+// known takes the nearest of the features nearest to its 26 neighbours, or its own if nearer
+// (the nearest feature of a point is also the nearest of the points between it and the
+// surface, which lie near its neighbours). `best` and `nearest` hold each sample's squared
+// distance and feature, exact within `reach`; `nearer(p, t, best2)` is the squared distance
+// from p to feature t where it is below best2 (else best2 or more).
+template <class Nearer>
+void MeshField::dilate(const MeshField& f, const std::vector<uint32_t>& brickSlots, float reach,
+                       float margin, std::vector<float>& best, std::vector<uint32_t>& nearest,
+                       const Nearer& nearer) {
+    constexpr uint32_t kNone = ~0u;
+    const size_t brickCount = brickSlots.size(), sampleCount = brickCount * kBrickSamples;
+    const auto slotOf = [&](glm::ivec3 b) {
+        return (size_t(b.z) * size_t(f.bricks_.y) + size_t(b.y)) * size_t(f.bricks_.x) +
+               size_t(b.x);
+    };
+    const auto brickOfSlot = [&](size_t s) {
+        return glm::ivec3(int(s % size_t(f.bricks_.x)),
+                          int(s / size_t(f.bricks_.x) % size_t(f.bricks_.y)),
+                          int(s / (size_t(f.bricks_.x) * size_t(f.bricks_.y))));
+    };
+    const auto brickBase = [&](size_t b) { return brickOfSlot(brickSlots[b]) * kBrick; };
+    const auto pointAt = [&](glm::ivec3 g) { return f.origin_ + f.cell_ * vec3(g); };
+    const auto local = [](int x, int y, int z) {
+        return (size_t(z) * kBrickSide + size_t(y)) * kBrickSide + size_t(x);
+    };
+    // `offer`: the nearest feature of each sample of the front, those that became known with
+    // one in the last layer (kNone elsewhere), which their neighbours take up; `touched`: whether
+    // a sample has had a neighbour with one. Only the front's neighbours have new features to
+    // take up, and only touched samples can become known: a layer visits those alone, not the
+    // far samples that make most of the bricks and never change.
+    std::vector<uint8_t> known(sampleCount, 0), touched(sampleCount, 0), reached(sampleCount, 0);
+    std::vector<uint32_t> offer(sampleCount, kNone), fresh(sampleCount, kNone);
+    // Per brick, sets of its samples as bits (x) in rows (y, z): the front, the touched not yet
+    // known (a deeper layer may reach them), and those a layer visits.
+    using Rows = std::array<uint16_t, kBrickSide * kBrickSide>;
+    std::vector<Rows> front(brickCount, Rows{}), pending(brickCount, Rows{}), visits(brickCount);
+    std::vector<uint8_t> moving(brickCount, 0); // whether a brick has a front or touched samples
+    parallelFor(brickCount, [&](size_t b) {
+        for (size_t s = 0; s < kBrickSamples; ++s) {
+            const size_t at = b * kBrickSamples + s;
+            if (!(best[at] < reach * reach)) continue;
+            known[at] = 1, offer[at] = nearest[at];
+            if (offer[at] != kNone) front[b][s / kBrickSide] |= uint16_t(1u << (s % kBrickSide));
+        }
+        moving[b] = std::any_of(front[b].begin(), front[b].end(), [](uint16_t r) { return r; });
+    });
+    constexpr size_t kNowhere = ~size_t(0);
+    // Layers by distance, half a cell deep: a sample is known once it is nearer than the layer's
+    // far side, when the samples between it and the surface are known.
+    const float step = 0.5f * f.cell_;
+    const int layers = int(std::ceil((margin - reach) / step)) + 4;
+    for (int layer = 0; layer < layers; ++layer) {
+        const float within = reach + float(layer + 1) * step;
+        const float within2 = within >= margin ? INFINITY : within * within;
+        std::atomic<bool> grew{false};
+        parallelFor(brickCount, [&](size_t b) {
+            const glm::ivec3 home = brickBase(b) / kBrick;
+            // The first samples of this brick and the 26 about it (kNowhere: none stored).
+            size_t around[27];
+            bool stirred = false;
+            for (int k = 0; k < 27; ++k) {
+                const glm::ivec3 there = home + glm::ivec3(k % 3, k / 3 % 3, k / 9) - 1;
+                const bool in = glm::all(glm::greaterThanEqual(there, glm::ivec3(0))) &&
+                                glm::all(glm::lessThan(there, f.bricks_));
+                const int32_t slot = in ? f.slots_[slotOf(there)] : kOutside;
+                around[k] = slot >= 0 ? size_t(slot) : kNowhere;
+                stirred = stirred || (slot >= 0 && moving[size_t(slot) / kBrickSamples]);
+            }
+            Rows& visit = visits[b];
+            visit = Rows{};
+            if (!stirred) return;
+            // The front about the brick, one sample beyond its faces (11 x 11 rows of 11 bits),
+            // as its samples read their neighbours (sampleAt below): the brick's own copy of
+            // each sample it holds, else the one in from the neighbour's face. Then grown by a
+            // sample along each axis: the samples next to it.
+            constexpr int kAround = kBrickSide + 2;
+            const auto frontRow = [&](int k, int y, int z) -> uint32_t {
+                return around[k] == kNowhere ? 0u
+                                             : front[around[k] / kBrickSamples][z * kBrickSide + y];
+            };
+            std::array<uint16_t, kAround * kAround> grown{};
+            // Along one axis, place p of the 11 is sample l of the brick o (0, 1, 2: before, this,
+            // after).
+            const auto place = [](int p, int& o, int& l) {
+                o = p == 0 ? 0 : p == kAround - 1 ? 2 : 1;
+                l = p == 0 ? kBrick - 1 : p == kAround - 1 ? 1 : p - 1;
+            };
+            for (int pz = 0; pz < kAround; ++pz)
+                for (int py = 0; py < kAround; ++py) {
+                    int oy, ly, oz, lz;
+                    place(py, oy, ly), place(pz, oz, lz);
+                    const int k = 3 * oy + 9 * oz;
+                    const uint32_t row = frontRow(k + 1, ly, lz) << 1 |
+                                         (frontRow(k, ly, lz) >> (kBrick - 1) & 1u) |
+                                         (frontRow(k + 2, ly, lz) >> 1 & 1u) << (kAround - 1);
+                    grown[size_t(pz * kAround + py)] = uint16_t(row | row << 1 | row >> 1);
+                }
+            bool any = false;
+            for (int z = 0; z <= kBrick; ++z)
+                for (int y = 0; y <= kBrick; ++y) {
+                    uint32_t row = 0;
+                    for (int dz = 0; dz < 3; ++dz)
+                        for (int dy = 0; dy < 3; ++dy)
+                            row |= grown[size_t((z + dz) * kAround + y + dy)];
+                    const size_t r = size_t(z * kBrickSide + y);
+                    visit[r] = uint16_t((row >> 1 & 0x1ffu) | pending[b][r]);
+                    any = any || visit[r];
+                }
+            if (!any) return;
+            // A neighbour's sample, this brick's where it holds it (its copy of the faces it
+            // shares), else the neighbouring brick's.
+            const auto sampleAt = [&](glm::ivec3 l) {
+                int k = 13;
+                for (int a = 0, weight = 1; a < 3; ++a, weight *= 3)
+                    if (l[a] < 0)
+                        l[a] += kBrick, k -= weight;
+                    else if (l[a] > kBrick)
+                        l[a] -= kBrick, k += weight;
+                return around[k] == kNowhere ? kNowhere : around[k] + local(l.x, l.y, l.z);
+            };
+            bool grows = false;
+            for (int z = 0; z <= kBrick; ++z)
+                for (int y = 0; y <= kBrick; ++y) {
+                    uint16_t& row = visit[size_t(z * kBrickSide + y)];
+                    for (int x = 0; x <= kBrick; ++x) {
+                        const size_t at = b * kBrickSamples + local(x, y, z);
+                        if (!(row >> x & 1u)) continue;
+                        if (known[at]) {
+                            row = uint16_t(row & ~(1u << x));
+                            continue;
+                        }
+                        const bool inside =
+                            x > 0 && x < kBrick && y > 0 && y < kBrick && z > 0 && z < kBrick;
+                        const vec3 p = pointAt(home * kBrick + glm::ivec3(x, y, z));
+                        uint32_t seen[27] = {nearest[at]};
+                        int count = 1;
+                        fresh[at] = nearest[at];
+                        for (int dz = -1; dz <= 1; ++dz)
+                            for (int dy = -1; dy <= 1; ++dy)
+                                for (int dx = -1; dx <= 1; ++dx) {
+                                    const size_t n =
+                                        inside ? at + local(dx + 1, dy + 1, dz + 1) - local(1, 1, 1)
+                                               : sampleAt(glm::ivec3(x + dx, y + dy, z + dz));
+                                    const uint32_t t = n == kNowhere ? kNone : offer[n];
+                                    if (t == kNone) continue;
+                                    touched[at] = 1;
+                                    if (std::find(seen, seen + count, t) != seen + count) continue;
+                                    seen[count++] = t;
+                                    const float d2 = nearer(p, t, best[at]);
+                                    if (d2 < best[at]) best[at] = d2, fresh[at] = t;
+                                }
+                        // 1: a neighbour with a triangle, 2: and now known itself.
+                        reached[at] = touched[at] ? best[at] < within2 ? 2 : 1 : 0;
+                        grows = grows || reached[at] == 2;
+                    }
+                }
+            if (grows) grew = true;
+        });
+        if (!grew) break;
+        parallelFor(brickCount, [&](size_t b) {
+            Rows& fr = front[b];
+            for (size_t r = 0; r < fr.size(); ++r)
+                for (int x = 0; x <= kBrick; ++x)
+                    if (fr[r] >> x & 1u)
+                        offer[b * kBrickSamples + r * kBrickSide + size_t(x)] = kNone;
+            fr = Rows{}, pending[b] = Rows{};
+            bool any = false;
+            for (size_t r = 0; r < fr.size(); ++r)
+                for (int x = 0; x <= kBrick; ++x) {
+                    if (!(visits[b][r] >> x & 1u)) continue;
+                    const size_t at = b * kBrickSamples + r * kBrickSide + size_t(x);
+                    if (reached[at] == 1) {
+                        nearest[at] = fresh[at];
+                        pending[b][r] = uint16_t(pending[b][r] | 1u << x);
+                    }
+                    if (reached[at] == 2) {
+                        nearest[at] = offer[at] = fresh[at], known[at] = 1;
+                        if (fresh[at] != kNone) fr[r] = uint16_t(fr[r] | 1u << x);
+                    }
+                    any = any || reached[at] != 0;
+                    reached[at] = 0;
+                }
+            moving[b] = any;
+        });
+    }
+}
+
 Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float bandCells,
                                   size_t maxBytes) {
     Box box;
@@ -712,171 +902,9 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
         }
     });
 
-    // Out to the margin by dilation: layer by layer, each sample next to one with its triangle
-    // known takes the nearest of the triangles nearest to its 26 neighbours, or the one its box
-    // reached if nearer (the nearest triangle of a point is also the nearest of the points
-    // between it and the surface, which lie near its neighbours).
-    // `offer`: the nearest triangle of each sample of the front, those that became known with
-    // one in the last layer (kNone elsewhere), which their neighbours take up; `touched`: whether
-    // a sample has had a neighbour with one. Only the front's neighbours have new triangles to
-    // take up, and only touched samples can become known: a layer visits those alone, not the
-    // far samples that make most of the bricks and never change.
-    std::vector<uint8_t> known(sampleCount, 0), touched(sampleCount, 0), reached(sampleCount, 0);
-    std::vector<uint32_t> offer(sampleCount, kNone), fresh(sampleCount, kNone);
-    // Per brick, sets of its samples as bits (x) in rows (y, z): the front, the touched not yet
-    // known (a deeper layer may reach them), and those a layer visits.
-    using Rows = std::array<uint16_t, kBrickSide * kBrickSide>;
-    std::vector<Rows> front(brickCount, Rows{}), pending(brickCount, Rows{}), visits(brickCount);
-    std::vector<uint8_t> moving(brickCount, 0); // whether a brick has a front or touched samples
-    parallelFor(brickCount, [&](size_t b) {
-        for (size_t s = 0; s < kBrickSamples; ++s) {
-            const size_t at = b * kBrickSamples + s;
-            if (!(best[at] < reach * reach)) continue;
-            known[at] = 1, offer[at] = nearest[at];
-            if (offer[at] != kNone) front[b][s / kBrickSide] |= uint16_t(1u << (s % kBrickSide));
-        }
-        moving[b] = std::any_of(front[b].begin(), front[b].end(), [](uint16_t r) { return r; });
-    });
-    constexpr size_t kNowhere = ~size_t(0);
-    // Layers by distance, half a cell deep: a sample is known once it is nearer than the layer's
-    // far side, when the samples between it and the surface are known.
-    const float step = 0.5f * f.cell_;
-    const int layers = int(std::ceil((margin - reach) / step)) + 4;
-    for (int layer = 0; layer < layers; ++layer) {
-        const float within = reach + float(layer + 1) * step;
-        const float within2 = within >= margin ? INFINITY : within * within;
-        std::atomic<bool> grew{false};
-        parallelFor(brickCount, [&](size_t b) {
-            const glm::ivec3 home = brickBase(b) / kBrick;
-            // The first samples of this brick and the 26 about it (kNowhere: none stored).
-            size_t around[27];
-            bool stirred = false;
-            for (int k = 0; k < 27; ++k) {
-                const glm::ivec3 there = home + glm::ivec3(k % 3, k / 3 % 3, k / 9) - 1;
-                const bool in = glm::all(glm::greaterThanEqual(there, glm::ivec3(0))) &&
-                                glm::all(glm::lessThan(there, f.bricks_));
-                const int32_t slot = in ? f.slots_[slotOf(there)] : kOutside;
-                around[k] = slot >= 0 ? size_t(slot) : kNowhere;
-                stirred = stirred || (slot >= 0 && moving[size_t(slot) / kBrickSamples]);
-            }
-            Rows& visit = visits[b];
-            visit = Rows{};
-            if (!stirred) return;
-            // The front about the brick, one sample beyond its faces (11 x 11 rows of 11 bits),
-            // as its samples read their neighbours (sampleAt below): the brick's own copy of
-            // each sample it holds, else the one in from the neighbour's face. Then grown by a
-            // sample along each axis: the samples next to it.
-            constexpr int kAround = kBrickSide + 2;
-            const auto frontRow = [&](int k, int y, int z) -> uint32_t {
-                return around[k] == kNowhere ? 0u
-                                             : front[around[k] / kBrickSamples][z * kBrickSide + y];
-            };
-            std::array<uint16_t, kAround * kAround> grown{};
-            // Along one axis, place p of the 11 is sample l of the brick o (0, 1, 2: before, this,
-            // after).
-            const auto place = [](int p, int& o, int& l) {
-                o = p == 0 ? 0 : p == kAround - 1 ? 2 : 1;
-                l = p == 0 ? kBrick - 1 : p == kAround - 1 ? 1 : p - 1;
-            };
-            for (int pz = 0; pz < kAround; ++pz)
-                for (int py = 0; py < kAround; ++py) {
-                    int oy, ly, oz, lz;
-                    place(py, oy, ly), place(pz, oz, lz);
-                    const int k = 3 * oy + 9 * oz;
-                    const uint32_t row = frontRow(k + 1, ly, lz) << 1 |
-                                         (frontRow(k, ly, lz) >> (kBrick - 1) & 1u) |
-                                         (frontRow(k + 2, ly, lz) >> 1 & 1u) << (kAround - 1);
-                    grown[size_t(pz * kAround + py)] = uint16_t(row | row << 1 | row >> 1);
-                }
-            bool any = false;
-            for (int z = 0; z <= kBrick; ++z)
-                for (int y = 0; y <= kBrick; ++y) {
-                    uint32_t row = 0;
-                    for (int dz = 0; dz < 3; ++dz)
-                        for (int dy = 0; dy < 3; ++dy)
-                            row |= grown[size_t((z + dz) * kAround + y + dy)];
-                    const size_t r = size_t(z * kBrickSide + y);
-                    visit[r] = uint16_t((row >> 1 & 0x1ffu) | pending[b][r]);
-                    any = any || visit[r];
-                }
-            if (!any) return;
-            // A neighbour's sample, this brick's where it holds it (its copy of the faces it
-            // shares), else the neighbouring brick's.
-            const auto sampleAt = [&](glm::ivec3 l) {
-                int k = 13;
-                for (int a = 0, weight = 1; a < 3; ++a, weight *= 3)
-                    if (l[a] < 0)
-                        l[a] += kBrick, k -= weight;
-                    else if (l[a] > kBrick)
-                        l[a] -= kBrick, k += weight;
-                return around[k] == kNowhere ? kNowhere : around[k] + local(l.x, l.y, l.z);
-            };
-            bool grows = false;
-            for (int z = 0; z <= kBrick; ++z)
-                for (int y = 0; y <= kBrick; ++y) {
-                    uint16_t& row = visit[size_t(z * kBrickSide + y)];
-                    for (int x = 0; x <= kBrick; ++x) {
-                        const size_t at = b * kBrickSamples + local(x, y, z);
-                        if (!(row >> x & 1u)) continue;
-                        if (known[at]) {
-                            row = uint16_t(row & ~(1u << x));
-                            continue;
-                        }
-                        const bool inside =
-                            x > 0 && x < kBrick && y > 0 && y < kBrick && z > 0 && z < kBrick;
-                        const vec3 p = pointAt(home * kBrick + glm::ivec3(x, y, z));
-                        uint32_t seen[27] = {nearest[at]};
-                        int count = 1;
-                        fresh[at] = nearest[at];
-                        for (int dz = -1; dz <= 1; ++dz)
-                            for (int dy = -1; dy <= 1; ++dy)
-                                for (int dx = -1; dx <= 1; ++dx) {
-                                    const size_t n =
-                                        inside ? at + local(dx + 1, dy + 1, dz + 1) - local(1, 1, 1)
-                                               : sampleAt(glm::ivec3(x + dx, y + dy, z + dz));
-                                    const uint32_t t = n == kNowhere ? kNone : offer[n];
-                                    if (t == kNone) continue;
-                                    touched[at] = 1;
-                                    if (std::find(seen, seen + count, t) != seen + count) continue;
-                                    seen[count++] = t;
-                                    const float d2 = nearer(p, t, best[at]);
-                                    if (d2 < best[at]) best[at] = d2, fresh[at] = t;
-                                }
-                        // 1: a neighbour with a triangle, 2: and now known itself.
-                        reached[at] = touched[at] ? best[at] < within2 ? 2 : 1 : 0;
-                        grows = grows || reached[at] == 2;
-                    }
-                }
-            if (grows) grew = true;
-        });
-        if (!grew) break;
-        parallelFor(brickCount, [&](size_t b) {
-            Rows& fr = front[b];
-            for (size_t r = 0; r < fr.size(); ++r)
-                for (int x = 0; x <= kBrick; ++x)
-                    if (fr[r] >> x & 1u)
-                        offer[b * kBrickSamples + r * kBrickSide + size_t(x)] = kNone;
-            fr = Rows{}, pending[b] = Rows{};
-            bool any = false;
-            for (size_t r = 0; r < fr.size(); ++r)
-                for (int x = 0; x <= kBrick; ++x) {
-                    if (!(visits[b][r] >> x & 1u)) continue;
-                    const size_t at = b * kBrickSamples + r * kBrickSide + size_t(x);
-                    if (reached[at] == 1) {
-                        nearest[at] = fresh[at];
-                        pending[b][r] = uint16_t(pending[b][r] | 1u << x);
-                    }
-                    if (reached[at] == 2) {
-                        nearest[at] = offer[at] = fresh[at], known[at] = 1;
-                        if (fresh[at] != kNone) fr[r] = uint16_t(fr[r] | 1u << x);
-                    }
-                    any = any || reached[at] != 0;
-                    reached[at] = 0;
-                }
-            moving[b] = any;
-        });
-    }
-    fresh = {}, offer = {}, front = {}, pending = {}, visits = {};
+    // Out to the margin by dilation (dilate).
+    dilate(f, brickSlots, reach, margin, best, nearest,
+           [&](vec3 p, uint32_t t, float best2) { return nearer(p, t, best2); });
 
     // Each sample's colour: the colour of its nearest triangle at the point of it nearest to the
     // sample, from its corners' by the point's barycentric coordinates.
@@ -1015,6 +1043,259 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
             for (int k = 0; k < kBrickSamples; ++k)
                 samples[k] = -samples[k];
         }
+    }
+    return f;
+}
+
+Result<MeshField> MeshField::fromField(const std::function<float(vec3)>& value,
+                                       const std::function<vec3(vec3)>& color, vec3 lo, vec3 hi,
+                                       float cell, float band, size_t maxBytes) {
+    if (!(cell > 0.0f) || !std::isfinite(cell) || !(lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z) ||
+        !std::isfinite(lo.x + lo.y + lo.z + hi.x + hi.y + hi.z))
+        return reason("no finite box to bake in");
+    MeshField f;
+    f.cell_ = cell;
+    f.band_ = std::max(band, std::sqrt(3.0f) * cell);
+    const float margin = f.band_ + cell;
+    f.origin_ = lo - margin;
+    const vec3 extent = (hi - lo + 2.0f * margin) / (cell * float(kBrick));
+    if (std::max({extent.x, extent.y, extent.z}) > float(maxBytes / sizeof(int32_t)))
+        return reason("a cell of " + formatFloat(cell) + " makes too many bricks");
+    f.bricks_ = glm::max(glm::ivec3(glm::ceil(extent)), glm::ivec3(1));
+    const size_t slots = size_t(f.bricks_.x) * size_t(f.bricks_.y) * size_t(f.bricks_.z);
+    const size_t sampleBytes = sizeof(float) * (color ? 2 : 1);
+    const auto tooLarge = [&](size_t bytes) {
+        return reason("a field of " + std::to_string(bytes >> 20) + " MiB at a cell of " +
+                      formatFloat(cell) + ", over the limit of " + std::to_string(maxBytes >> 20) +
+                      " MiB");
+    };
+    if (slots > maxBytes / sizeof(int32_t)) return tooLarge(slots * sizeof(int32_t));
+    f.slots_.assign(slots, kOutside);
+    const float brickSize = cell * float(kBrick);
+    const auto slotOf = [&](glm::ivec3 b) {
+        return (size_t(b.z) * size_t(f.bricks_.y) + size_t(b.y)) * size_t(f.bricks_.x) +
+               size_t(b.x);
+    };
+    const auto brickOfSlot = [&](size_t s) {
+        return glm::ivec3(int(s % size_t(f.bricks_.x)),
+                          int(s / size_t(f.bricks_.x) % size_t(f.bricks_.y)),
+                          int(s / (size_t(f.bricks_.x) * size_t(f.bricks_.y))));
+    };
+    const auto pointAt = [&](glm::ivec3 g) { return f.origin_ + f.cell_ * vec3(g); };
+    const auto local = [](int x, int y, int z) {
+        return (size_t(z) * kBrickSide + size_t(y)) * kBrickSide + size_t(x);
+    };
+
+    // The bricks that may reach within the margin of the surface, coarse to fine: a block of 4^3
+    // bricks, then each brick of a block that may. The field is at most the distance, so a box
+    // whose centre's value exceeds the margin by its half-diagonal lies beyond it, all on the
+    // side of that value's sign.
+    constexpr int kBlock = 4;
+    const glm::ivec3 blocks = (f.bricks_ + kBlock - 1) / kBlock;
+    const size_t blockCount = size_t(blocks.x) * size_t(blocks.y) * size_t(blocks.z);
+    std::atomic<size_t> storedCount{0};
+    parallelFor(blockCount, [&](size_t k) {
+        const glm::ivec3 block(int(k % size_t(blocks.x)),
+                               int(k / size_t(blocks.x) % size_t(blocks.y)),
+                               int(k / (size_t(blocks.x) * size_t(blocks.y))));
+        const glm::ivec3 b0 = block * kBlock, b1 = glm::min(b0 + kBlock, f.bricks_);
+        const vec3 c0 = f.origin_ + brickSize * vec3(b0), c1 = f.origin_ + brickSize * vec3(b1);
+        const float v = value(0.5f * (c0 + c1));
+        if (std::abs(v) - 0.5f * glm::length(c1 - c0) > margin) {
+            if (v < 0.0f)
+                for (int z = b0.z; z < b1.z; ++z)
+                    for (int y = b0.y; y < b1.y; ++y)
+                        for (int x = b0.x; x < b1.x; ++x)
+                            f.slots_[slotOf({x, y, z})] = kInside;
+            return;
+        }
+        const float half = 0.5f * std::sqrt(3.0f) * brickSize;
+        size_t count = 0;
+        for (int z = b0.z; z < b1.z; ++z)
+            for (int y = b0.y; y < b1.y; ++y)
+                for (int x = b0.x; x < b1.x; ++x) {
+                    const float w = value(f.origin_ + brickSize * (vec3(x, y, z) + 0.5f));
+                    if (std::abs(w) - half > margin) {
+                        if (w < 0.0f) f.slots_[slotOf({x, y, z})] = kInside;
+                    } else {
+                        f.slots_[slotOf({x, y, z})] = 0, ++count;
+                    }
+                }
+        storedCount += count;
+    });
+    const size_t bytes = storedCount * kBrickSamples * sampleBytes + slots * sizeof(int32_t);
+    if (bytes > maxBytes) return tooLarge(bytes);
+    std::vector<uint32_t> brickSlots;
+    brickSlots.reserve(storedCount);
+    for (size_t s = 0; s < slots; ++s)
+        if (f.slots_[s] == 0) {
+            f.slots_[s] = int32_t(brickSlots.size() * kBrickSamples);
+            brickSlots.push_back(uint32_t(s));
+        }
+    const size_t brickCount = brickSlots.size(), sampleCount = brickCount * kBrickSamples;
+    const auto brickBase = [&](size_t b) { return brickOfSlot(brickSlots[b]) * kBrick; };
+    const auto stored = [&](glm::ivec3 b) {
+        return glm::all(glm::greaterThanEqual(b, glm::ivec3(0))) &&
+               glm::all(glm::lessThan(b, f.bricks_)) && f.slots_[slotOf(b)] >= 0;
+    };
+
+    // The field at every sample of those bricks that the surface may cross; in the others,
+    // their centre's value, which has every sample's sign.
+    std::vector<float> values(sampleCount);
+    const float half = 0.5f * std::sqrt(3.0f) * brickSize;
+    parallelFor(brickCount, [&](size_t b) {
+        const glm::ivec3 base = brickBase(b);
+        const float centre = value(pointAt(base) + 0.5f * brickSize);
+        if (std::abs(centre) > half) {
+            std::fill_n(&values[b * kBrickSamples], kBrickSamples, centre);
+            return;
+        }
+        for (int z = 0; z <= kBrick; ++z)
+            for (int y = 0; y <= kBrick; ++y)
+                for (int x = 0; x <= kBrick; ++x)
+                    values[b * kBrickSamples + local(x, y, z)] =
+                        value(pointAt(base + glm::ivec3(x, y, z)));
+    });
+
+    // Points of the surface: each grid edge whose ends' signs differ, bisected. An edge on a
+    // brick's upper face is its neighbour's there, where that is stored.
+    std::vector<std::vector<vec3>> found(brickCount);
+    parallelFor(brickCount, [&](size_t b) {
+        const glm::ivec3 base = brickBase(b), home = base / kBrick;
+        for (int a = 0; a < 3; ++a) {
+            glm::ivec3 step(0);
+            step[a] = 1;
+            bool shared[3];
+            for (int o = 0; o < 3; ++o) {
+                glm::ivec3 next = home;
+                next[o] += 1;
+                shared[o] = o != a && stored(next);
+            }
+            for (int z = 0; z <= kBrick; ++z)
+                for (int y = 0; y <= kBrick; ++y)
+                    for (int x = 0; x <= kBrick; ++x) {
+                        const glm::ivec3 g(x, y, z);
+                        if (g[a] == kBrick) continue;
+                        bool skip = false;
+                        for (int o = 0; o < 3; ++o)
+                            skip = skip || (shared[o] && g[o] == kBrick);
+                        if (skip) continue;
+                        const glm::ivec3 e = g + step;
+                        const float va = values[b * kBrickSamples + local(x, y, z)];
+                        const float vb = values[b * kBrickSamples + local(e.x, e.y, e.z)];
+                        if ((va < 0.0f) == (vb < 0.0f)) continue;
+                        // Bisected to a 64th of the cell, then the line through the ends'
+                        // values: the field is all but linear along so short a piece.
+                        vec3 from = pointAt(base + g), to = pointAt(base + e);
+                        float vf = va, vt = vb;
+                        for (int i = 0; i < 6; ++i) {
+                            const vec3 mid = 0.5f * (from + to);
+                            const float vm = value(mid);
+                            if ((vm < 0.0f) == (va < 0.0f))
+                                from = mid, vf = vm;
+                            else
+                                to = mid, vt = vm;
+                        }
+                        const float t = vf != vt ? std::clamp(vf / (vf - vt), 0.0f, 1.0f) : 0.5f;
+                        found[b].push_back(glm::mix(from, to, t));
+                    }
+        }
+        // Where the surface comes to a point or an edge sharper than the grid resolves (a
+        // twisted box's corners), the crossings stay a few cells short of it: from each sample
+        // within two cells of the surface (the field's value being at most the distance), Newton
+        // steps along the gradient (four taps about the point, sdf.glsl's valueTap) reach the
+        // tip, alternating between the faces that meet there. Points that land within a
+        // sixteenth of a cell of one before count once.
+        const float h = cell / 64.0f;
+        std::vector<vec3> projected;
+        const glm::vec3 taps[4] = {{1, -1, -1}, {-1, -1, 1}, {-1, 1, -1}, {1, 1, 1}};
+        for (int z = 0; z <= kBrick; ++z)
+            for (int y = 0; y <= kBrick; ++y)
+                for (int x = 0; x <= kBrick; ++x) {
+                    if (!(std::abs(values[b * kBrickSamples + local(x, y, z)]) < 2.0f * cell))
+                        continue;
+                    const vec3 start = pointAt(base + glm::ivec3(x, y, z));
+                    vec3 q = start;
+                    float v = 0.0f;
+                    for (int i = 0; i < 6; ++i) {
+                        vec3 g(0.0f);
+                        v = 0.0f;
+                        for (const vec3& k : taps) {
+                            const float tap = value(q + h * k);
+                            g += tap * k, v += tap;
+                        }
+                        g /= 4.0f * h, v /= 4.0f;
+                        const float g2 = glm::dot(g, g);
+                        if (!(g2 > 1e-6f)) break;
+                        q -= v / g2 * g;
+                    }
+                    if (std::abs(v) <= 1e-3f * cell && glm::length(q - start) <= 3.0f * cell)
+                        projected.push_back(q);
+                }
+        std::sort(projected.begin(), projected.end(), [&](vec3 a, vec3 c) {
+            const glm::ivec3 ka(glm::floor(a * (16.0f / cell))), kc(glm::floor(c * (16.0f / cell)));
+            return std::tie(ka.x, ka.y, ka.z) < std::tie(kc.x, kc.y, kc.z);
+        });
+        for (size_t k = 0; k < projected.size(); ++k)
+            if (k == 0 || glm::floor(projected[k] * (16.0f / cell)) !=
+                              glm::floor(projected[k - 1] * (16.0f / cell)))
+                found[b].push_back(projected[k]);
+    });
+    std::vector<size_t> firstSeed(brickCount + 1, 0);
+    for (size_t b = 0; b < brickCount; ++b)
+        firstSeed[b + 1] = firstSeed[b] + found[b].size();
+    std::vector<vec3> seeds;
+    seeds.reserve(firstSeed.back());
+    for (std::vector<vec3>& points : found) {
+        seeds.insert(seeds.end(), points.begin(), points.end());
+        points = {};
+    }
+    for (const vec3& p : seeds)
+        f.surfaceMin_ = glm::min(f.surfaceMin_, p), f.surfaceMax_ = glm::max(f.surfaceMax_, p);
+
+    // Each sample's nearest point exactly within `reach` (two cells): the points of the brick
+    // and the 26 about it against the samples within reach of each.
+    constexpr uint32_t kNone = ~0u;
+    const float reach = 2.0f * cell;
+    std::vector<float> best(sampleCount, margin * margin);
+    std::vector<uint32_t> nearest(sampleCount, kNone);
+    parallelFor(brickCount, [&](size_t b) {
+        const glm::ivec3 base = brickBase(b), home = base / kBrick;
+        for (int k = 0; k < 27; ++k) {
+            const glm::ivec3 there = home + glm::ivec3(k % 3, k / 3 % 3, k / 9) - 1;
+            if (!stored(there)) continue;
+            const size_t n = size_t(f.slots_[slotOf(there)]) / kBrickSamples;
+            for (size_t t = firstSeed[n]; t < firstSeed[n + 1]; ++t) {
+                const vec3 g = (seeds[t] - pointAt(base)) / cell;
+                const glm::ivec3 from = glm::max(glm::ivec3(glm::ceil(g - 2.0f)), glm::ivec3(0));
+                const glm::ivec3 to =
+                    glm::min(glm::ivec3(glm::floor(g + 2.0f)), glm::ivec3(kBrick));
+                for (int z = from.z; z <= to.z; ++z)
+                    for (int y = from.y; y <= to.y; ++y)
+                        for (int x = from.x; x <= to.x; ++x) {
+                            const vec3 d = vec3(x, y, z) - g;
+                            const float d2 = glm::dot(d, d) * cell * cell;
+                            const size_t at = b * kBrickSamples + local(x, y, z);
+                            if (d2 < best[at]) best[at] = d2, nearest[at] = uint32_t(t);
+                        }
+            }
+        }
+    });
+    dilate(f, brickSlots, reach, margin, best, nearest, [&](vec3 p, uint32_t t, float) {
+        const vec3 d = p - seeds[t];
+        return glm::dot(d, d);
+    });
+
+    f.samples_.resize(sampleCount);
+    for (size_t at = 0; at < sampleCount; ++at)
+        f.samples_[at] = (values[at] < 0.0f ? -1.0f : 1.0f) * std::sqrt(best[at]);
+    if (color) {
+        std::vector<float> seedColors(seeds.size());
+        parallelFor(seeds.size(),
+                    [&](size_t t) { seedColors[t] = float(packColor(color(seeds[t]))); });
+        f.colors_.assign(sampleCount, -1.0f);
+        for (size_t at = 0; at < sampleCount; ++at)
+            if (nearest[at] != kNone) f.colors_[at] = seedColors[nearest[at]];
     }
     return f;
 }

@@ -118,5 +118,9 @@ float transitionValue(const FlatNode& op, glm::vec3 p, float a, float b);
 glm::vec3 nodeLocalPoint(const FlatNode& node, glm::vec3 p);
 // A primitive's colour at p: its own (FlatNode::ownColors) or the node's (eval.cpp).
 glm::vec3 primitiveColor(const FlatNode& node, glm::vec3 p);
+// Node `node`'s subtree alone at a point of its frame (FlatNode::frame), as its parent passes it
+// (eval.cpp): its value, and its colour.
+float subtreeValue(const Evaluator& evaluator, uint32_t node, glm::vec3 p);
+glm::vec3 subtreeColor(const Evaluator& evaluator, uint32_t node, glm::vec3 p);
 
 } // namespace sdfcsg::detail

@@ -6,6 +6,7 @@
 
 #include "codegen/scene_buffers.h"
 #include "codegen/shader_compile.h"
+#include "field/bake.h"
 #include "field/prune.h"
 #include "gpu/vk.h"
 #include "render/camera.h"
@@ -182,7 +183,7 @@ static size_t wordCount(const Node& n) {
 
 // Whether the code calls node n's colour formula (ownColors).
 static bool colored(const Node& n) {
-    return ownColors(n.kind, n.words.get());
+    return ownColors(detail::baked(n) ? NodeKind::Mesh : n.kind, n.words.get());
 }
 
 bool sameStructure(const Scene& a, const Scene& b) {

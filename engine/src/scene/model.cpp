@@ -2,6 +2,7 @@
 // the loader, so that a shape and its file are one scene, checked by one set of rules.
 #include "sdfcsg/model.h"
 
+#include "field/bake.h"
 #include "scene/json_writer.h"
 
 #include <algorithm>
@@ -532,6 +533,8 @@ Status setValue(Scene& scene, uint32_t index, std::string_view key, const Value&
         node.strings = edited.strings;
         node.words = edited.words;
     }
+    // A value may change the field of an offset's or shell's child, which bakes it (bake.h).
+    detail::bakeOffsets(scene);
     return Ok{};
 }
 

@@ -5,6 +5,7 @@
 
 #include "sdfcsg/eval.h"
 
+#include "field/bake.h"
 #include "field/mesh_field.h"
 #include "scene/image.h"
 #include "scene/json_syntax.h"
@@ -1232,6 +1233,7 @@ Result<Scene> parseScene(std::string_view json, std::string_view file,
     if (problems.empty()) closeRevolvedProfiles(scene);
     if (problems.empty()) checkCombinedTransforms(scene, problems);
     if (!problems.empty()) return problems.error();
+    detail::bakeOffsets(scene);
     scene.file = fileName;
     scene.files = options.files;
     return scene;
