@@ -50,11 +50,11 @@ case_validate() {
     expect_text "validate counts in the singular" out.txt "one.json: ok (1 node)"
     # A valid scene whose offset acts on a field that is not a distance, too thin against its
     # child to bake: a note, exit 0.
-    printf '{"version": 1, "root": {"type": "offset", "distance": 0.002, "children": [%s]}}' \
+    printf '{"version": 1, "root": {"type": "offset", "distance": 0.3, "children": [%s]}}' \
         '{"type": "twist", "angle": 90, "children": [{"type": "box", "size": [1, 2, 1]}]}' >twisted.json
     check "validate notes" 0 "$bin" validate twisted.json
-    expect_text "validate note" out.txt "twisted.json: root: note: offset over a field that is not a distance (twist at root.children[0] divides its field by up to 2.08): the surface lies about 0.002 from the child's (divided by the field's gradient, to first order, not baked: at a quarter of the distance its field would exceed 32 MiB, or its child is unbounded or of more than 256 nodes; 0.002 to 0.00416 without)"
-    expect_text "validate shading note" out.txt "twisted.json: root: note: ambient occlusion and soft shadows over a field that is not a distance (twist at root.children[0] divides its field by up to 2.08): the shading can be darker where its values lie below the distance (down to 1/2.08 of it); --no-ao and --no-shadows leave them out"
+    expect_text "validate note" out.txt "twisted.json: root: note: offset over a field that is not a distance (twist at root.children[0] divides its field by up to 2.65): the surface lies about 0.3 from the child's (divided by the field's gradient, to first order; \"accuracy\": \"exact\" bakes the child's distance; 0.3 to 0.794 without)"
+    expect_text "validate shading note" out.txt "twisted.json: root: note: ambient occlusion and soft shadows over a field that is not a distance (twist at root.children[0] divides its field by up to 2.65): the shading can be darker where its values lie below the distance (down to 1/2.65 of it); --no-ao and --no-shadows leave them out"
 
     # A mesh whose file has a hole (a box less one triangle) and a flipped triangle: validate,
     # render and mesh each note it once.

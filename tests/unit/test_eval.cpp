@@ -452,7 +452,7 @@ TEST(Eval, SolidBoundsAreTight) {
 // over distances, baked, and in the bundled scenes, nothing is.
 TEST(Eval, FieldNotesNameWhatDependsOnDistancesThatAreNot) {
     const Scene scene = parseRoot(R"({"type": "union", "children": [
-        {"type": "offset", "distance": 0.002, "children": [
+        {"type": "offset", "distance": 0.002, "accuracy": "exact", "children": [
             {"type": "twist", "angle": 90, "children": [{"type": "box", "size": [1, 2, 1]}]}]},
         {"type": "shell", "thickness": 0.002, "children": [
             {"type": "sphere", "radius": 0.5, "scale": [1, 2, 1]}]},
@@ -476,9 +476,8 @@ TEST(Eval, FieldNotesNameWhatDependsOnDistancesThatAreNot) {
     EXPECT_EQ(notes[1].message,
               "shell over a field that is not a distance (sphere at root.children[1].children[0], "
               "scaled unevenly: its field below the distance by up to 2): the skin is about 0.002 "
-              "thick (divided by the field's gradient, to first order, not baked: at a quarter of "
-              "the distance its field would exceed 32 MiB, or its child is unbounded or of more "
-              "than 256 nodes; 0.002 to 0.004 without)");
+              "thick (divided by the field's gradient, to first order; \"accuracy\": \"exact\" "
+              "bakes the child's distance; 0.002 to 0.004 without)");
     EXPECT_EQ(notes[2].message,
               "smooth union over a field that is not a distance (ellipsoid at "
               "root.children[2].children[0]: a bound, below the distance by up to 1.67): the "
@@ -488,8 +487,8 @@ TEST(Eval, FieldNotesNameWhatDependsOnDistancesThatAreNot) {
               "offset over a field that is not a distance (smooth blend at "
               "root.children[3].children[0]: no distance within 0.1 of its seam): the surface "
               "lies about 0.001 from the child's (divided by the field's gradient, to first "
-              "order, not baked: at a quarter of the distance its field would exceed 32 MiB, or "
-              "its child is unbounded or of more than 256 nodes; not 0.001 within the blend)");
+              "order; \"accuracy\": \"exact\" bakes the child's distance; not 0.001 within the "
+              "blend)");
     EXPECT_EQ(notes[4].path, "root");
     EXPECT_EQ(notes[4].message,
               "ambient occlusion and soft shadows over a field that is not a distance (twist at "
@@ -500,7 +499,8 @@ TEST(Eval, FieldNotesNameWhatDependsOnDistancesThatAreNot) {
     const Scene gentle = parseRoot(
         R"({"type": "twist", "angle": 40, "children": [{"type": "box", "size": [1, 2, 1]}]})");
     EXPECT_TRUE(fieldNotes(gentle, Evaluator(gentle)).empty());
-    const Scene baked = parseRoot(R"({"type": "offset", "distance": 0.3, "children": [
+    const Scene baked =
+        parseRoot(R"({"type": "offset", "distance": 0.3, "accuracy": "exact", "children": [
         {"type": "twist", "angle": 90, "children": [{"type": "box", "size": [1, 2, 1]}]}]})");
     EXPECT_NE(baked.nodes[0].words, nullptr);
     EXPECT_TRUE(fieldNotes(baked, Evaluator(baked)).empty());

@@ -195,29 +195,31 @@ TEST_F(GpuEval, ScalesPerAxisAndRepetitionsMatchTheCpu) {
     expectGpuMatchesCpu(context(), scene, 4096);
 }
 
-// Offsets and shells over twist, bend, taper and a smooth union read their child's distance
-// baked at load (field/bake.h) as a mesh node's field, their child's code left out, in every
-// mode; one too thin to bake divides by its child's gradient from four taps (sdf.glsl,
-// valueNormalised): the child's code in a loop in the inlined kernels, and opened as a domain
-// operation on tapes.
+// Offsets and shells over twist, bend, taper and a smooth union that ask for "exact" read their
+// child's distance baked at load (field/bake.h) as a mesh node's field, their child's code left
+// out, in every mode; one left "fast" (the default) divides by its child's gradient from four
+// taps (sdf.glsl, valueNormalised): the child's code in a loop in the inlined kernels, and opened
+// as a domain operation on tapes.
 TEST_F(GpuEval, OffsetsOverStretchedFieldsMatchTheCpu) {
     Scene scene = parseOrDie(R"({"version": 1, "root": {"type": "union", "children": [
-        {"type": "offset", "distance": 0.3, "children": [
+        {"type": "offset", "distance": 0.3, "accuracy": "exact", "children": [
             {"type": "twist", "angle": 90, "children": [
                 {"type": "box", "size": [1, 2, 1], "color": [0.9, 0.3, 0.1]}]}]},
-        {"type": "shell", "thickness": 0.1, "translate": [2, 0, 0], "children": [
+        {"type": "shell", "thickness": 0.1, "accuracy": "exact", "translate": [2, 0, 0],
+         "children": [
             {"type": "bend", "angle": 40, "children": [{"type": "box", "size": [1.5, 0.4, 0.6]}]}]},
-        {"type": "offset", "distance": -0.05, "translate": [-2, 0, 0], "children": [
+        {"type": "offset", "distance": -0.05, "accuracy": "exact", "translate": [-2, 0, 0],
+         "children": [
             {"type": "taper", "height": 1.5, "top_scale": 0.4, "children": [
                 {"type": "union", "smooth": 0.2, "children": [
                     {"type": "box", "size": [1, 1.5, 1], "color": [0.1, 0.4, 0.9]},
                     {"type": "sphere", "radius": 0.5, "translate": [0.5, 0, 0]}]}]}]},
-        {"type": "offset", "distance": 0.002, "translate": [0, 0, 2], "children": [
+        {"type": "offset", "distance": 0.1, "translate": [0, 0, 2], "children": [
             {"type": "twist", "angle": 90, "children": [{"type": "box", "size": [1, 2, 1]}]}]}]}})");
     ASSERT_FALSE(scene.nodes.empty());
     for (const uint32_t offset : {1u, 4u, 7u})
         EXPECT_NE(scene.nodes[offset].words, nullptr) << scene.nodes[offset].path;
-    EXPECT_EQ(scene.nodes[12].words, nullptr); // too thin against its child to bake
+    EXPECT_EQ(scene.nodes[12].words, nullptr); // "fast"
     expectGpuMatchesCpu(context(), scene, 4096);
 }
 

@@ -282,14 +282,14 @@ TEST(Model, EditsGoThroughTheLoadersChecks) {
     EXPECT_FALSE(m::setValue(scene, 1, "radius", m::Value()));
 }
 
-// An offset over a twist reads the twist's distance baked at load (field/bake.h): an edit of the
-// twist, or of the offset, bakes it again, to the field the edited scene's file loads with; the
+// An exact offset over a twist reads the twist's distance baked at load (field/bake.h): an edit of
+// the twist, or of the offset, bakes it again, to the field the edited scene's file loads with; the
 // words are never written to JSON.
 TEST(Model, EditsBakeOffsetsAgain) {
     const auto offset = [](float distance, float angle) {
         return R"({"type": "offset", "distance": )" + std::to_string(distance) +
-               R"(, "children": [{"type": "twist", "angle": )" + std::to_string(angle) +
-               R"(, "children": [{"type": "box", "size": [1, 2, 1]}]}]})";
+               R"(, "accuracy": "exact", "children": [{"type": "twist", "angle": )" +
+               std::to_string(angle) + R"(, "children": [{"type": "box", "size": [1, 2, 1]}]}]})";
     };
     Scene scene = parseRoot(offset(0.3f, 90.0f));
     ASSERT_NE(scene.nodes[0].words, nullptr);

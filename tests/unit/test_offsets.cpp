@@ -178,8 +178,9 @@ struct Measure {
 
 Measure measure(const Case& c) {
     const std::string key = std::string(c.op) == "offset" ? "distance" : "thickness";
-    const Scene scene = parseRoot(std::string(R"({"type": ")") + c.op + R"(", ")" + key + "\": " +
-                                  std::to_string(c.amount) + R"(, "children": [)" + c.child + "]}");
+    const Scene scene =
+        parseRoot(std::string(R"({"type": ")") + c.op + R"(", "accuracy": "exact", ")" + key +
+                  "\": " + std::to_string(c.amount) + R"(, "children": [)" + c.child + "]}");
     const Scene alone = parseRoot(c.child);
     const Evaluator e(scene), childEvaluator(alone);
     const auto child = [&](glm::vec3 p) { return childEvaluator.distance(p); };
@@ -296,8 +297,9 @@ TEST(Offsets, ThinShellWithinThreePercent) {
     EXPECT_TRUE(m.baked);
     EXPECT_GE(m.lo, 0.97f * 0.025f);
     EXPECT_LE(m.hi, 1.03f * 0.025f);
-    const Scene twisted = parseRoot(R"({"type": "shell", "thickness": 0.05, "children": [)" +
-                                    std::string(kTwistedBox) + "]}");
+    const Scene twisted =
+        parseRoot(R"({"type": "shell", "thickness": 0.05, "accuracy": "exact", "children": [)" +
+                  std::string(kTwistedBox) + "]}");
     EXPECT_EQ(twisted.nodes[0].words, nullptr);
 }
 
@@ -310,7 +312,7 @@ TEST(Offsets, BakedOffsetStaysABound) {
         SCOPED_TRACE(std::string(c.op) + " " + c.child);
         const std::string key = std::string(c.op) == "offset" ? "distance" : "thickness";
         const Scene scene =
-            parseRoot(std::string(R"({"type": ")") + c.op + R"(", ")" + key +
+            parseRoot(std::string(R"({"type": ")") + c.op + R"(", "accuracy": "exact", ")" + key +
                       "\": " + std::to_string(c.amount) + R"(, "children": [)" + c.child + "]}");
         const Scene alone = parseRoot(c.child);
         const Evaluator e(scene), childEvaluator(alone);
@@ -342,10 +344,23 @@ TEST(Offsets, BakedOffsetStaysABound) {
     }
 }
 
+// The bake is asked for: by default ("accuracy": "fast") an offset over a twist divides.
+TEST(Offsets, OnlyExactAccuracyBakes) {
+    for (const char* accuracy : {"", R"("accuracy": "fast", )", R"("accuracy": "exact", )"}) {
+        const Scene scene =
+            parseRoot(R"({"type": "offset", "distance": 0.3, )" + std::string(accuracy) +
+                      R"("children": [)" + std::string(kTwistedBox) + "]}");
+        const bool exact = std::string(accuracy).find("exact") != std::string::npos;
+        EXPECT_EQ(scene.nodes[0].words != nullptr, exact) << accuracy;
+        EXPECT_EQ(Evaluator(scene).nodes()[1].kind, exact ? NodeKind::Mesh : NodeKind::Twist);
+    }
+}
+
 // An offset too thin to bake against its child's size (a field at a quarter of it would exceed
 // the limit) keeps the first-order division, near its distance.
 TEST(Offsets, TooThinToBakeKeepsTheFirstOrderDivision) {
-    const Scene scene = parseRoot(R"({"type": "offset", "distance": 0.002, "children": [)" +
+    const Scene scene = parseRoot(R"({"type": "offset", "distance": 0.002, "accuracy": "exact",
+                                  "children": [)" +
                                   std::string(kTwistedBox) + "]}");
     const Evaluator e(scene);
     EXPECT_EQ(e.nodes()[1].kind, NodeKind::Twist);

@@ -193,10 +193,9 @@ SCRIPT
 }
 
 # The field notes that the Scene and Node panels show: those of `sdfcsg validate`, and none once
-# an edit makes the field a distance again. The offset is too thin against its child to bake
-# (field/bake.h), whose notes a baked one would not have.
+# an edit makes the field a distance again.
 case_notes() {
-    printf '{"version": 1, "root": {"type": "offset", "distance": 0.002, "children": [%s]}}' \
+    printf '{"version": 1, "root": {"type": "offset", "distance": 0.3, "children": [%s]}}' \
         '{"type": "twist", "name": "twist", "angle": 90, "children": [{"type": "box", "size": [1, 2, 1]}]}' >twisted.json
     printf 'print-notes\nselect twist\nset angle 0\nprint-notes\n' >notes.txt
     run twisted.json --script notes.txt --size 320x240 --no-ui >notes.out || fail "notes script: $(cat notes.out)"

@@ -61,7 +61,9 @@ void bakeOffsets(Scene& scene) {
     std::optional<Evaluator> e; // made again after each bake, which changes what is above it
     for (size_t i = scene.nodes.size(); i-- > 0;) {
         Node& n = scene.nodes[i];
-        if (kindInfo(n.kind).role != Role::Value || n.children.size() != 1) continue;
+        if (kindInfo(n.kind).role != Role::Value || n.children.size() != 1 ||
+            n.params[kAccuracySlot] != kAccuracyExact)
+            continue;
         if (!e) e.emplace(scene);
         const uint32_t c = n.children[0];
         const FlatNode& child = e->nodes()[c];

@@ -32,14 +32,20 @@ namespace sdfcsg::detail {
 inline constexpr size_t kMaxBakeBytes = size_t(32) << 20;
 inline constexpr size_t kMaxBakedNodes = 256;
 
+// An offset's or shell's "accuracy" (nodes.cpp): its slot and the value of "exact", which asks
+// for the bake; "fast" (0, the default) keeps the first-order division.
+inline constexpr int kAccuracySlot = 1;
+inline constexpr float kAccuracyExact = 1.0f;
+
 // Whether node n is an offset or shell that reads its child's baked distance from its words.
 inline bool baked(const Node& n) {
     return kindInfo(n.kind).role == Role::Value && n.words != nullptr;
 }
 
-// Bakes, anew, the child of every offset and shell whose child's field is not a distance (its
-// FlatNode::loss above 1), innermost first, within the scene's words; the others' words are
-// cleared. Never fails: a node that cannot be baked keeps the first-order correction.
+// Bakes, anew, the child of every offset and shell that asks for it ("accuracy": "exact") and
+// whose child's field is not a distance (its FlatNode::loss above 1), innermost first, within the
+// scene's words; the others' words are cleared. Never fails: a node that cannot be baked keeps the
+// first-order correction.
 void bakeOffsets(Scene& scene);
 
 // The scene as the code generator walks it: the child of each baked node a mesh node with the

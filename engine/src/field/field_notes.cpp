@@ -94,11 +94,15 @@ std::string noteOf(const Node& n, const Loss& loss) {
     // Offsets and shells divide by the field's gradient (FlatNode::loss) where their child's
     // distance could not be baked (field/bake.h): a first-order distance, which strays where the
     // stretch changes within their reach.
-    const std::string divides = "divided by the field's gradient, to first order, not baked: at "
-                                "a quarter of the distance its field would exceed " +
-                                std::to_string(detail::kMaxBakeBytes >> 20) +
-                                " MiB, or its child is unbounded or of more than " +
-                                std::to_string(detail::kMaxBakedNodes) + " nodes; ";
+    const std::string divides =
+        n.params[detail::kAccuracySlot] != detail::kAccuracyExact
+            ? "divided by the field's gradient, to first order; \"accuracy\": \"exact\" bakes "
+              "the child's distance; "
+            : "divided by the field's gradient, to first order, not baked: at a quarter of the "
+              "distance its field would exceed " +
+                  std::to_string(detail::kMaxBakeBytes >> 20) +
+                  " MiB, or its child is unbounded or of more than " +
+                  std::to_string(detail::kMaxBakedNodes) + " nodes; ";
     if (n.kind == NodeKind::Offset) {
         const float r = std::abs(n.params[0]);
         effect = "the surface lies about " + number(r) + " from the child's (" + divides +
