@@ -34,9 +34,11 @@ SceneBuffers::~SceneBuffers() {
 }
 
 Result<std::vector<uint32_t>>
-SceneBuffers::fieldWords(const Scene& scene, const Evaluator& evaluator, Evaluation evaluation) {
+SceneBuffers::fieldWords(const Scene& scene, const Evaluator& evaluator, Evaluation evaluation,
+                         bool keep) {
     if (!usesTapes(scene, evaluation)) return emptyField();
-    const PrunedField& field = detail::prunedField(evaluator);
+    PrunedField made;
+    const PrunedField& field = keep ? prunedField(evaluator) : (made = pruneField(evaluator));
     if (const double mean = field.meanActiveLength(); mean > kMaxMeanCellInstructions)
         return prunesTooLittle(scene, mean);
     return packField(field, evaluator.nodes());

@@ -25,9 +25,10 @@ class SceneBuffers {
     // What shaders/tape.glsl reads: the scene's pruned field where its kernels run tapes
     // (refused past kMaxMeanCellInstructions), a header alone otherwise (the binding must still
     // hold a buffer). Host work only, on no buffer, so it may run on another thread while the
-    // kernels build: they do not depend on it.
+    // kernels build: they do not depend on it. With `keep`, the evaluator keeps the prune for its
+    // own prunedDistance (detail::prunedField: the mesher's host steps); without, it is freed.
     static Result<std::vector<uint32_t>> fieldWords(const Scene& scene, const Evaluator& evaluator,
-                                                    Evaluation evaluation);
+                                                    Evaluation evaluation, bool keep = false);
 
     // Makes the node buffer for the evaluator's nodes and uploads them, and a field that no
     // kernel evaluates yet (a header alone: the kernels' warm-ups run no invocation), so that

@@ -434,7 +434,7 @@ Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& sc
     m.evaluator = std::make_unique<Evaluator>(scene);
     // Pruned on the host while the kernels build, as in Renderer::create.
     auto fieldWords = std::async(std::launch::async, [&] {
-        return detail::SceneBuffers::fieldWords(scene, *m.evaluator, evaluation);
+        return detail::SceneBuffers::fieldWords(scene, *m.evaluator, evaluation, true);
     });
 
     CodegenOptions codegen;
