@@ -33,9 +33,9 @@ SceneBuffers::~SceneBuffers() {
     destroyBuffer(ctx_, field_);
 }
 
-Result<std::vector<uint32_t>>
-SceneBuffers::fieldWords(const Scene& scene, const Evaluator& evaluator, Evaluation evaluation,
-                         bool keep) {
+Result<std::vector<uint32_t>> SceneBuffers::fieldWords(const Scene& scene,
+                                                       const Evaluator& evaluator,
+                                                       Evaluation evaluation, bool keep) {
     if (!usesTapes(scene, evaluation)) return emptyField();
     PrunedField made;
     const PrunedField& field = keep ? prunedField(evaluator) : (made = pruneField(evaluator));
