@@ -567,16 +567,7 @@ void MeshField::dilate(const MeshField& f, const std::vector<uint32_t>& brickSlo
                        const Nearer& nearer) {
     constexpr uint32_t kNone = ~0u;
     const size_t brickCount = brickSlots.size(), sampleCount = brickCount * kBrickSamples;
-    const auto slotOf = [&](glm::ivec3 b) {
-        return (size_t(b.z) * size_t(f.bricks_.y) + size_t(b.y)) * size_t(f.bricks_.x) +
-               size_t(b.x);
-    };
-    const auto brickOfSlot = [&](size_t s) {
-        return glm::ivec3(int(s % size_t(f.bricks_.x)),
-                          int(s / size_t(f.bricks_.x) % size_t(f.bricks_.y)),
-                          int(s / (size_t(f.bricks_.x) * size_t(f.bricks_.y))));
-    };
-    const auto brickBase = [&](size_t b) { return brickOfSlot(brickSlots[b]) * kBrick; };
+    const auto brickBase = [&](size_t b) { return f.brickOfSlot(brickSlots[b]) * kBrick; };
     const auto pointAt = [&](glm::ivec3 g) { return f.origin_ + f.cell_ * vec3(g); };
     const auto local = [](int x, int y, int z) {
         return (size_t(z) * kBrickSide + size_t(y)) * kBrickSide + size_t(x);
@@ -620,7 +611,7 @@ void MeshField::dilate(const MeshField& f, const std::vector<uint32_t>& brickSlo
                 const glm::ivec3 there = home + glm::ivec3(k % 3, k / 3 % 3, k / 9) - 1;
                 const bool in = glm::all(glm::greaterThanEqual(there, glm::ivec3(0))) &&
                                 glm::all(glm::lessThan(there, f.bricks_));
-                const int32_t slot = in ? f.slots_[slotOf(there)] : kOutside;
+                const int32_t slot = in ? f.slots_[f.slotOf(there)] : kOutside;
                 around[k] = slot >= 0 ? size_t(slot) : kNowhere;
                 stirred = stirred || (slot >= 0 && moving[size_t(slot) / kBrickSamples]);
             }
@@ -771,15 +762,6 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
         return glm::clamp(glm::ivec3(glm::floor((p - f.origin_) / brickSize)), glm::ivec3(0),
                           f.bricks_ - 1);
     };
-    const auto slotOf = [&](glm::ivec3 b) {
-        return (size_t(b.z) * size_t(f.bricks_.y) + size_t(b.y)) * size_t(f.bricks_.x) +
-               size_t(b.x);
-    };
-    const auto brickOfSlot = [&](size_t s) {
-        return glm::ivec3(int(s % size_t(f.bricks_.x)),
-                          int(s / size_t(f.bricks_.x) % size_t(f.bricks_.y)),
-                          int(s / (size_t(f.bricks_.x) * size_t(f.bricks_.y))));
-    };
     const auto corners = [&](uint32_t t) {
         const glm::uvec3 i = mesh.triangles[t];
         return std::array<vec3, 3>{mesh.positions[i.x], mesh.positions[i.y], mesh.positions[i.z]};
@@ -792,7 +774,7 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
         for (int z = lo.z; z <= hi.z; ++z)
             for (int y = lo.y; y <= hi.y; ++y)
                 for (int x = lo.x; x <= hi.x; ++x)
-                    visit(slotOf({x, y, z}));
+                    visit(f.slotOf({x, y, z}));
     };
     const uint32_t triangleCount = uint32_t(mesh.triangles.size());
 
@@ -844,7 +826,7 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
     constexpr uint32_t kNone = ~0u;
     std::vector<float> best(sampleCount, margin * margin);
     std::vector<uint32_t> nearest(sampleCount, kNone);
-    const auto brickBase = [&](size_t b) { return brickOfSlot(brickSlots[b]) * kBrick; };
+    const auto brickBase = [&](size_t b) { return f.brickOfSlot(brickSlots[b]) * kBrick; };
     const auto pointAt = [&](glm::ivec3 g) { return f.origin_ + f.cell_ * vec3(g); };
     const auto local = [](int x, int y, int z) {
         return (size_t(z) * kBrickSide + size_t(y)) * kBrickSide + size_t(x);
@@ -998,7 +980,7 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
         // Bricks without samples: their centre's inside.
         parallelFor(slots, [&](size_t s) {
             if (f.slots_[s] == kOutside &&
-                h->winding(pointAt(brickOfSlot(s) * kBrick) + 0.5f * brickSize) >= 0.5f)
+                h->winding(pointAt(f.brickOfSlot(s) * kBrick) + 0.5f * brickSize) >= 0.5f)
                 f.slots_[s] = kInside;
         });
         return f;
@@ -1013,7 +995,7 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
         if (!signless[b]) queue.push_back(brickSlots[b]);
     for (size_t k = 0; k < queue.size(); ++k) {
         const size_t s = queue[k];
-        const glm::ivec3 here = brickOfSlot(s);
+        const glm::ivec3 here = f.brickOfSlot(s);
         const int32_t slot = f.slots_[s];
         const bool hasSamples = slot >= 0 && !signless[size_t(slot) / kBrickSamples];
         for (int a = 0; a < 3; ++a)
@@ -1021,7 +1003,7 @@ Result<MeshField> MeshField::make(const TriangleMesh& mesh, int cells, float ban
                 glm::ivec3 there = here;
                 there[a] += side;
                 if (there[a] < 0 || there[a] >= f.bricks_[a]) continue;
-                const size_t n = slotOf(there);
+                const size_t n = f.slotOf(there);
                 const int32_t nslot = f.slots_[n];
                 const bool signedThere = nslot >= 0 && !signless[size_t(nslot) / kBrickSamples];
                 if (signedThere || inside[n] != 0) continue;
@@ -1072,15 +1054,6 @@ Result<MeshField> MeshField::fromField(const std::function<float(vec3)>& value,
     if (slots > maxBytes / sizeof(int32_t)) return tooLarge(slots * sizeof(int32_t));
     f.slots_.assign(slots, kOutside);
     const float brickSize = cell * float(kBrick);
-    const auto slotOf = [&](glm::ivec3 b) {
-        return (size_t(b.z) * size_t(f.bricks_.y) + size_t(b.y)) * size_t(f.bricks_.x) +
-               size_t(b.x);
-    };
-    const auto brickOfSlot = [&](size_t s) {
-        return glm::ivec3(int(s % size_t(f.bricks_.x)),
-                          int(s / size_t(f.bricks_.x) % size_t(f.bricks_.y)),
-                          int(s / (size_t(f.bricks_.x) * size_t(f.bricks_.y))));
-    };
     const auto pointAt = [&](glm::ivec3 g) { return f.origin_ + f.cell_ * vec3(g); };
     const auto local = [](int x, int y, int z) {
         return (size_t(z) * kBrickSide + size_t(y)) * kBrickSide + size_t(x);
@@ -1106,7 +1079,7 @@ Result<MeshField> MeshField::fromField(const std::function<float(vec3)>& value,
                 for (int z = b0.z; z < b1.z; ++z)
                     for (int y = b0.y; y < b1.y; ++y)
                         for (int x = b0.x; x < b1.x; ++x)
-                            f.slots_[slotOf({x, y, z})] = kInside;
+                            f.slots_[f.slotOf({x, y, z})] = kInside;
             return;
         }
         const float half = 0.5f * std::sqrt(3.0f) * brickSize;
@@ -1116,9 +1089,9 @@ Result<MeshField> MeshField::fromField(const std::function<float(vec3)>& value,
                 for (int x = b0.x; x < b1.x; ++x) {
                     const float w = value(f.origin_ + brickSize * (vec3(x, y, z) + 0.5f));
                     if (std::abs(w) - half > margin) {
-                        if (w < 0.0f) f.slots_[slotOf({x, y, z})] = kInside;
+                        if (w < 0.0f) f.slots_[f.slotOf({x, y, z})] = kInside;
                     } else {
-                        f.slots_[slotOf({x, y, z})] = 0, ++count;
+                        f.slots_[f.slotOf({x, y, z})] = 0, ++count;
                     }
                 }
         storedCount += count;
@@ -1133,10 +1106,10 @@ Result<MeshField> MeshField::fromField(const std::function<float(vec3)>& value,
             brickSlots.push_back(uint32_t(s));
         }
     const size_t brickCount = brickSlots.size(), sampleCount = brickCount * kBrickSamples;
-    const auto brickBase = [&](size_t b) { return brickOfSlot(brickSlots[b]) * kBrick; };
+    const auto brickBase = [&](size_t b) { return f.brickOfSlot(brickSlots[b]) * kBrick; };
     const auto stored = [&](glm::ivec3 b) {
         return glm::all(glm::greaterThanEqual(b, glm::ivec3(0))) &&
-               glm::all(glm::lessThan(b, f.bricks_)) && f.slots_[slotOf(b)] >= 0;
+               glm::all(glm::lessThan(b, f.bricks_)) && f.slots_[f.slotOf(b)] >= 0;
     };
 
     // The field at every sample of those bricks that the surface may cross; in the others,
@@ -1264,7 +1237,7 @@ Result<MeshField> MeshField::fromField(const std::function<float(vec3)>& value,
         for (int k = 0; k < 27; ++k) {
             const glm::ivec3 there = home + glm::ivec3(k % 3, k / 3 % 3, k / 9) - 1;
             if (!stored(there)) continue;
-            const size_t n = size_t(f.slots_[slotOf(there)]) / kBrickSamples;
+            const size_t n = size_t(f.slots_[f.slotOf(there)]) / kBrickSamples;
             for (size_t t = firstSeed[n]; t < firstSeed[n + 1]; ++t) {
                 const vec3 g = (seeds[t] - pointAt(base)) / cell;
                 const glm::ivec3 from = glm::max(glm::ivec3(glm::ceil(g - 2.0f)), glm::ivec3(0));

@@ -137,6 +137,15 @@ class MeshField {
     glm::vec3 surfaceMax() const { return surfaceMax_; }
 
   private:
+    // A brick's slot in slots_ (x fastest), and the brick of a slot.
+    size_t slotOf(glm::ivec3 b) const {
+        return (size_t(b.z) * size_t(bricks_.y) + size_t(b.y)) * size_t(bricks_.x) + size_t(b.x);
+    }
+    glm::ivec3 brickOfSlot(size_t s) const {
+        return glm::ivec3(int(s % size_t(bricks_.x)),
+                          int(s / size_t(bricks_.x) % size_t(bricks_.y)),
+                          int(s / (size_t(bricks_.x) * size_t(bricks_.y))));
+    }
     // make's and fromField's dilation outwards from the surface (mesh_field.cpp).
     template <class Nearer>
     static void dilate(const MeshField& f, const std::vector<uint32_t>& brickSlots, float reach,
