@@ -176,11 +176,15 @@ struct Measure {
     bool baked = false;
 };
 
-Measure measure(const Case& c) {
+// The case's offset or shell, asking for the baked distance, over its child.
+Scene exactScene(const Case& c) {
     const std::string key = std::string(c.op) == "offset" ? "distance" : "thickness";
-    const Scene scene =
-        parseRoot(std::string(R"({"type": ")") + c.op + R"(", "accuracy": "exact", ")" + key +
-                  "\": " + std::to_string(c.amount) + R"(, "children": [)" + c.child + "]}");
+    return parseRoot(std::string(R"({"type": ")") + c.op + R"(", "accuracy": "exact", ")" + key +
+                     "\": " + std::to_string(c.amount) + R"(, "children": [)" + c.child + "]}");
+}
+
+Measure measure(const Case& c) {
+    const Scene scene = exactScene(c);
     const Scene alone = parseRoot(c.child);
     const Evaluator e(scene), childEvaluator(alone);
     const auto child = [&](glm::vec3 p) { return childEvaluator.distance(p); };
@@ -310,10 +314,7 @@ TEST(Offsets, ThinShellWithinThreePercent) {
 TEST(Offsets, BakedOffsetStaysABound) {
     for (const Case& c : {Case{kTwistedBox, "offset", 0.3f}, Case{kSmoothUnion, "shell", 0.1f}}) {
         SCOPED_TRACE(std::string(c.op) + " " + c.child);
-        const std::string key = std::string(c.op) == "offset" ? "distance" : "thickness";
-        const Scene scene =
-            parseRoot(std::string(R"({"type": ")") + c.op + R"(", "accuracy": "exact", ")" + key +
-                      "\": " + std::to_string(c.amount) + R"(, "children": [)" + c.child + "]}");
+        const Scene scene = exactScene(c);
         const Scene alone = parseRoot(c.child);
         const Evaluator e(scene), childEvaluator(alone);
         ASSERT_EQ(e.nodes()[1].kind, NodeKind::Mesh);
