@@ -55,11 +55,10 @@ class MeshTest : public GpuTest {
         return *mesh;
     }
 
-    // The scene `file` (relative to the source folder) meshed at each resolution, closed and
-    // manifold and within the grid, each mesh then passed to `check` with its scene's evaluator.
+    // The scene meshed by one mesher at each resolution, each mesh passed to `check` with the
+    // scene's evaluator and the extraction's stats.
     template <typename Check>
-    void meshSceneAt(const char* file, std::initializer_list<uint32_t> resolutions, Check check) {
-        const Scene scene = loadOrDie(std::filesystem::path(SDFCSG_SOURCE_DIR) / file);
+    void meshAt(const Scene& scene, std::initializer_list<uint32_t> resolutions, Check check) {
         const Evaluator evaluator(scene);
         auto mesher = Mesher::create(context(), scene);
         ASSERT_TRUE(mesher) << mesher.error().str();
@@ -70,11 +69,21 @@ class MeshTest : public GpuTest {
             MeshStats stats;
             auto mesh = (*mesher)->extract(options, &stats);
             ASSERT_TRUE(mesh) << mesh.error().str();
-            EXPECT_FALSE(stats.surfaceCut);
-            const MeshProperties m = measureMesh(*mesh);
-            EXPECT_TRUE(m.closedManifold()) << m.str();
-            check(*mesh, evaluator, stats.voxelSize);
+            check(*mesh, evaluator, stats);
         }
+    }
+
+    // The scene `file` (relative to the source folder) meshed at each resolution, closed and
+    // manifold and within the grid, each mesh then passed to `check` with its scene's evaluator.
+    template <typename Check>
+    void meshSceneAt(const char* file, std::initializer_list<uint32_t> resolutions, Check check) {
+        meshAt(loadOrDie(std::filesystem::path(SDFCSG_SOURCE_DIR) / file), resolutions,
+               [&](const Mesh& mesh, const Evaluator& evaluator, const MeshStats& stats) {
+                   EXPECT_FALSE(stats.surfaceCut);
+                   const MeshProperties m = measureMesh(mesh);
+                   EXPECT_TRUE(m.closedManifold()) << m.str();
+                   check(mesh, evaluator, stats.voxelSize);
+               });
     }
 };
 
@@ -295,29 +304,20 @@ std::vector<std::pair<std::string, std::string>> qualityScenes(uint32_t seeds);
 // meshes have not been examined one by one (unfoldVertices leaves those that no candidate point
 // of one vertex's cell unfolds without making triangles cross, those it reaches no more once
 // the mesh's cap on the field is spent, those within 10 degrees of their vertices' normals,
-// which it does not ask the field of, and all in scenes of pruned tapes, kTapeMinNodes in
-// mesh.cpp, which have no field on the host).
+// which it does not ask the field of).
 TEST_F(MeshTest, RandomScenesHaveVerticesNearTheSurfaceAndFewFlippedTriangles) {
     const char* seeds = std::getenv("SDFCSG_MESH_SEEDS");
     const uint32_t count = seeds ? uint32_t(std::strtoul(seeds, nullptr, 10)) : 3u;
     for (const auto& [name, json] : qualityScenes(count)) {
         SCOPED_TRACE(name + ": " + json);
-        const Scene scene = sceneFrom(json);
-        const Evaluator evaluator(scene);
-        auto mesher = Mesher::create(context(), scene);
-        ASSERT_TRUE(mesher) << mesher.error().str();
-        for (uint32_t resolution : {37u, 64u, 96u, 131u}) {
-            SCOPED_TRACE("at " + std::to_string(resolution));
-            MeshOptions options;
-            options.resolution = resolution;
-            MeshStats stats;
-            auto mesh = (*mesher)->extract(options, &stats);
-            ASSERT_TRUE(mesh) << mesh.error().str();
-            EXPECT_LE(maxSurfaceDistance(*mesh, evaluator), 0.5f * stats.voxelSize);
-            const TriangleFacing facing = checkTriangleFacing(*mesh, evaluator, stats.voxelSize);
-            EXPECT_LE(double(facing.flipped), 0.005 * double(mesh->triangleCount()))
-                << facing.str();
-        }
+        meshAt(sceneFrom(json), {37u, 64u, 96u, 131u},
+               [](const Mesh& mesh, const Evaluator& evaluator, const MeshStats& stats) {
+                   EXPECT_LE(maxSurfaceDistance(mesh, evaluator), 0.5f * stats.voxelSize);
+                   const TriangleFacing facing =
+                       checkTriangleFacing(mesh, evaluator, stats.voxelSize);
+                   EXPECT_LE(double(facing.flipped), 0.005 * double(mesh.triangleCount()))
+                       << facing.str();
+               });
     }
 }
 
