@@ -417,7 +417,7 @@ Status measureMeshScene(Context& context, const fs::path& path, const MeshArgs& 
     if (!scene) return scene.error();
     auto mesher = Mesher::create(context, *scene);
     if (!mesher) return mesher.error();
-    Evaluator evaluator(*scene);
+    const Evaluator& evaluator = (*mesher)->evaluator();
     MeshOptions options;
     options.method = args.method;
     for (const ReferenceBounds& r : kReferenceBounds)

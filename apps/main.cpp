@@ -546,13 +546,12 @@ int cmdMesh(int argc, char** argv) {
     }();
     if (!mesh) return fail(mesh.error());
     if (simplify.maxError || simplify.targetTriangles) {
-        const sdfcsg::Evaluator evaluator(*scene);
         ProgressBar bar("simplifying");
         const bool tty = ::isatty(STDERR_FILENO);
         simplify.progress = [&](float done) {
             return (!tty || bar.update(done)) && !interrupted();
         };
-        mesh = sdfcsg::simplifyMesh(*mesh, evaluator, simplify, &stats);
+        mesh = sdfcsg::simplifyMesh(*mesh, (*mesher)->evaluator(), simplify, &stats);
         if (!mesh) return fail(mesh.error());
     } else {
         t0 = Clock::now();
@@ -570,7 +569,7 @@ int cmdMesh(int argc, char** argv) {
     if (args.has("--stats")) printMeshStats(stats, compileSeconds, writeSeconds);
     if (args.has("--report") || args.has("--report-json")) {
         const sdfcsg::MeshReport report =
-            sdfcsg::reportMesh(*mesh, sdfcsg::Evaluator(*scene), minWall);
+            sdfcsg::reportMesh(*mesh, (*mesher)->evaluator(), minWall);
         if (args.has("--report"))
             std::fputs(sdfcsg::reportText(report).c_str(), out == "-" ? stderr : stdout);
         if (args.has("--report-json"))

@@ -588,12 +588,13 @@ PYBIND11_MODULE(sdfcsg, module) {
             else if (method != "dual_contouring")
                 throw py::value_error("sdfcsg.mesh: method is dual_contouring or marching_cubes");
             options.progress = interruptible(progress);
-            Mesh mesh = unwrap(extractMesh(context(), scene, options));
+            const std::unique_ptr<Mesher> mesher = unwrap(Mesher::create(context(), scene));
+            Mesh mesh = unwrap(mesher->extract(options));
             if (simplify) {
                 SimplifyOptions s;
                 s.maxError = *simplify;
                 s.progress = interruptible(progress);
-                mesh = unwrap(simplifyMesh(mesh, Evaluator(scene), s));
+                mesh = unwrap(simplifyMesh(mesh, mesher->evaluator(), s));
             }
             if (PyErr_Occurred()) throw py::error_already_set(); // from progress at the end
             return mesh;

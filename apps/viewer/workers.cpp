@@ -376,7 +376,7 @@ Result<ExtractedMesh> MeshWorker::extract(const Scene& scene, MeshOptions option
         auto mesh = (*mesher)->extract(options, &stats);
         if (!mesh) return mesh.error();
         ExtractedMesh extracted{std::move(*mesh), std::nullopt};
-        const Evaluator evaluator(scene);
+        const Evaluator& evaluator = (*mesher)->evaluator();
         if (simplify > 0.0f && !job_.cancelled()) {
             SimplifyOptions fewer;
             fewer.maxError = simplify * stats.voxelSize;

@@ -147,6 +147,9 @@ class Mesher {
     // coarse grids again, each cancelled as options.progress says). Nothing where the reason
     // is not known (options.bounds may just miss the solid) or an extraction failed.
     std::optional<std::string> whyEmpty(const MeshOptions& options);
+    // The scene's CPU evaluator the extraction steps use: simplifyMesh and reportMesh given this
+    // one share its pruning and its baked fields instead of making them again.
+    const Evaluator& evaluator() const;
 
     struct Impl;
 

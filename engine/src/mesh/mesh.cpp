@@ -424,6 +424,9 @@ struct Mesher::Impl {
 
 Mesher::Mesher(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 Mesher::~Mesher() = default;
+const Evaluator& Mesher::evaluator() const {
+    return *impl_->evaluator;
+}
 
 Result<std::unique_ptr<Mesher>> Mesher::create(Context& context, const Scene& scene,
                                                Evaluation evaluation) {
