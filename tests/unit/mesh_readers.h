@@ -28,22 +28,28 @@ struct MeshData {
 
 // ---- A minimal JSON reader (RFC 8259 values; enough for glTF and the validator's report) ----
 
+struct JsonMember;
 struct Json {
     enum class Type { Null, Bool, Number, String, Array, Object } type = Type::Null;
     bool boolean = false;
     double number = 0;
     std::string string;
     std::vector<Json> array;
-    std::vector<std::pair<std::string, Json>> object;
+    std::vector<JsonMember> object; // not pairs, which need Json whole where clang checks them
 
     // Member `key` of an object, or nullptr.
-    const Json* get(std::string_view key) const {
-        for (const auto& [k, v] : object)
-            if (k == key) return &v;
-        return nullptr;
-    }
+    const Json* get(std::string_view key) const;
     const Json* at(size_t i) const { return i < array.size() ? &array[i] : nullptr; }
 };
+struct JsonMember {
+    std::string key;
+    Json value;
+};
+inline const Json* Json::get(std::string_view key) const {
+    for (const auto& [k, v] : object)
+        if (k == key) return &v;
+    return nullptr;
+}
 
 class JsonReader {
   public:
@@ -140,7 +146,7 @@ class JsonReader {
                 if (pos_ >= s_.size() || s_[pos_++] != ':') return fail("expected ':'");
                 Json member;
                 if (!readValue(member, depth + 1)) return false;
-                v.object.emplace_back(std::move(key), std::move(member));
+                v.object.push_back({std::move(key), std::move(member)});
                 skipSpace();
                 if (pos_ < s_.size() && s_[pos_] == ',') {
                     ++pos_;

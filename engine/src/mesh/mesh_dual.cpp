@@ -1241,14 +1241,20 @@ size_t unfoldVertices(Mesh& mesh, glm::vec3 origin, float h, const Distance& dis
         mesh.positions[v] = placed;
         const size_t before = meets();
         bool done = false;
-        // Along the gradient, a share of the way (the last to about 0.45 of a cell, the field
-        // being about linear there); then toward each neighbour, a quarter and half of the way,
-        // kept to the cell or face: a fan's face point, halfway along a chord of a curved piece,
-        // nears it toward the chord's ends where the gradient's way turns a triangle over.
-        const float least = (d - 0.45f * h) / std::max(d - std::abs(distance(to)), 1e-6f * h);
+        // Along the gradient, a share of the way, the largest first: then the shares that bring
+        // it to about 0.45 and 0.49 of a cell (the field being about linear there), below a
+        // quarter, where a quarter turns a triangle over; then a fifth, nearer at least. Then
+        // toward each neighbour, a quarter and half of the way, kept to the cell or face: a fan's
+        // face point, halfway along a chord of a curved piece, nears it toward the chord's ends
+        // where the gradient's way turns a triangle over.
+        const float gain = std::max(d - std::abs(distance(to)), 1e-6f * h);
+        const float to45 = 1.1f * (d - 0.45f * h) / gain, to49 = 1.05f * (d - 0.49f * h) / gain;
         candidates.clear();
-        for (const float share : {1.0f, 0.75f, 0.5f, 0.25f, std::min(least * 1.1f, 0.2f)})
+        for (const float share : {1.0f, 0.75f, 0.5f, 0.25f})
             candidates.push_back({0, placed + share * (to - placed)});
+        for (const float share : {to45, to49, 0.2f})
+            if (share > 0.0f && share < 0.25f)
+                candidates.push_back({0, placed + share * (to - placed)});
         for (uint32_t t : star)
             for (int k = 0; k < 3; ++k)
                 if (const uint32_t u = mesh.indices[3 * size_t(t) + size_t(k)]; u != v)
