@@ -19,9 +19,10 @@ if(SDFCSG_FUZZ)
 endif()
 
 if(SDFCSG_SANITIZERS)
-    # Frame pointers and line tables make the reports readable.
+    # Frame pointers and line tables (-g1: no more, which keeps the build short) make the
+    # reports readable.
     add_compile_options(-fsanitize=${SDFCSG_SANITIZERS} -fno-sanitize-recover=all
-                        -fno-omit-frame-pointer -g)
+                        -fno-omit-frame-pointer -g1)
     add_link_options(-fsanitize=${SDFCSG_SANITIZERS})
     # UBSan's vptr check needs the typeinfo of every polymorphic class it meets, and Debian builds
     # glslang without RTTI (the shader compiler derives from and deletes glslang's classes).
@@ -41,11 +42,13 @@ endif()
 # exit scans the whole heap, hundreds of megabytes after a large mesh; and 3 seeds for each seeded
 # mesh property test (SDFCSG_MESH_SEEDS): the sanitizers look for memory and undefined-behaviour
 # errors along code paths that 3 random scenes take as well as 40, and the release suite runs
-# every seed (40 scenes of many small primitives took 139 s of the sanitized suite's time).
+# every seed (40 scenes of many small primitives took 139 s of the sanitized suite's time); and
+# SDFCSG_SANITIZED, by which tests that repeat one code path over costly cases run a few (the
+# offsets' baking, ten times slower under the sanitizers, bakes 2 of its 5 children).
 set(SDFCSG_SANITIZER_ENV "")
 if(SDFCSG_SANITIZERS)
     find_library(SDFCSG_LAVAPIPE_LIBRARY vulkan_lvp)
-    set(SDFCSG_SANITIZER_ENV ";LSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/tests/sanitizers/lsan.supp:print_suppressions=0;UBSAN_OPTIONS=print_stacktrace=1;SDFCSG_TEST_DEADLINE_SCALE=3;SDFCSG_MESH_SEEDS=3")
+    set(SDFCSG_SANITIZER_ENV ";LSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/tests/sanitizers/lsan.supp:print_suppressions=0;UBSAN_OPTIONS=print_stacktrace=1;SDFCSG_TEST_DEADLINE_SCALE=3;SDFCSG_MESH_SEEDS=3;SDFCSG_SANITIZED=1")
     if(SDFCSG_LAVAPIPE_LIBRARY)
         # The preloaded driver precedes the sanitizer runtime in the library list.
         string(APPEND SDFCSG_SANITIZER_ENV

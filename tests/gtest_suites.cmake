@@ -35,15 +35,20 @@ function(sdfcsg_add_gtest_suites program source listing)
         message(FATAL_ERROR "${program} --gtest_list_tests failed (${result}):\n${output}")
     endif()
 
-    # Suites whose every case is a plain TEST() get no fixture, so no device.
+    # Suites whose every case is a plain TEST() get no fixture, so no device. A program whose
+    # CPU suites take minutes says so in a line `// ctest cost N`, N their COST (see below).
     set(gpu_program FALSE)
     set(plain_suites "")
-    file(STRINGS "${source}" lines REGEX "^#include \"gpu_test\\.h\"|^TEST\\(")
+    set(program_cost 0)
+    file(STRINGS "${source}" lines
+        REGEX "^#include \"gpu_test\\.h\"|^TEST\\(|^// ctest cost [0-9]+")
     foreach(line IN LISTS lines)
         if(line MATCHES "^#include")
             set(gpu_program TRUE)
         elseif(line MATCHES "^TEST\\(([A-Za-z0-9_]+),")
             list(APPEND plain_suites "${CMAKE_MATCH_1}")
+        elseif(line MATCHES "^// ctest cost ([0-9]+)")
+            set(program_cost ${CMAKE_MATCH_1})
         endif()
     endforeach()
 
@@ -81,8 +86,9 @@ function(sdfcsg_add_gtest_suites program source listing)
             set(test "${suite}")
             set(environment "${SDFCSG_TEST_ENVIRONMENT}")
             # Without measured times (a first run), ctest starts the tests of highest COST
-            # first: GPU suites by their count of cases, the quick CPU suites last.
-            set(cost 0)
+            # first: GPU suites by their count of cases, the quick CPU suites last, and slow
+            # ones by their program's cost line (a slow suite started last ends the run alone).
+            set(cost ${program_cost})
             if(label STREQUAL "gpu")
                 math(EXPR cost "${cases} / ${parts}")
             endif()
