@@ -845,6 +845,9 @@ TEST_F(Render, CompileHelperHandsMachineCodeOver) {
 
 // Mesa turns its disk cache off where it cannot make its folder, which the environment does not
 // tell. The context then sees this device compile what the helper compiled, and stops using it.
+// It sees that by time (this device's compile against the helper's), so on a loaded machine it
+// may take a second build: the first build's helper compiles the march kernel, clip and ends
+// passes, a later one the march kernel alone, and none compiles after the miss.
 TEST_F(Render, CompileHelperStopsWhereTheCacheHandsNothingOver) {
     if (!onLavapipe(context())) GTEST_SKIP() << "lavapipe only; " << context().deviceName();
     const DriverCacheFolder cache(testFolder("sdfcsg-no-folder") / "mesa");
@@ -855,17 +858,22 @@ TEST_F(Render, CompileHelperStopsWhereTheCacheHandsNothingOver) {
     ASSERT_TRUE(ctx) << ctx.error().str();
     Context::Impl& impl = detail::contextImpl(**ctx);
     ASSERT_TRUE(impl.helperWanted);
-    for (const char* name : {"robot.json", "snowman.json"}) {
-        SCOPED_TRACE(name);
+    uint32_t missedAt = 0; // the build after which the context knew
+    const char* const scenes[] = {"robot.json", "snowman.json", "gear.json"};
+    for (uint32_t build = 1; build <= 3; ++build) {
+        SCOPED_TRACE(scenes[build - 1]);
         clearShaderMemoryCache();
-        auto renderer = Renderer::create(**ctx, loadOrDie(scenePath(name)));
+        auto renderer = Renderer::create(**ctx, loadOrDie(scenePath(scenes[build - 1])));
         ASSERT_TRUE(renderer) << renderer.error().str();
-        // The first build's march kernel, clip and ends passes.
-        EXPECT_EQ(impl.helperCompiles.load(), 3u) << "the helper compiled after it missed";
         std::lock_guard lock(impl.helperMutex);
-        EXPECT_TRUE(impl.helperFailed);
-        EXPECT_EQ(impl.helper, nullptr);
+        if (!missedAt && impl.helperFailed) missedAt = build;
+        if (missedAt) {
+            EXPECT_EQ(impl.helperCompiles.load(), 3u + (missedAt - 1))
+                << "the helper compiled after it missed";
+            EXPECT_EQ(impl.helper, nullptr);
+        }
     }
+    EXPECT_TRUE(missedAt == 1 || missedAt == 2) << "missed after build " << missedAt;
     EXPECT_EQ((*ctx)->validationMessageCount(), 0u);
     EXPECT_FALSE(fs::exists(cache.dir()));
 }
